@@ -1,0 +1,388 @@
+//! One FMU instance: the model, its variable values, the state machine mode and the time.
+//! API-independent; the FMI 3 and FMI 2 layers are thin translations onto these methods.
+//!
+//! Methods return `Err(message)` for anything the importer did wrong or the model reported;
+//! the entry guard prefixes the function name, logs it and moves the instance to Error.
+
+use std::ffi::{c_void, CString};
+use std::panic::catch_unwind;
+
+use crate::ctype::CType;
+use crate::logger::Logger;
+use crate::model::{Model, Var};
+use crate::registry::Api;
+use crate::state::{settable, Mode};
+use crate::store::{Store, Value};
+
+/// Where a value reference points.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Slot {
+    /// vr 0, the independent variable.
+    Time,
+    /// Index into the model's variable table (vr - 1).
+    Var(usize),
+}
+
+/// A saved FMU state (`fmi3FMUState` / `fmi2FMUstate`): everything that changes over a run.
+#[derive(Clone)]
+pub struct Snapshot<M: Model> {
+    model: M,
+    store: Store,
+    mode: Mode,
+    time: f64,
+    start_time: f64,
+    stop_time: Option<f64>,
+}
+
+pub struct Instance<M: Model> {
+    pub api: Api,
+    pub logger: Logger,
+    pub mode: Mode,
+    pub model: M,
+    pub store: Store,
+    /// Current time: the start time until the first step, then the end of the last step.
+    pub time: f64,
+    pub start_time: f64,
+    pub stop_time: Option<f64>,
+    /// In Initialization Mode: model and values after `initialize` on a clone, so getters
+    /// return outputs consistent with the parameters set so far. Cleared by every set.
+    preview: Option<(M, Store)>,
+    /// Strings returned by GetString, alive until the next GetString.
+    strings: Vec<CString>,
+    /// FMU states handed out and not yet freed (only these pointers are ever dereferenced).
+    states: Vec<*mut Snapshot<M>>,
+}
+
+impl<M: Model> Drop for Instance<M> {
+    fn drop(&mut self) {
+        for s in self.states.drain(..) {
+            // SAFETY: every pointer in `states` came from Box::into_raw and was not freed.
+            drop(unsafe { Box::from_raw(s) });
+        }
+    }
+}
+
+/// Message of a caught panic payload.
+pub fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    if let Some(s) = payload.downcast_ref::<&str>() {
+        (*s).to_string()
+    } else if let Some(s) = payload.downcast_ref::<String>() {
+        s.clone()
+    } else {
+        "(non-string panic payload)".to_string()
+    }
+}
+
+impl<M: Model> Instance<M> {
+    pub fn new(api: Api, logger: Logger) -> Result<Instance<M>, String> {
+        let model = catch_unwind(M::new).map_err(|p| format!("the model panicked in new(): {}", panic_message(&*p)))?;
+        Ok(Instance {
+            api,
+            logger,
+            mode: Mode::Instantiated,
+            model,
+            store: Store::new(M::VARIABLES),
+            time: 0.0,
+            start_time: 0.0,
+            stop_time: None,
+            preview: None,
+            strings: Vec::new(),
+            states: Vec::new(),
+        })
+    }
+
+    /// Back to a freshly instantiated model. A model that panics here cannot be rebuilt:
+    /// the caller turns the error into Fatal.
+    pub fn reset(&mut self) -> Result<(), String> {
+        self.preview = None;
+        self.strings.clear();
+        self.model = catch_unwind(M::new).map_err(|p| format!("the model panicked in new(): {}", panic_message(&*p)))?;
+        self.store = Store::new(M::VARIABLES);
+        self.time = 0.0;
+        self.start_time = 0.0;
+        self.stop_time = None;
+        self.mode = Mode::Instantiated;
+        Ok(())
+    }
+
+    pub fn var_name(&self, slot: Slot) -> String {
+        match slot {
+            Slot::Time => "'time' (vr 0)".to_string(),
+            Slot::Var(i) => format!("'{}' (vr {})", M::VARIABLES[i].name, i + 1),
+        }
+    }
+
+    /// Resolves a value reference visible through this instance's API.
+    pub fn slot(&self, vr: u32) -> Result<Slot, String> {
+        if vr == 0 {
+            return Ok(Slot::Time);
+        }
+        let i = vr as usize - 1;
+        match M::VARIABLES.get(i) {
+            Some(v) if self.api == Api::Fmi3 || v.fmi2_representable() => Ok(Slot::Var(i)),
+            Some(v) => Err(format!(
+                "value reference {vr} ('{}') is not available through FMI 2.0 (its type has no FMI 2 equivalent)",
+                v.name
+            )),
+            None => Err(format!("unknown value reference {vr} (valid: 0..={})", M::VARIABLES.len())),
+        }
+    }
+
+    fn type_name(&self, v: &Value) -> &'static str {
+        match (v, self.api) {
+            (Value::Float64(_), Api::Fmi2) => "Real",
+            (Value::Int32(_), Api::Fmi2) => "Integer",
+            (Value::Float64(_), _) => "Float64",
+            (Value::Int32(_), _) => "Int32",
+            (Value::Int64(_), _) => "Int64",
+            (Value::Boolean(_), _) => "Boolean",
+            (Value::String(_), _) => "String",
+            (Value::Binary(_), _) => "Binary",
+        }
+    }
+
+    /// Values to read from: the initialization preview in Initialization Mode.
+    fn ensure_view(&mut self) -> Result<(), String> {
+        if self.mode == Mode::InitializationMode && self.preview.is_none() {
+            let (mut model, mut store) = (self.model.clone(), self.store.clone());
+            model
+                .initialize(&mut store, self.start_time, &mut self.logger)
+                .map_err(|e| format!("the model failed to initialize (while computing initial values): {e}"))?;
+            self.preview = Some((model, store));
+        }
+        Ok(())
+    }
+
+    /// Typed getter for `vrs`; one C value per reference (all variables are scalars).
+    pub fn get<T: CType>(&mut self, vrs: &[u32]) -> Result<Vec<T::C>, String> {
+        let slots = vrs.iter().map(|&vr| self.slot(vr)).collect::<Result<Vec<_>, _>>()?;
+        self.ensure_view()?;
+        self.strings.clear();
+        let mut out = Vec::with_capacity(slots.len());
+        for slot in slots {
+            let time;
+            let value = match slot {
+                Slot::Time => {
+                    time = Value::Float64(self.time);
+                    &time
+                }
+                Slot::Var(i) => match (&self.preview, self.mode) {
+                    (Some((_, s)), Mode::InitializationMode) => s.value(i),
+                    _ => self.store.value(i),
+                },
+            };
+            if !T::accepts(value) {
+                return Err(format!(
+                    "variable {} has type {}, which this function cannot access",
+                    self.var_name(slot),
+                    self.type_name(value)
+                ));
+            }
+            out.push(T::read(value, &mut self.strings));
+        }
+        Ok(out)
+    }
+
+    /// Typed setter: validates every reference and value first, then applies all of them.
+    ///
+    /// # Safety
+    /// Pointers inside `values` must be valid (see [`CType::decode`]).
+    pub unsafe fn set<T: CType>(&mut self, vrs: &[u32], values: &[T::C]) -> Result<(), String> {
+        let mut decoded = Vec::with_capacity(vrs.len());
+        for (&vr, &x) in vrs.iter().zip(values) {
+            let slot = self.slot(vr)?;
+            let Slot::Var(i) = slot else {
+                return Err("cannot set 'time' (vr 0): the independent variable advances only with DoStep".into());
+            };
+            let var = &M::VARIABLES[i];
+            settable(var, self.mode).map_err(|why| format!("cannot set variable {}: {why}", self.var_name(slot)))?;
+            let current = self.store.value(i);
+            if !T::accepts(current) {
+                return Err(format!(
+                    "variable {} has type {}, which this function cannot set",
+                    self.var_name(slot),
+                    self.type_name(current)
+                ));
+            }
+            let value = T::decode(x).map_err(|e| format!("bad value for variable {}: {e}", self.var_name(slot)))?;
+            check_value(var, &value).map_err(|e| format!("bad value for variable {}: {e}", self.var_name(slot)))?;
+            decoded.push((i, value));
+        }
+        for (i, value) in decoded {
+            *self.store.value_mut(i) = value;
+        }
+        if !vrs.is_empty() {
+            self.preview = None;
+        }
+        Ok(())
+    }
+
+    /// Start and stop time of the experiment (FMI 2 SetupExperiment; part of FMI 3 EnterInitializationMode).
+    pub fn setup(&mut self, start: f64, stop: Option<f64>) -> Result<(), String> {
+        if !start.is_finite() {
+            return Err(format!("startTime must be finite, got {start}"));
+        }
+        if let Some(stop) = stop {
+            if stop.is_nan() || stop < start {
+                return Err(format!("stopTime ({stop}) must not be less than startTime ({start})"));
+            }
+        }
+        self.start_time = start;
+        self.stop_time = stop;
+        self.time = start;
+        Ok(())
+    }
+
+    pub fn enter_initialization(&mut self, start: f64, stop: Option<f64>) -> Result<(), String> {
+        self.setup(start, stop)?;
+        self.preview = None;
+        self.mode = Mode::InitializationMode;
+        Ok(())
+    }
+
+    /// Ends initialization: the model computes its initial outputs (reusing the preview
+    /// computed for getters when nothing changed since).
+    pub fn exit_initialization(&mut self) -> Result<(), String> {
+        match self.preview.take() {
+            Some((model, store)) => {
+                self.model = model;
+                self.store = store;
+            }
+            None => self
+                .model
+                .initialize(&mut self.store, self.start_time, &mut self.logger)
+                .map_err(|e| format!("the model failed to initialize: {e}"))?,
+        }
+        self.mode = Mode::StepMode;
+        Ok(())
+    }
+
+    /// Advances from `tc` (the importer's time, adopted as is; it must match the FMU's time
+    /// up to rounding) to `tc + h`.
+    pub fn do_step(&mut self, tc: f64, h: f64) -> Result<(), String> {
+        if !tc.is_finite() {
+            return Err(format!("currentCommunicationPoint must be finite, got {tc}"));
+        }
+        if !(h > 0.0 && h.is_finite()) {
+            return Err(format!("communicationStepSize must be positive and finite, got {h}"));
+        }
+        let end = tc + h;
+        if !end.is_finite() {
+            return Err(format!("the step would end at {end}"));
+        }
+        let tol = 1e-9 * self.time.abs().max(tc.abs()).max(1.0);
+        if (tc - self.time).abs() > tol {
+            return Err(format!(
+                "currentCommunicationPoint ({tc:?}) differs from the FMU's current time ({:?})",
+                self.time
+            ));
+        }
+        if let Some(stop) = self.stop_time {
+            if end > stop + 1e-9 * stop.abs().max(1.0) {
+                return Err(format!("the step would end at {end:?}, after stopTime ({stop:?})"));
+            }
+        }
+        self.time = tc;
+        self.model
+            .do_step(&mut self.store, tc, h, &mut self.logger)
+            .map_err(|e| format!("the model failed in the step from t={tc:?} with h={h:?}: {e}"))?;
+        self.time = end;
+        Ok(())
+    }
+
+    pub fn terminate(&mut self) {
+        self.mode = Mode::Terminated;
+    }
+
+    fn snapshot(&self) -> Snapshot<M> {
+        Snapshot {
+            model: self.model.clone(),
+            store: self.store.clone(),
+            mode: self.mode,
+            time: self.time,
+            start_time: self.start_time,
+            stop_time: self.stop_time,
+        }
+    }
+
+    /// GetFMUState: a new state, or `existing` (a state of this instance) overwritten.
+    pub fn get_state(&mut self, existing: *mut c_void) -> Result<*mut c_void, String> {
+        let snap = self.snapshot();
+        if existing.is_null() {
+            let p = Box::into_raw(Box::new(snap));
+            self.states.push(p);
+            return Ok(p.cast());
+        }
+        let p = self.find_state(existing)?;
+        // SAFETY: `p` is a live state of this instance.
+        unsafe { *p = snap };
+        Ok(existing)
+    }
+
+    pub fn set_state(&mut self, state: *mut c_void) -> Result<(), String> {
+        let p = self.find_state(state)?;
+        // SAFETY: `p` is a live state of this instance.
+        let s = unsafe { &*p }.clone();
+        self.model = s.model;
+        self.store = s.store;
+        self.mode = s.mode;
+        self.time = s.time;
+        self.start_time = s.start_time;
+        self.stop_time = s.stop_time;
+        self.preview = None;
+        Ok(())
+    }
+
+    pub fn free_state(&mut self, state: *mut c_void) -> Result<(), String> {
+        if state.is_null() {
+            return Ok(());
+        }
+        let p = self.find_state(state)?;
+        self.states.retain(|&q| q != p);
+        // SAFETY: `p` came from Box::into_raw and was just removed from the live list.
+        drop(unsafe { Box::from_raw(p) });
+        Ok(())
+    }
+
+    fn find_state(&self, state: *mut c_void) -> Result<*mut Snapshot<M>, String> {
+        if state.is_null() {
+            return Err("the FMU state is NULL".into());
+        }
+        self.states
+            .iter()
+            .copied()
+            .find(|&p| p.cast() == state)
+            .ok_or_else(|| format!("{state:p} is not a live FMU state of this instance (freed, foreign or invalid)"))
+    }
+
+    /// Number of FMU states not yet freed (for tests).
+    pub fn live_states(&self) -> usize {
+        self.states.len()
+    }
+}
+
+/// Value checks beyond the type: finite floats and the declared range.
+fn check_value(var: &Var, value: &Value) -> Result<(), String> {
+    let x = match *value {
+        Value::Float64(x) => {
+            if !x.is_finite() {
+                return Err(format!("{x} is not a finite number"));
+            }
+            x
+        }
+        Value::Int32(x) => x as f64,
+        Value::Int64(x) => x as f64,
+        _ => return Ok(()),
+    };
+    if let Some(min) = var.min {
+        if x < min {
+            return Err(format!("{x} is below its minimum {min}"));
+        }
+    }
+    if let Some(max) = var.max {
+        if x > max {
+            return Err(format!("{x} is above its maximum {max}"));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,27 @@
+//! agrisim's FMU export layer: write a model once as a Rust type implementing [`Model`], get
+//! the FMI 3.0 co-simulation C API, modelDescription.xml and (for the FMI-2-representable
+//! variables) the FMI 2.0 co-simulation API from one variable table.
+//!
+//! - [`export_fmu!`] emits the C symbols of a cdylib (both APIs + the XML texts);
+//! - [`fmi3`] / [`fmi2`] are the generic API layers those symbols wrap (call them in tests);
+//! - [`xml`] generates modelDescription.xml;
+//! - [`testing`] is a randomized call-sequence harness every FMU crate runs.
+
+pub mod ctype;
+mod export;
+pub mod fmi2;
+pub mod fmi3;
+mod guard;
+mod instance;
+pub mod logger;
+mod model;
+mod registry;
+pub mod state;
+mod store;
+pub mod testing;
+mod units;
+pub mod xml;
+
+pub use model::{Causality, Log, Model, ModelError, Start, Var, Variability};
+pub use state::{Mode, Status};
+pub use store::{Store, Value};

@@ -1,0 +1,758 @@
+//! Randomized call-sequence harness for any [`Model`]: every FMU crate runs
+//! `agrisim_fmi::testing::fuzz_fmi3::<M>(seed, cases)` and `fuzz_fmi2` in a one-line test.
+//!
+//! Each case instantiates (sometimes wrongly), then issues random calls into the generic API
+//! layer: legal and illegal order, NULL and garbage handles and pointers, unknown value
+//! references, type mismatches, wrong array sizes, NaN/huge/negative times, FMU-state
+//! round trips, unsupported functions. A shadow state machine predicts what must happen.
+//! Asserted: no panic escapes, every status is a valid value, illegal calls fail, errors move
+//! the instance to Error (where only the allowed calls work), every failure on a live
+//! instance is logged with the function's name, time after a step is `tc + h`.
+//! Failures panic with the seed, case and call trace.
+
+use std::ffi::{c_char, c_int, c_void, CString};
+
+use crate::ctype::{self, CType};
+use crate::fmi2::{self, CallbackFunctions};
+use crate::fmi3;
+use crate::instance::Instance;
+use crate::logger::Fmi2Logger;
+use crate::model::Model;
+use crate::state::{self, Mask, Mode, Status};
+use crate::store::Value;
+
+/// Asserts that `M`'s variable table yields a valid FMU (see [`crate::xml::check_table`]).
+pub fn assert_valid_table<M: Model>() {
+    let problems = crate::xml::check_table(M::VARIABLES);
+    assert!(problems.is_empty(), "{}: invalid variable table:\n{}", M::NAME, problems.join("\n"));
+}
+
+/// Small deterministic PRNG (SplitMix64): no dependencies, reproducible per seed.
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Rng {
+        Rng(seed ^ 0x9E37_79B9_7F4A_7C15)
+    }
+    pub fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    pub fn below(&mut self, n: usize) -> usize {
+        (self.next() % n.max(1) as u64) as usize
+    }
+    pub fn chance(&mut self, percent: u64) -> bool {
+        self.next() % 100 < percent
+    }
+    fn pick<T: Copy>(&mut self, xs: &[T]) -> T {
+        xs[self.below(xs.len())]
+    }
+    fn f64(&mut self) -> f64 {
+        match self.below(10) {
+            0 => f64::NAN,
+            1 => self.pick(&[f64::INFINITY, f64::NEG_INFINITY, 1e300, -1e300]),
+            2 => 0.0,
+            _ => (self.next() % 2001) as f64 / 100.0 - 10.0,
+        }
+    }
+    fn int(&mut self) -> i64 {
+        match self.below(4) {
+            0 => self.next() as i64,
+            _ => self.below(7) as i64 - 2,
+        }
+    }
+}
+
+/// Log messages received through the logger callback of the current case.
+#[derive(Default)]
+struct Logs(Vec<(Status, String)>);
+
+unsafe extern "C" fn log3(env: *mut c_void, status: Status, _category: *const c_char, message: *const c_char) {
+    let logs = &mut *(env as *mut Logs);
+    logs.0.push((status, std::ffi::CStr::from_ptr(message).to_string_lossy().into_owned()));
+}
+
+unsafe extern "C" fn log2_fixed(
+    env: *mut c_void,
+    _name: *const c_char,
+    status: Status,
+    category: *const c_char,
+    message: *const c_char,
+) {
+    log3(env, status, category, message)
+}
+
+/// A non-variadic function called through the variadic `fmi2CallbackLogger` type (what
+/// every non-C importer does; no variadic arguments are ever passed).
+fn log2() -> Fmi2Logger {
+    // SAFETY: identical fixed arguments; the FMU passes no variadic arguments.
+    unsafe {
+        std::mem::transmute::<unsafe extern "C" fn(*mut c_void, *const c_char, Status, *const c_char, *const c_char), Fmi2Logger>(
+            log2_fixed,
+        )
+    }
+}
+
+/// What the shadow expects of a call's result.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Must {
+    /// Any status (e.g. the model may fail).
+    Any,
+    /// Arguments are wrong: Error (or Fatal in Fatal).
+    Fail,
+    /// Arguments are right and no model code runs: OK (or Warning) when the mode allows it.
+    Succeed,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Then {
+    Nothing,
+    Mode(Mode),
+    Restore(*mut c_void),
+    NewState(*mut c_void),
+    FreedState(*mut c_void),
+    Stepped(f64),
+}
+
+struct Outcome {
+    function: &'static str,
+    mask: Mask,
+    status: Status,
+    must: Must,
+    then: Then,
+}
+
+/// The shadow of one instance.
+struct Shadow {
+    mode: Mode,
+    /// Live FMU states and the mode they captured.
+    states: Vec<(*mut c_void, Mode, f64)>,
+    /// Freed state pointers (to pass again: must fail).
+    freed: Vec<*mut c_void>,
+    time: f64,
+}
+
+/// Things whose pointers are handed to the FMU during one call.
+#[derive(Default)]
+struct Keep {
+    strings: Vec<CString>,
+    bytes: Vec<Vec<u8>>,
+}
+
+fn garbage_ptr(rng: &mut Rng) -> *mut c_void {
+    // Never dereferenced by a correct layer: only compared against its registries.
+    (0x1000 + (rng.next() % 0xFFFF_0000) * 8) as *mut c_void
+}
+
+/// Value references: mostly ones accepting `T`, sometimes any, sometimes unknown.
+fn pick_vrs<M: Model, T: CType>(rng: &mut Rng, fmi2_only: bool) -> Vec<u32> {
+    let n = match rng.below(6) {
+        0 => 0,
+        1 => 2 + rng.below(3),
+        _ => 1,
+    };
+    let visible = |i: usize| !fmi2_only || M::VARIABLES[i].fmi2_representable();
+    let mut matching: Vec<u32> = (0..M::VARIABLES.len())
+        .filter(|&i| visible(i) && T::accepts(&Value::from_start(&M::VARIABLES[i].start)))
+        .map(|i| i as u32 + 1)
+        .collect();
+    if T::accepts(&Value::Float64(0.0)) {
+        matching.push(0);
+    }
+    (0..n)
+        .map(|_| match rng.below(10) {
+            0 => rng.pick(&[M::VARIABLES.len() as u32 + 1, u32::MAX, 1_000_000]),
+            1 | 2 => rng.below(M::VARIABLES.len() + 1) as u32,
+            _ if !matching.is_empty() => rng.pick(&matching),
+            _ => rng.below(M::VARIABLES.len() + 1) as u32,
+        })
+        .collect()
+}
+
+/// True when every reference in `vrs` is visible and of a type `T` can access.
+fn all_match<M: Model, T: CType>(vrs: &[u32], fmi2_only: bool) -> bool {
+    vrs.iter().all(|&vr| {
+        if vr == 0 {
+            return T::accepts(&Value::Float64(0.0));
+        }
+        match M::VARIABLES.get(vr as usize - 1) {
+            Some(v) => (!fmi2_only || v.fmi2_representable()) && T::accepts(&Value::from_start(&v.start)),
+            None => false,
+        }
+    })
+}
+
+/// Random C values for the setters.
+trait Gen: CType {
+    fn gen(rng: &mut Rng, keep: &mut Keep) -> Self::C;
+}
+
+macro_rules! gen_int {
+    ($($m:ident),*) => {$(
+        impl Gen for ctype::$m {
+            fn gen(rng: &mut Rng, _: &mut Keep) -> Self::C {
+                rng.int() as Self::C
+            }
+        }
+    )*};
+}
+gen_int!(Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, UInt64, Bool2);
+
+impl Gen for ctype::Float64 {
+    fn gen(rng: &mut Rng, _: &mut Keep) -> f64 {
+        rng.f64()
+    }
+}
+impl Gen for ctype::Float32 {
+    fn gen(rng: &mut Rng, _: &mut Keep) -> f32 {
+        rng.f64() as f32
+    }
+}
+impl Gen for ctype::Bool3 {
+    fn gen(rng: &mut Rng, _: &mut Keep) -> u8 {
+        rng.pick(&[0, 1, 1, 2, 255])
+    }
+}
+impl Gen for ctype::Str {
+    fn gen(rng: &mut Rng, keep: &mut Keep) -> *const c_char {
+        let s = match rng.below(8) {
+            0 => return std::ptr::null(),
+            1 => CString::new(vec![0xC3u8, 0x28]).unwrap_or_default(), // invalid UTF-8
+            2 => CString::new("äöü <&> \"quoted\" 100%").unwrap_or_default(),
+            _ => CString::new(format!("s{}", rng.next() % 1000)).unwrap_or_default(),
+        };
+        keep.strings.push(s);
+        keep.strings.last().map_or(std::ptr::null(), |s| s.as_ptr())
+    }
+}
+impl Gen for ctype::Bin {
+    fn gen(rng: &mut Rng, keep: &mut Keep) -> (usize, *const u8) {
+        match rng.below(8) {
+            0 => (1 + rng.below(4), std::ptr::null()),
+            1 => (0, std::ptr::null()),
+            _ => {
+                let n = rng.below(64);
+                keep.bytes.push((0..n).map(|_| rng.next() as u8).collect());
+                let b = keep.bytes.last().map_or(&[][..], |b| &b[..]);
+                (b.len(), b.as_ptr())
+            }
+        }
+    }
+}
+
+/// Array sizes for a get/set: (nValues, NULL values array?) and whether they are right.
+fn sizes(rng: &mut Rng, n_vr: usize) -> (usize, bool, bool) {
+    match rng.below(12) {
+        0 => (n_vr + 1, false, false),
+        1 if n_vr > 0 => (n_vr - 1, false, false),
+        2 if n_vr > 0 => (n_vr, true, false),
+        _ => (n_vr, false, true),
+    }
+}
+
+fn zeroed<T>(n: usize) -> Vec<T> {
+    // SAFETY: only instantiated with C number/pointer types, for which all-zero is valid.
+    (0..n).map(|_| unsafe { std::mem::zeroed() }).collect()
+}
+
+unsafe fn get3<M: Model, T: CType>(rng: &mut Rng, inst: *mut c_void, function: &'static str, mode: Mode) -> Outcome {
+    let vrs = pick_vrs::<M, T>(rng, false);
+    let (n_values, null_values, right) = sizes(rng, vrs.len());
+    let mut values: Vec<T::C> = zeroed(n_values.max(vrs.len()) + 1);
+    let vp = if null_values { std::ptr::null_mut() } else { values.as_mut_ptr() };
+    let status = fmi3::get::<M, T>(inst, function, vrs.as_ptr(), vrs.len(), vp, n_values);
+    let ok = right && all_match::<M, T>(&vrs, false);
+    let must = if !ok { Must::Fail } else if mode == Mode::InitializationMode { Must::Any } else { Must::Succeed };
+    Outcome { function, mask: state::fmi3::GET, status, must, then: Then::Nothing }
+}
+
+unsafe fn set3<M: Model, T: Gen>(rng: &mut Rng, inst: *mut c_void, function: &'static str) -> Outcome {
+    let vrs = pick_vrs::<M, T>(rng, false);
+    let (n_values, null_values, right) = sizes(rng, vrs.len());
+    let mut keep = Keep::default();
+    let values: Vec<T::C> = (0..n_values.max(vrs.len()) + 1).map(|_| T::gen(rng, &mut keep)).collect();
+    let vp = if null_values { std::ptr::null() } else { values.as_ptr() };
+    let status = fmi3::set::<M, T>(inst, function, vrs.as_ptr(), vrs.len(), vp, n_values);
+    let must = if !right || !all_match::<M, T>(&vrs, false) { Must::Fail } else { Must::Any };
+    Outcome { function, mask: state::fmi3::SET, status, must, then: Then::Nothing }
+}
+
+const UNSUPPORTED3: &[&str] = &[
+    "fmi3EnterEventMode",
+    "fmi3EnterStepMode",
+    "fmi3UpdateDiscreteStates",
+    "fmi3GetClock",
+    "fmi3SetIntervalDecimal",
+    "fmi3EnterConfigurationMode",
+    "fmi3SerializeFMUState",
+    "fmi3GetDirectionalDerivative",
+    "fmi3GetNumberOfContinuousStates",
+    "fmi3SetTime",
+    "fmi3GetOutputDerivatives",
+    "fmi3GetVariableDependencies",
+    "fmi3ActivateModelPartition",
+];
+
+unsafe fn random_call3<M: Model>(rng: &mut Rng, inst: *mut c_void, sh: &Shadow) -> Outcome {
+    use state::fmi3 as m;
+    let o = |function, mask, status, must, then| Outcome { function, mask, status, must, then };
+    match rng.below(22) {
+        0 => {
+            let cats = [c"logStatusError".as_ptr(), c"logCalls".as_ptr(), c"noSuchCategory".as_ptr()];
+            let n = rng.below(4);
+            let null = rng.chance(10) && n > 0;
+            let p = if null { std::ptr::null() } else { cats.as_ptr() };
+            let s = fmi3::set_debug_logging::<M>(inst, rng.below(2) as u8, n, p);
+            o("fmi3SetDebugLogging", m::SET_DEBUG_LOGGING, s, if null { Must::Fail } else { Must::Succeed }, Then::Nothing)
+        }
+        1 | 2 => {
+            let start = if rng.chance(85) { 0.0 } else { rng.f64() };
+            let stop_defined = rng.chance(30);
+            let stop = if rng.chance(80) { start + 1e6 } else { rng.f64() };
+            let s = fmi3::enter_initialization_mode::<M>(inst, 0, 0.0, start, stop_defined as u8, stop);
+            let good = start.is_finite() && (!stop_defined || stop >= start);
+            let must = if good { Must::Succeed } else { Must::Fail };
+            o("fmi3EnterInitializationMode", m::ENTER_INITIALIZATION_MODE, s, must, Then::Mode(Mode::InitializationMode))
+        }
+        3 | 4 => {
+            let s = fmi3::exit_initialization_mode::<M>(inst);
+            o("fmi3ExitInitializationMode", m::EXIT_INITIALIZATION_MODE, s, Must::Any, Then::Mode(Mode::StepMode))
+        }
+        5..=8 => {
+            let tc = match rng.below(12) {
+                0 => f64::NAN,
+                1 => sh.time + 1.0,
+                _ => sh.time,
+            };
+            let h = match rng.below(12) {
+                0 => rng.pick(&[0.0, -0.02, f64::NAN, f64::INFINITY]),
+                1 => rng.pick(&[1e-12, 1e300, 1e6]),
+                _ => 0.02,
+            };
+            let (mut ev, mut term, mut early, mut last) = (7u8, 7u8, 7u8, -1.0f64);
+            let null = rng.chance(5);
+            let s = fmi3::do_step::<M>(
+                inst,
+                tc,
+                h,
+                0,
+                if null { std::ptr::null_mut() } else { &mut ev },
+                &mut term,
+                &mut early,
+                &mut last,
+            );
+            let must = if null || !tc.is_finite() || !(h > 0.0 && h.is_finite()) || tc != sh.time {
+                Must::Fail
+            } else {
+                Must::Any
+            };
+            if s == Status::Ok {
+                assert!(ev == 0 && term == 0 && early == 0 && last == tc + h, "fmi3DoStep outputs wrong: {ev} {term} {early} {last}");
+            }
+            o("fmi3DoStep", m::DO_STEP, s, must, Then::Stepped(tc + h))
+        }
+        9 => o("fmi3Terminate", m::TERMINATE, fmi3::terminate::<M>(inst), Must::Succeed, Then::Mode(Mode::Terminated)),
+        10 => o("fmi3Reset", m::RESET, fmi3::reset::<M>(inst), Must::Any, Then::Mode(Mode::Instantiated)),
+        11 | 12 => match rng.below(13) {
+            0 => get3::<M, ctype::Float32>(rng, inst, "fmi3GetFloat32", sh.mode),
+            1 => get3::<M, ctype::Int8>(rng, inst, "fmi3GetInt8", sh.mode),
+            2 => get3::<M, ctype::UInt64>(rng, inst, "fmi3GetUInt64", sh.mode),
+            3 => get3::<M, ctype::Int32>(rng, inst, "fmi3GetInt32", sh.mode),
+            4 => get3::<M, ctype::Int64>(rng, inst, "fmi3GetInt64", sh.mode),
+            5 => get3::<M, ctype::Bool3>(rng, inst, "fmi3GetBoolean", sh.mode),
+            6 => get3::<M, ctype::Str>(rng, inst, "fmi3GetString", sh.mode),
+            7 | 8 => {
+                let vrs = pick_vrs::<M, ctype::Bin>(rng, false);
+                let (n, null, right) = sizes(rng, vrs.len());
+                let mut sz = vec![0usize; n + 1];
+                let mut ptrs: Vec<*const u8> = vec![std::ptr::null(); n + 1];
+                let pp = if null { std::ptr::null_mut() } else { ptrs.as_mut_ptr() };
+                let s = fmi3::get_binary::<M>(inst, vrs.as_ptr(), vrs.len(), sz.as_mut_ptr(), pp, n);
+                if s == Status::Ok {
+                    for k in 0..n {
+                        assert!(!ptrs[k].is_null(), "fmi3GetBinary returned NULL data");
+                        // Touch the bytes: they must be readable.
+                        let _ = std::slice::from_raw_parts(ptrs[k], sz[k]).iter().fold(0u8, |a, b| a ^ b);
+                    }
+                }
+                let ok = right && all_match::<M, ctype::Bin>(&vrs, false);
+                let must = if !ok { Must::Fail } else if sh.mode == Mode::InitializationMode { Must::Any } else { Must::Succeed };
+                o("fmi3GetBinary", m::GET, s, must, Then::Nothing)
+            }
+            _ => get3::<M, ctype::Float64>(rng, inst, "fmi3GetFloat64", sh.mode),
+        },
+        13..=15 => match rng.below(12) {
+            0 => set3::<M, ctype::Float32>(rng, inst, "fmi3SetFloat32"),
+            1 => set3::<M, ctype::UInt16>(rng, inst, "fmi3SetUInt16"),
+            2 | 3 => set3::<M, ctype::Int32>(rng, inst, "fmi3SetInt32"),
+            4 => set3::<M, ctype::Int64>(rng, inst, "fmi3SetInt64"),
+            5 => set3::<M, ctype::Bool3>(rng, inst, "fmi3SetBoolean"),
+            6 => set3::<M, ctype::Str>(rng, inst, "fmi3SetString"),
+            7 | 8 => {
+                let vrs = pick_vrs::<M, ctype::Bin>(rng, false);
+                let (n, null, right) = sizes(rng, vrs.len());
+                let mut keep = Keep::default();
+                let vals: Vec<(usize, *const u8)> = (0..n + 1).map(|_| <ctype::Bin as Gen>::gen(rng, &mut keep)).collect();
+                let sz: Vec<usize> = vals.iter().map(|v| v.0).collect();
+                let ptrs: Vec<*const u8> = vals.iter().map(|v| v.1).collect();
+                let pp = if null { std::ptr::null() } else { ptrs.as_ptr() };
+                let s = fmi3::set_binary::<M>(inst, vrs.as_ptr(), vrs.len(), sz.as_ptr(), pp, n);
+                let must = if !right || !all_match::<M, ctype::Bin>(&vrs, false) { Must::Fail } else { Must::Any };
+                o("fmi3SetBinary", m::SET, s, must, Then::Nothing)
+            }
+            _ => set3::<M, ctype::Float64>(rng, inst, "fmi3SetFloat64"),
+        },
+        16 | 17 => {
+            let overwrite = !sh.states.is_empty() && rng.chance(30);
+            let mut p = if overwrite { sh.states[rng.below(sh.states.len())].0 } else { std::ptr::null_mut() };
+            let null = rng.chance(5);
+            let s = fmi3::get_fmu_state::<M>(inst, if null { std::ptr::null_mut() } else { &mut p });
+            let then = if overwrite { Then::FreedState(p) } else { Then::NewState(p) };
+            let then = if s == Status::Ok { then } else { Then::Nothing };
+            // Overwriting = free + new at the same address in the shadow.
+            o("fmi3GetFMUState", m::GET_FMU_STATE, s, if null { Must::Fail } else { Must::Succeed }, then)
+        }
+        18 => {
+            let (p, good) = pick_state(rng, sh);
+            let s = fmi3::set_fmu_state::<M>(inst, p);
+            o("fmi3SetFMUState", m::SET_FMU_STATE, s, if good { Must::Succeed } else { Must::Fail }, Then::Restore(p))
+        }
+        19 => {
+            let (mut p, good) = pick_state(rng, sh);
+            let orig = p;
+            let s = fmi3::free_fmu_state::<M>(inst, &mut p);
+            if s == Status::Ok {
+                assert!(p.is_null(), "fmi3FreeFMUState must set *FMUState = NULL");
+            }
+            let must = if good || orig.is_null() { Must::Succeed } else { Must::Fail };
+            o("fmi3FreeFMUState", m::FREE_FMU_STATE, s, must, Then::FreedState(orig))
+        }
+        _ => {
+            let f = rng.pick(UNSUPPORTED3);
+            o(f, state::NEVER, fmi3::unsupported::<M>(inst, f), Must::Fail, Then::Nothing)
+        }
+    }
+}
+
+/// A state pointer: live (true), freed, garbage or NULL (false).
+fn pick_state(rng: &mut Rng, sh: &Shadow) -> (*mut c_void, bool) {
+    match rng.below(10) {
+        0 => (std::ptr::null_mut(), false),
+        1 => (garbage_ptr(rng), false),
+        2 if !sh.freed.is_empty() => {
+            let p = sh.freed[rng.below(sh.freed.len())];
+            // A freed address may have been reused by a newer live state.
+            (p, sh.states.iter().any(|s| s.0 == p))
+        }
+        _ if !sh.states.is_empty() => (sh.states[rng.below(sh.states.len())].0, true),
+        _ => (garbage_ptr(rng), false),
+    }
+}
+
+/// Applies an outcome to the shadow and checks it; `trace` names the calls so far.
+unsafe fn check<M: Model>(o: &Outcome, sh: &mut Shadow, inst: *mut c_void, logs: &mut Logs, trace: &str) {
+    let before = sh.mode;
+    let ctx = || format!("{}: {} returned {:?} in {:?}\ntrace:\n{trace}", M::NAME, o.function, o.status, before);
+    let code = o.status as i32;
+    assert!((0..=4).contains(&code), "invalid status value; {}", ctx());
+    let allowed = o.mask & sh.mode.bit() != 0;
+    if sh.mode == Mode::Fatal {
+        assert_eq!(o.status, Status::Fatal, "only Fatal in Fatal; {}", ctx());
+    } else if !allowed {
+        assert_eq!(o.status, Status::Error, "call not allowed in this mode must fail; {}", ctx());
+    } else {
+        match o.must {
+            Must::Fail => assert_eq!(o.status, Status::Error, "bad arguments must fail; {}", ctx()),
+            Must::Succeed => assert!(o.status <= Status::Warning, "valid call must succeed; {}", ctx()),
+            Must::Any => {}
+        }
+        assert!(o.status != Status::Discard || o.function.contains("Status"), "unexpected Discard; {}", ctx());
+    }
+    if o.status >= Status::Error {
+        let logged = logs.0.iter().any(|(s, m)| *s >= Status::Error && m.contains(o.function));
+        assert!(logged, "failure not logged with the function name; logs: {:?}; {}", logs.0, ctx());
+        if o.status == Status::Fatal {
+            sh.mode = Mode::Fatal;
+        } else {
+            sh.mode = Mode::Error;
+        }
+    } else {
+        match o.then {
+            Then::Nothing => {}
+            Then::Mode(m) => {
+                sh.mode = m;
+                if m == Mode::Instantiated {
+                    sh.time = 0.0;
+                }
+                if m == Mode::InitializationMode {
+                    sh.time = (*inst.cast::<Instance<M>>()).start_time;
+                }
+            }
+            Then::Stepped(end) => sh.time = end,
+            Then::NewState(p) => {
+                sh.freed.retain(|&q| q != p);
+                sh.states.push((p, sh.mode, sh.time));
+            }
+            Then::Restore(p) => {
+                let (_, m, t) = *sh.states.iter().find(|s| s.0 == p).expect("restored a state the shadow does not know");
+                sh.mode = m;
+                sh.time = t;
+            }
+            Then::FreedState(p) => {
+                if !p.is_null() {
+                    sh.states.retain(|s| s.0 != p);
+                    sh.freed.push(p);
+                }
+                if o.function.contains("GetFMU") {
+                    // overwrite: same pointer, new content
+                    sh.freed.retain(|&q| q != p);
+                    sh.states.push((p, sh.mode, sh.time));
+                }
+            }
+        }
+    }
+    let actual = &*inst.cast::<Instance<M>>();
+    assert_eq!(actual.mode, sh.mode, "mode differs from the shadow; {}", ctx());
+    assert_eq!(actual.live_states(), sh.states.len(), "live FMU states differ; {}", ctx());
+    if matches!(sh.mode, Mode::StepMode | Mode::Terminated) && o.status <= Status::Warning {
+        assert_eq!(actual.time, sh.time, "time differs from tc + h; {}", ctx());
+    }
+    logs.0.clear();
+}
+
+/// Runs `cases` random FMI 3.0 call sequences against `M` (see the module docs).
+pub fn fuzz_fmi3<M: Model>(seed: u64, cases: usize) {
+    assert_valid_table::<M>();
+    let mut rng = Rng::new(seed);
+    let token = CString::new(M::TOKEN).unwrap_or_default();
+    for case in 0..cases {
+        let mut logs = Box::new(Logs::default());
+        let env = (&mut *logs as *mut Logs).cast::<c_void>();
+        unsafe {
+            // Wrong instantiations: NULL, logged.
+            let bad_token = c"{not-the-token}";
+            let (name, tok, event_mode, n_req) = match rng.below(6) {
+                0 => (c"".as_ptr(), token.as_ptr(), 0u8, 0usize),
+                1 => (c"fuzz".as_ptr(), bad_token.as_ptr(), 0, 0),
+                2 => (c"fuzz".as_ptr(), std::ptr::null(), 0, 0),
+                3 => (c"fuzz".as_ptr(), token.as_ptr(), 1, 0),
+                4 => (c"fuzz".as_ptr(), token.as_ptr(), 0, 1),
+                _ => (std::ptr::null(), token.as_ptr(), 0, 0),
+            };
+            let req = [1u32];
+            let p = fmi3::instantiate_co_simulation::<M>(name, tok, std::ptr::null(), 0, 0, event_mode, 0, req.as_ptr(), n_req, env, Some(log3), None);
+            assert!(p.is_null(), "{}: bad instantiation accepted (case {case})", M::NAME);
+            assert!(!logs.0.is_empty(), "{}: bad instantiation not logged (case {case})", M::NAME);
+            let p = fmi3::instantiate_model_exchange::<M>(c"me".as_ptr(), token.as_ptr(), std::ptr::null(), 0, 0, env, Some(log3));
+            assert!(p.is_null(), "{}: Model Exchange instantiated", M::NAME);
+            logs.0.clear();
+
+            let inst = fmi3::instantiate_co_simulation::<M>(
+                c"fuzz".as_ptr(), token.as_ptr(), std::ptr::null(), 0, rng.below(2) as u8, 0, rng.below(2) as u8,
+                std::ptr::null(), 0, env, Some(log3), None,
+            );
+            assert!(!inst.is_null(), "{}: instantiation failed: {:?}", M::NAME, logs.0);
+            let mut sh = Shadow { mode: Mode::Instantiated, states: Vec::new(), freed: Vec::new(), time: 0.0 };
+            let mut trace = String::new();
+            // Bias towards a legal run first, so that Step Mode gets exercised.
+            let legal_prefix = rng.chance(70);
+            let n_calls = 10 + rng.below(60);
+            for k in 0..n_calls {
+                let o = if legal_prefix && k == 0 {
+                    Outcome { function: "fmi3EnterInitializationMode", mask: state::fmi3::ENTER_INITIALIZATION_MODE,
+                        status: fmi3::enter_initialization_mode::<M>(inst, 0, 0.0, 0.0, 0, 0.0), must: Must::Succeed,
+                        then: Then::Mode(Mode::InitializationMode) }
+                } else if legal_prefix && k == 1 {
+                    Outcome { function: "fmi3ExitInitializationMode", mask: state::fmi3::EXIT_INITIALIZATION_MODE,
+                        status: fmi3::exit_initialization_mode::<M>(inst), must: Must::Any, then: Then::Mode(Mode::StepMode) }
+                } else if rng.chance(3) {
+                    // NULL and garbage handles: Error, no effect on the real instance.
+                    let bad = if rng.chance(50) { std::ptr::null_mut() } else { garbage_ptr(&mut rng) };
+                    assert_eq!(fmi3::do_step::<M>(bad, 0.0, 0.02, 0, std::ptr::null_mut(), std::ptr::null_mut(), std::ptr::null_mut(), std::ptr::null_mut()), Status::Error);
+                    assert_eq!(fmi3::reset::<M>(bad), Status::Error);
+                    fmi3::free_instance::<M>(bad);
+                    continue;
+                } else {
+                    random_call3::<M>(&mut rng, inst, &sh)
+                };
+                trace.push_str(&format!("  {} -> {:?}\n", o.function, o.status));
+                check::<M>(&o, &mut sh, inst, &mut logs, &trace);
+            }
+            // Free some states explicitly; FreeInstance frees the rest.
+            if let Some(&(mut p, _, _)) = sh.states.first() {
+                let s = fmi3::free_fmu_state::<M>(inst, &mut p);
+                assert!(sh.mode == Mode::Fatal || s == Status::Ok, "{}: FreeFMUState failed in {:?}", M::NAME, sh.mode);
+            }
+            fmi3::free_instance::<M>(inst);
+            // The handle is dead now: Error, never a crash.
+            assert_eq!(fmi3::terminate::<M>(inst), Status::Error);
+            fmi3::free_instance::<M>(inst);
+        }
+    }
+}
+
+const UNSUPPORTED2: &[&str] = &[
+    "fmi2SerializeFMUstate",
+    "fmi2GetDirectionalDerivative",
+    "fmi2EnterEventMode",
+    "fmi2NewDiscreteStates",
+    "fmi2SetTime",
+    "fmi2GetDerivatives",
+    "fmi2SetRealInputDerivatives",
+    "fmi2GetRealOutputDerivatives",
+    "fmi2CancelStep",
+];
+
+unsafe fn get2<M: Model, T: CType>(rng: &mut Rng, c: *mut c_void, function: &'static str, mode: Mode) -> Outcome {
+    let vrs = pick_vrs::<M, T>(rng, true);
+    let null = rng.chance(8) && !vrs.is_empty();
+    let mut values: Vec<T::C> = zeroed(vrs.len() + 1);
+    let vp = if null { std::ptr::null_mut() } else { values.as_mut_ptr() };
+    let status = fmi2::get::<M, T>(c, function, vrs.as_ptr(), vrs.len(), vp);
+    let ok = !null && all_match::<M, T>(&vrs, true);
+    let must = if !ok {
+        Must::Fail
+    } else if matches!(mode, Mode::InitializationMode | Mode::Error) {
+        Must::Any
+    } else {
+        Must::Succeed
+    };
+    Outcome { function, mask: state::fmi2::GET, status, must, then: Then::Nothing }
+}
+
+unsafe fn set2<M: Model, T: Gen>(rng: &mut Rng, c: *mut c_void, function: &'static str) -> Outcome {
+    let vrs = pick_vrs::<M, T>(rng, true);
+    let null = rng.chance(8) && !vrs.is_empty();
+    let mut keep = Keep::default();
+    let values: Vec<T::C> = (0..vrs.len() + 1).map(|_| T::gen(rng, &mut keep)).collect();
+    let vp = if null { std::ptr::null() } else { values.as_ptr() };
+    let status = fmi2::set::<M, T>(c, function, vrs.as_ptr(), vrs.len(), vp);
+    let must = if null || !all_match::<M, T>(&vrs, true) { Must::Fail } else { Must::Any };
+    Outcome { function, mask: state::fmi2::SET, status, must, then: Then::Nothing }
+}
+
+unsafe fn random_call2<M: Model>(rng: &mut Rng, c: *mut c_void, sh: &Shadow) -> Outcome {
+    use state::fmi2 as m;
+    let o = |function, mask, status, must, then| Outcome { function, mask, status, must, then };
+    match rng.below(22) {
+        0 => {
+            let s = fmi2::set_debug_logging::<M>(c, 1, 0, std::ptr::null());
+            o("fmi2SetDebugLogging", m::SET_DEBUG_LOGGING, s, Must::Succeed, Then::Nothing)
+        }
+        1 => {
+            let start = if rng.chance(85) { 0.0 } else { rng.f64() };
+            let s = fmi2::setup_experiment::<M>(c, 0, 0.0, start, 0, 0.0);
+            o("fmi2SetupExperiment", m::SETUP_EXPERIMENT, s, if start.is_finite() { Must::Succeed } else { Must::Fail }, Then::Nothing)
+        }
+        2 => o("fmi2EnterInitializationMode", m::ENTER_INITIALIZATION_MODE, fmi2::enter_initialization_mode::<M>(c), Must::Succeed, Then::Mode(Mode::InitializationMode)),
+        3 | 4 => o("fmi2ExitInitializationMode", m::EXIT_INITIALIZATION_MODE, fmi2::exit_initialization_mode::<M>(c), Must::Any, Then::Mode(Mode::StepMode)),
+        5..=8 => {
+            let tc = if rng.chance(90) { sh.time } else { rng.pick(&[f64::NAN, sh.time - 1.0]) };
+            let h = if rng.chance(85) { 0.02 } else { rng.pick(&[0.0, -1.0, f64::NAN, 1e300, 1e-12]) };
+            let s = fmi2::do_step::<M>(c, tc, h, 1);
+            let must = if tc != sh.time || !(h > 0.0 && h.is_finite()) { Must::Fail } else { Must::Any };
+            o("fmi2DoStep", m::DO_STEP, s, must, Then::Stepped(tc + h))
+        }
+        9 => o("fmi2Terminate", m::TERMINATE, fmi2::terminate::<M>(c), Must::Succeed, Then::Mode(Mode::Terminated)),
+        10 => o("fmi2Reset", m::RESET, fmi2::reset::<M>(c), Must::Any, Then::Mode(Mode::Instantiated)),
+        11 | 12 => match rng.below(4) {
+            0 => get2::<M, ctype::Int32>(rng, c, "fmi2GetInteger", sh.mode),
+            1 => get2::<M, ctype::Bool2>(rng, c, "fmi2GetBoolean", sh.mode),
+            2 => get2::<M, ctype::Str>(rng, c, "fmi2GetString", sh.mode),
+            _ => get2::<M, ctype::Float64>(rng, c, "fmi2GetReal", sh.mode),
+        },
+        13..=15 => match rng.below(4) {
+            0 => set2::<M, ctype::Int32>(rng, c, "fmi2SetInteger"),
+            1 => set2::<M, ctype::Bool2>(rng, c, "fmi2SetBoolean"),
+            2 => set2::<M, ctype::Str>(rng, c, "fmi2SetString"),
+            _ => set2::<M, ctype::Float64>(rng, c, "fmi2SetReal"),
+        },
+        16 => {
+            let mut p = std::ptr::null_mut();
+            let s = fmi2::get_fmu_state::<M>(c, &mut p);
+            o("fmi2GetFMUstate", m::GET_FMU_STATE, s, Must::Succeed, if s == Status::Ok { Then::NewState(p) } else { Then::Nothing })
+        }
+        17 => {
+            let (p, good) = pick_state(rng, sh);
+            let s = fmi2::set_fmu_state::<M>(c, p);
+            o("fmi2SetFMUstate", m::SET_FMU_STATE, s, if good { Must::Succeed } else { Must::Fail }, Then::Restore(p))
+        }
+        18 => {
+            let (mut p, good) = pick_state(rng, sh);
+            let orig = p;
+            let s = fmi2::free_fmu_state::<M>(c, &mut p);
+            let must = if good || orig.is_null() { Must::Succeed } else { Must::Fail };
+            o("fmi2FreeFMUstate", m::FREE_FMU_STATE, s, must, Then::FreedState(orig))
+        }
+        19 => {
+            let mut t = -1.0;
+            let s = fmi2::get_real_status::<M>(c, fmi2::FMI2_LAST_SUCCESSFUL_TIME, &mut t);
+            if s == Status::Ok {
+                assert_eq!(t, (*c.cast::<Instance<M>>()).time);
+            }
+            o("fmi2GetRealStatus", m::GET_STATUS, s, Must::Succeed, Then::Nothing)
+        }
+        _ => {
+            let f = rng.pick(UNSUPPORTED2);
+            o(f, state::NEVER, fmi2::unsupported::<M>(c, f), Must::Fail, Then::Nothing)
+        }
+    }
+}
+
+/// Runs `cases` random FMI 2.0 call sequences against `M` (see the module docs).
+pub fn fuzz_fmi2<M: Model>(seed: u64, cases: usize) {
+    assert_valid_table::<M>();
+    let mut rng = Rng::new(seed);
+    let guid = CString::new(M::TOKEN).unwrap_or_default();
+    for case in 0..cases {
+        let mut logs = Box::new(Logs::default());
+        let env = (&mut *logs as *mut Logs).cast::<c_void>();
+        let callbacks = CallbackFunctions {
+            logger: Some(log2()),
+            allocate_memory: None,
+            free_memory: None,
+            step_finished: None,
+            component_environment: env,
+        };
+        unsafe {
+            let (name, ty, g): (*const c_char, c_int, *const c_char) = match rng.below(4) {
+                0 => (c"fuzz".as_ptr(), 0, guid.as_ptr()),
+                1 => (c"fuzz".as_ptr(), 1, c"{wrong}".as_ptr()),
+                2 => (c"".as_ptr(), 1, guid.as_ptr()),
+                _ => (c"fuzz".as_ptr(), 7, guid.as_ptr()),
+            };
+            let p = fmi2::instantiate::<M>(name, ty, g, std::ptr::null(), &callbacks, 0, 0);
+            assert!(p.is_null() && !logs.0.is_empty(), "{}: bad fmi2Instantiate accepted or not logged (case {case})", M::NAME);
+            assert!(fmi2::instantiate::<M>(c"x".as_ptr(), 1, guid.as_ptr(), std::ptr::null(), std::ptr::null(), 0, 0).is_null());
+            logs.0.clear();
+            let c = fmi2::instantiate::<M>(c"fuzz".as_ptr(), 1, guid.as_ptr(), std::ptr::null(), &callbacks, 0, 0);
+            assert!(!c.is_null(), "{}: fmi2Instantiate failed: {:?}", M::NAME, logs.0);
+            let mut sh = Shadow { mode: Mode::Instantiated, states: Vec::new(), freed: Vec::new(), time: 0.0 };
+            let mut trace = String::new();
+            let legal_prefix = rng.chance(70);
+            for k in 0..10 + rng.below(60) {
+                let o = if legal_prefix && k == 0 {
+                    Outcome { function: "fmi2EnterInitializationMode", mask: state::fmi2::ENTER_INITIALIZATION_MODE,
+                        status: fmi2::enter_initialization_mode::<M>(c), must: Must::Succeed, then: Then::Mode(Mode::InitializationMode) }
+                } else if legal_prefix && k == 1 {
+                    Outcome { function: "fmi2ExitInitializationMode", mask: state::fmi2::EXIT_INITIALIZATION_MODE,
+                        status: fmi2::exit_initialization_mode::<M>(c), must: Must::Any, then: Then::Mode(Mode::StepMode) }
+                } else if rng.chance(3) {
+                    let bad = if rng.chance(50) { std::ptr::null_mut() } else { garbage_ptr(&mut rng) };
+                    assert_eq!(fmi2::do_step::<M>(bad, 0.0, 0.02, 0), Status::Error);
+                    fmi2::free_instance::<M>(bad);
+                    continue;
+                } else {
+                    random_call2::<M>(&mut rng, c, &sh)
+                };
+                trace.push_str(&format!("  {} -> {:?}\n", o.function, o.status));
+                check::<M>(&o, &mut sh, c, &mut logs, &trace);
+            }
+            fmi2::free_instance::<M>(c);
+            assert_eq!(fmi2::terminate::<M>(c), Status::Error);
+        }
+    }
+}

@@ -1,0 +1,53 @@
+//! Decoding check by type name: lets the orchestrator verify a message crossing a connection
+//! against the ROS 2 type its port declares, without knowing the type at compile time.
+
+use crate::cdr::CdrError;
+use crate::message::Message;
+use crate::{agrisim, builtin_interfaces, geometry_msgs, nav_msgs, rosgraph_msgs, sensor_msgs, std_msgs, tf2_msgs};
+
+/// `Some(Ok(()))` when `bytes` decode as `type_name` (`pkg/msg/Type`), `Some(Err)` when they
+/// do not, `None` when the type is not one this crate defines.
+pub fn check_cdr(type_name: &str, bytes: &[u8]) -> Option<Result<(), CdrError>> {
+    fn ok<M: Message>(b: &[u8]) -> Option<Result<(), CdrError>> {
+        Some(M::from_cdr(b).map(|_| ()))
+    }
+    match type_name {
+        "agrisim_msgs/msg/Signals" => ok::<agrisim::Signals>(bytes),
+        "agrisim_msgs/msg/FmuStatus" => ok::<agrisim::FmuStatus>(bytes),
+        "builtin_interfaces/msg/Time" => ok::<builtin_interfaces::Time>(bytes),
+        "geometry_msgs/msg/Vector3" => ok::<geometry_msgs::Vector3>(bytes),
+        "geometry_msgs/msg/Point" => ok::<geometry_msgs::Point>(bytes),
+        "geometry_msgs/msg/Quaternion" => ok::<geometry_msgs::Quaternion>(bytes),
+        "geometry_msgs/msg/Pose" => ok::<geometry_msgs::Pose>(bytes),
+        "geometry_msgs/msg/PoseStamped" => ok::<geometry_msgs::PoseStamped>(bytes),
+        "geometry_msgs/msg/PoseWithCovariance" => ok::<geometry_msgs::PoseWithCovariance>(bytes),
+        "geometry_msgs/msg/Twist" => ok::<geometry_msgs::Twist>(bytes),
+        "geometry_msgs/msg/TwistStamped" => ok::<geometry_msgs::TwistStamped>(bytes),
+        "geometry_msgs/msg/TwistWithCovariance" => ok::<geometry_msgs::TwistWithCovariance>(bytes),
+        "geometry_msgs/msg/Transform" => ok::<geometry_msgs::Transform>(bytes),
+        "geometry_msgs/msg/TransformStamped" => ok::<geometry_msgs::TransformStamped>(bytes),
+        "nav_msgs/msg/Odometry" => ok::<nav_msgs::Odometry>(bytes),
+        "nav_msgs/msg/Path" => ok::<nav_msgs::Path>(bytes),
+        "rosgraph_msgs/msg/Clock" => ok::<rosgraph_msgs::Clock>(bytes),
+        "sensor_msgs/msg/JointState" => ok::<sensor_msgs::JointState>(bytes),
+        "std_msgs/msg/Header" => ok::<std_msgs::Header>(bytes),
+        "tf2_msgs/msg/TFMessage" => ok::<tf2_msgs::TFMessage>(bytes),
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_known_type_is_checkable_and_garbage_fails() {
+        for name in crate::all_type_names() {
+            let full = if name.contains("/msg/") { name.to_string() } else { name.replacen('/', "/msg/", 1) };
+            assert!(check_cdr(&full, &[0, 1, 0, 0]).is_some(), "{full} missing from check_cdr");
+        }
+        assert!(check_cdr("geometry_msgs/msg/Twist", &[1, 2, 3]).unwrap().is_err());
+        assert!(check_cdr("geometry_msgs/msg/Twist", &geometry_msgs::Twist::default().to_cdr()).unwrap().is_ok());
+        assert!(check_cdr("nope/msg/Nope", &[]).is_none());
+    }
+}

@@ -1,0 +1,22 @@
+//! `std_msgs`: the common stamped-data header.
+
+use crate::builtin_interfaces::Time;
+use crate::message::ros_message;
+
+ros_message! {
+    /// `std_msgs/msg/Header`: timestamp and coordinate frame of stamped data.
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct Header = "std_msgs/msg/Header" {
+        pub stamp: Time,
+        pub frame_id: String,
+    }
+}
+
+impl Header {
+    pub fn new(stamp: Time, frame_id: impl Into<String>) -> Self {
+        Self {
+            stamp,
+            frame_id: frame_id.into(),
+        }
+    }
+}

@@ -1,0 +1,241 @@
+//! Sample messages shared by the crate's tests and the `write_samples` example (which the
+//! Python cross-check decodes). The values are mirrored in tests/test_msgs_crosscheck.py
+//! (EXPECTED): change both together. Values are chosen to be exact in decimal (or the same
+//! single IEEE operation on both sides) and to exercise alignment after strings.
+#![allow(dead_code)]
+
+use agrisim_msgs::agrisim::{FmuStatus, Signals};
+use agrisim_msgs::builtin_interfaces::Time;
+use agrisim_msgs::geometry_msgs::*;
+use agrisim_msgs::nav_msgs::{Odometry, Path};
+use agrisim_msgs::rosgraph_msgs::Clock;
+use agrisim_msgs::sensor_msgs::JointState;
+use agrisim_msgs::std_msgs::Header;
+use agrisim_msgs::tf2_msgs::TFMessage;
+use agrisim_msgs::{CdrError, Message};
+use std::fmt::Debug;
+
+pub type Checker = Box<dyn Fn(&[u8]) -> Result<(), String>>;
+
+pub struct Sample {
+    pub name: &'static str,
+    pub type_name: &'static str,
+    pub bytes: Vec<u8>,
+    /// Decodes bytes as this sample's type and compares with the sample value.
+    pub check: Checker,
+    /// Decodes bytes as this sample's type; on success re-encodes and decodes again
+    /// (must succeed). For fuzzing: exercises the decoder without comparing values.
+    pub decode: fn(&[u8]) -> Result<(), CdrError>,
+}
+
+fn decode_reencode<M: Message>(b: &[u8]) -> Result<(), CdrError> {
+    let m = M::from_cdr(b)?;
+    let again = m.to_cdr();
+    M::from_cdr(&again).expect("re-encoded message must decode");
+    Ok(())
+}
+
+pub fn sample<M: Message + PartialEq + Debug + 'static>(name: &'static str, msg: M) -> Sample {
+    let bytes = msg.to_cdr();
+    Sample {
+        name,
+        type_name: M::TYPE_NAME,
+        bytes,
+        check: Box::new(move |b| {
+            let got = M::from_cdr(b).map_err(|e| e.to_string())?;
+            if got == msg {
+                Ok(())
+            } else {
+                Err(format!("decoded {got:?}\nexpected {msg:?}"))
+            }
+        }),
+        decode: decode_reencode::<M>,
+    }
+}
+
+fn hdr(sec: i32, nanosec: u32, frame: &str) -> Header {
+    Header::new(Time::new(sec, nanosec), frame)
+}
+
+fn v3(x: f64, y: f64, z: f64) -> Vector3 {
+    Vector3 { x, y, z }
+}
+
+fn q(x: f64, y: f64, z: f64, w: f64) -> Quaternion {
+    Quaternion { x, y, z, w }
+}
+
+fn pose(x: f64, y: f64, z: f64, o: Quaternion) -> Pose {
+    Pose {
+        position: Point { x, y, z },
+        orientation: o,
+    }
+}
+
+fn twist() -> Twist {
+    Twist {
+        linear: v3(0.5, 0.0, 0.0),
+        angular: v3(0.0, 0.0, -0.25),
+    }
+}
+
+fn pose_cov() -> PoseWithCovariance {
+    let mut covariance = [0.0; 36];
+    for (i, c) in covariance.iter_mut().enumerate() {
+        *c = i as f64 * 0.5;
+    }
+    PoseWithCovariance {
+        pose: pose(1.0, 2.0, 3.0, q(0.5, 0.5, 0.5, 0.5)),
+        covariance,
+    }
+}
+
+fn twist_cov() -> TwistWithCovariance {
+    let mut covariance = [0.0; 36];
+    for i in 0..6 {
+        covariance[i * 7] = (i + 1) as f64 * 0.01;
+    }
+    TwistWithCovariance {
+        twist: twist(),
+        covariance,
+    }
+}
+
+fn tf(sec: i32, parent: &str, child: &str, x: f64) -> TransformStamped {
+    TransformStamped {
+        header: hdr(sec, 2, parent),
+        child_frame_id: child.into(),
+        transform: Transform {
+            translation: v3(x, 0.0, 0.45),
+            rotation: Quaternion::IDENTITY,
+        },
+    }
+}
+
+pub fn all_samples() -> Vec<Sample> {
+    let h = std::f64::consts::FRAC_1_SQRT_2; // 0.7071067811865476
+    vec![
+        sample("time", Time::new(1_700_000_000, 123_456_789)),
+        sample("time_negative", Time::new(-2, 300_000_000)),
+        sample("header", hdr(12, 500_000_000, "odom")),
+        sample("header_empty_frame", hdr(0, 1, "")),
+        sample("vector3", v3(1.5, -2.25, 1e-300)),
+        sample(
+            "point",
+            Point {
+                x: 0.1,
+                y: 0.2,
+                z: 0.3,
+            },
+        ),
+        sample("quaternion", q(0.0, 0.0, h, h)),
+        sample("pose", pose(1.0, 2.0, 3.0, q(0.5, 0.5, 0.5, 0.5))),
+        sample(
+            "pose_stamped",
+            PoseStamped {
+                header: hdr(3, 0, "map"),
+                pose: pose(-1.0, 0.5, 0.0, Quaternion::IDENTITY),
+            },
+        ),
+        sample("pose_with_covariance", pose_cov()),
+        sample("twist", twist()),
+        sample(
+            "twist_stamped",
+            TwistStamped {
+                header: hdr(7, 20_000_000, "base_link"),
+                twist: twist(),
+            },
+        ),
+        sample("twist_with_covariance", twist_cov()),
+        sample(
+            "transform",
+            Transform {
+                translation: v3(0.2, 0.0, 0.45),
+                rotation: Quaternion::IDENTITY,
+            },
+        ),
+        sample(
+            "transform_stamped",
+            tf(1, "base_link", "camera_optical_frame", 0.2),
+        ),
+        sample(
+            "odometry",
+            Odometry {
+                header: hdr(10, 0, "odom"),
+                child_frame_id: "base_link".into(),
+                pose: pose_cov(),
+                twist: twist_cov(),
+            },
+        ),
+        sample(
+            "path",
+            Path {
+                header: hdr(5, 0, "map"),
+                poses: vec![
+                    PoseStamped {
+                        header: hdr(5, 0, "map"),
+                        pose: pose(0.0, 0.0, 0.0, Quaternion::IDENTITY),
+                    },
+                    PoseStamped {
+                        header: hdr(5, 1, "m"),
+                        pose: pose(1.0, 0.0, 0.0, q(0.0, 0.0, h, h)),
+                    },
+                    PoseStamped {
+                        header: hdr(6, 2, ""),
+                        pose: pose(1.0, 1.0, 0.0, q(0.0, 0.0, 1.0, 0.0)),
+                    },
+                ],
+            },
+        ),
+        sample(
+            "path_empty",
+            Path {
+                header: hdr(0, 0, "map"),
+                poses: vec![],
+            },
+        ),
+        sample(
+            "tf_message",
+            TFMessage {
+                transforms: vec![
+                    tf(1, "odom", "base_link", 1.25),
+                    tf(1, "base_link", "lift_link", -0.125),
+                ],
+            },
+        ),
+        sample("tf_message_empty", TFMessage::default()),
+        sample(
+            "clock",
+            Clock {
+                clock: Time::new(42, 999_999_999),
+            },
+        ),
+        sample(
+            "joint_state",
+            JointState {
+                header: hdr(2, 40_000_000, ""),
+                name: vec!["lift_joint".into(), "wheel_fl".into(), "gr\u{fc}n".into()],
+                position: vec![0.1, 0.2, 0.3],
+                velocity: vec![],
+                effort: vec![1.0],
+            },
+        ),
+        sample(
+            "signals",
+            Signals {
+                header: hdr(0, 20_000_000, "chassis"),
+                names: vec!["v_x".into(), "omega".into(), "collided".into()],
+                values: vec![0.5, -0.1, 1.0],
+            },
+        ),
+        sample(
+            "fmu_status",
+            FmuStatus {
+                header: hdr(1, 240_000_000, "lift"),
+                instance: "lift".into(),
+                status: "Error".into(),
+                message: "fmi3DoStep returned fmi3Error at t=1.24 s: wheel slip > 1".into(),
+            },
+        ),
+    ]
+}

@@ -1,0 +1,598 @@
+//! [`Instance`]: one FMU co-simulation instance behind a safe API.
+//!
+//! The wrapper tracks the FMI state machine only as far as safety needs: which states need
+//! `fmi3Terminate` before `fmi3FreeInstance` on drop, and that nothing is called after
+//! `fmi3Fatal` (the standard forbids any further call, even freeing). Everything else (call
+//! order, allowed variables per state) the FMU checks itself and reports through its status
+//! and log, which end up in the [`FmiError`].
+
+use std::collections::BTreeMap;
+use std::ffi::{c_char, c_void, CStr, CString};
+use std::path::Path;
+use std::ptr;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+
+use super::error::{FmiError, FmiErrorInfo};
+use super::ffi::{self, Fmi3FmuState, Fmi3Instance, Vr};
+use super::library::{Fmi3Library, Functions};
+use super::log::{log_callback, LogMessage, LogSink};
+use super::status::Status;
+use crate::archive::FmuArchive;
+
+/// Where the instance is in the FMI co-simulation state machine, as far as the wrapper knows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InstanceState {
+    Instantiated,
+    InitializationMode,
+    StepMode,
+    Terminated,
+    /// The last call returned fmi3Error: only `reset` (or dropping) makes sense now.
+    Error,
+    /// The FMU returned fmi3Fatal: every further call is refused, and it is never freed.
+    Fatal,
+}
+
+/// Flags returned by `fmi3DoStep`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepResult {
+    pub event_handling_needed: bool,
+    pub terminate_simulation: bool,
+    pub early_return: bool,
+    pub last_successful_time: f64,
+}
+
+/// A saved FMU state (`fmi3FMUState`). Owned by the instance that made it, which frees any
+/// states still held when it is dropped; only valid with that instance.
+#[derive(Debug)]
+pub struct FmuState {
+    slot: usize,
+    owner: u64,
+}
+
+static NEXT_INSTANCE_ID: AtomicU64 = AtomicU64::new(1);
+
+/// A live FMU co-simulation instance.
+pub struct Instance {
+    handle: Fmi3Instance,
+    state: InstanceState,
+    name: String,
+    model: String,
+    can_get_and_set_state: bool,
+    /// vr -> variable name, for error messages.
+    names: Arc<BTreeMap<Vr, String>>,
+    /// FMU states by slot; `None` once freed.
+    fmu_states: Vec<Option<Fmi3FmuState>>,
+    id: u64,
+    /// Read by the logger callback via `instanceEnvironment`; boxed so its address is stable.
+    sink: Box<LogSink>,
+    /// Kept alive as long as the instance; declared last so it is released last.
+    lib: Arc<Fmi3Library>,
+}
+
+// SAFETY: FMI allows an instance to be used from any thread as long as calls are not
+// concurrent; `&mut self` on every FFI call guarantees that. Not `Sync`.
+unsafe impl Send for Instance {}
+
+impl Instance {
+    /// Loads the archive's binary and instantiates it for co-simulation.
+    ///
+    /// `resourcePath` is passed as the FMI 3.0 standard defines it: the absolute native path
+    /// of `resources/` with a trailing separator (not the FMI 2.0 `file://` URI).
+    pub fn instantiate(
+        archive: &FmuArchive,
+        instance_name: &str,
+        logging_on: bool,
+    ) -> Result<Instance, FmiError> {
+        let md = &archive.md;
+        let fail = |function: &str, detail: String, messages: Vec<LogMessage>| -> FmiError {
+            FmiErrorInfo {
+                instance: instance_name.to_string(),
+                model: md.model_name.clone(),
+                function: function.to_string(),
+                context: None,
+                variables: Vec::new(),
+                status: None,
+                detail: Some(detail),
+                messages,
+            }
+            .into()
+        };
+        let lib =
+            Fmi3Library::load(&archive.library_path).map_err(|e| fail("loading", e, Vec::new()))?;
+        let version = lib.version();
+        if !version.starts_with("3.") {
+            return Err(fail(
+                "fmi3GetVersion",
+                format!("reports FMI version \"{version}\", expected 3.0"),
+                Vec::new(),
+            ));
+        }
+        let lib = Arc::new(lib);
+        let names: BTreeMap<Vr, String> = md
+            .variables
+            .iter()
+            .map(|v| (v.value_reference, v.name.clone()))
+            .collect();
+
+        let c_name = CString::new(instance_name).map_err(|_| {
+            fail(
+                "fmi3InstantiateCoSimulation",
+                "instance name contains a NUL byte".into(),
+                Vec::new(),
+            )
+        })?;
+        let c_token = CString::new(md.instantiation_token.as_str()).map_err(|_| {
+            fail(
+                "fmi3InstantiateCoSimulation",
+                "instantiationToken contains a NUL byte".into(),
+                Vec::new(),
+            )
+        })?;
+        let c_resources = CString::new(resource_path(&archive.resources_dir)).map_err(|_| {
+            fail(
+                "fmi3InstantiateCoSimulation",
+                "resources path contains a NUL byte".into(),
+                Vec::new(),
+            )
+        })?;
+
+        let sink = Box::new(LogSink::default());
+        let env = &*sink as *const LogSink as *mut c_void;
+        // SAFETY: all strings outlive the call; `env` outlives the instance (see Drop).
+        let handle = unsafe {
+            (lib.f.instantiate_co_simulation)(
+                c_name.as_ptr(),
+                c_token.as_ptr(),
+                c_resources.as_ptr(),
+                false,
+                logging_on,
+                false,
+                false,
+                ptr::null(),
+                0,
+                env,
+                Some(log_callback),
+                None,
+            )
+        };
+        if handle.is_null() {
+            return Err(fail(
+                "fmi3InstantiateCoSimulation",
+                "returned NULL (instantiation failed)".into(),
+                sink.take(),
+            ));
+        }
+        Ok(Instance {
+            handle,
+            state: InstanceState::Instantiated,
+            name: instance_name.to_string(),
+            model: md.model_name.clone(),
+            can_get_and_set_state: md.can_get_and_set_fmu_state,
+            names: Arc::new(names),
+            fmu_states: Vec::new(),
+            id: NEXT_INSTANCE_ID.fetch_add(1, Ordering::Relaxed),
+            sink,
+            lib,
+        })
+    }
+
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    pub fn model_name(&self) -> &str {
+        &self.model
+    }
+
+    pub fn state(&self) -> InstanceState {
+        self.state
+    }
+
+    /// All messages logged since the last call (warnings included), oldest first.
+    pub fn take_log(&mut self) -> Vec<LogMessage> {
+        self.sink.take()
+    }
+
+    pub fn enter_initialization_mode(
+        &mut self,
+        start_time: f64,
+        stop_time: Option<f64>,
+    ) -> Result<(), FmiError> {
+        let ctx = format!("at t={start_time}");
+        self.call(
+            "fmi3EnterInitializationMode",
+            &[],
+            Some(ctx),
+            |f, h| unsafe {
+                (f.enter_initialization_mode)(
+                    h,
+                    false,
+                    0.0,
+                    start_time,
+                    stop_time.is_some(),
+                    stop_time.unwrap_or(0.0),
+                )
+            },
+        )?;
+        self.state = InstanceState::InitializationMode;
+        Ok(())
+    }
+
+    pub fn exit_initialization_mode(&mut self) -> Result<(), FmiError> {
+        self.call("fmi3ExitInitializationMode", &[], None, |f, h| unsafe {
+            (f.exit_initialization_mode)(h)
+        })?;
+        self.state = InstanceState::StepMode;
+        Ok(())
+    }
+
+    /// Advances from `t` to `t + h`. Discard (step not completed) is an error like Error.
+    pub fn do_step(&mut self, t: f64, h: f64) -> Result<StepResult, FmiError> {
+        let mut r = StepResult {
+            event_handling_needed: false,
+            terminate_simulation: false,
+            early_return: false,
+            last_successful_time: t,
+        };
+        let ctx = format!("at t={t} (h={h})");
+        self.call("fmi3DoStep", &[], Some(ctx), |f, inst| unsafe {
+            (f.do_step)(
+                inst,
+                t,
+                h,
+                false,
+                &mut r.event_handling_needed,
+                &mut r.terminate_simulation,
+                &mut r.early_return,
+                &mut r.last_successful_time,
+            )
+        })?;
+        Ok(r)
+    }
+
+    pub fn terminate(&mut self) -> Result<(), FmiError> {
+        self.call("fmi3Terminate", &[], None, |f, h| unsafe {
+            (f.terminate)(h)
+        })?;
+        self.state = InstanceState::Terminated;
+        Ok(())
+    }
+
+    /// Back to the just-instantiated state (also the way out of an Error).
+    pub fn reset(&mut self) -> Result<(), FmiError> {
+        self.call("fmi3Reset", &[], None, |f, h| unsafe { (f.reset)(h) })?;
+        self.state = InstanceState::Instantiated;
+        Ok(())
+    }
+
+    pub fn set_f64(&mut self, vrs: &[Vr], values: &[f64]) -> Result<(), FmiError> {
+        self.check_len("fmi3SetFloat64", vrs, values.len())?;
+        self.call("fmi3SetFloat64", vrs, None, |f, h| unsafe {
+            (f.set_float64)(h, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len())
+        })
+        .map(drop)
+    }
+
+    pub fn get_f64(&mut self, vrs: &[Vr], values: &mut [f64]) -> Result<(), FmiError> {
+        self.check_len("fmi3GetFloat64", vrs, values.len())?;
+        self.call("fmi3GetFloat64", vrs, None, |f, h| unsafe {
+            (f.get_float64)(
+                h,
+                vrs.as_ptr(),
+                vrs.len(),
+                values.as_mut_ptr(),
+                values.len(),
+            )
+        })
+        .map(drop)
+    }
+
+    pub fn set_i32(&mut self, vrs: &[Vr], values: &[i32]) -> Result<(), FmiError> {
+        self.check_len("fmi3SetInt32", vrs, values.len())?;
+        self.call("fmi3SetInt32", vrs, None, |f, h| unsafe {
+            (f.set_int32)(h, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len())
+        })
+        .map(drop)
+    }
+
+    pub fn get_i32(&mut self, vrs: &[Vr], values: &mut [i32]) -> Result<(), FmiError> {
+        self.check_len("fmi3GetInt32", vrs, values.len())?;
+        self.call("fmi3GetInt32", vrs, None, |f, h| unsafe {
+            (f.get_int32)(
+                h,
+                vrs.as_ptr(),
+                vrs.len(),
+                values.as_mut_ptr(),
+                values.len(),
+            )
+        })
+        .map(drop)
+    }
+
+    pub fn set_i64(&mut self, vrs: &[Vr], values: &[i64]) -> Result<(), FmiError> {
+        self.check_len("fmi3SetInt64", vrs, values.len())?;
+        self.call("fmi3SetInt64", vrs, None, |f, h| unsafe {
+            (f.set_int64)(h, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len())
+        })
+        .map(drop)
+    }
+
+    pub fn get_i64(&mut self, vrs: &[Vr], values: &mut [i64]) -> Result<(), FmiError> {
+        self.check_len("fmi3GetInt64", vrs, values.len())?;
+        self.call("fmi3GetInt64", vrs, None, |f, h| unsafe {
+            (f.get_int64)(
+                h,
+                vrs.as_ptr(),
+                vrs.len(),
+                values.as_mut_ptr(),
+                values.len(),
+            )
+        })
+        .map(drop)
+    }
+
+    pub fn set_bool(&mut self, vrs: &[Vr], values: &[bool]) -> Result<(), FmiError> {
+        self.check_len("fmi3SetBoolean", vrs, values.len())?;
+        self.call("fmi3SetBoolean", vrs, None, |f, h| unsafe {
+            (f.set_boolean)(h, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len())
+        })
+        .map(drop)
+    }
+
+    pub fn get_bool(&mut self, vrs: &[Vr], values: &mut [bool]) -> Result<(), FmiError> {
+        self.check_len("fmi3GetBoolean", vrs, values.len())?;
+        self.call("fmi3GetBoolean", vrs, None, |f, h| unsafe {
+            (f.get_boolean)(
+                h,
+                vrs.as_ptr(),
+                vrs.len(),
+                values.as_mut_ptr(),
+                values.len(),
+            )
+        })
+        .map(drop)
+    }
+
+    pub fn set_string(&mut self, vr: Vr, value: &str) -> Result<(), FmiError> {
+        let c = CString::new(value)
+            .map_err(|_| self.refuse("fmi3SetString", &[vr], "the string contains a NUL byte"))?;
+        let p = c.as_ptr();
+        self.call("fmi3SetString", &[vr], None, |f, h| unsafe {
+            (f.set_string)(h, &vr, 1, &p, 1)
+        })
+        .map(drop)
+    }
+
+    /// Copies the string out of FMU-owned memory.
+    pub fn get_string(&mut self, vr: Vr) -> Result<String, FmiError> {
+        let mut p: *const c_char = ptr::null();
+        self.call("fmi3GetString", &[vr], None, |f, h| unsafe {
+            (f.get_string)(h, &vr, 1, &mut p, 1)
+        })?;
+        if p.is_null() {
+            return Err(self.refuse("fmi3GetString", &[vr], "the FMU returned a NULL string"));
+        }
+        // SAFETY: the FMU guarantees a NUL-terminated string valid until its next call.
+        Ok(unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned())
+    }
+
+    pub fn set_binary(&mut self, vr: Vr, value: &[u8]) -> Result<(), FmiError> {
+        let size = value.len();
+        let p = value.as_ptr();
+        self.call("fmi3SetBinary", &[vr], None, |f, h| unsafe {
+            (f.set_binary)(h, &vr, 1, &size, &p, 1)
+        })
+        .map(drop)
+    }
+
+    /// Copies the bytes out of FMU-owned memory (valid only until the FMU's next call).
+    pub fn get_binary(&mut self, vr: Vr) -> Result<Vec<u8>, FmiError> {
+        let mut size: usize = 0;
+        let mut p: *const u8 = ptr::null();
+        self.call("fmi3GetBinary", &[vr], None, |f, h| unsafe {
+            (f.get_binary)(h, &vr, 1, &mut size, &mut p, 1)
+        })?;
+        if size == 0 {
+            return Ok(Vec::new());
+        }
+        if p.is_null() {
+            return Err(self.refuse(
+                "fmi3GetBinary",
+                &[vr],
+                &format!("the FMU returned NULL for {size} bytes"),
+            ));
+        }
+        // SAFETY: the FMU guarantees `size` readable bytes at `p` until its next call.
+        Ok(unsafe { std::slice::from_raw_parts(p, size) }.to_vec())
+    }
+
+    /// Saves the FMU's state (needs canGetAndSetFMUState).
+    pub fn get_state(&mut self) -> Result<FmuState, FmiError> {
+        let get = self.state_fn("fmi3GetFMUState", |f| f.get_fmu_state)?;
+        let mut s: Fmi3FmuState = ptr::null_mut();
+        self.call("fmi3GetFMUState", &[], None, |_, h| unsafe {
+            get(h, &mut s)
+        })?;
+        if s.is_null() {
+            return Err(self.refuse("fmi3GetFMUState", &[], "the FMU returned a NULL state"));
+        }
+        self.fmu_states.push(Some(s));
+        Ok(FmuState {
+            slot: self.fmu_states.len() - 1,
+            owner: self.id,
+        })
+    }
+
+    /// Restores a state saved by this instance.
+    pub fn set_state(&mut self, state: &FmuState) -> Result<(), FmiError> {
+        let set = self.state_fn("fmi3SetFMUState", |f| f.set_fmu_state)?;
+        let s = self.own_state("fmi3SetFMUState", state)?;
+        self.call("fmi3SetFMUState", &[], None, |_, h| unsafe { set(h, s) })
+            .map(drop)
+    }
+
+    /// Frees a saved state now (otherwise it is freed with the instance).
+    pub fn free_state(&mut self, state: FmuState) -> Result<(), FmiError> {
+        let free = self.state_fn("fmi3FreeFMUState", |f| f.free_fmu_state)?;
+        let mut s = self.own_state("fmi3FreeFMUState", &state)?;
+        self.fmu_states[state.slot] = None;
+        self.call("fmi3FreeFMUState", &[], None, |_, h| unsafe {
+            free(h, &mut s)
+        })
+        .map(drop)
+    }
+
+    // ---- internals ----
+
+    /// Runs one FFI call: refuses after Fatal, maps the status, attaches the call's log.
+    fn call(
+        &mut self,
+        function: &str,
+        vrs: &[Vr],
+        context: Option<String>,
+        f: impl FnOnce(&Functions, Fmi3Instance) -> ffi::Fmi3Status,
+    ) -> Result<Status, FmiError> {
+        if self.state == InstanceState::Fatal {
+            let mut e = self.refuse(
+                function,
+                vrs,
+                "refused: this instance returned fmi3Fatal earlier and is unusable",
+            );
+            e.status = Some(Status::Fatal);
+            e.context = context;
+            return Err(e);
+        }
+        let mark = self.sink.mark();
+        let status = Status::from_raw(f(&self.lib.f, self.handle));
+        if status <= Status::Warning {
+            return Ok(status);
+        }
+        match status {
+            Status::Fatal => self.state = InstanceState::Fatal,
+            Status::Error => self.state = InstanceState::Error,
+            _ => {}
+        }
+        Err(FmiErrorInfo {
+            instance: self.name.clone(),
+            model: self.model.clone(),
+            function: function.to_string(),
+            context,
+            variables: self.var_names(vrs),
+            status: Some(status),
+            detail: None,
+            messages: self.sink.since(mark),
+        }
+        .into())
+    }
+
+    /// An error the wrapper raises itself (no FMU status).
+    fn refuse(&self, function: &str, vrs: &[Vr], detail: &str) -> FmiError {
+        FmiErrorInfo {
+            instance: self.name.clone(),
+            model: self.model.clone(),
+            function: function.to_string(),
+            context: None,
+            variables: self.var_names(vrs),
+            status: None,
+            detail: Some(detail.to_string()),
+            messages: Vec::new(),
+        }
+        .into()
+    }
+
+    fn check_len(&self, function: &str, vrs: &[Vr], n: usize) -> Result<(), FmiError> {
+        if vrs.len() == n {
+            Ok(())
+        } else {
+            Err(self.refuse(
+                function,
+                vrs,
+                &format!("{} value references but {n} values", vrs.len()),
+            ))
+        }
+    }
+
+    fn var_names(&self, vrs: &[Vr]) -> Vec<String> {
+        vrs.iter()
+            .map(|vr| {
+                self.names
+                    .get(vr)
+                    .cloned()
+                    .unwrap_or_else(|| format!("vr {vr}"))
+            })
+            .collect()
+    }
+
+    fn state_fn<T>(
+        &self,
+        function: &str,
+        pick: impl FnOnce(&Functions) -> Option<T>,
+    ) -> Result<T, FmiError> {
+        if !self.can_get_and_set_state {
+            return Err(self.refuse(
+                function,
+                &[],
+                "not supported: the FMU declares canGetAndSetFMUState=\"false\"",
+            ));
+        }
+        pick(&self.lib.f).ok_or_else(|| {
+            self.refuse(
+                function,
+                &[],
+                "the shared library does not export this function",
+            )
+        })
+    }
+
+    fn own_state(&self, function: &str, state: &FmuState) -> Result<Fmi3FmuState, FmiError> {
+        match self.fmu_states.get(state.slot) {
+            Some(Some(s)) if state.owner == self.id => Ok(*s),
+            _ => Err(self.refuse(
+                function,
+                &[],
+                "the FMU state belongs to another instance or was freed",
+            )),
+        }
+    }
+}
+
+impl Drop for Instance {
+    fn drop(&mut self) {
+        if self.handle.is_null() || self.state == InstanceState::Fatal {
+            // After fmi3Fatal the standard allows no call at all, not even freeing: leak it.
+            return;
+        }
+        let f = &self.lib.f;
+        // SAFETY: the handle is live (never freed before; nulled right after freeing).
+        unsafe {
+            if matches!(
+                self.state,
+                InstanceState::InitializationMode | InstanceState::StepMode
+            ) {
+                let _ = (f.terminate)(self.handle);
+            }
+            if self.state != InstanceState::Error {
+                if let Some(free) = f.free_fmu_state {
+                    for s in self.fmu_states.iter_mut().filter_map(Option::take) {
+                        let mut s = s;
+                        let _ = free(self.handle, &mut s);
+                    }
+                }
+            }
+            (f.free_instance)(self.handle);
+        }
+        self.handle = ptr::null_mut();
+        // `sink` and then `lib` are dropped after this, i.e. after the FMU can no longer log.
+    }
+}
+
+/// The FMI 3.0 `resourcePath` argument: absolute, native, with a trailing separator.
+fn resource_path(dir: &Path) -> String {
+    let abs = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.to_path_buf());
+    let mut s = abs.to_string_lossy().into_owned();
+    if !s.ends_with(std::path::MAIN_SEPARATOR) {
+        s.push(std::path::MAIN_SEPARATOR);
+    }
+    s
+}

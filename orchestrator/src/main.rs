@@ -1,0 +1,139 @@
+//! `agrisim`: the command-line front of the orchestrator.
+
+use agrisim::error::Result;
+use agrisim::run::RunOptions;
+use agrisim::scenario::Scenario;
+use clap::{Parser, Subcommand};
+use std::collections::BTreeMap;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "agrisim", version, about = "Greenhouse-robotics co-simulation: FMUs, SSP systems, ROS 2 messages, MCAP logs")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a scenario's system and record DIR/run.mcap.
+    Run {
+        /// Scenario file (TOML).
+        #[arg(long, default_value = "models/scenarios/default.toml")]
+        scenario: PathBuf,
+        /// Simulated duration [s] (default: the scenario's).
+        #[arg(long)]
+        duration: Option<f64>,
+        /// Master seed (default: the scenario's).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Replace a component's FMU: COMPONENT=FILE.fmu (e.g. chassis=ChassisDynamic.fmu).
+        #[arg(long = "fmu", value_parser = parse_override)]
+        fmus: Vec<(String, String)>,
+        #[command(flatten)]
+        dirs: Dirs,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// FMU packaging.
+    Fmu {
+        #[command(subcommand)]
+        command: FmuCommand,
+    },
+}
+
+#[derive(Subcommand)]
+enum FmuCommand {
+    /// Write target/fmu/<Name>.fmu (FMI 3.0) and target/fmu/fmi2/<Name>.fmu (FMI 2.0).
+    Pack {
+        /// Directory with the built FMU libraries (default: this executable's directory).
+        #[arg(long)]
+        lib_dir: Option<PathBuf>,
+        /// Output directory (default: target/fmu next to the build directory).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+}
+
+#[derive(clap::Args)]
+struct Dirs {
+    /// Directory of packed FMUs (default: target/fmu next to this executable's build directory).
+    #[arg(long)]
+    fmu_dir: Option<PathBuf>,
+    /// Where FMU archives are unpacked (default: target/fmu-cache).
+    #[arg(long)]
+    cache_dir: Option<PathBuf>,
+}
+
+fn parse_override(s: &str) -> std::result::Result<(String, String), String> {
+    s.split_once('=').map(|(a, b)| (a.to_string(), b.to_string())).ok_or_else(|| format!("expected COMPONENT=FILE.fmu, got '{s}'"))
+}
+
+/// target/<profile>/ of this executable, and target/.
+fn build_dirs() -> (PathBuf, PathBuf) {
+    let exe_dir = std::env::current_exe().ok().and_then(|p| p.parent().map(|d| d.to_path_buf())).unwrap_or_else(|| PathBuf::from("target/release"));
+    let target = exe_dir.parent().map(|p| p.to_path_buf()).unwrap_or_else(|| PathBuf::from("target"));
+    (exe_dir, target)
+}
+
+/// A one-line progress display on a terminal; nothing in pipes and CI logs.
+fn progress_printer() -> impl FnMut(u64, u64) {
+    let tty = std::io::stderr().is_terminal();
+    let mut last = u64::MAX;
+    move |k, n| {
+        if !tty || n == 0 {
+            return;
+        }
+        let pct = k * 100 / n;
+        if pct != last {
+            last = pct;
+            eprint!("\r[{:<40}] {pct:>3}%", "#".repeat((pct * 40 / 100) as usize));
+            if k == n {
+                eprintln!();
+            }
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    match real_main() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("agrisim: error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn real_main() -> Result<()> {
+    let cli = Cli::parse();
+    let (exe_dir, target) = build_dirs();
+    match cli.command {
+        Command::Run { scenario, duration, seed, fmus, dirs, out } => {
+            let s = Scenario::load(&scenario)?;
+            let opts = RunOptions {
+                fmu_dir: dirs.fmu_dir.unwrap_or_else(|| target.join("fmu")),
+                cache_dir: dirs.cache_dir.unwrap_or_else(|| target.join("fmu-cache")),
+                seed,
+                duration,
+                fmu_overrides: fmus.into_iter().collect::<BTreeMap<_, _>>(),
+            };
+            let summary = agrisim::run::run(&s, &opts, &out, progress_printer())?;
+            println!("{} steps ({} s simulated) -> {}", summary.steps, summary.simulated, summary.mcap.display());
+        }
+        Command::Fmu { command: FmuCommand::Pack { lib_dir, out } } => {
+            let lib_dir = lib_dir.unwrap_or(exe_dir);
+            let out = out.unwrap_or_else(|| target.join("fmu"));
+            for p in agrisim::pack::pack_all(&lib_dir, &out)? {
+                match &p.fmi2 {
+                    Some(f2) => println!("{}: {} {}", p.model_identifier, p.fmi3.display(), f2.display()),
+                    None => println!("{}: {}", p.model_identifier, p.fmi3.display()),
+                }
+            }
+        }
+    }
+    Ok(())
+}

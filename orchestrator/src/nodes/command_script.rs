@@ -1,0 +1,47 @@
+//! Plays a scenario's timed commands: a teleop-like publisher of geometry_msgs/Twist on
+//! /cmd_vel at the message rate (the last command holds until the next, and `silent`
+//! entries stop publishing so the chassis watchdog takes over), and lift set-points.
+
+use super::Node;
+use crate::bus::Bus;
+use crate::error::Result;
+use crate::scenario::{BaseCommand, LiftCommand};
+use agrisim_msgs::geometry_msgs::{Twist, Vector3};
+
+pub const CMD_VEL: &str = "/cmd_vel";
+pub const LIFT_SETPOINT: &str = "/lift/setpoint";
+
+pub struct CommandScript {
+    base: Vec<BaseCommand>,
+    lift: Vec<LiftCommand>,
+}
+
+impl CommandScript {
+    pub fn new(base: Vec<BaseCommand>, lift: Vec<LiftCommand>) -> CommandScript {
+        CommandScript { base, lift }
+    }
+}
+
+/// The last entry whose time has come (entries are sorted by time).
+fn current<T>(entries: &[T], t_ns: i64, time: impl Fn(&T) -> f64) -> Option<&T> {
+    entries.iter().take_while(|e| (time(e) * 1e9).round() as i64 <= t_ns).last()
+}
+
+impl Node for CommandScript {
+    fn name(&self) -> &str {
+        "command_script"
+    }
+
+    fn step(&mut self, t_ns: i64, bus: &mut Bus) -> Result<()> {
+        if let Some(c) = current(&self.base, t_ns, |c| c.t) {
+            if !c.silent {
+                let msg = Twist { linear: Vector3 { x: c.vx, y: c.vy, z: 0.0 }, angular: Vector3 { x: 0.0, y: 0.0, z: c.wz } };
+                bus.publish(CMD_VEL, t_ns, &msg);
+            }
+        }
+        if let Some(c) = current(&self.lift, t_ns, |c| c.t) {
+            bus.set_scalar(LIFT_SETPOINT, c.position);
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,214 @@
+//! Scenario files (TOML, models/scenarios/): which system to run, timing, seed, parameter
+//! overrides per component, and the scripted inputs of a plain `agrisim run`.
+//!
+//! Unknown keys are errors (a typo must not silently fall back to a default).
+
+use crate::error::{Context, Result};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    #[serde(default = "default_name")]
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    /// Master seed: every component's `seed` parameter is derived from it.
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// Simulated duration of `agrisim run` [s].
+    #[serde(default = "default_duration")]
+    pub duration: f64,
+    #[serde(default)]
+    pub timing: Timing,
+    pub system: SystemRef,
+    /// Parameter overrides: component name -> parameter name -> value.
+    #[serde(default)]
+    pub parameters: BTreeMap<String, BTreeMap<String, toml::Value>>,
+    /// Timed base velocity commands (base frame, REP 103), published on /cmd_vel.
+    #[serde(default)]
+    pub base_commands: Vec<BaseCommand>,
+    /// Timed lift position set-points.
+    #[serde(default)]
+    pub lift_commands: Vec<LiftCommand>,
+    /// Fault injection: raw bytes published on a topic at a time (robustness tests).
+    #[serde(default)]
+    pub inject: Vec<Injection>,
+    /// Where the file was read from (relative paths resolve against its directory).
+    #[serde(skip)]
+    pub path: PathBuf,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Timing {
+    /// Master communication step [s].
+    #[serde(default = "default_step")]
+    pub step: f64,
+    /// Rate of message connections [Hz] (those without their own period in the system file).
+    #[serde(default = "default_message_rate")]
+    pub message_rate: f64,
+}
+
+impl Default for Timing {
+    fn default() -> Self {
+        Timing { step: default_step(), message_rate: default_message_rate() }
+    }
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SystemRef {
+    /// SSP SystemStructure.ssd, relative to the scenario file.
+    pub file: PathBuf,
+    /// Component -> FMU file override (e.g. `chassis = "ChassisDynamic.fmu"`).
+    #[serde(default)]
+    pub fmus: BTreeMap<String, String>,
+}
+
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct BaseCommand {
+    /// From this time on [s].
+    pub t: f64,
+    #[serde(default)]
+    pub vx: f64,
+    #[serde(default)]
+    pub vy: f64,
+    #[serde(default)]
+    pub wz: f64,
+    /// Stop publishing (the chassis watchdog then stops the base).
+    #[serde(default)]
+    pub silent: bool,
+}
+
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct LiftCommand {
+    pub t: f64,
+    pub position: f64,
+}
+
+/// A raw message to publish once, e.g. a corrupt command, to test how the system copes.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Injection {
+    pub t: f64,
+    pub topic: String,
+    /// ROS 2 type recorded for the bytes (`pkg/msg/Type`).
+    #[serde(rename = "type")]
+    pub type_name: String,
+    /// The bytes, as hex.
+    pub hex: String,
+}
+
+impl Injection {
+    pub fn bytes(&self) -> Result<Vec<u8>> {
+        let h = self.hex.trim();
+        if h.len() % 2 != 0 || !h.bytes().all(|b| b.is_ascii_hexdigit()) {
+            return Err(crate::err!("inject on {} at t={}: hex {:?} is not an even number of hex digits", self.topic, self.t, self.hex));
+        }
+        Ok((0..h.len()).step_by(2).map(|i| u8::from_str_radix(&h[i..i + 2], 16).expect("checked hex")).collect())
+    }
+}
+
+fn default_name() -> String {
+    "unnamed".into()
+}
+fn default_seed() -> u64 {
+    1
+}
+fn default_duration() -> f64 {
+    20.0
+}
+fn default_step() -> f64 {
+    0.02
+}
+fn default_message_rate() -> f64 {
+    10.0
+}
+
+impl Scenario {
+    pub fn load(path: &Path) -> Result<Scenario> {
+        let text = std::fs::read_to_string(path).context(|| format!("cannot read scenario {}", path.display()))?;
+        Self::parse(&text, path)
+    }
+
+    pub fn parse(text: &str, path: &Path) -> Result<Scenario> {
+        let mut s: Scenario = toml::from_str(text).context(|| format!("scenario {}", path.display()))?;
+        s.path = path.to_path_buf();
+        s.validate()?;
+        Ok(s)
+    }
+
+    fn validate(&self) -> Result<()> {
+        let file = self.path.display();
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        if !positive(self.duration) {
+            return Err(crate::err!("scenario {file}: duration must be positive, got {}", self.duration));
+        }
+        if !positive(self.timing.step) || !positive(self.timing.message_rate) {
+            return Err(crate::err!("scenario {file}: timing.step and timing.message_rate must be positive"));
+        }
+        for (i, c) in self.base_commands.iter().enumerate() {
+            if !(c.t.is_finite() && c.t >= 0.0 && c.vx.is_finite() && c.vy.is_finite() && c.wz.is_finite()) {
+                return Err(crate::err!("scenario {file}: base_commands[{i}] has a negative or non-finite value"));
+            }
+            if i > 0 && c.t < self.base_commands[i - 1].t {
+                return Err(crate::err!("scenario {file}: base_commands[{i}].t goes back in time"));
+            }
+        }
+        for (i, c) in self.lift_commands.iter().enumerate() {
+            if !(c.t.is_finite() && c.t >= 0.0 && c.position.is_finite()) || (i > 0 && c.t < self.lift_commands[i - 1].t) {
+                return Err(crate::err!("scenario {file}: lift_commands[{i}] is not finite, negative or out of order"));
+            }
+        }
+        for inj in &self.inject {
+            inj.bytes().map_err(|e| crate::err!("scenario {file}: {e}"))?;
+        }
+        Ok(())
+    }
+
+    /// The system file, resolved against the scenario's directory.
+    pub fn system_path(&self) -> PathBuf {
+        self.path.parent().unwrap_or(Path::new(".")).join(&self.system.file)
+    }
+}
+
+/// The seed of one component: the master seed mixed with the component's name, so that
+/// components draw independent noise and adding a component changes no one else's.
+pub fn component_seed(master: u64, component: &str) -> i32 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64 ^ master.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    for b in component.bytes() {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    (h >> 33) as i32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unknown_keys_are_errors_naming_the_file() {
+        let e = Scenario::parse("[system]\nfile = \"a.ssd\"\nduraton = 3\n", Path::new("x.toml")).unwrap_err();
+        assert!(e.0.contains("x.toml") && e.0.contains("duraton"), "{e}");
+    }
+
+    #[test]
+    fn defaults_are_the_papers_timing() {
+        let s = Scenario::parse("[system]\nfile = \"a.ssd\"\n", Path::new("dir/x.toml")).unwrap();
+        assert_eq!((s.timing.step, s.timing.message_rate), (0.02, 10.0));
+        assert_eq!(s.system_path(), Path::new("dir/a.ssd"));
+    }
+
+    #[test]
+    fn component_seeds_differ_by_name_and_master_seed() {
+        assert_ne!(component_seed(1, "chassis"), component_seed(1, "lift"));
+        assert_ne!(component_seed(1, "chassis"), component_seed(2, "chassis"));
+        assert_eq!(component_seed(7, "chassis"), component_seed(7, "chassis"));
+    }
+}

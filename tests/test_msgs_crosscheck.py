@@ -1,0 +1,305 @@
+"""Cross-check agrisim-msgs (Rust) against ROS 2 CDR/msg code that no one here wrote.
+
+The Rust example `write_samples` writes sample messages (fmus/msgs/tests/common/samples.rs)
+as CDR files plus their `ros2msg` schema texts. Here they are decoded by
+
+* mcap-ros2-support's dynamic decoder built from our schema text (what Foxglove-style
+  readers do with an MCAP Schema record), also through a real MCAP file;
+* rosbags, with types registered from our .msg files and, separately, from our
+  concatenated schema text; rosbags must also re-serialize them to the same bytes;
+
+and compared with EXPECTED below (which mirrors samples.rs: change both together).
+In the other direction, mcap-ros2-support serializes EXPECTED and the Rust example decodes
+those bytes (`write_samples --check`). The .msg texts of standard types are also compared
+field by field with the definitions rosbags ships for ROS 2 Humble and Jazzy.
+
+Binary: $AGRISIM_MSGS_WRITE_SAMPLES if set, else `cargo run -p agrisim-msgs --example
+write_samples` from the repository root.
+Requires: pip install mcap-ros2-support==0.6.0 rosbags==0.11.9 pytest
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+import mcap_ros2._dynamic as mcap_ros2_dynamic  # noqa: E402  (a missing checker must fail, not skip)
+import rosbags.typesys as typesys  # noqa: E402
+import numpy as np  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[1]
+MSG_DIR = REPO / "models" / "msgs"
+SEP = "=" * 80
+
+# ----------------------------------------------------------------------------- expected
+
+
+def hdr(sec, nanosec, frame):
+    return {"stamp": {"sec": sec, "nanosec": nanosec}, "frame_id": frame}
+
+
+def v3(x, y, z):
+    return {"x": x, "y": y, "z": z}
+
+
+def q(x, y, z, w):
+    return {"x": x, "y": y, "z": z, "w": w}
+
+
+IDENT = q(0.0, 0.0, 0.0, 1.0)
+H = math.sqrt(0.5)  # 0.7071067811865476, same double as Rust FRAC_1_SQRT_2
+assert H == 0.7071067811865476
+
+
+def pose(x, y, z, o):
+    return {"position": v3(x, y, z), "orientation": o}
+
+
+TWIST = {"linear": v3(0.5, 0.0, 0.0), "angular": v3(0.0, 0.0, -0.25)}
+POSE_COV = {
+    "pose": pose(1.0, 2.0, 3.0, q(0.5, 0.5, 0.5, 0.5)),
+    "covariance": [i * 0.5 for i in range(36)],
+}
+_tcov = [0.0] * 36
+for _i in range(6):
+    _tcov[_i * 7] = (_i + 1) * 0.01
+TWIST_COV = {"twist": TWIST, "covariance": _tcov}
+
+
+def tf(sec, parent, child, x):
+    return {
+        "header": hdr(sec, 2, parent),
+        "child_frame_id": child,
+        "transform": {"translation": v3(x, 0.0, 0.45), "rotation": IDENT},
+    }
+
+
+EXPECTED = {
+    "time": {"sec": 1_700_000_000, "nanosec": 123_456_789},
+    "time_negative": {"sec": -2, "nanosec": 300_000_000},
+    "header": hdr(12, 500_000_000, "odom"),
+    "header_empty_frame": hdr(0, 1, ""),
+    "vector3": v3(1.5, -2.25, 1e-300),
+    "point": v3(0.1, 0.2, 0.3),
+    "quaternion": q(0.0, 0.0, H, H),
+    "pose": pose(1.0, 2.0, 3.0, q(0.5, 0.5, 0.5, 0.5)),
+    "pose_stamped": {"header": hdr(3, 0, "map"), "pose": pose(-1.0, 0.5, 0.0, IDENT)},
+    "pose_with_covariance": POSE_COV,
+    "twist": TWIST,
+    "twist_stamped": {"header": hdr(7, 20_000_000, "base_link"), "twist": TWIST},
+    "twist_with_covariance": TWIST_COV,
+    "transform": {"translation": v3(0.2, 0.0, 0.45), "rotation": IDENT},
+    "transform_stamped": tf(1, "base_link", "camera_optical_frame", 0.2),
+    "odometry": {
+        "header": hdr(10, 0, "odom"),
+        "child_frame_id": "base_link",
+        "pose": POSE_COV,
+        "twist": TWIST_COV,
+    },
+    "path": {
+        "header": hdr(5, 0, "map"),
+        "poses": [
+            {"header": hdr(5, 0, "map"), "pose": pose(0.0, 0.0, 0.0, IDENT)},
+            {"header": hdr(5, 1, "m"), "pose": pose(1.0, 0.0, 0.0, q(0.0, 0.0, H, H))},
+            {"header": hdr(6, 2, ""), "pose": pose(1.0, 1.0, 0.0, q(0.0, 0.0, 1.0, 0.0))},
+        ],
+    },
+    "path_empty": {"header": hdr(0, 0, "map"), "poses": []},
+    "tf_message": {
+        "transforms": [
+            tf(1, "odom", "base_link", 1.25),
+            tf(1, "base_link", "lift_link", -0.125),
+        ]
+    },
+    "tf_message_empty": {"transforms": []},
+    "clock": {"clock": {"sec": 42, "nanosec": 999_999_999}},
+    "joint_state": {
+        "header": hdr(2, 40_000_000, ""),
+        "name": ["lift_joint", "wheel_fl", "gr\u00fcn"],
+        "position": [0.1, 0.2, 0.3],
+        "velocity": [],
+        "effort": [1.0],
+    },
+    "signals": {
+        "header": hdr(0, 20_000_000, "chassis"),
+        "names": ["v_x", "omega", "collided"],
+        "values": [0.5, -0.1, 1.0],
+    },
+    "fmu_status": {
+        "header": hdr(1, 240_000_000, "lift"),
+        "instance": "lift",
+        "status": "Error",
+        "message": "fmi3DoStep returned fmi3Error at t=1.24 s: wheel slip > 1",
+    },
+}
+
+# ----------------------------------------------------------------------------- helpers
+
+
+def _samples_cmd(*args: str) -> list[str]:
+    exe = os.environ.get("AGRISIM_MSGS_WRITE_SAMPLES")
+    if exe:
+        return [exe, *args]
+    if shutil.which("cargo") is None:
+        pytest.skip("cargo not found and AGRISIM_MSGS_WRITE_SAMPLES not set")
+    return ["cargo", "run", "-q", "-p", "agrisim-msgs", "--example", "write_samples", "--", *args]
+
+
+def plain(obj):
+    """Decoded message (mcap_ros2 slots class or rosbags dataclass) -> dicts and lists."""
+    if isinstance(obj, (str, bytes, int, float, bool)) or obj is None:
+        return obj
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, (list, tuple)):
+        return [plain(v) for v in obj]
+    if isinstance(obj, dict):
+        return {k: plain(v) for k, v in obj.items()}
+    fields = getattr(obj, "__dataclass_fields__", None)
+    names = list(fields) if fields is not None else list(getattr(obj, "__slots__", ()))
+    if not names:
+        raise TypeError(f"cannot convert {type(obj)!r}")
+    return {n: plain(getattr(obj, n)) for n in names if n != "__msgtype__"}
+
+
+def msg_files() -> dict[str, str]:
+    """'pkg/msg/Type' -> .msg text, for every file in models/msgs."""
+    out = {}
+    for p in sorted(MSG_DIR.glob("*/msg/*.msg")):
+        out[f"{p.parts[-3]}/msg/{p.stem}"] = p.read_text()
+    return out
+
+
+@pytest.fixture(scope="session")
+def samples(tmp_path_factory):
+    """name -> (type_name, cdr bytes, schema text)."""
+    out = tmp_path_factory.mktemp("msgs-samples")
+    subprocess.run(_samples_cmd(str(out)), cwd=REPO, check=True)
+    result = {}
+    for line in (out / "index.tsv").read_text().splitlines():
+        name, type_name = line.split("\t")
+        result[name] = (
+            type_name,
+            (out / f"{name}.cdr").read_bytes(),
+            (out / f"{name}.ros2msg").read_text(),
+        )
+    return result
+
+
+@pytest.fixture(scope="session")
+def rosbags_store():
+    """Typestore with every type registered from our individual .msg files."""
+    store = typesys.get_typestore(typesys.Stores.EMPTY)
+    for name, text in msg_files().items():
+        store.register(typesys.get_types_from_msg(text, name))
+    return store
+
+
+SAMPLE_NAMES = sorted(EXPECTED)
+
+# ----------------------------------------------------------------------------- tests
+
+
+def test_samples_cover_every_msg_file(samples):
+    assert set(samples) == set(EXPECTED)
+    assert {t for t, _, _ in samples.values()} == set(msg_files())
+    assert len(msg_files()) == 20
+
+
+@pytest.mark.parametrize("name", SAMPLE_NAMES)
+def test_mcap_ros2_decodes_with_our_schema(samples, name):
+    type_name, data, schema = samples[name]
+    decoders = mcap_ros2_dynamic.generate_dynamic(type_name, schema)
+    assert plain(decoders[type_name](data)) == EXPECTED[name]
+
+
+@pytest.mark.parametrize("name", SAMPLE_NAMES)
+def test_rosbags_decodes_and_reencodes_identically(samples, rosbags_store, name):
+    type_name, data, _ = samples[name]
+    msg = rosbags_store.deserialize_cdr(data, type_name)
+    assert plain(msg) == EXPECTED[name]
+    assert bytes(rosbags_store.serialize_cdr(msg, type_name)) == data
+
+
+@pytest.mark.parametrize("name", SAMPLE_NAMES)
+def test_rosbags_parses_our_concatenated_schema(samples, name):
+    type_name, data, schema = samples[name]
+    types = typesys.get_types_from_msg(schema, type_name)
+    store = typesys.get_typestore(typesys.Stores.EMPTY)
+    store.register(types)
+    assert plain(store.deserialize_cdr(data, type_name)) == EXPECTED[name]
+
+
+def test_schema_format(samples):
+    for name, (type_name, _, schema) in samples.items():
+        own = msg_files()[type_name]
+        assert schema.startswith(own), name
+        blocks = schema.split(SEP + "\n")
+        for block in blocks[1:]:
+            head, _, body = block.partition("\n")
+            assert head.startswith("MSG: "), (name, head)
+            dep = head[len("MSG: "):]
+            assert dep.count("/") == 1, dep  # rosbag2 style: pkg/Type
+            pkg, ty = dep.split("/")
+            assert body == msg_files()[f"{pkg}/msg/{ty}"], (name, dep)
+
+
+def test_mcap_ros2_encoder_bytes_decode_in_rust(samples, tmp_path):
+    """Other direction: a foreign encoder's bytes must decode to our sample values."""
+    for name, (type_name, data, schema) in samples.items():
+        enc = mcap_ros2_dynamic.serialize_dynamic(type_name, schema)[type_name]
+        foreign = bytes(enc(EXPECTED[name]))
+        # Same layout; mcap_ros2 may add trailing alignment padding, which we accept.
+        assert foreign[: len(data)] == data, name
+        assert set(foreign[len(data):]) <= {0}, name
+        (tmp_path / f"{name}.cdr").write_bytes(foreign)
+    out = subprocess.run(
+        _samples_cmd("--check", str(tmp_path)), cwd=REPO, capture_output=True, text=True
+    )
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert f"checked {len(samples)} files, 0 failed" in out.stdout
+
+
+def test_mcap_file_round_trip(samples):
+    """Our schema + bytes in a real MCAP file, read back via mcap-ros2-support's decoder."""
+    import mcap.writer as writer_mod
+    reader_mod = pytest.importorskip("mcap.reader")
+    decoder_mod = pytest.importorskip("mcap_ros2.decoder")
+    buf = io.BytesIO()
+    w = writer_mod.Writer(buf)
+    w.start(profile="ros2", library="agrisim-crosscheck")
+    order = []
+    for i, (name, (type_name, data, schema)) in enumerate(sorted(samples.items())):
+        sid = w.register_schema(name=type_name, encoding="ros2msg", data=schema.encode())
+        cid = w.register_channel(
+            topic=f"/{name}",
+            message_encoding="cdr",
+            schema_id=sid,
+            metadata={"offered_qos_profiles": ""},
+        )
+        w.add_message(channel_id=cid, log_time=i, publish_time=i, data=data)
+        order.append(name)
+    w.finish()
+    buf.seek(0)
+    reader = reader_mod.make_reader(buf, decoder_factories=[decoder_mod.DecoderFactory()])
+    got = {ch.topic[1:]: plain(msg) for _, ch, _, msg in reader.iter_decoded_messages()}
+    assert got == {n: EXPECTED[n] for n in order}
+
+
+@pytest.mark.parametrize("store_name", ["ROS2_HUMBLE", "ROS2_JAZZY"])
+def test_msg_texts_match_ros2_distro(rosbags_store, store_name):
+    """Field names and types of our standard .msg files equal the real ROS 2 ones."""
+    ref = typesys.get_typestore(getattr(typesys.Stores, store_name))
+    checked = 0
+    for name in msg_files():
+        if name.startswith("agrisim_msgs/"):
+            continue
+        assert rosbags_store.fielddefs[name] == ref.fielddefs[name], name
+        checked += 1
+    assert checked == 18
