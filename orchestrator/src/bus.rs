@@ -72,6 +72,11 @@ impl Bus {
         self.scalars.get(name).copied()
     }
 
+    /// All scalar system inputs, by name.
+    pub fn scalars(&self) -> &BTreeMap<String, f64> {
+        &self.scalars
+    }
+
     /// Messages published since the last drain, in publication order.
     pub fn drain(&mut self) -> Vec<Published> {
         std::mem::take(&mut self.outbox)

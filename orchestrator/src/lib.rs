@@ -3,6 +3,7 @@
 //! the algorithm layer's nodes on ROS 2 messages, and records everything to MCAP.
 
 pub mod archive;
+pub mod bench;
 pub mod bus;
 pub mod error;
 pub mod fmi3;

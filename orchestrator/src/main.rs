@@ -38,6 +38,11 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// Benchmarks.
+    Bench {
+        #[command(subcommand)]
+        command: BenchCommand,
+    },
     /// FMU packaging.
     Fmu {
         #[command(subcommand)]
@@ -55,6 +60,21 @@ enum FmuCommand {
         /// Output directory (default: target/fmu next to the build directory).
         #[arg(long)]
         out: Option<PathBuf>,
+    },
+}
+
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// Orchestrator cost per FMU and step, beside the bare fmi3DoStep cost (JSON on stdout).
+    Overhead {
+        #[arg(long, default_value = "models/scenarios/default.toml")]
+        scenario: PathBuf,
+        #[arg(long, default_value_t = 5000)]
+        steps: u64,
+        #[command(flatten)]
+        dirs: Dirs,
+        #[arg(long)]
+        out: PathBuf,
     },
 }
 
@@ -98,6 +118,16 @@ fn progress_printer() -> impl FnMut(u64, u64) {
     }
 }
 
+fn run_options(dirs: Dirs, target: &std::path::Path, seed: Option<u64>, duration: Option<f64>, fmu_overrides: BTreeMap<String, String>) -> RunOptions {
+    RunOptions {
+        fmu_dir: dirs.fmu_dir.unwrap_or_else(|| target.join("fmu")),
+        cache_dir: dirs.cache_dir.unwrap_or_else(|| target.join("fmu-cache")),
+        seed,
+        duration,
+        fmu_overrides,
+    }
+}
+
 fn main() -> ExitCode {
     match real_main() {
         Ok(()) => ExitCode::SUCCESS,
@@ -114,15 +144,15 @@ fn real_main() -> Result<()> {
     match cli.command {
         Command::Run { scenario, duration, seed, fmus, dirs, out } => {
             let s = Scenario::load(&scenario)?;
-            let opts = RunOptions {
-                fmu_dir: dirs.fmu_dir.unwrap_or_else(|| target.join("fmu")),
-                cache_dir: dirs.cache_dir.unwrap_or_else(|| target.join("fmu-cache")),
-                seed,
-                duration,
-                fmu_overrides: fmus.into_iter().collect::<BTreeMap<_, _>>(),
-            };
+            let opts = run_options(dirs, &target, seed, duration, fmus.into_iter().collect());
             let summary = agrisim::run::run(&s, &opts, &out, progress_printer())?;
             println!("{} steps ({} s simulated) -> {}", summary.steps, summary.simulated, summary.mcap.display());
+        }
+        Command::Bench { command: BenchCommand::Overhead { scenario, steps, dirs, out } } => {
+            let s = Scenario::load(&scenario)?;
+            let opts = run_options(dirs, &target, None, None, BTreeMap::new());
+            let report = agrisim::bench::overhead(&s, &opts, steps, &out)?;
+            println!("{}", serde_json::to_string_pretty(&report).expect("plain struct serializes"));
         }
         Command::Fmu { command: FmuCommand::Pack { lib_dir, out } } => {
             let lib_dir = lib_dir.unwrap_or(exe_dir);

@@ -22,6 +22,8 @@ use agrisim_msgs::rosgraph_msgs::Clock;
 use agrisim_msgs::std_msgs::Header;
 
 pub const STATUS_TOPIC: &str = "/agrisim/status";
+/// Scalar system connectors (set by nodes or FMU outputs) recorded every step.
+pub const SCALARS_TOPIC: &str = "/agrisim/scalars";
 
 pub struct Master {
     pub system: System,
@@ -190,6 +192,11 @@ impl Master {
             self.recorder.write(ch, m.time_ns, &m.cdr)?;
         }
         self.recorder.publish("/clock", t_ns, &Clock { clock: Time::from_nanos(t_ns) })?;
+        if !self.bus.scalars().is_empty() {
+            let (names, values) = self.bus.scalars().iter().map(|(k, v)| (k.clone(), *v)).unzip();
+            let msg = Signals { header: Header { stamp: Time::from_nanos(t_ns), frame_id: String::new() }, names, values };
+            self.recorder.publish(SCALARS_TOPIC, t_ns, &msg)?;
+        }
         for c in &mut self.system.components {
             let mut values = Vec::with_capacity(c.signals.len());
             for v in &c.signals {

@@ -39,6 +39,8 @@ pub trait Drive: Clone + Send + Default + 'static {
     const NAME: &'static str;
     const TOKEN: &'static str;
     const DESCRIPTION: &'static str;
+    /// Longest communication step the drive integrates [s] (a dynamic model substeps).
+    const MAX_STEP: f64 = f64::INFINITY;
     /// Reads the drive's own parameters.
     fn initialize(&mut self, io: &Store) -> Result<(), String>;
     /// Advances the wheels (`wheels`, updated in place) and the base over one step.
@@ -169,6 +171,9 @@ impl<D: Drive> Model for Chassis<D> {
     }
 
     fn do_step(&mut self, io: &mut Store, t: f64, h: f64, _log: &mut dyn Log) -> Result<(), String> {
+        if !(h > 0.0 && h <= D::MAX_STEP) {
+            return Err(format!("communication step {h} s outside (0, {}] s that {} integrates", D::MAX_STEP, D::NAME));
+        }
         self.commands.poll(io, t)?;
         let command = self.commands.active(t, io.f64(CMD_TIMEOUT));
         let l = self.limits.clone();

@@ -40,6 +40,9 @@ impl Drive for DynamicDrive {
     const TOKEN: &'static str = "{0b7d9e21-58c3-4f6a-8e14-agrisim-chassis-dynamic-1}";
     const DESCRIPTION: &'static str = "4-wheel-steering omnidirectional base, dynamic model: mass/inertia, torque-limited wheel motors, tyre slip and friction, load transfer; wheel odometry";
 
+    /// 10 s is 20,000 substeps: longer steps would stall the importer, so they are refused.
+    const MAX_STEP: f64 = 10.0;
+
     fn initialize(&mut self, io: &Store) -> Result<(), String> {
         *self = DynamicDrive {
             mass: finite_positive(io, MASS)?,

@@ -195,7 +195,6 @@ impl<M: Model> Instance<M> {
                 return Err("cannot set 'time' (vr 0): the independent variable advances only with DoStep".into());
             };
             let var = &M::VARIABLES[i];
-            settable(var, self.mode).map_err(|why| format!("cannot set variable {}: {why}", self.var_name(slot)))?;
             let current = self.store.value(i);
             if !T::accepts(current) {
                 return Err(format!(
@@ -204,6 +203,7 @@ impl<M: Model> Instance<M> {
                     self.type_name(current)
                 ));
             }
+            settable(var, self.mode).map_err(|why| format!("cannot set variable {}: {why}", self.var_name(slot)))?;
             let value = T::decode(x).map_err(|e| format!("bad value for variable {}: {e}", self.var_name(slot)))?;
             check_value(var, &value).map_err(|e| format!("bad value for variable {}: {e}", self.var_name(slot)))?;
             decoded.push((i, value));

@@ -1,0 +1,71 @@
+//! modelDescription.xml of the test model: structure, escaping, determinism, table checks.
+
+use agrisim_fmi::{xml, Model, Start, Var};
+use agrisim_fmu_testmodel::TestModel;
+
+#[test]
+fn fmi3_description_has_the_required_parts() {
+    let x = xml::fmi3::<TestModel>();
+    for needle in [
+        r#"fmiVersion="3.0""#,
+        r#"instantiationToken="{8c4e810f-3df3-4a00-8276-176fa3c9f001}""#,
+        r#"<CoSimulation modelIdentifier="TestModel""#,
+        r#"canHandleVariableCommunicationStepSize="true""#,
+        r#"canGetAndSetFMUState="true""#,
+        r#"canSerializeFMUState="false""#,
+        r#"<Float64 name="time" valueReference="0""#,
+        r#"causality="independent""#,
+        r#"<Unit name="1/s">"#,
+        r#"<BaseUnit s="-1"/>"#,
+        r#"<Binary name="msg_in" valueReference="5""#,
+        r#"mimeType="application/x-ros2-cdr; type=std_msgs/msg/String""#,
+        r#"<Start value="000100000100000000"/>"#,
+        r#"<Start value="agrisim &quot;test&quot; &lt;model&gt; &amp; more"/>"#,
+        r#"name="x" valueReference="8" description="State x(t)" causality="output" variability="continuous" initial="calculated" unit="m"/>"#,
+        r#"<Output valueReference="8"/>"#,
+        r#"<InitialUnknown valueReference="12"/>"#,
+        r#"<DefaultExperiment startTime="0.0" stepSize="0.02"/>"#,
+    ] {
+        assert!(x.contains(needle), "missing {needle} in\n{x}");
+    }
+    assert_eq!(x.matches("<Output ").count(), 5);
+    assert_eq!(x.matches("<InitialUnknown ").count(), 5);
+    assert_eq!(x, xml::fmi3::<TestModel>(), "deterministic");
+}
+
+#[test]
+fn fmi2_description_hides_fmi3_only_variables_and_indexes_by_position() {
+    let x = xml::fmi2::<TestModel>();
+    assert!(x.contains(r#"fmiVersion="2.0""#) && x.contains(r#"guid="{8c4e810f-3df3-4a00-8276-176fa3c9f001}""#));
+    assert!(!x.contains("msg_in") && !x.contains("msg_seq") && !x.contains("msg_out"));
+    // time, k, x0, u, hold, label, fault, x, steps, above_half -> x is position 8
+    assert!(x.contains(r#"<Unknown index="8"/>"#), "{x}");
+    assert_eq!(x.matches("<ScalarVariable").count(), 10);
+    assert!(x.contains(r#"<String start="agrisim &quot;test&quot; &lt;model&gt; &amp; more"/>"#));
+}
+
+#[test]
+fn the_table_is_valid_and_bad_tables_are_reported() {
+    assert!(xml::check_table(TestModel::VARIABLES).is_empty());
+    let bad = [
+        Var::input_discrete("time", Start::Int32(0)),
+        Var::param("p", Start::Boolean(true)).unit("m"),
+        Var::param("p", Start::Float64(f64::NAN)),
+        Var { variability: agrisim_fmi::Variability::Continuous, ..Var::input_discrete("i", Start::Int32(0)) },
+        Var::param("q", Start::Float64(5.0)).range(0.0, 1.0),
+    ];
+    let problems = xml::check_table(&bad);
+    for needle in ["reserved", "unit", "duplicate", "not finite", "continuous", "outside"] {
+        assert!(problems.iter().any(|p| p.contains(needle)), "{needle}: {problems:?}");
+    }
+}
+
+#[test]
+fn escaping_and_number_formatting() {
+    assert_eq!(xml::escape("a<b>&\"'\n"), "a&lt;b&gt;&amp;&quot;&apos;&#10;");
+    assert_eq!(xml::escape("\u{1}"), "\u{FFFD}");
+    assert_eq!(xml::fmt_f64(0.1), "0.1");
+    assert_eq!(xml::fmt_f64(1e-20), "1e-20");
+    assert_eq!(xml::fmt_f64(f64::INFINITY), "INF");
+    assert_eq!(xml::fmt_f64(2.0), "2.0");
+}
