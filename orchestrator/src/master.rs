@@ -198,10 +198,8 @@ impl Master {
             self.recorder.publish(SCALARS_TOPIC, t_ns, &msg)?;
         }
         for c in &mut self.system.components {
-            let mut values = Vec::with_capacity(c.signals.len());
-            for v in &c.signals {
-                values.push(value::get(&mut c.instance, v)?.as_f64().expect("signals are numeric"));
-            }
+            let mut values = Vec::new();
+            c.read_signals(&mut values)?;
             let msg = Signals { header: Header { stamp: Time::from_nanos(t_ns), frame_id: String::new() }, names: c.signals.iter().map(|v| v.name.clone()).collect(), values };
             self.recorder.publish(&format!("/fmu/{}/signals", c.name), t_ns, &msg)?;
         }

@@ -37,6 +37,45 @@ pub struct Component {
     pub signals: Vec<ModelVariable>,
 }
 
+impl Component {
+    /// Current values of all [`Component::signals`], in their order, read with one call per
+    /// type (the recorder does this every step, so FFI round trips matter).
+    pub fn read_signals(&mut self, out: &mut Vec<f64>) -> Result<()> {
+        out.clear();
+        out.resize(self.signals.len(), 0.0);
+        for ty in [VarType::Float64, VarType::Int32, VarType::Int64, VarType::Boolean] {
+            let idx: Vec<usize> = (0..self.signals.len()).filter(|&i| self.signals[i].ty == ty).collect();
+            if idx.is_empty() {
+                continue;
+            }
+            let vrs: Vec<u32> = idx.iter().map(|&i| self.signals[i].value_reference).collect();
+            match ty {
+                VarType::Float64 => {
+                    let mut v = vec![0.0; vrs.len()];
+                    self.instance.get_f64(&vrs, &mut v)?;
+                    idx.iter().zip(v).for_each(|(&i, x)| out[i] = x);
+                }
+                VarType::Int32 => {
+                    let mut v = vec![0; vrs.len()];
+                    self.instance.get_i32(&vrs, &mut v)?;
+                    idx.iter().zip(v).for_each(|(&i, x)| out[i] = x as f64);
+                }
+                VarType::Int64 => {
+                    let mut v = vec![0; vrs.len()];
+                    self.instance.get_i64(&vrs, &mut v)?;
+                    idx.iter().zip(v).for_each(|(&i, x)| out[i] = x as f64);
+                }
+                _ => {
+                    let mut v = vec![false; vrs.len()];
+                    self.instance.get_bool(&vrs, &mut v)?;
+                    idx.iter().zip(v).for_each(|(&i, x)| out[i] = x as u8 as f64);
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
 /// One end of a route.
 #[derive(Clone, Debug)]
 pub enum Port {
