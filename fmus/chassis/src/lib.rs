@@ -8,12 +8,12 @@ pub mod chassis;
 pub mod command;
 pub mod dynamic;
 pub mod kinematic;
-pub mod noise;
 pub mod odometry;
 pub mod ports;
-pub mod schedule;
 pub mod se2;
 pub mod wheels;
+
+pub use agrisim_fmu_util::{noise, schedule};
 
 pub use dynamic::ChassisDynamic;
 pub use kinematic::ChassisKinematic;

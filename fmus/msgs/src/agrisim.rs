@@ -29,3 +29,39 @@ ros_message! {
         pub message: String,
     }
 }
+
+ros_message! {
+    /// `agrisim_msgs/msg/Contact`: one robot-scene contact, in the map frame.
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct Contact = "agrisim_msgs/msg/Contact" {
+        pub object_id: u32,
+        pub object_name: String,
+        pub object_kind: String,
+        pub robot_link: String,
+        pub position: crate::geometry_msgs::Point,
+        pub normal: crate::geometry_msgs::Vector3,
+        pub depth: f64,
+    }
+}
+
+ros_message! {
+    /// `agrisim_msgs/msg/CollisionState`: all robot-scene contacts at one instant.
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct CollisionState = "agrisim_msgs/msg/CollisionState" {
+        pub header: Header,
+        pub in_collision: bool,
+        pub count: u32,
+        pub contacts: Vec<Contact>,
+    }
+}
+
+ros_message! {
+    /// `agrisim_msgs/msg/NavigationStatus`: what the navigation executor is doing.
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct NavigationStatus = "agrisim_msgs/msg/NavigationStatus" {
+        pub header: Header,
+        pub state: String,
+        pub detail: String,
+        pub goal: crate::geometry_msgs::PoseStamped,
+    }
+}

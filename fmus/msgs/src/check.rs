@@ -32,6 +32,15 @@ pub fn check_cdr(type_name: &str, bytes: &[u8]) -> Option<Result<(), CdrError>> 
         "sensor_msgs/msg/JointState" => ok::<sensor_msgs::JointState>(bytes),
         "std_msgs/msg/Header" => ok::<std_msgs::Header>(bytes),
         "tf2_msgs/msg/TFMessage" => ok::<tf2_msgs::TFMessage>(bytes),
+        "sensor_msgs/msg/PointField" => ok::<sensor_msgs::PointField>(bytes),
+        "sensor_msgs/msg/PointCloud2" => ok::<sensor_msgs::PointCloud2>(bytes),
+        "sensor_msgs/msg/Imu" => ok::<sensor_msgs::Imu>(bytes),
+        "geometry_msgs/msg/PoseArray" => ok::<geometry_msgs::PoseArray>(bytes),
+        "nav_msgs/msg/MapMetaData" => ok::<nav_msgs::MapMetaData>(bytes),
+        "nav_msgs/msg/OccupancyGrid" => ok::<nav_msgs::OccupancyGrid>(bytes),
+        "agrisim_msgs/msg/Contact" => ok::<agrisim::Contact>(bytes),
+        "agrisim_msgs/msg/CollisionState" => ok::<agrisim::CollisionState>(bytes),
+        "agrisim_msgs/msg/NavigationStatus" => ok::<agrisim::NavigationStatus>(bytes),
         _ => None,
     }
 }

@@ -152,3 +152,12 @@ ros_message! {
         pub transform: Transform,
     }
 }
+
+ros_message! {
+    /// `geometry_msgs/msg/PoseArray`: poses in one frame (e.g. ground-truth fruit poses).
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct PoseArray = "geometry_msgs/msg/PoseArray" {
+        pub header: Header,
+        pub poses: Vec<Pose>,
+    }
+}

@@ -23,3 +23,25 @@ ros_message! {
         pub poses: Vec<PoseStamped>,
     }
 }
+
+ros_message! {
+    /// `nav_msgs/msg/MapMetaData`: resolution, size and origin (pose of cell (0,0)'s corner).
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct MapMetaData = "nav_msgs/msg/MapMetaData" {
+        pub map_load_time: crate::builtin_interfaces::Time,
+        pub resolution: f32,
+        pub width: u32,
+        pub height: u32,
+        pub origin: crate::geometry_msgs::Pose,
+    }
+}
+
+ros_message! {
+    /// `nav_msgs/msg/OccupancyGrid`: row-major cells, 0 free .. 100 occupied, -1 unknown.
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct OccupancyGrid = "nav_msgs/msg/OccupancyGrid" {
+        pub header: Header,
+        pub info: MapMetaData,
+        pub data: Vec<i8>,
+    }
+}

@@ -1,0 +1,2 @@
+//! Greenhouse scene.
+pub mod scene;
