@@ -26,8 +26,8 @@ from mcap_ros2.decoder import DecoderFactory
 REPO = Path(__file__).resolve().parents[1]
 FMU_DIR = REPO / "target" / "fmu"
 FMU2_DIR = FMU_DIR / "fmi2"
-DEFAULT_SCENARIO = REPO / "models" / "scenarios" / "default.toml"
-DEFAULT_SSD = REPO / "models" / "systems" / "default.ssd"
+DEFAULT_SCENARIO = REPO / "models" / "scenarios" / "base.toml"
+DEFAULT_SSD = REPO / "models" / "systems" / "base.ssd"
 EXPECTED_MODELS = ("ChassisKinematic", "ChassisDynamic", "Lift")
 
 NS = {
@@ -342,6 +342,13 @@ class MasterReplay:
     def initialize(self) -> None:
         for s in self.slaves:
             s.slave.enterInitializationMode(startTime=0.0)
+        # As master.rs: scalar FMU-to-FMU connections propagate in initialization mode, one
+        # pass per component so chains settle.
+        for _ in self.slaves:
+            for r in self.routes:
+                if r.src.comp is None or r.dst.comp is None or r.is_message:
+                    continue
+                self.slaves[r.dst.comp].set(r.dst.name, self.slaves[r.src.comp].get(r.src.name))
         for s in self.slaves:
             s.slave.exitInitializationMode()
 

@@ -13,12 +13,12 @@ from mcap_ros2.decoder import DecoderFactory
 
 from conftest import FMU_DIR, REPO, run_agrisim
 
-SSD = REPO / "models" / "systems" / "default.ssd"
-SCENARIO = REPO / "models" / "scenarios" / "default.toml"
+SSD = REPO / "models" / "systems" / "base.ssd"
+SCENARIO = REPO / "models" / "scenarios" / "base.toml"
 
 
 def scenario_with(tmp: Path, ssd: Path = SSD, extra: str = "") -> Path:
-    text = SCENARIO.read_text().replace('file = "../systems/default.ssd"', f'file = "{ssd}"')
+    text = SCENARIO.read_text().replace('file = "../systems/base.ssd"', f'file = "{ssd}"')
     p = tmp / "scenario.toml"
     p.write_text(text + extra)
     return p
@@ -64,7 +64,7 @@ def test_type_mismatched_connection(tmp_path, fmu_dir):
 
 def test_unknown_scenario_parameter(tmp_path, fmu_dir):
     sc = tmp_path / "s.toml"
-    sc.write_text(SCENARIO.read_text().replace('file = "../systems/default.ssd"', f'file = "{SSD}"').replace("enc_noise = 0.05", "enc_noize = 0.05"))
+    sc.write_text(SCENARIO.read_text().replace('file = "../systems/base.ssd"', f'file = "{SSD}"').replace("enc_noise = 0.05", "enc_noize = 0.05"))
     err = failing_run("--scenario", str(sc), "--out", str(tmp_path / "out"))
     assert "enc_noize" in err and "chassis" in err, err
 
@@ -111,6 +111,6 @@ def test_non_finite_command_is_refused(tmp_path, fmu_dir):
 
 def test_invalid_parameter_value_fails_at_initialization(tmp_path, fmu_dir):
     sc = tmp_path / "s.toml"
-    sc.write_text(SCENARIO.read_text().replace('file = "../systems/default.ssd"', f'file = "{SSD}"').replace("slip_std = 0.02", "slip_std = 0.02\nwheel_radius = -0.1"))
+    sc.write_text(SCENARIO.read_text().replace('file = "../systems/base.ssd"', f'file = "{SSD}"').replace("slip_std = 0.02", "slip_std = 0.02\nwheel_radius = -0.1"))
     err = failing_run("--scenario", str(sc), "--out", str(tmp_path / "out"))
     assert "wheel_radius" in err and "chassis" in err, err

@@ -24,6 +24,7 @@ import io
 import math
 import os
 import shutil
+import struct
 import subprocess
 from pathlib import Path
 
@@ -77,6 +78,31 @@ def tf(sec, parent, child, x):
         "header": hdr(sec, 2, parent),
         "child_frame_id": child,
         "transform": {"translation": v3(x, 0.0, 0.45), "rotation": IDENT},
+    }
+
+
+def field(name, offset, datatype=7):  # 7 = PointField.FLOAT32
+    return {"name": name, "offset": offset, "datatype": datatype, "count": 1}
+
+
+MAP_META = {
+    "map_load_time": {"sec": 0, "nanosec": 5},
+    "resolution": 0.25,
+    "width": 3,
+    "height": 2,
+    "origin": pose(-1.5, -0.5, 0.0, IDENT),
+}
+
+
+def contact(oid, name, link):
+    return {
+        "object_id": oid,
+        "object_name": name,
+        "object_kind": "post",
+        "robot_link": link,
+        "position": v3(2.5, -1.0, 0.25),
+        "normal": v3(-1.0, 0.0, 0.0),
+        "depth": 0.125,
     }
 
 
@@ -137,6 +163,67 @@ EXPECTED = {
         "status": "Error",
         "message": "fmi3DoStep returned fmi3Error at t=1.24 s: wheel slip > 1",
     },
+    "point_field": field("intensity", 12),
+    "point_cloud2": {
+        "header": hdr(4, 100_000_000, "lidar_link"),
+        "height": 1,
+        "width": 2,
+        "fields": [field("x", 0), field("y", 4), field("z", 8), field("intensity", 12)],
+        "is_bigendian": False,
+        "point_step": 16,
+        "row_step": 32,
+        "data": list(struct.pack("<8f", 1.0, 2.0, 3.0, 0.5, -1.0, 0.25, 0.0, 100.0)),
+        "is_dense": True,
+    },
+    "point_cloud2_empty": {
+        "header": hdr(0, 0, "l"),
+        "height": 0,
+        "width": 0,
+        "fields": [],
+        "is_bigendian": False,
+        "point_step": 0,
+        "row_step": 0,
+        "data": [],
+        "is_dense": False,
+    },
+    "imu": {
+        "header": hdr(9, 5_000_000, "imu_link"),
+        "orientation": q(0.0, 0.0, H, H),
+        "orientation_covariance": [-1.0] + [0.0] * 8,
+        "angular_velocity": v3(0.001, -0.002, 0.5),
+        "angular_velocity_covariance": [1e-6, 0.0, 0.0, 0.0, 1e-6, 0.0, 0.0, 0.0, 1e-6],
+        "linear_acceleration": v3(0.125, 0.0, 9.80665),
+        "linear_acceleration_covariance": [4e-4, 0.0, 0.0, 0.0, 4e-4, 0.0, 0.0, 0.0, 4e-4],
+    },
+    "pose_array": {
+        "header": hdr(8, 0, "map"),
+        "poses": [pose(1.0, 2.0, 0.75, IDENT), pose(-0.5, 0.0, 1.25, q(0.0, 0.0, H, H))],
+    },
+    "map_meta_data": MAP_META,
+    "occupancy_grid": {
+        "header": hdr(0, 0, "map"),
+        "info": MAP_META,
+        "data": [0, 100, -1, 0, 50, 100],
+    },
+    "contact": contact(7, "row3/post2", "base_link"),
+    "collision_state": {
+        "header": hdr(11, 20_000_000, "map"),
+        "in_collision": True,
+        "count": 2,
+        "contacts": [contact(7, "row3/post2", "base_link"), contact(42, "", "arm_l_link4")],
+    },
+    "collision_state_empty": {
+        "header": hdr(0, 0, "map"),
+        "in_collision": False,
+        "count": 0,
+        "contacts": [],
+    },
+    "navigation_status": {
+        "header": hdr(13, 0, "map"),
+        "state": "failed",
+        "detail": "no_path",
+        "goal": {"header": hdr(12, 900_000_000, "map"), "pose": pose(4.0, 2.0, 0.0, q(0.0, 0.0, 1.0, 0.0))},
+    },
 }
 
 # ----------------------------------------------------------------------------- helpers
@@ -152,8 +239,13 @@ def _samples_cmd(*args: str) -> list[str]:
 
 
 def plain(obj):
-    """Decoded message (mcap_ros2 slots class or rosbags dataclass) -> dicts and lists."""
-    if isinstance(obj, (str, bytes, int, float, bool)) or obj is None:
+    """Decoded message (mcap_ros2 slots class or rosbags dataclass) -> dicts and lists.
+
+    Byte arrays become lists of ints: mcap-ros2-support decodes uint8[] as bytes, rosbags as
+    a numpy array."""
+    if isinstance(obj, (bytes, bytearray, memoryview)):
+        return list(bytes(obj))
+    if isinstance(obj, (str, int, float, bool)) or obj is None:
         return obj
     if isinstance(obj, np.ndarray):
         return obj.tolist()
@@ -163,6 +255,9 @@ def plain(obj):
         return {k: plain(v) for k, v in obj.items()}
     fields = getattr(obj, "__dataclass_fields__", None)
     names = list(fields) if fields is not None else list(getattr(obj, "__slots__", ()))
+    # rosbags lists .msg constants (PointField.FLOAT32) as fields; ROS 2 field names are
+    # lower case and constant names upper case, so drop the latter.
+    names = [n for n in names if not n.isupper()]
     if not names:
         raise TypeError(f"cannot convert {type(obj)!r}")
     return {n: plain(getattr(obj, n)) for n in names if n != "__msgtype__"}
@@ -209,7 +304,7 @@ SAMPLE_NAMES = sorted(EXPECTED)
 def test_samples_cover_every_msg_file(samples):
     assert set(samples) == set(EXPECTED)
     assert {t for t, _, _ in samples.values()} == set(msg_files())
-    assert len(msg_files()) == 20
+    assert len(msg_files()) == 29
 
 
 @pytest.mark.parametrize("name", SAMPLE_NAMES)
@@ -302,4 +397,4 @@ def test_msg_texts_match_ros2_distro(rosbags_store, store_name):
             continue
         assert rosbags_store.fielddefs[name] == ref.fielddefs[name], name
         checked += 1
-    assert checked == 18
+    assert checked == 24

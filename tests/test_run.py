@@ -12,7 +12,7 @@ from mcap_ros2.decoder import DecoderFactory
 
 from conftest import REPO, run_agrisim
 
-SCENARIO = REPO / "models" / "scenarios" / "default.toml"
+SCENARIO = REPO / "models" / "scenarios" / "base.toml"
 
 
 def run(out: Path, *extra: str) -> Path:

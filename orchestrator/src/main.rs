@@ -43,6 +43,11 @@ enum Command {
         #[command(subcommand)]
         command: BenchCommand,
     },
+    /// The greenhouse scene.
+    Scene {
+        #[command(subcommand)]
+        command: SceneCommand,
+    },
     /// FMU packaging.
     Fmu {
         #[command(subcommand)]
@@ -73,6 +78,17 @@ enum BenchCommand {
         steps: u64,
         #[command(flatten)]
         dirs: Dirs,
+        #[arg(long)]
+        out: PathBuf,
+    },
+}
+
+#[derive(Subcommand)]
+enum SceneCommand {
+    /// Write the scenario's greenhouse as binary glTF (.glb) for any 3D viewer.
+    Export {
+        #[arg(long, default_value = "models/scenarios/default.toml")]
+        scenario: PathBuf,
         #[arg(long)]
         out: PathBuf,
     },
@@ -153,6 +169,12 @@ fn real_main() -> Result<()> {
             let opts = run_options(dirs, &target, None, None, BTreeMap::new());
             let report = agrisim::bench::overhead(&s, &opts, steps, &out)?;
             println!("{}", serde_json::to_string_pretty(&report).expect("plain struct serializes"));
+        }
+        Command::Scene { command: SceneCommand::Export { scenario, out } } => {
+            let s = Scenario::load(&scenario)?;
+            let g = agrisim::scene::generate_scene(&s)?;
+            agrisim_greenhouse::gltf::write_glb(&g.objects, &out).map_err(|e| agrisim::err!("cannot write {}: {e}", out.display()))?;
+            println!("{} objects -> {}", g.objects.len(), out.display());
         }
         Command::Fmu { command: FmuCommand::Pack { lib_dir, out } } => {
             let lib_dir = lib_dir.unwrap_or(exe_dir);

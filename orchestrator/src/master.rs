@@ -54,10 +54,22 @@ impl Master {
         time_of(self.tick, self.step_ns)
     }
 
-    /// Enters and leaves initialization mode for every FMU at t = 0.
+    /// Initializes every FMU at t = 0.
     pub fn initialize(&mut self) -> Result<()> {
         for c in &mut self.system.components {
             c.instance.enter_initialization_mode(0.0, None)?;
+        }
+        // Consistent start: scalar FMU-to-FMU connections are propagated in initialization
+        // mode, once per component so chains (lift -> chassis -> world) settle, so that no
+        // FMU starts from its default inputs (e.g. the world from a base at the origin).
+        for _ in 0..self.system.components.len() {
+            for r in 0..self.system.routes.len() {
+                let route = &self.system.routes[r];
+                let (Port::Fmu { comp: src, var: sv, seq: None }, Port::Fmu { comp: dst, var: dv, seq: None }) = (&route.from, &route.to) else { continue };
+                let (src, dst, sv, dv) = (*src, *dst, sv.clone(), dv.clone());
+                let v = value::get(&mut self.system.components[src].instance, &sv)?;
+                value::set(&mut self.system.components[dst].instance, &dv, &v)?;
+            }
         }
         for c in &mut self.system.components {
             c.instance.exit_initialization_mode()?;
@@ -70,18 +82,34 @@ impl Master {
     pub fn run(&mut self, ticks: u64, mut progress: impl FnMut(u64)) -> Result<()> {
         let result = (|| {
             for _ in 0..ticks {
-                self.communicate()?;
-                self.step_all()?;
+                self.advance()?;
                 progress(self.tick);
             }
-            // Final point: outputs of the last step reach the bus and the log.
-            self.collect_outputs(self.tick)?;
-            self.record_point()
+            self.finish_point()
         })();
         if let Err(e) = &result {
             self.record_failure(e);
         }
         result
+    }
+
+    /// One communication point and one step of every FMU. Callers that drive the master
+    /// step by step (benchmarks deciding when a trial ends) call [`Master::finish_point`]
+    /// at the end, and [`Master::record_failure`] on an error.
+    pub fn advance(&mut self) -> Result<()> {
+        self.communicate()?;
+        self.step_all()
+    }
+
+    /// True when the next communication point is a message instant (nodes run there).
+    pub fn at_message_instant(&self) -> bool {
+        self.tick % self.message_ticks == 0
+    }
+
+    /// Final point: outputs of the last step reach the bus and the log.
+    pub fn finish_point(&mut self) -> Result<()> {
+        self.collect_outputs(self.tick)?;
+        self.record_point()
     }
 
     fn communicate(&mut self) -> Result<()> {
@@ -223,7 +251,8 @@ impl Master {
         self.recorder.finish_in_place()
     }
 
-    fn record_failure(&mut self, e: &Error) {
+    /// Records an error on /agrisim/status (the MCAP stays complete and readable).
+    pub fn record_failure(&mut self, e: &Error) {
         let t_ns = self.tick as i64 * self.step_ns;
         let msg = FmuStatus { header: Header { stamp: Time::from_nanos(t_ns), frame_id: String::new() }, instance: String::new(), status: "error".into(), message: e.to_string() };
         let _ = self.recorder.publish(STATUS_TOPIC, t_ns, &msg);

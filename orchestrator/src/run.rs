@@ -37,10 +37,25 @@ fn load_options(s: &Scenario, o: &RunOptions) -> LoadOptions {
 /// Builds the master for a scenario, recording to `mcap`. Setup errors come back before any
 /// file is written; from here on the MCAP exists and is finished whatever happens.
 pub fn prepare(s: &Scenario, o: &RunOptions, mcap: &Path) -> Result<Master> {
+    let nodes: Vec<Box<dyn Node>> = vec![Box::new(CommandScript::new(s.base_commands.clone(), s.lift_commands.clone())), Box::new(OdomTf::default()), Box::new(FaultInjector::new(&s.inject))];
+    prepare_with(s, o, mcap, nodes)
+}
+
+/// [`prepare`] with the algorithm layer's nodes chosen by the caller.
+pub fn prepare_with(s: &Scenario, o: &RunOptions, mcap: &Path, nodes: Vec<Box<dyn Node>>) -> Result<Master> {
     let seed = o.seed.unwrap_or(s.seed);
     let lo = load_options(s, o);
     let mut system = System::load(&s.system_path(), &lo)?;
-    let applied = system.apply_parameters(&s.parameters, seed)?;
+    // The base starts at the greenhouse's predefined initial pose unless the scenario says otherwise.
+    let mut params = s.parameters.clone();
+    if system.structure.components.iter().any(|c| c.name == "world") {
+        let g = crate::scene::generate_scene(s)?;
+        let start = params.entry("chassis".to_string()).or_default();
+        for (name, v) in ["x0", "y0", "yaw0"].iter().zip(g.layout.start_pose) {
+            start.entry(name.to_string()).or_insert(toml::Value::Float(v));
+        }
+    }
+    let applied = system.apply_parameters(&params, seed, &s.scene_toml())?;
     let mut recorder = Recorder::create(mcap)?;
     let mut run_info = BTreeMap::from([
         ("scenario".to_string(), s.name.clone()),
@@ -57,7 +72,6 @@ pub fn prepare(s: &Scenario, o: &RunOptions, mcap: &Path) -> Result<Master> {
     for (comp, params) in applied {
         recorder.metadata(&format!("agrisim.parameters.{comp}"), params)?;
     }
-    let nodes: Vec<Box<dyn Node>> = vec![Box::new(CommandScript::new(s.base_commands.clone(), s.lift_commands.clone())), Box::new(OdomTf::default()), Box::new(FaultInjector::new(&s.inject))];
     let mut master = Master::new(system, nodes, recorder, s.timing.step, lo.message_period)?;
     master.initialize()?;
     Ok(master)

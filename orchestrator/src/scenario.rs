@@ -24,6 +24,14 @@ pub struct Scenario {
     #[serde(default)]
     pub timing: Timing,
     pub system: SystemRef,
+    /// The greenhouse (agrisim_greenhouse::GreenhouseConfig keys). Passed verbatim, as TOML
+    /// text, to every component with a String parameter `scene`, so all of them build the
+    /// same scene. Its `seed` (the scene's layout seed) defaults to the scenario's seed.
+    #[serde(default)]
+    pub greenhouse: toml::Table,
+    /// Navigation benchmark settings.
+    #[serde(default)]
+    pub nav: NavSettings,
     /// Parameter overrides: component name -> parameter name -> value.
     #[serde(default)]
     pub parameters: BTreeMap<String, BTreeMap<String, toml::Value>>,
@@ -55,6 +63,26 @@ pub struct Timing {
 impl Default for Timing {
     fn default() -> Self {
         Timing { step: default_step(), message_rate: default_message_rate() }
+    }
+}
+
+/// `[nav]`: how navigation trials are set up and judged.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct NavSettings {
+    /// Simulated time limit of a trial [s].
+    pub trial_timeout: f64,
+    /// Success radius around the target for the ground-truth base centre [m] (Nav2's default).
+    pub goal_tolerance: f64,
+    /// Where targets are drawn: aisles and the headland.
+    pub targets_in_headland: bool,
+    /// Keep targets at least this far from the aisle ends [m].
+    pub aisle_margin: f64,
+}
+
+impl Default for NavSettings {
+    fn default() -> Self {
+        NavSettings { trial_timeout: 120.0, goal_tolerance: 0.25, targets_in_headland: true, aisle_margin: 1.0 }
     }
 }
 
@@ -169,6 +197,13 @@ impl Scenario {
             inj.bytes().map_err(|e| crate::err!("scenario {file}: {e}"))?;
         }
         Ok(())
+    }
+
+    /// The `[greenhouse]` section as TOML text, with its layout `seed` filled in.
+    pub fn scene_toml(&self) -> String {
+        let mut t = self.greenhouse.clone();
+        t.entry("seed").or_insert(toml::Value::Integer(self.seed as i64));
+        toml::to_string(&t).expect("a TOML table serializes")
     }
 
     /// The system file, resolved against the scenario's directory.

@@ -53,9 +53,90 @@ impl Placement {
 pub struct Object {
     /// Unique within the scene, dense from 0 (usable as an index and as a label value).
     pub id: u32,
-    /// Stable human-readable name, e.g. `row3/plant12/truss2/fruit4`.
+    /// Stable human-readable name, e.g. `row3/plant12/fruit2_4` (fruit 4 of truss 2);
+    /// see [`crate::generate`] for the full scheme.
     pub name: String,
     pub kind: Kind,
     pub shape: Shape,
     pub placement: Placement,
+}
+
+impl Placement {
+    /// A rotation of `angle` radians about the unit `axis`.
+    pub fn axis_angle(translation: [f64; 3], axis: [f64; 3], angle: f64) -> Placement {
+        let (s, c) = (0.5 * angle).sin_cos();
+        Placement { translation, rotation: [axis[0] * s, axis[1] * s, axis[2] * s, c] }
+    }
+
+    /// Yaw (about +z) then translation.
+    pub fn yawed(translation: [f64; 3], yaw: f64) -> Placement {
+        Placement::axis_angle(translation, [0.0, 0.0, 1.0], yaw)
+    }
+
+    /// The rotation as a row-major 3x3 matrix (local -> map).
+    pub fn matrix(&self) -> [[f64; 3]; 3] {
+        let [x, y, z, w] = self.rotation;
+        [
+            [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w)],
+            [2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w)],
+            [2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)],
+        ]
+    }
+
+    /// Local point -> map frame.
+    pub fn transform_point(&self, p: [f64; 3]) -> [f64; 3] {
+        let m = self.matrix();
+        let t = self.translation;
+        [
+            m[0][0] * p[0] + m[0][1] * p[1] + m[0][2] * p[2] + t[0],
+            m[1][0] * p[0] + m[1][1] * p[1] + m[1][2] * p[2] + t[1],
+            m[2][0] * p[0] + m[2][1] * p[1] + m[2][2] * p[2] + t[2],
+        ]
+    }
+}
+
+impl Object {
+    /// Tight axis-aligned bounds in the map frame: (min, max).
+    pub fn aabb(&self) -> ([f64; 3], [f64; 3]) {
+        let m = self.placement.matrix();
+        let t = self.placement.translation;
+        let ext: [f64; 3] = match self.shape {
+            Shape::Sphere { radius } => [radius; 3],
+            // Oriented box: |R| * half.
+            Shape::Box { half } => {
+                let mut e = [0.0; 3];
+                for (i, ei) in e.iter_mut().enumerate() {
+                    *ei = m[i][0].abs() * half[0] + m[i][1].abs() * half[1] + m[i][2].abs() * half[2];
+                }
+                e
+            }
+            // Cylinder: axis a = R e_z; extent = |a_i| h + r sqrt(1 - a_i^2) (exact for a disc cap).
+            Shape::Cylinder { radius, half_height } => {
+                let mut e = [0.0; 3];
+                for (i, ei) in e.iter_mut().enumerate() {
+                    let a = m[i][2];
+                    *ei = a.abs() * half_height + radius * (1.0 - a * a).max(0.0).sqrt();
+                }
+                e
+            }
+        };
+        ([t[0] - ext[0], t[1] - ext[1], t[2] - ext[2]], [t[0] + ext[0], t[1] + ext[1], t[2] + ext[2]])
+    }
+}
+
+/// Hamilton product a * b of unit quaternions (x, y, z, w): rotate by b, then by a.
+pub fn quat_mul(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+    let [ax, ay, az, aw] = a;
+    let [bx, by, bz, bw] = b;
+    [
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+        aw * bw - ax * bx - ay * by - az * bz,
+    ]
+}
+
+/// Quaternion of a rotation of `angle` about the unit `axis`.
+pub fn quat_axis_angle(axis: [f64; 3], angle: f64) -> [f64; 4] {
+    Placement::axis_angle([0.0; 3], axis, angle).rotation
 }

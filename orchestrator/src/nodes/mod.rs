@@ -3,10 +3,14 @@
 
 mod command_script;
 mod fault_injector;
+mod goal_publisher;
+mod map_server;
 mod odom_tf;
 
 pub use command_script::CommandScript;
 pub use fault_injector::FaultInjector;
+pub use goal_publisher::GoalPublisher;
+pub use map_server::{grid_message, MapServer};
 pub use odom_tf::OdomTf;
 
 use crate::bus::Bus;

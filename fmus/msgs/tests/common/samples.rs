@@ -4,12 +4,12 @@
 //! single IEEE operation on both sides) and to exercise alignment after strings.
 #![allow(dead_code)]
 
-use agrisim_msgs::agrisim::{FmuStatus, Signals};
+use agrisim_msgs::agrisim::{CollisionState, Contact, FmuStatus, NavigationStatus, Signals};
 use agrisim_msgs::builtin_interfaces::Time;
 use agrisim_msgs::geometry_msgs::*;
-use agrisim_msgs::nav_msgs::{Odometry, Path};
+use agrisim_msgs::nav_msgs::{MapMetaData, OccupancyGrid, Odometry, Path};
 use agrisim_msgs::rosgraph_msgs::Clock;
-use agrisim_msgs::sensor_msgs::JointState;
+use agrisim_msgs::sensor_msgs::{Imu, JointState, PointCloud2, PointField};
 use agrisim_msgs::std_msgs::Header;
 use agrisim_msgs::tf2_msgs::TFMessage;
 use agrisim_msgs::{CdrError, Message};
@@ -109,6 +109,62 @@ fn tf(sec: i32, parent: &str, child: &str, x: f64) -> TransformStamped {
             translation: v3(x, 0.0, 0.45),
             rotation: Quaternion::IDENTITY,
         },
+    }
+}
+
+fn field(name: &str, offset: u32, datatype: u8) -> PointField {
+    PointField {
+        name: name.into(),
+        offset,
+        datatype,
+        count: 1,
+    }
+}
+
+/// Two points of (x, y, z, intensity) float32, little-endian: 32 bytes.
+fn cloud() -> PointCloud2 {
+    let values: [f32; 8] = [1.0, 2.0, 3.0, 0.5, -1.0, 0.25, 0.0, 100.0];
+    PointCloud2 {
+        header: hdr(4, 100_000_000, "lidar_link"),
+        height: 1,
+        width: 2,
+        fields: vec![
+            field("x", 0, PointField::FLOAT32),
+            field("y", 4, PointField::FLOAT32),
+            field("z", 8, PointField::FLOAT32),
+            field("intensity", 12, PointField::FLOAT32),
+        ],
+        is_bigendian: false,
+        point_step: 16,
+        row_step: 32,
+        data: values.iter().flat_map(|v| v.to_le_bytes()).collect(),
+        is_dense: true,
+    }
+}
+
+fn map_meta() -> MapMetaData {
+    MapMetaData {
+        map_load_time: Time::new(0, 5),
+        resolution: 0.25,
+        width: 3,
+        height: 2,
+        origin: pose(-1.5, -0.5, 0.0, Quaternion::IDENTITY),
+    }
+}
+
+fn contact(id: u32, name: &str, link: &str) -> Contact {
+    Contact {
+        object_id: id,
+        object_name: name.into(),
+        object_kind: "post".into(),
+        robot_link: link.into(),
+        position: Point {
+            x: 2.5,
+            y: -1.0,
+            z: 0.25,
+        },
+        normal: v3(-1.0, 0.0, 0.0),
+        depth: 0.125,
     }
 }
 
@@ -235,6 +291,77 @@ pub fn all_samples() -> Vec<Sample> {
                 instance: "lift".into(),
                 status: "Error".into(),
                 message: "fmi3DoStep returned fmi3Error at t=1.24 s: wheel slip > 1".into(),
+            },
+        ),
+        sample("point_field", field("intensity", 12, PointField::FLOAT32)),
+        sample("point_cloud2", cloud()),
+        sample(
+            "point_cloud2_empty",
+            PointCloud2 {
+                header: hdr(0, 0, "l"),
+                ..Default::default()
+            },
+        ),
+        sample(
+            "imu",
+            Imu {
+                header: hdr(9, 5_000_000, "imu_link"),
+                orientation: q(0.0, 0.0, h, h),
+                orientation_covariance: [-1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+                angular_velocity: v3(0.001, -0.002, 0.5),
+                angular_velocity_covariance: [1e-6, 0.0, 0.0, 0.0, 1e-6, 0.0, 0.0, 0.0, 1e-6],
+                linear_acceleration: v3(0.125, 0.0, 9.80665),
+                linear_acceleration_covariance: [4e-4, 0.0, 0.0, 0.0, 4e-4, 0.0, 0.0, 0.0, 4e-4],
+            },
+        ),
+        sample(
+            "pose_array",
+            PoseArray {
+                header: hdr(8, 0, "map"),
+                poses: vec![
+                    pose(1.0, 2.0, 0.75, Quaternion::IDENTITY),
+                    pose(-0.5, 0.0, 1.25, q(0.0, 0.0, h, h)),
+                ],
+            },
+        ),
+        sample("map_meta_data", map_meta()),
+        sample(
+            "occupancy_grid",
+            OccupancyGrid {
+                header: hdr(0, 0, "map"),
+                info: map_meta(),
+                data: vec![0, 100, -1, 0, 50, 100],
+            },
+        ),
+        sample("contact", contact(7, "row3/post2", "base_link")),
+        sample(
+            "collision_state",
+            CollisionState {
+                header: hdr(11, 20_000_000, "map"),
+                in_collision: true,
+                count: 2,
+                contacts: vec![contact(7, "row3/post2", "base_link"), contact(42, "", "arm_l_link4")],
+            },
+        ),
+        sample(
+            "collision_state_empty",
+            CollisionState {
+                header: hdr(0, 0, "map"),
+                in_collision: false,
+                count: 0,
+                contacts: vec![],
+            },
+        ),
+        sample(
+            "navigation_status",
+            NavigationStatus {
+                header: hdr(13, 0, "map"),
+                state: "failed".into(),
+                detail: "no_path".into(),
+                goal: PoseStamped {
+                    header: hdr(12, 900_000_000, "map"),
+                    pose: pose(4.0, 2.0, 0.0, q(0.0, 0.0, 1.0, 0.0)),
+                },
             },
         ),
     ]

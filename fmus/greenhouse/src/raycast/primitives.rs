@@ -1,0 +1,225 @@
+//! Exact ray intersection with the analytic primitives (oriented box, finite capped cylinder,
+//! sphere), precomputed per object in the form the inner loop wants.
+//!
+//! Semantics, for every shape: the hit is the first crossing of the shape's *surface* with
+//! `t` in `[tmin, tmax]` — so a ray starting inside a solid reports where it leaves it — and
+//! the normal is the outward surface normal there (not flipped toward the ray).
+
+use crate::scene::{Object, Shape};
+
+/// An object ready for intersection: centre, map->local rotation (rows of R^T), sizes.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Prim {
+    Sphere { c: [f64; 3], r: f64 },
+    /// Box with identity rotation (floor, walls, gutters, most obstacles): no transform.
+    AaBox { c: [f64; 3], half: [f64; 3] },
+    /// Cylinder whose axis is map axis `axis` (stems, posts, heating pipes): no transform.
+    AxisCylinder { c: [f64; 3], axis: usize, r: f64, h: f64 },
+    Box { c: [f64; 3], rt: [[f64; 3]; 3], half: [f64; 3] },
+    Cylinder { c: [f64; 3], rt: [[f64; 3]; 3], r: f64, h: f64 },
+}
+
+#[inline(always)]
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+#[inline(always)]
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[inline(always)]
+fn apply(m: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
+    [dot(m[0], v), dot(m[1], v), dot(m[2], v)]
+}
+
+/// R * v where `rt` = R^T: the columns of `rt` are the rows of R.
+#[inline(always)]
+fn apply_t(rt: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
+    [
+        rt[0][0] * v[0] + rt[1][0] * v[1] + rt[2][0] * v[2],
+        rt[0][1] * v[0] + rt[1][1] * v[1] + rt[2][1] * v[2],
+        rt[0][2] * v[0] + rt[1][2] * v[1] + rt[2][2] * v[2],
+    ]
+}
+
+const IDENTITY: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+fn transpose(m: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    [[m[0][0], m[1][0], m[2][0]], [m[0][1], m[1][1], m[2][1]], [m[0][2], m[1][2], m[2][2]]]
+}
+
+impl Prim {
+    pub(crate) fn from_object(o: &Object) -> Prim {
+        let c = o.placement.translation;
+        match o.shape {
+            Shape::Sphere { radius } => Prim::Sphere { c, r: radius },
+            Shape::Box { half } => {
+                let m = o.placement.matrix();
+                if m == IDENTITY {
+                    Prim::AaBox { c, half }
+                } else {
+                    Prim::Box { c, rt: transpose(m), half }
+                }
+            }
+            Shape::Cylinder { radius, half_height } => {
+                let m = o.placement.matrix();
+                // The local z axis (third column) along a map axis, exactly (up to sign).
+                let col = [m[0][2], m[1][2], m[2][2]];
+                match (0..3).find(|&k| col[k].abs() == 1.0 && col[(k + 1) % 3] == 0.0 && col[(k + 2) % 3] == 0.0) {
+                    Some(axis) => Prim::AxisCylinder { c, axis, r: radius, h: half_height },
+                    None => Prim::Cylinder { c, rt: transpose(m), r: radius, h: half_height },
+                }
+            }
+        }
+    }
+
+    /// First surface crossing along `o + t d` with `t` in `[tmin, tmax]`: (t, outward normal).
+    #[inline]
+    pub(crate) fn intersect(&self, o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64) -> Option<(f64, [f64; 3])> {
+        match *self {
+            Prim::Sphere { c, r } => sphere(c, r, o, d, tmin, tmax),
+            Prim::AaBox { c, half } => box_local(half, sub(o, c), d, tmin, tmax),
+            Prim::Box { c, ref rt, half } => {
+                let (t, n) = box_local(half, apply(rt, sub(o, c)), apply(rt, d), tmin, tmax)?;
+                Some((t, apply_t(rt, n)))
+            }
+            Prim::AxisCylinder { c, axis, r, h } => {
+                // Swizzle so the axis is local z: (u, v, w) = (axis + 1, axis + 2, axis), a
+                // cyclic permutation (a proper rotation).
+                let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
+                let p = sub(o, c);
+                let (t, n) = cylinder_local(r, h, [p[i], p[j], p[axis]], [d[i], d[j], d[axis]], tmin, tmax)?;
+                let mut m = [0.0; 3];
+                m[i] = n[0];
+                m[j] = n[1];
+                m[axis] = n[2];
+                Some((t, m))
+            }
+            Prim::Cylinder { c, ref rt, r, h } => {
+                let (t, n) = cylinder_local(r, h, apply(rt, sub(o, c)), apply(rt, d), tmin, tmax)?;
+                Some((t, apply_t(rt, n)))
+            }
+        }
+    }
+}
+
+#[inline]
+fn sphere(c: [f64; 3], r: f64, o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64) -> Option<(f64, [f64; 3])> {
+    let oc = sub(o, c);
+    let a = dot(d, d);
+    let b = dot(oc, d);
+    let cc = dot(oc, oc) - r * r;
+    let disc = b * b - a * cc;
+    if disc < 0.0 {
+        return None;
+    }
+    let s = disc.sqrt();
+    // Numerically stable roots (avoid cancellation in -b +- s).
+    let q = if b > 0.0 { -(b + s) } else { -b + s };
+    let (mut t0, mut t1) = if q != 0.0 { (q / a, cc / q) } else { (0.0, 0.0) };
+    if t0 > t1 {
+        std::mem::swap(&mut t0, &mut t1);
+    }
+    let t = if t0 >= tmin && t0 <= tmax {
+        t0
+    } else if t1 >= tmin && t1 <= tmax {
+        t1
+    } else {
+        return None;
+    };
+    let inv = 1.0 / r;
+    Some((t, [(oc[0] + t * d[0]) * inv, (oc[1] + t * d[1]) * inv, (oc[2] + t * d[2]) * inv]))
+}
+
+/// Box centred at the origin, axis-aligned, ray in its frame.
+#[inline(always)]
+fn box_local(half: [f64; 3], lo: [f64; 3], ld: [f64; 3], tmin: f64, tmax: f64) -> Option<(f64, [f64; 3])> {
+    let (mut tn, mut tf) = (f64::NEG_INFINITY, f64::INFINITY);
+    let (mut an, mut af) = (usize::MAX, usize::MAX);
+    for i in 0..3 {
+        if ld[i] == 0.0 {
+            if lo[i].abs() > half[i] {
+                return None;
+            }
+            continue;
+        }
+        let inv = 1.0 / ld[i];
+        let mut t1 = (-half[i] - lo[i]) * inv;
+        let mut t2 = (half[i] - lo[i]) * inv;
+        if t1 > t2 {
+            std::mem::swap(&mut t1, &mut t2);
+        }
+        if t1 > tn {
+            tn = t1;
+            an = i;
+        }
+        if t2 < tf {
+            tf = t2;
+            af = i;
+        }
+    }
+    if tn > tf {
+        return None;
+    }
+    let (t, axis, sign) = if tn >= tmin && tn <= tmax && an != usize::MAX {
+        (tn, an, -ld[an].signum())
+    } else if tf >= tmin && tf <= tmax && af != usize::MAX {
+        (tf, af, ld[af].signum())
+    } else {
+        return None;
+    };
+    let mut n = [0.0; 3];
+    n[axis] = sign;
+    Some((t, n))
+}
+
+/// Cylinder centred at the origin along z, ray in its frame.
+#[inline(always)]
+fn cylinder_local(r: f64, h: f64, lo: [f64; 3], ld: [f64; 3], tmin: f64, tmax: f64) -> Option<(f64, [f64; 3])> {
+    let mut best = f64::INFINITY;
+    let mut n = [0.0; 3];
+    // Side: (ox + t dx)^2 + (oy + t dy)^2 = r^2, |z| <= h.
+    let a = ld[0] * ld[0] + ld[1] * ld[1];
+    if a > 0.0 {
+        let b = lo[0] * ld[0] + lo[1] * ld[1];
+        let cc = lo[0] * lo[0] + lo[1] * lo[1] - r * r;
+        let disc = b * b - a * cc;
+        if disc >= 0.0 {
+            let s = disc.sqrt();
+            let q = if b > 0.0 { -(b + s) } else { -b + s };
+            if q != 0.0 {
+                for t in [q / a, cc / q] {
+                    if t >= tmin && t <= tmax && t < best {
+                        let z = lo[2] + t * ld[2];
+                        if z.abs() <= h {
+                            best = t;
+                            n = [(lo[0] + t * ld[0]) / r, (lo[1] + t * ld[1]) / r, 0.0];
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // Caps: z = +-h, x^2 + y^2 <= r^2.
+    if ld[2] != 0.0 {
+        let inv = 1.0 / ld[2];
+        for sz in [-1.0, 1.0] {
+            let t = (sz * h - lo[2]) * inv;
+            if t >= tmin && t <= tmax && t < best {
+                let x = lo[0] + t * ld[0];
+                let y = lo[1] + t * ld[1];
+                if x * x + y * y <= r * r {
+                    best = t;
+                    n = [0.0, 0.0, sz];
+                }
+            }
+        }
+    }
+    if best.is_finite() {
+        Some((best, n))
+    } else {
+        None
+    }
+}

@@ -1,0 +1,206 @@
+//! The BVH caster must agree exactly with a brute-force scan over all objects.
+
+use agrisim_greenhouse::raycast::cast_brute_force;
+use agrisim_greenhouse::rng::Rng;
+use agrisim_greenhouse::{generate, GreenhouseConfig, Kind, Object, Placement, RayCaster, Shape};
+
+fn unit(v: [f64; 3]) -> [f64; 3] {
+    let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    [v[0] / n, v[1] / n, v[2] / n]
+}
+
+fn random_dir(rng: &mut Rng) -> [f64; 3] {
+    unit([rng.normal(), rng.normal(), rng.normal()])
+}
+
+fn small_scene() -> (GreenhouseConfig, Vec<Object>) {
+    let cfg = GreenhouseConfig::from_toml_str(
+        "rows = 4\nactive_rows = 3\nrow_length = 6.0\nlength = 14.0\nwidth = 14.0\nrandom_obstacles = 3\n\
+         [[obstacles]]\nx = 8.0\ny = 5.0\nsize_x = 0.5\nsize_y = 0.4\nheight = 0.8\n",
+    )
+    .unwrap();
+    let objs = generate(&cfg, 7).objects;
+    (cfg, objs)
+}
+
+#[test]
+fn bvh_equals_brute_force_on_random_rays() {
+    let (cfg, objs) = small_scene();
+    let rc = RayCaster::new(&objs);
+    let mut rng = Rng::new(42);
+    let mut hits = 0;
+    for k in 0..20_000 {
+        // Mix of origins: anywhere in the hall, and LiDAR-like ones in the aisles.
+        let o = if k % 2 == 0 {
+            [rng.range(-1.0, cfg.length + 1.0), rng.range(-1.0, cfg.width + 1.0), rng.range(-0.5, cfg.height + 0.5)]
+        } else {
+            [rng.range(cfg.headland, cfg.headland + cfg.row_length), rng.range(0.0, cfg.width), rng.range(0.2, 2.0)]
+        };
+        let d = random_dir(&mut rng);
+        let (tmin, tmax) = (rng.range(0.0, 0.2), rng.range(0.5, 60.0));
+        let a = rc.cast(o, d, tmin, tmax, &[]);
+        let b = cast_brute_force(&objs, o, d, tmin, tmax);
+        match (a, b) {
+            (None, None) => {}
+            (Some(a), Some(b)) => {
+                hits += 1;
+                assert!((a.distance - b.distance).abs() <= 1e-9, "ray {k}: {a:?} vs {b:?}");
+                assert_eq!(a.object, b.object, "ray {k}");
+                assert_eq!(a.normal, b.normal, "ray {k}");
+            }
+            _ => panic!("ray {k} from {o:?} dir {d:?}: bvh {a:?} vs brute force {b:?}"),
+        }
+    }
+    assert!(hits > 10_000, "only {hits} hits");
+}
+
+#[test]
+fn axis_aligned_rays_agree_too() {
+    // Axis-aligned directions hit the zero-component paths of the slab tests.
+    let (cfg, objs) = small_scene();
+    let rc = RayCaster::new(&objs);
+    let mut rng = Rng::new(3);
+    let dirs = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+    for k in 0..6000 {
+        let o = [rng.range(0.0, cfg.length), rng.range(0.0, cfg.width), rng.range(0.0, 3.0)];
+        let d = dirs[k % 6];
+        let a = rc.cast(o, d, 0.0, 100.0, &[]);
+        let b = cast_brute_force(&objs, o, d, 0.0, 100.0);
+        assert_eq!(a.map(|h| (h.object, h.distance)), b.map(|h| (h.object, h.distance)), "ray {k}");
+    }
+}
+
+#[test]
+fn dynamic_objects_are_hit() {
+    let (_, objs) = small_scene();
+    let rc = RayCaster::new(&objs);
+    let robot = Object {
+        id: 1_000_000,
+        name: "robot/base".into(),
+        kind: Kind::Robot,
+        shape: Shape::Box { half: [0.6, 0.45, 0.3] },
+        placement: Placement::at(2.0, 7.0, 0.3),
+    };
+    let h = rc.cast([0.5, 7.0, 0.3], [1.0, 0.0, 0.0], 0.0, 50.0, std::slice::from_ref(&robot)).unwrap();
+    assert_eq!(h.object, 1_000_000);
+    assert!((h.distance - 0.9).abs() < 1e-12);
+    assert_eq!(h.normal, [-1.0, 0.0, 0.0]);
+}
+
+fn one(shape: Shape, placement: Placement) -> Vec<Object> {
+    vec![Object { id: 0, name: "o".into(), kind: Kind::Obstacle, shape, placement }]
+}
+
+#[test]
+fn analytic_distances() {
+    let s = one(Shape::Sphere { radius: 0.5 }, Placement::at(3.0, 0.0, 0.0));
+    let h = RayCaster::new(&s).cast([0.0; 3], [1.0, 0.0, 0.0], 0.0, 10.0, &[]).unwrap();
+    assert!((h.distance - 2.5).abs() < 1e-12 && h.normal == [-1.0, 0.0, 0.0]);
+    // From inside: the exit point.
+    let h = RayCaster::new(&s).cast([3.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.0, 10.0, &[]).unwrap();
+    assert!((h.distance - 0.5).abs() < 1e-12);
+
+    // Upright cylinder: side and cap.
+    let c = one(Shape::Cylinder { radius: 0.2, half_height: 1.0 }, Placement::at(2.0, 0.0, 1.0));
+    let rc = RayCaster::new(&c);
+    let h = rc.cast([0.0, 0.0, 0.5], [1.0, 0.0, 0.0], 0.0, 10.0, &[]).unwrap();
+    assert!((h.distance - 1.8).abs() < 1e-12);
+    let h = rc.cast([2.05, 0.0, 5.0], [0.0, 0.0, -1.0], 0.0, 10.0, &[]).unwrap();
+    assert!((h.distance - 3.0).abs() < 1e-12 && (h.normal[2] - 1.0).abs() < 1e-12);
+    assert!(rc.cast([2.25, 0.0, 5.0], [0.0, 0.0, -1.0], 0.0, 10.0, &[]).is_none());
+
+    // Box yawed 45 deg: corner toward the ray at distance 2 - sqrt(2) * 0.5.
+    let b = one(Shape::Box { half: [0.5, 0.5, 0.5] }, Placement::yawed([2.0, 0.0, 0.0], std::f64::consts::FRAC_PI_4));
+    let h = RayCaster::new(&b).cast([0.0, 0.0, 0.1], [1.0, 0.0, 0.0], 0.0, 10.0, &[]).unwrap();
+    assert!((h.distance - (2.0 - 0.5 * 2f64.sqrt())).abs() < 1e-12, "{h:?}");
+    // Range limits.
+    assert!(RayCaster::new(&b).cast([0.0, 0.0, 0.1], [1.0, 0.0, 0.0], 0.0, 1.0, &[]).is_none());
+}
+
+#[test]
+fn empty_scene_casts_nothing() {
+    let rc = RayCaster::new(&[]);
+    assert!(rc.cast([0.0; 3], [1.0, 0.0, 0.0], 0.0, 10.0, &[]).is_none());
+}
+
+/// Random solids with random rotations (tilted cylinders, rotated boxes) in a 10 m cube.
+fn random_solids(rng: &mut Rng, n: usize) -> Vec<Object> {
+    (0..n)
+        .map(|i| {
+            let shape = match i % 3 {
+                0 => Shape::Sphere { radius: rng.range(0.02, 0.6) },
+                1 => Shape::Box { half: [rng.range(0.01, 0.8), rng.range(0.01, 0.8), rng.range(0.01, 0.8)] },
+                _ => Shape::Cylinder { radius: rng.range(0.005, 0.4), half_height: rng.range(0.02, 1.5) },
+            };
+            let axis = unit([rng.normal(), rng.normal(), rng.normal()]);
+            // A third stay axis-aligned (the specialised code paths).
+            let angle = if i % 7 < 2 { 0.0 } else if i % 7 == 2 { std::f64::consts::FRAC_PI_2 } else { rng.range(-3.2, 3.2) };
+            let axis = if i % 7 == 2 { [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]][i % 3] } else { axis };
+            let t = [rng.range(0.0, 10.0), rng.range(0.0, 10.0), rng.range(0.0, 10.0)];
+            Object { id: i as u32, name: format!("s{i}"), kind: Kind::Obstacle, shape, placement: Placement::axis_angle(t, axis, angle) }
+        })
+        .collect()
+}
+
+/// Exact-on-the-surface signed distance bound (max form): < 0 inside, 0 on the surface.
+fn sdf(o: &Object, p: [f64; 3]) -> f64 {
+    let m = o.placement.matrix();
+    let c = o.placement.translation;
+    let v = [p[0] - c[0], p[1] - c[1], p[2] - c[2]];
+    let l = [
+        m[0][0] * v[0] + m[1][0] * v[1] + m[2][0] * v[2],
+        m[0][1] * v[0] + m[1][1] * v[1] + m[2][1] * v[2],
+        m[0][2] * v[0] + m[1][2] * v[1] + m[2][2] * v[2],
+    ];
+    match o.shape {
+        Shape::Sphere { radius } => (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt() - radius,
+        Shape::Box { half } => (l[0].abs() - half[0]).max(l[1].abs() - half[1]).max(l[2].abs() - half[2]),
+        Shape::Cylinder { radius, half_height } => ((l[0] * l[0] + l[1] * l[1]).sqrt() - radius).max(l[2].abs() - half_height),
+    }
+}
+
+#[test]
+fn random_solids_match_brute_force_and_geometry() {
+    let mut rng = Rng::new(11);
+    let objs = random_solids(&mut rng, 400);
+    let rc = RayCaster::new(&objs);
+    let mut hits = 0;
+    for k in 0..10_000 {
+        let o = [rng.range(-1.0, 11.0), rng.range(-1.0, 11.0), rng.range(-1.0, 11.0)];
+        let d = random_dir(&mut rng);
+        let a = rc.cast(o, d, 0.0, 30.0, &[]);
+        let b = cast_brute_force(&objs, o, d, 0.0, 30.0);
+        assert_eq!(a, b, "ray {k}");
+        let outside = objs.iter().all(|s| sdf(s, o) > 0.0);
+        match a {
+            Some(h) => {
+                hits += 1;
+                let p = [o[0] + h.distance * d[0], o[1] + h.distance * d[1], o[2] + h.distance * d[2]];
+                let s = &objs[h.object as usize];
+                assert!(sdf(s, p).abs() < 1e-9, "ray {k}: hit point off the surface by {}", sdf(s, p));
+                let nn = h.normal.iter().map(|x| x * x).sum::<f64>().sqrt();
+                assert!((nn - 1.0).abs() < 1e-9, "normal not unit");
+                // Outward: a step along the normal leaves the solid.
+                let q = [p[0] + 1e-6 * h.normal[0], p[1] + 1e-6 * h.normal[1], p[2] + 1e-6 * h.normal[2]];
+                assert!(sdf(s, q) > 0.0, "ray {k}: normal points inward");
+                if outside {
+                    // Nothing solid between the origin and the hit (sampled).
+                    for j in 0..50 {
+                        let t = h.distance * (j as f64 + 0.5) / 50.0 - 1e-7;
+                        let x = [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
+                        assert!(objs.iter().all(|s| sdf(s, x) > 0.0), "ray {k}: solid before the hit at t = {t}");
+                    }
+                }
+            }
+            None if outside => {
+                for j in 0..100 {
+                    let t = 30.0 * (j as f64 + 0.5) / 100.0;
+                    let x = [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
+                    assert!(objs.iter().all(|s| sdf(s, x) > 0.0), "ray {k}: missed a solid at t = {t}");
+                }
+            }
+            None => {}
+        }
+    }
+    assert!(hits > 3000, "{hits}");
+}

@@ -1,0 +1,53 @@
+//! Rays per second of whole frames: the default greenhouse, the robot at the layout's start
+//! pose and in the middle of aisle 0, default sensor. `cargo run --release -p
+//! agrisim-fmu-lidar --example frame_rate [SCENE.toml-keys-file]`.
+
+use agrisim_fmi::{Log, Model, Store, Value};
+use agrisim_fmu_lidar::ports::*;
+use agrisim_fmu_lidar::Lidar;
+use agrisim_greenhouse::{generate, GreenhouseConfig};
+use std::time::Instant;
+
+struct Quiet;
+impl Log for Quiet {
+    fn info(&mut self, _: &str) {}
+    fn warning(&mut self, _: &str) {}
+}
+
+fn main() {
+    let scene = std::env::args().nth(1).map(|p| std::fs::read_to_string(p).expect("scene file")).unwrap_or_default();
+    let cfg = GreenhouseConfig::from_toml_str(&scene).expect("scene");
+    let t = Instant::now();
+    let gh = generate(&cfg, cfg.seed);
+    let aisle = &gh.layout.aisles[0];
+    let poses = [("start pose", gh.layout.start_pose), ("aisle 0 middle", [0.5 * (aisle.x_start + aisle.x_end), aisle.y, 0.0])];
+    let mut io = Store::new(Lidar::VARIABLES);
+    *io.value_mut(SCENE) = Value::String(scene.clone());
+    let mut m = Lidar::new();
+    m.initialize(&mut io, 0.0, &mut Quiet).expect("initialize");
+    println!("scene: {} objects, generated and prepared in {:.2} s", m.scene().unwrap().object_count, t.elapsed().as_secs_f64());
+    let mut k = 0;
+    for (name, [x, y, yaw]) in poses {
+        io.set_f64(BASE_X, x);
+        io.set_f64(BASE_Y, y);
+        io.set_f64(BASE_YAW, yaw);
+        // One second to settle on the new pose, then 2 s (20 frames) timed.
+        for _ in 0..50 {
+            m.do_step(&mut io, k as f64 * 0.02, 0.02, &mut Quiet).expect("step");
+            k += 1;
+        }
+        let (mut rays, mut returns, mut secs) = (0usize, 0usize, 0.0);
+        for _ in 0..100 {
+            let t = Instant::now();
+            m.do_step(&mut io, k as f64 * 0.02, 0.02, &mut Quiet).expect("step");
+            secs += t.elapsed().as_secs_f64();
+            k += 1;
+            if k % 5 == 0 {
+                rays += io.i32(POINTS_IN_FRAME) as usize;
+                returns += io.i32(RETURNS_IN_FRAME) as usize;
+            }
+        }
+        println!("{name}: {rays} rays in {secs:.3} s = {:.0} rays/s ({:.1} % returns)", rays as f64 / secs, 100.0 * returns as f64 / rays as f64);
+    }
+}
+

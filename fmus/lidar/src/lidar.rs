@@ -1,0 +1,211 @@
+//! The `Lidar` model: keeps the base's recent path, and at every frame instant (on simulation
+//! time) casts the frame's rays at the scene and publishes the cloud.
+//!
+//! Time: the frame published at T holds the pattern's points of [T - 1/frame_rate, T). By
+//! default each is cast from the base pose at its own time (interpolated between the chassis
+//! inputs, see [`crate::trajectory`]) and expressed in lidar_link at that time, as a real
+//! sensor delivers them; header.stamp is the first point's time and `t` >= 0 the offset from
+//! it, so a consumer can deskew. With `deskewed` every point is cast from the pose at the
+//! frame's end instead (the latest input pose: the chassis pose at T itself is not known yet
+//! during the step) and header.stamp is T, so `t` <= 0: a motion-compensated cloud for
+//! consumers that do not deskew.
+
+use crate::cloud::{CloudBuilder, Point};
+use crate::frame::{yaw_rotate, Mount};
+use crate::pattern::ScanPattern;
+use crate::ports::*;
+use crate::reflectivity;
+use crate::scene::{self, BaseBox, Scene};
+use crate::trajectory::{Pose2, Trajectory};
+use agrisim_fmi::{Log, Model, Store, Var};
+use agrisim_fmu_util::{Rng, Schedule};
+use agrisim_greenhouse::Kind;
+use agrisim_msgs::sensor_msgs::PointCloud2;
+use agrisim_msgs::Message;
+use std::sync::Arc;
+
+/// Most rays in one frame (memory and time guard).
+pub const MAX_POINTS_PER_FRAME: usize = 1_000_000;
+
+/// Everything fixed at initialization.
+#[derive(Clone, Debug)]
+struct Config {
+    scene: Arc<Scene>,
+    pattern: ScanPattern,
+    points_per_frame: usize,
+    frame_period: f64,
+    mount: Mount,
+    range: (f64, f64),
+    noise: f64,
+    frame_id: String,
+    deskewed: bool,
+    drop_no_return: bool,
+}
+
+/// What one captured frame produced.
+pub struct Frame {
+    pub cloud: PointCloud2,
+    pub returns: usize,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct Lidar {
+    config: Option<Config>,
+    base: Option<BaseBox>,
+    trajectory: Trajectory,
+    schedule: Schedule,
+    rng: Rng,
+    seq: i64,
+}
+
+fn param(io: &Store, i: usize, ok: impl Fn(f64) -> bool, what: &str) -> Result<f64, String> {
+    let v = io.f64(i);
+    if v.is_finite() && ok(v) {
+        Ok(v)
+    } else {
+        Err(format!("parameter {} must be {what}, got {v}", VARIABLES[i].name))
+    }
+}
+
+fn pose(io: &Store) -> Result<Pose2, String> {
+    let p = Pose2 { x: io.f64(BASE_X), y: io.f64(BASE_Y), yaw: io.f64(BASE_YAW) };
+    if [p.x, p.y, p.yaw].iter().all(|v| v.is_finite() && v.abs() < 1e6) {
+        Ok(p)
+    } else {
+        Err(format!("robot pose input (base_x, base_y, base_yaw) = ({}, {}, {}) is not finite or beyond 1e6", p.x, p.y, p.yaw))
+    }
+}
+
+impl Config {
+    fn from_params(io: &Store) -> Result<Config, String> {
+        let any = |_: f64| true;
+        let positive = |v: f64| v > 0.0;
+        let frame_rate = param(io, FRAME_RATE, positive, "positive")?;
+        let point_rate = param(io, POINT_RATE, positive, "positive")?;
+        let points_per_frame = (point_rate / frame_rate).round();
+        if !(1.0..=MAX_POINTS_PER_FRAME as f64).contains(&points_per_frame) {
+            return Err(format!("point_rate / frame_rate = {points_per_frame} points per frame, outside [1, {MAX_POINTS_PER_FRAME}]"));
+        }
+        let range_min = param(io, RANGE_MIN, |v| v >= 0.0, ">= 0")?;
+        let range_max = param(io, RANGE_MAX, |v| v > range_min, "above range_min")?;
+        let el_min = param(io, ELEVATION_MIN, |v| v.abs() < 90.0, "within (-90, 90) deg")?;
+        let el_max = param(io, ELEVATION_MAX, |v| v.abs() < 90.0 && v > el_min, "within (-90, 90) deg and above elevation_min")?;
+        let translation = [param(io, MOUNT_X, any, "finite")?, param(io, MOUNT_Y, any, "finite")?, param(io, MOUNT_Z, any, "finite")?];
+        let mount = Mount::new(translation, param(io, MOUNT_ROLL, any, "finite")?, param(io, MOUNT_PITCH, any, "finite")?, param(io, MOUNT_YAW, any, "finite")?);
+        Ok(Config {
+            scene: scene::load(io.string(SCENE), io.i32(SEED))?,
+            pattern: ScanPattern::mid360(point_rate, el_min.to_radians(), el_max.to_radians()),
+            points_per_frame: points_per_frame as usize,
+            frame_period: 1.0 / frame_rate,
+            mount,
+            range: (range_min, range_max),
+            noise: param(io, RANGE_NOISE, |v| v >= 0.0, ">= 0")?,
+            frame_id: io.string(FRAME_ID).to_string(),
+            deskewed: io.bool(DESKEWED),
+            drop_no_return: io.bool(DROP_NO_RETURN),
+        })
+    }
+}
+
+impl Lidar {
+    /// Casts the frame that ends at `end_ns` (its points are the pattern's last
+    /// `points_per_frame` before that instant).
+    pub fn capture(&mut self, end_ns: i64) -> Frame {
+        let c = self.config.as_ref().expect("initialized");
+        let base = self.base.as_mut().expect("initialized");
+        let p = &c.pattern;
+        let n_end = (end_ns as f64 * 1e-9 * p.point_rate).floor() as i64;
+        let n0 = n_end - c.points_per_frame as i64;
+        let end_s = end_ns as f64 * 1e-9;
+        let stamp_ns = if c.deskewed { end_ns } else { (p.time(n0) * 1e9).round() as i64 };
+        let stamp_s = stamp_ns as f64 * 1e-9;
+        let robot_id = base.object.id;
+        let end_pose = self.trajectory.at(end_s);
+        let mut cloud = CloudBuilder::with_capacity(c.points_per_frame);
+        let mut returns = 0;
+        let mut last: Option<(Pose2, f64, f64)> = None;
+        for n in n0..n_end {
+            let s = p.time(n);
+            let pose = if c.deskewed { end_pose } else { self.trajectory.at(s) };
+            let (sin, cos) = match last {
+                Some((q, sin, cos)) if q == pose => (sin, cos),
+                _ => {
+                    let (sin, cos) = pose.yaw.sin_cos();
+                    base.place(pose.x, pose.y, pose.yaw);
+                    last = Some((pose, sin, cos));
+                    (sin, cos)
+                }
+            };
+            let d_sensor = p.direction(n);
+            let d = yaw_rotate(sin, cos, c.mount.rotate(d_sensor));
+            let m = yaw_rotate(sin, cos, c.mount.translation);
+            let origin = [pose.x + m[0], pose.y + m[1], m[2]];
+            let t = (s - stamp_s) as f32;
+            match c.scene.caster.cast(origin, d, c.range.0, c.range.1, std::slice::from_ref(&base.object)) {
+                Some(hit) => {
+                    let rho = if hit.object == robot_id {
+                        reflectivity::of_kind(Kind::Robot)
+                    } else {
+                        c.scene.reflectivity.get(hit.object as usize).copied().unwrap_or(0.0)
+                    };
+                    let cos_incidence = -(hit.normal[0] * d[0] + hit.normal[1] * d[1] + hit.normal[2] * d[2]);
+                    let r = hit.distance + self.rng.gauss(c.noise);
+                    let xyz = [(d_sensor[0] * r) as f32, (d_sensor[1] * r) as f32, (d_sensor[2] * r) as f32];
+                    cloud.push(&Point { xyz, intensity: reflectivity::intensity(rho, cos_incidence), t });
+                    returns += 1;
+                }
+                None if c.drop_no_return => {}
+                None => cloud.push(&Point { t, ..Point::default() }),
+            }
+        }
+        Frame { cloud: cloud.finish(stamp_ns, &c.frame_id), returns }
+    }
+
+    /// The scene the rays are cast at (after initialization).
+    pub fn scene(&self) -> Option<&Scene> {
+        self.config.as_ref().map(|c| &*c.scene)
+    }
+}
+
+impl Model for Lidar {
+    const NAME: &'static str = "Lidar";
+    const TOKEN: &'static str = "{2d5e7a10-8c4f-4b96-a3e1-agrisim-lidar-1}";
+    const DESCRIPTION: &'static str = "LiDAR modelled on the Livox MID-360 (non-repetitive pattern, 200k points/s, 10 Hz frames) cast at the greenhouse scene: sensor_msgs/PointCloud2";
+    const VARIABLES: &'static [Var] = VARIABLES;
+
+    fn new() -> Self {
+        Self::default()
+    }
+
+    fn initialize(&mut self, io: &mut Store, start_time: f64, _log: &mut dyn Log) -> Result<(), String> {
+        let config = Config::from_params(io)?;
+        let length = param(io, BASE_LENGTH, |v| v > 0.0, "positive")?;
+        let width = param(io, BASE_WIDTH, |v| v > 0.0, "positive")?;
+        let height = param(io, BASE_HEIGHT, |v| v > 0.0, "positive")?;
+        let clearance = param(io, BASE_CLEARANCE, |v| v >= 0.0, ">= 0")?;
+        self.base = Some(BaseBox::new(config.scene.object_count as u32, length, width, height, clearance));
+        self.trajectory = Trajectory::default();
+        self.trajectory.push(start_time, pose(io)?, 2.0 * config.frame_period);
+        self.schedule = Schedule::new(1.0 / config.frame_period, start_time)?;
+        // No frame at the start instant: it would cover time before the run.
+        self.schedule.due(start_time);
+        self.rng = Rng::new(io.i32(NOISE_SEED) as u32 as u64);
+        self.seq = 0;
+        self.config = Some(config);
+        Ok(())
+    }
+
+    fn do_step(&mut self, io: &mut Store, t: f64, h: f64, _log: &mut dyn Log) -> Result<(), String> {
+        let period = self.config.as_ref().map_or(0.1, |c| c.frame_period);
+        self.trajectory.push(t, pose(io)?, 2.0 * period + h);
+        if let Some(end_ns) = self.schedule.due(t + h) {
+            let frame = self.capture(end_ns);
+            self.seq += 1;
+            io.set_i32(POINTS_IN_FRAME, frame.cloud.width as i32);
+            io.set_i32(RETURNS_IN_FRAME, frame.returns as i32);
+            io.set_binary(POINTS, &frame.cloud.to_cdr());
+            io.set_i64(POINTS_SEQ, self.seq);
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,9 @@
+//! Benchmarks: the master's overhead, and the many-trial evaluations (navigation) with honest
+//! statistics and every trial recorded.
+
+pub mod overhead;
+pub mod report;
+pub mod stats;
+pub mod targets;
+
+pub use overhead::{overhead, OverheadReport};

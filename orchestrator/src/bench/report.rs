@@ -1,0 +1,74 @@
+//! report.html: a self-contained page (inline SVG, no scripts, no network) with the summary
+//! table, a top-down map of the greenhouse and every trial's ground-truth path.
+
+use agrisim_greenhouse::{Kind, Object, Shape};
+use std::fmt::Write;
+
+/// One trial as drawn: its path, target and outcome.
+pub struct TrialTrace {
+    pub index: u64,
+    pub success: bool,
+    pub reason: String,
+    pub target: [f64; 3],
+    pub path: Vec<[f64; 2]>,
+}
+
+fn colour(kind: Kind) -> &'static str {
+    match kind {
+        Kind::Post | Kind::Wall => "#555",
+        Kind::Gutter | Kind::Roof => "#bbb",
+        Kind::HeatingPipe => "#c96",
+        Kind::Stem | Kind::Leaf | Kind::Truss => "#4a8a3a",
+        Kind::Fruit { .. } => "#d33",
+        Kind::Obstacle => "#a0f",
+        Kind::Robot => "#07c",
+        Kind::Floor => "none",
+    }
+}
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+/// Writes the report. `summary` rows are (label, value) pairs shown in a table.
+pub fn render(title: &str, summary: &[(String, String)], objects: &[Object], bounds: [f64; 4], trials: &[TrialTrace]) -> String {
+    let [x0, y0, x1, y1] = bounds;
+    let scale = 900.0 / (x1 - x0).max(y1 - y0).max(1e-6);
+    let (w, h) = ((x1 - x0) * scale, (y1 - y0) * scale);
+    // map frame: y up; SVG: y down.
+    let px = |x: f64| (x - x0) * scale;
+    let py = |y: f64| (y1 - y) * scale;
+    let mut svg = String::new();
+    let _ = write!(svg, r##"<svg xmlns="http://www.w3.org/2000/svg" width="{w:.0}" height="{h:.0}" viewBox="0 0 {w:.1} {h:.1}" style="background:#f7f5ef">"##);
+    for o in objects {
+        let c = colour(o.kind);
+        if c == "none" || matches!(o.kind, Kind::Gutter | Kind::Roof | Kind::Fruit { .. } | Kind::Leaf) {
+            continue; // overhead or tiny: the top-down map shows what blocks the base
+        }
+        let [x, y, _] = o.placement.translation;
+        match o.shape {
+            Shape::Box { half } => {
+                let [qx, qy, qz, qw] = o.placement.rotation;
+                let yaw = (2.0 * (qw * qz + qx * qy)).atan2(1.0 - 2.0 * (qy * qy + qz * qz));
+                let _ = write!(svg, r#"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="{c}" transform="rotate({:.2} {:.1} {:.1})"/>"#,
+                    px(x - half[0]), py(y + half[1]), 2.0 * half[0] * scale, 2.0 * half[1] * scale, -yaw.to_degrees(), px(x), py(y));
+            }
+            Shape::Cylinder { radius, .. } | Shape::Sphere { radius } => {
+                let _ = write!(svg, r#"<circle cx="{:.1}" cy="{:.1}" r="{:.1}" fill="{c}"/>"#, px(x), py(y), (radius * scale).max(0.6));
+            }
+        }
+    }
+    for t in trials {
+        let c = if t.success { "#1a7f37" } else { "#cf222e" };
+        let pts: Vec<String> = t.path.iter().map(|p| format!("{:.1},{:.1}", px(p[0]), py(p[1]))).collect();
+        let _ = write!(svg, r#"<polyline points="{}" fill="none" stroke="{c}" stroke-width="1.2" stroke-opacity="0.6"><title>trial {} {}</title></polyline>"#, pts.join(" "), t.index, escape(&t.reason));
+        let _ = write!(svg, r#"<circle cx="{:.1}" cy="{:.1}" r="3" fill="none" stroke="{c}" stroke-width="1.5"><title>target of trial {}</title></circle>"#, px(t.target[0]), py(t.target[1]), t.index);
+    }
+    svg.push_str("</svg>");
+    let rows: String = summary.iter().map(|(k, v)| format!("<tr><th>{}</th><td>{}</td></tr>", escape(k), escape(v))).collect();
+    let failures: String = trials.iter().filter(|t| !t.success).map(|t| format!("<li>trial {:04}: {}</li>", t.index, escape(&t.reason))).collect();
+    format!(
+        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{t}</title><style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse}}th,td{{border:1px solid #ccc;padding:4px 10px;text-align:left}}</style></head>\n<body><h1>{t}</h1><table>{rows}</table><h2>Top-down map and trial paths</h2><p>Green: success, red: failure; circles: targets. Map frame x to the right, y up.</p>{svg}<h2>Failures</h2><ul>{failures}</ul></body></html>\n",
+        t = escape(title)
+    )
+}
