@@ -242,7 +242,8 @@ fn goal_msg(t_ns: i64, x: f64, y: f64, yaw: Option<f64>) -> PoseStamped {
 struct Harness {
     sim: Sim,
     bus: Bus,
-    loc: Localizer,
+    /// A separate localizer node (`None`: the navigator's embedded one).
+    loc: Option<Localizer>,
     nav: Navigator,
     status: NavigationStatus,
     plans: Vec<Path>,
@@ -258,14 +259,20 @@ struct Harness {
 
 impl Harness {
     fn new(map_occ: &[bool], truth_occ: Vec<bool>, geom: GridGeom, start: Pose2, seed: u64) -> Harness {
-        let mut cfg = NavConfig::default();
-        cfg.localization.initial_pose = [start.x, start.y, start.yaw];
+        Harness::with_nodes(map_occ, truth_occ, geom, start, seed, false)
+    }
+
+    /// `embedded`: one Navigator node running its own localizer (as the benchmark does),
+    /// else a Localizer node and a Navigator node.
+    fn with_nodes(map_occ: &[bool], truth_occ: Vec<bool>, geom: GridGeom, start: Pose2, seed: u64, embedded: bool) -> Harness {
+        let mut cfg = NavConfig::for_start([start.x, start.y, start.yaw]);
+        cfg.embedded_localizer = embedded;
         let mut bus = Bus::default();
         bus.publish(topics::MAP, 0, &occupancy_grid(&geom, map_occ, "map", Time::default()));
         Harness {
             sim: Sim::new(truth_occ, geom, start, seed),
             bus,
-            loc: Localizer::new(&cfg),
+            loc: (!embedded).then(|| Localizer::new(&cfg)),
             nav: Navigator::new(cfg),
             status: NavigationStatus::default(),
             plans: Vec::new(),
@@ -283,7 +290,9 @@ impl Harness {
         self.sim.publish_sensors(&mut self.bus);
         let t = self.sim.t_ns;
         let clock = std::time::Instant::now();
-        self.loc.step(t, &mut self.bus).unwrap();
+        if let Some(l) = self.loc.as_mut() {
+            l.step(t, &mut self.bus).unwrap();
+        }
         self.nav.step(t, &mut self.bus).unwrap();
         self.node_time += clock.elapsed().as_secs_f64();
         self.ticks += 1;
@@ -302,11 +311,15 @@ impl Harness {
                 _ => {}
             }
         }
-        let est = self.loc.pose();
+        let est = self.localizer().pose();
         self.max_loc_err = self.max_loc_err.max(est.dist(&self.sim.truth));
         self.max_loc_yaw_err = self.max_loc_yaw_err.max(agrisim::nav::pose2::wrap_angle(est.yaw - self.sim.truth.yaw).abs());
         self.truth_track.push(self.sim.truth);
         self.sim.advance();
+    }
+
+    fn localizer(&self) -> &Localizer {
+        self.loc.as_ref().or(self.nav.localizer()).unwrap()
     }
 
     /// Sends a goal and runs until the navigator finishes or `limit_s` passes.
@@ -376,7 +389,7 @@ fn reaches_random_goals_in_aisles_and_headland() {
         h.max_loc_yaw_err,
         h.sim.collisions,
         h.nav.stats(),
-        h.loc.stats
+        h.localizer().stats
     );
     assert_eq!(successes, 20);
     assert!(h.max_loc_err < 0.1, "localization error reached {} m", h.max_loc_err);
@@ -486,10 +499,10 @@ fn gives_up_with_stuck_after_recoveries() {
 
 #[test]
 fn new_goal_preempts_and_runs_are_deterministic() {
-    let run = || {
+    let run = |embedded: bool| {
         let (geom, occ) = greenhouse();
         let start = Pose2::new(1.8, aisle_centre(3), 0.0);
-        let mut h = Harness::new(&occ, occ.clone(), geom, start, 5);
+        let mut h = Harness::with_nodes(&occ, occ.clone(), geom, start, 5, embedded);
         let t0 = h.sim.t_ns;
         h.bus.publish(topics::GOAL, t0, &goal_msg(t0, 12.0, aisle_centre(3), None));
         for _ in 0..50 {
@@ -501,8 +514,11 @@ fn new_goal_preempts_and_runs_are_deterministic() {
         assert!(h.sim.truth.dist(&Pose2::new(2.0, aisle_centre(0), 0.0)) <= 0.25);
         h.digest
     };
-    let (a, b) = (run(), run());
+    let (a, b, c) = (run(false), run(false), run(true));
     assert_eq!(a, b, "two identical runs published different messages");
+    // One navigator node with its embedded localizer publishes exactly what the two
+    // separate nodes publish.
+    assert_eq!(a, c, "embedded and separate localization differ");
 }
 
 #[test]
@@ -540,7 +556,7 @@ fn navigates_with_a_3d_mid360_sized_cloud() {
     // roof out of the obstacle layer and the scan slice.
     let (geom, occ) = greenhouse();
     let start = Pose2::new(1.8, aisle_centre(2), 0.0);
-    let mut h = Harness::new(&occ, occ.clone(), geom, start, 9);
+    let mut h = Harness::with_nodes(&occ, occ.clone(), geom, start, 9, true);
     h.sim.layers = 28;
     let wall = std::time::Instant::now();
     let (state, detail, t) = h.navigate(10.0, aisle_centre(4), None, 120.0);

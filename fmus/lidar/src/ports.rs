@@ -11,10 +11,10 @@ agrisim_fmi::variables! { pub VARIABLES {
     // --- scene ---
     SCENE = Var::param("scene", Start::String(""))
         .desc("The keys of the scenario's [greenhouse] table as TOML (no header); empty = the default greenhouse"),
-    SEED = Var::param("seed", Start::Int32(-1))
+    SEED = Var::param("scene_seed", Start::Int32(-1))
         .desc("Seed of the greenhouse generator; < 0 = the scene's own seed key (as the world FMU)"),
     // --- sensor (Livox MID-360 defaults) ---
-    NOISE_SEED = Var::param("noise_seed", Start::Int32(0)).desc("Seed of the range noise"),
+    NOISE_SEED = Var::param("seed", Start::Int32(0)).desc("Seed of the range noise (set per run by the orchestrator)"),
     FRAME_RATE = Var::param("frame_rate", Start::Float64(ds::FRAME_RATE)).unit("Hz").range(0.1, 1000.0)
         .desc("Frames per second of simulation time"),
     POINT_RATE = Var::param("point_rate", Start::Float64(ds::POINT_RATE)).unit("1/s").range(1.0, 2.0e6)

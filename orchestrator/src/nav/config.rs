@@ -100,7 +100,8 @@ pub struct LocalizationConfig {
     pub initial_std: [f64; 3],
     /// Time between scan matches [s] (matches run on the next cloud after it).
     pub scan_period: f64,
-    /// Height band (above the floor) of the horizontal slice matched against the 2-D map [m].
+    /// Height band (above the floor) of the horizontal slice matched against the 2-D map [m];
+    /// keep it inside the band the map was rasterized from.
     pub slice_min_z: f64,
     pub slice_max_z: f64,
     /// Range band of the points used [m].
@@ -132,7 +133,7 @@ impl Default for LocalizationConfig {
             initial_std: [0.05, 0.05, 0.02],
             scan_period: 0.2,
             slice_min_z: 0.2,
-            slice_max_z: 2.0,
+            slice_max_z: 1.5,
             min_range: 0.3,
             max_range: 25.0,
             voxel: 0.1,
@@ -209,15 +210,42 @@ impl Default for ExecutorConfig {
 }
 
 /// The whole stack's configuration.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct NavConfig {
+    /// The [`Navigator`](super::Navigator) runs a [`Localizer`](super::Localizer) itself, just
+    /// before its own step. Set false to run localization as a separate node (or replace it,
+    /// e.g. by AMCL through a bridge): the navigator then only reads `/localization/pose`.
+    pub embedded_localizer: bool,
     pub robot: RobotConfig,
     pub costmap: CostmapConfig,
     pub planner: PlannerConfig,
     pub controller: ControllerConfig,
     pub localization: LocalizationConfig,
     pub executor: ExecutorConfig,
+}
+
+impl Default for NavConfig {
+    fn default() -> Self {
+        NavConfig {
+            embedded_localizer: true,
+            robot: RobotConfig::default(),
+            costmap: CostmapConfig::default(),
+            planner: PlannerConfig::default(),
+            controller: ControllerConfig::default(),
+            localization: LocalizationConfig::default(),
+            executor: ExecutorConfig::default(),
+        }
+    }
+}
+
+impl NavConfig {
+    /// Defaults with the localizer starting at the predefined start pose (x, y, yaw).
+    pub fn for_start(start: [f64; 3]) -> NavConfig {
+        let mut c = NavConfig::default();
+        c.localization.initial_pose = start;
+        c
+    }
 }
 
 #[cfg(test)]

@@ -1,20 +1,21 @@
 //! The navigation stack, Nav2-shaped and speaking only ROS 2 messages, so real Nav2 nodes
 //! can replace it piece by piece.
 //!
-//! Two nodes:
+//! Two nodes, which by default run as one (the navigator steps an embedded localizer first):
 //! * [`Localizer`] (`localization.rs`): `/odom` + `/imu` + `/points` + `/map` ->
 //!   `/tf` (map -> odom) and `/localization/pose`.
 //! * [`Navigator`] (this file): `/goal_pose` + `/localization/pose` + `/points` + `/map` ->
 //!   `/cmd_vel`, `/plan`, `/navigate/status`.
+//!
+//! With `embedded_localizer = false` they are separate nodes (run the localizer first, so the
+//! navigator sees this instant's pose); the messages on the bus are the same either way.
 //!
 //! Inside, one concept per file: [`map`] (the OccupancyGrid), [`distance`] (exact distance
 //! transform), [`costmap`] (global costmap, inflation), [`local_costmap`] (rolling window from
 //! the LiDAR), [`footprint`], [`astar`] (global planner), [`tracking`] (progress along the
 //! plan), [`dwa`] (local planner), [`scan_match`] + [`localization`], [`executor`] (the
 //! goal's state machine), [`config`] (all parameters) and [`cloud`] (PointCloud2 codec).
-//!
-//! Run the localizer before the navigator in a node list ([`stack`] does), so the navigator
-//! sees this instant's pose. Deterministic: no clocks, no hash maps, no threads.
+//! Deterministic: no clocks, no hash maps, no threads.
 
 pub mod astar;
 pub mod cloud;
@@ -32,6 +33,8 @@ pub mod scan_match;
 pub mod tracking;
 
 pub use config::NavConfig;
+/// The name the benchmark harness uses for [`NavConfig`].
+pub type NavigatorConfig = NavConfig;
 pub use executor::{ExecutorStats, Goal, State};
 pub use localization::Localizer;
 pub use pose2::Pose2;
@@ -77,14 +80,10 @@ pub mod topics {
     pub const LOCAL_COSTMAP: &str = "/local_costmap/costmap";
 }
 
-/// The localizer and the navigator, in the order they must run.
-pub fn stack(config: &NavConfig) -> Vec<Box<dyn Node>> {
-    vec![Box::new(Localizer::new(config)), Box::new(Navigator::new(*config))]
-}
-
 /// The navigation node: costmaps, planner, controller and executor behind ROS 2 topics.
 pub struct Navigator {
     cfg: NavConfig,
+    localizer: Option<Localizer>,
     seen: [u64; 4],
     map: Option<StaticMap>,
     global: Option<GlobalCostmap>,
@@ -103,6 +102,7 @@ impl Navigator {
     pub fn new(config: NavConfig) -> Navigator {
         Navigator {
             cfg: config,
+            localizer: config.embedded_localizer.then(|| Localizer::new(&config)),
             seen: [0; 4],
             map: None,
             global: None,
@@ -137,6 +137,15 @@ impl Navigator {
     /// The current plan (map frame).
     pub fn path(&self) -> &[(f64, f64)] {
         self.exec.path()
+    }
+
+    /// The embedded localizer, if any.
+    pub fn localizer(&self) -> Option<&Localizer> {
+        self.localizer.as_ref()
+    }
+
+    pub fn localizer_mut(&mut self) -> Option<&mut Localizer> {
+        self.localizer.as_mut()
     }
 
     pub fn global_costmap(&self) -> Option<&GlobalCostmap> {
@@ -192,6 +201,9 @@ impl Node for Navigator {
     }
 
     fn step(&mut self, t_ns: i64, bus: &mut Bus) -> Result<()> {
+        if let Some(l) = self.localizer.as_mut() {
+            l.step(t_ns, bus)?;
+        }
         if let Some(m) = bus.take_new::<OccupancyGrid>(topics::MAP, &mut self.seen[0])? {
             self.set_map(&m)?;
         }
