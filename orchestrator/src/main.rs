@@ -70,6 +70,20 @@ enum FmuCommand {
 
 #[derive(Subcommand)]
 enum BenchCommand {
+    /// The navigation experiment: N trials to seeded targets; DIR/summary.json, trials.jsonl,
+    /// trials/<NNNN>.mcap, report.html.
+    Nav {
+        #[arg(long, default_value = "models/scenarios/default.toml")]
+        scenario: PathBuf,
+        #[arg(long, default_value_t = 50)]
+        trials: u64,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        #[command(flatten)]
+        dirs: Dirs,
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Orchestrator cost per FMU and step, beside the bare fmi3DoStep cost (JSON on stdout).
     Overhead {
         #[arg(long, default_value = "models/scenarios/default.toml")]
@@ -163,6 +177,12 @@ fn real_main() -> Result<()> {
             let opts = run_options(dirs, &target, seed, duration, fmus.into_iter().collect());
             let summary = agrisim::run::run(&s, &opts, &out, progress_printer())?;
             println!("{} steps ({} s simulated) -> {}", summary.steps, summary.simulated, summary.mcap.display());
+        }
+        Command::Bench { command: BenchCommand::Nav { scenario, trials, seed, dirs, out } } => {
+            let s = Scenario::load(&scenario)?;
+            let opts = run_options(dirs, &target, None, None, BTreeMap::new());
+            let summary = agrisim::bench::nav::bench_nav(&s, &opts, trials, seed, &out, progress_printer())?;
+            println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
         }
         Command::Bench { command: BenchCommand::Overhead { scenario, steps, dirs, out } } => {
             let s = Scenario::load(&scenario)?;

@@ -1,6 +1,7 @@
 //! Benchmarks: the master's overhead, and the many-trial evaluations (navigation) with honest
 //! statistics and every trial recorded.
 
+pub mod nav;
 pub mod overhead;
 pub mod report;
 pub mod stats;

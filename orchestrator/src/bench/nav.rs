@@ -104,7 +104,7 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &NavSetup, index: u64, see
     let nav = &s.nav;
     let target = draw_target(&setup.layout, &setup.map, &mut rng, nav.targets_in_headland, nav.aisle_margin, 0.7)
         .ok_or_else(|| crate::err!("scenario {}: no free navigation target could be drawn", s.path.display()))?;
-    let navigator = crate::nav::Navigator::new(crate::nav::NavigatorConfig::for_start(setup.layout.start_pose));
+    let navigator = crate::nav::Navigator::new(crate::nav::NavConfig::for_start(setup.layout.start_pose));
     let nodes: Vec<Box<dyn Node>> = vec![
         Box::new(MapServer::new(&setup.map)),
         Box::new(OdomTf::default()),
