@@ -86,14 +86,20 @@ fn read_f64(m: &mut Master, comp: usize, name: &str) -> Result<f64> {
 pub struct NavSetup {
     pub layout: agrisim_greenhouse::Layout,
     pub objects: Vec<agrisim_greenhouse::Object>,
+    /// The static map the robot is given: the building plan, without obstacles (those it
+    /// must find with its LiDAR and plan around).
     pub map: OccupancyMap,
+    /// Everything, obstacles included: only to keep targets out of obstacles.
+    pub truth: OccupancyMap,
 }
 
 impl NavSetup {
     pub fn new(s: &Scenario) -> Result<NavSetup> {
         let g = crate::scene::generate_scene(s)?;
-        let map = OccupancyMap::from_objects(&g.objects, MAP_RESOLUTION, MAP_BAND, g.layout.bounds);
-        Ok(NavSetup { layout: g.layout, objects: g.objects, map })
+        let planned: Vec<_> = g.objects.iter().filter(|o| o.kind != agrisim_greenhouse::Kind::Obstacle).cloned().collect();
+        let map = OccupancyMap::from_objects(&planned, MAP_RESOLUTION, MAP_BAND, g.layout.bounds);
+        let truth = OccupancyMap::from_objects(&g.objects, MAP_RESOLUTION, MAP_BAND, g.layout.bounds);
+        Ok(NavSetup { layout: g.layout, objects: g.objects, map, truth })
     }
 }
 
@@ -102,7 +108,7 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &NavSetup, index: u64, see
     let wall = Instant::now();
     let mut rng = Rng::new(seed);
     let nav = &s.nav;
-    let target = draw_target(&setup.layout, &setup.map, &mut rng, nav.targets_in_headland, nav.aisle_margin, 0.7)
+    let target = draw_target(&setup.layout, &setup.truth, &mut rng, nav.targets_in_headland, nav.aisle_margin, 0.7)
         .ok_or_else(|| crate::err!("scenario {}: no free navigation target could be drawn", s.path.display()))?;
     let navigator = crate::nav::Navigator::new(crate::nav::NavConfig::for_start(setup.layout.start_pose));
     let nodes: Vec<Box<dyn Node>> = vec![

@@ -53,9 +53,9 @@ pub struct ControllerConfig {
 impl Default for ControllerConfig {
     fn default() -> Self {
         ControllerConfig {
-            max_vx: 0.5,
-            max_vy: 0.5,
-            max_speed_xy: 0.5,
+            max_vx: 0.8,
+            max_vy: 0.8,
+            max_speed_xy: 0.8,
             max_wz: 0.8,
             acc_xy: 1.0,
             acc_wz: 2.0,

@@ -33,7 +33,7 @@ pub struct LocalCostmapConfig {
 
 impl Default for LocalCostmapConfig {
     fn default() -> Self {
-        LocalCostmapConfig { size: 8.0, min_z: 0.05, max_z: 1.5, max_range: 6.0, map_tolerance: 0.15, self_filter_margin: 0.1, clearing_bins: 720 }
+        LocalCostmapConfig { size: 20.0, min_z: 0.05, max_z: 1.5, max_range: 9.5, map_tolerance: 0.15, self_filter_margin: 0.1, clearing_bins: 720 }
     }
 }
 
