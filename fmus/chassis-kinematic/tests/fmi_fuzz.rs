@@ -1,21 +1,4 @@
 //! Random FMI call sequences (illegal orders, NULLs, bad value references, wrong sizes, NaN,
 //! odd step sizes) into the ChassisKinematic FMU's C API layer: no panic escapes, statuses stay valid.
 
-#[test]
-fn variable_table_makes_a_valid_fmu() {
-    agrisim_fmi::testing::assert_valid_table::<agrisim_chassis::ChassisKinematic>();
-}
-
-#[test]
-fn random_fmi3_call_sequences() {
-    for seed in 0..4 {
-        agrisim_fmi::testing::fuzz_fmi3::<agrisim_chassis::ChassisKinematic>(seed, 300);
-    }
-}
-
-#[test]
-fn random_fmi2_call_sequences() {
-    for seed in 0..4 {
-        agrisim_fmi::testing::fuzz_fmi2::<agrisim_chassis::ChassisKinematic>(seed, 300);
-    }
-}
+agrisim_fmi::fmu_conformance_tests!(agrisim_chassis::ChassisKinematic, seeds = 4, cases = 300);

@@ -793,3 +793,35 @@ pub fn fuzz_fmi2<M: Model>(seed: u64, cases: usize) {
         }
     }
 }
+
+/// The conformance tests every FMU crate runs, in one line of its `tests/fmi_fuzz.rs`:
+/// its variable table makes a valid FMU, and `seeds` x `cases` random FMI 3 and FMI 2 call
+/// sequences (illegal orders, NULLs, bad value references, wrong sizes, NaN, odd step sizes)
+/// never let a panic escape nor return an invalid status.
+///
+/// ```ignore
+/// agrisim_fmi::fmu_conformance_tests!(agrisim_chassis::ChassisKinematic, seeds = 4, cases = 300);
+/// ```
+#[macro_export]
+macro_rules! fmu_conformance_tests {
+    ($model:ty, seeds = $seeds:expr, cases = $cases:expr) => {
+        #[test]
+        fn variable_table_makes_a_valid_fmu() {
+            $crate::testing::assert_valid_table::<$model>();
+        }
+
+        #[test]
+        fn random_fmi3_call_sequences() {
+            for seed in 0..$seeds {
+                $crate::testing::fuzz_fmi3::<$model>(seed, $cases);
+            }
+        }
+
+        #[test]
+        fn random_fmi2_call_sequences() {
+            for seed in 0..$seeds {
+                $crate::testing::fuzz_fmi2::<$model>(seed, $cases);
+            }
+        }
+    };
+}

@@ -4,21 +4,4 @@
 
 use agrisim_fmu_world::GreenhouseWorld;
 
-#[test]
-fn variable_table_makes_a_valid_fmu() {
-    agrisim_fmi::testing::assert_valid_table::<GreenhouseWorld>();
-}
-
-#[test]
-fn random_fmi3_call_sequences() {
-    for seed in 0..4 {
-        agrisim_fmi::testing::fuzz_fmi3::<GreenhouseWorld>(seed, 300);
-    }
-}
-
-#[test]
-fn random_fmi2_call_sequences() {
-    for seed in 0..4 {
-        agrisim_fmi::testing::fuzz_fmi2::<GreenhouseWorld>(seed, 300);
-    }
-}
+agrisim_fmi::fmu_conformance_tests!(GreenhouseWorld, seeds = 4, cases = 300);

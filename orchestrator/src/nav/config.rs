@@ -267,7 +267,7 @@ mod tests {
         let c: NavConfig = toml::from_str("[localization]\ninitial_pose = [1.0, 2.0, 0.5]\n[controller]\nmax_vx = 0.4\n").unwrap();
         assert_eq!(c.localization.initial_pose, [1.0, 2.0, 0.5]);
         assert_eq!(c.controller.max_vx, 0.4);
-        assert_eq!(c.controller.max_vy, 0.5);
+        assert_eq!(c.controller.max_vy, 0.8);
         assert_eq!(c.executor.xy_goal_tolerance, 0.25);
     }
 }

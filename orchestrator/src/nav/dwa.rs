@@ -71,7 +71,7 @@ impl Default for ControllerConfig {
             w_heading: 0.3,
             w_obstacle: 0.3,
             w_spin: 0.02,
-            collision_margin: 0.03,
+            collision_margin: 0.06,
             clearance_scale: 0.15,
             rotate_gain: 1.5,
         }

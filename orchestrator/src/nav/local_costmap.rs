@@ -237,7 +237,7 @@ mod tests {
     #[test]
     fn marks_clears_and_rolls() {
         let map = empty_map();
-        let mut lc = LocalCostmap::new(LocalCostmapConfig::default(), &map.geom);
+        let mut lc = LocalCostmap::new(LocalCostmapConfig { size: 8.0, ..LocalCostmapConfig::default() }, &map.geom);
         let fp = Footprint::default();
         let robot = Pose2::new(0.0, 0.0, 0.0);
         // A post 2 m ahead, floor and self hits ignored.
