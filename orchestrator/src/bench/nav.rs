@@ -228,10 +228,30 @@ pub fn bench_nav(s: &Scenario, o: &RunOptions, trials: u64, seed: u64, out: &Pat
         ("mean time to goal [s]".to_string(), summary.time_to_goal_mean.map_or("-".into(), |t| format!("{t:.1}"))),
         ("min clearance [m]".to_string(), format!("{:.3}", summary.min_clearance_min)),
     ];
-    let html = render(&format!("agrisim nav benchmark: {}", s.name), &rows, &setup.objects, setup.layout.bounds, &traces);
+    let html = render(&format!("agrisim nav benchmark: {}", s.name), &rows, &setup.objects, view_bounds(&setup.layout, &traces), &traces);
     let rp = out.join("report.html");
     std::fs::write(&rp, html).context(|| rp.display().to_string())?;
     Ok(summary)
+}
+
+/// What the report's map shows: the rows, the headland and every path, with a margin (the
+/// hall around them is mostly empty floor).
+fn view_bounds(layout: &agrisim_greenhouse::Layout, traces: &[TrialTrace]) -> [f64; 4] {
+    let [hx0, hy0, hx1, hy1] = layout.headland;
+    let mut b = [hx0, hy0, hx1, hy1];
+    let mut grow = |x: f64, y: f64| {
+        b = [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)];
+    };
+    for r in layout.rows.iter().filter(|r| r.active) {
+        grow(r.x_start, r.y);
+        grow(r.x_end, r.y);
+    }
+    for p in traces.iter().flat_map(|t| t.path.iter()) {
+        grow(p[0], p[1]);
+    }
+    let m = 1.5;
+    let [x0, y0, x1, y1] = layout.bounds;
+    [(b[0] - m).max(x0), (b[1] - m).max(y0), (b[2] + m).min(x1), (b[3] + m).min(y1)]
 }
 
 fn decimate(path: &[[f64; 2]], every: usize) -> Vec<[f64; 2]> {
