@@ -2,7 +2,7 @@
 //! encoding, `offered_qos_profiles` channel metadata, log time = simulation time. Files made
 //! this way open in Foxglove and decode with mcap-ros2-support and rosbags.
 //!
-//! The writer is finished on drop as well, so a run that stops on an error still leaves a
+//! Chunks are zstd-compressed. The writer is finished on drop as well, so a run that stops on an error still leaves a
 //! complete, readable file with everything recorded up to the failure.
 
 use crate::error::{Context, Result};
@@ -30,7 +30,13 @@ pub struct Recorder {
 impl Recorder {
     pub fn create(path: &Path) -> Result<Recorder> {
         let file = File::create(path).context(|| format!("cannot create {}", path.display()))?;
-        let options = mcap::WriteOptions::new().profile("ros2").library("agrisim").compression(None);
+        // zstd chunks, single-threaded: point clouds make trials large, and one compression thread
+        // keeps the output a pure function of the input (byte-identical logs).
+        let options = mcap::WriteOptions::new()
+            .profile("ros2")
+            .library("agrisim")
+            .compression(Some(mcap::Compression::Zstd))
+            .compression_threads(0);
         let writer = options.create(BufWriter::new(file)).context(|| format!("cannot start MCAP file {}", path.display()))?;
         Ok(Recorder { writer: Some(writer), path: path.to_path_buf(), schemas: BTreeMap::new(), channels: BTreeMap::new(), sequence: BTreeMap::new() })
     }
