@@ -44,7 +44,9 @@ pub fn decode_xyz(cloud: &PointCloud2) -> Result<Vec<[f32; 3]>> {
         for i in 0..cloud.width as usize {
             let p = &cloud.data[r * row_step + i * step..r * row_step + (i + 1) * step];
             let q = [read(p, fx), read(p, fy), read(p, fz)];
-            if q.iter().all(|v| v.is_finite()) {
+            // No-return points come as (0, 0, 0) (as the Livox driver sends them): skip them,
+            // with anything non-finite, instead of reading them as obstacles at the sensor.
+            if q.iter().all(|v| v.is_finite()) && q != [0.0; 3] {
                 out.push(q);
             }
         }
