@@ -224,6 +224,29 @@ EXPECTED = {
         "detail": "no_path",
         "goal": {"header": hdr(12, 900_000_000, "map"), "pose": pose(4.0, 2.0, 0.0, q(0.0, 0.0, 1.0, 0.0))},
     },
+    "image": {
+        "header": hdr(3, 100_000_000, "camera_color_optical_frame"),
+        "height": 2,
+        "width": 2,
+        "encoding": "rgb8",
+        "is_bigendian": 0,
+        "step": 6,
+        "data": [255, 0, 0, 0, 255, 0, 0, 0, 255, 10, 20, 30],
+    },
+    "region_of_interest": {"x_offset": 3, "y_offset": 5, "height": 7, "width": 11, "do_rectify": True},
+    "camera_info": {
+        "header": hdr(3, 100_000_000, "camera_color_optical_frame"),
+        "height": 480,
+        "width": 640,
+        "distortion_model": "plumb_bob",
+        "d": [0.0] * 5,
+        "k": [400.5, 0.0, 319.5, 0.0, 400.5, 239.5, 0.0, 0.0, 1.0],
+        "r": [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+        "p": [400.5, 0.0, 319.5, 0.0, 0.0, 400.5, 239.5, 0.0, 0.0, 0.0, 1.0, 0.0],
+        "binning_x": 0,
+        "binning_y": 0,
+        "roi": {"x_offset": 0, "y_offset": 0, "height": 0, "width": 0, "do_rectify": False},
+    },
 }
 
 # ----------------------------------------------------------------------------- helpers
@@ -304,7 +327,7 @@ SAMPLE_NAMES = sorted(EXPECTED)
 def test_samples_cover_every_msg_file(samples):
     assert set(samples) == set(EXPECTED)
     assert {t for t, _, _ in samples.values()} == set(msg_files())
-    assert len(msg_files()) == 29
+    assert len(msg_files()) == 32
 
 
 @pytest.mark.parametrize("name", SAMPLE_NAMES)
@@ -397,4 +420,4 @@ def test_msg_texts_match_ros2_distro(rosbags_store, store_name):
             continue
         assert rosbags_store.fielddefs[name] == ref.fielddefs[name], name
         checked += 1
-    assert checked == 24
+    assert checked == 27

@@ -41,6 +41,9 @@ pub fn check_cdr(type_name: &str, bytes: &[u8]) -> Option<Result<(), CdrError>> 
         "agrisim_msgs/msg/Contact" => ok::<agrisim::Contact>(bytes),
         "agrisim_msgs/msg/CollisionState" => ok::<agrisim::CollisionState>(bytes),
         "agrisim_msgs/msg/NavigationStatus" => ok::<agrisim::NavigationStatus>(bytes),
+        "sensor_msgs/msg/Image" => ok::<sensor_msgs::Image>(bytes),
+        "sensor_msgs/msg/RegionOfInterest" => ok::<sensor_msgs::RegionOfInterest>(bytes),
+        "sensor_msgs/msg/CameraInfo" => ok::<sensor_msgs::CameraInfo>(bytes),
         _ => None,
     }
 }

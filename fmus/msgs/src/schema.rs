@@ -60,6 +60,9 @@ msg_table! {
     "agrisim_msgs" / "NavigationStatus",
     "agrisim_msgs" / "Signals",
     "agrisim_msgs" / "FmuStatus",
+    "sensor_msgs" / "Image",
+    "sensor_msgs" / "RegionOfInterest",
+    "sensor_msgs" / "CameraInfo",
 }
 
 /// Every type this crate knows, as `pkg/msg/Type`.

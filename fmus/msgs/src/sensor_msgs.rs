@@ -1,4 +1,4 @@
-//! `sensor_msgs`: joint states, point clouds, IMU.
+//! `sensor_msgs`: joint states, point clouds, IMU, images and camera calibration.
 
 use crate::message::ros_message;
 use crate::std_msgs::Header;
@@ -66,5 +66,51 @@ ros_message! {
         pub angular_velocity_covariance: [f64; 9],
         pub linear_acceleration: crate::geometry_msgs::Vector3,
         pub linear_acceleration_covariance: [f64; 9],
+    }
+}
+
+ros_message! {
+    /// `sensor_msgs/msg/Image`: an uncompressed image, rows top to bottom, `step` bytes each;
+    /// `encoding` names the pixel layout (`rgb8`, `32FC1`, `mono16`, `32SC1`, ...).
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct Image = "sensor_msgs/msg/Image" {
+        pub header: Header,
+        pub height: u32,
+        pub width: u32,
+        pub encoding: String,
+        pub is_bigendian: u8,
+        pub step: u32,
+        pub data: Vec<u8>,
+    }
+}
+
+ros_message! {
+    /// `sensor_msgs/msg/RegionOfInterest`: a sub-window of an image (all 0 = the full image).
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct RegionOfInterest = "sensor_msgs/msg/RegionOfInterest" {
+        pub x_offset: u32,
+        pub y_offset: u32,
+        pub height: u32,
+        pub width: u32,
+        pub do_rectify: bool,
+    }
+}
+
+ros_message! {
+    /// `sensor_msgs/msg/CameraInfo`: calibration of a camera; `k` (3x3), `r` (3x3) and `p`
+    /// (3x4) are row-major.
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct CameraInfo = "sensor_msgs/msg/CameraInfo" {
+        pub header: Header,
+        pub height: u32,
+        pub width: u32,
+        pub distortion_model: String,
+        pub d: Vec<f64>,
+        pub k: [f64; 9],
+        pub r: [f64; 9],
+        pub p: [f64; 12],
+        pub binning_x: u32,
+        pub binning_y: u32,
+        pub roi: RegionOfInterest,
     }
 }

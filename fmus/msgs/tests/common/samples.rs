@@ -9,7 +9,9 @@ use agrisim_msgs::builtin_interfaces::Time;
 use agrisim_msgs::geometry_msgs::*;
 use agrisim_msgs::nav_msgs::{MapMetaData, OccupancyGrid, Odometry, Path};
 use agrisim_msgs::rosgraph_msgs::Clock;
-use agrisim_msgs::sensor_msgs::{Imu, JointState, PointCloud2, PointField};
+use agrisim_msgs::sensor_msgs::{
+    CameraInfo, Image, Imu, JointState, PointCloud2, PointField, RegionOfInterest,
+};
 use agrisim_msgs::std_msgs::Header;
 use agrisim_msgs::tf2_msgs::TFMessage;
 use agrisim_msgs::{CdrError, Message};
@@ -362,6 +364,38 @@ pub fn all_samples() -> Vec<Sample> {
                     header: hdr(12, 900_000_000, "map"),
                     pose: pose(4.0, 2.0, 0.0, q(0.0, 0.0, 1.0, 0.0)),
                 },
+            },
+        ),
+        sample(
+            "image",
+            Image {
+                header: hdr(3, 100_000_000, "camera_color_optical_frame"),
+                height: 2,
+                width: 2,
+                encoding: "rgb8".into(),
+                is_bigendian: 0,
+                step: 6,
+                data: vec![255, 0, 0, 0, 255, 0, 0, 0, 255, 10, 20, 30],
+            },
+        ),
+        sample(
+            "region_of_interest",
+            RegionOfInterest { x_offset: 3, y_offset: 5, height: 7, width: 11, do_rectify: true },
+        ),
+        sample(
+            "camera_info",
+            CameraInfo {
+                header: hdr(3, 100_000_000, "camera_color_optical_frame"),
+                height: 480,
+                width: 640,
+                distortion_model: "plumb_bob".into(),
+                d: vec![0.0; 5],
+                k: [400.5, 0.0, 319.5, 0.0, 400.5, 239.5, 0.0, 0.0, 1.0],
+                r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
+                p: [400.5, 0.0, 319.5, 0.0, 0.0, 400.5, 239.5, 0.0, 0.0, 0.0, 1.0, 0.0],
+                binning_x: 0,
+                binning_y: 0,
+                roi: RegionOfInterest::default(),
             },
         ),
     ]

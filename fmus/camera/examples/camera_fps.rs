@@ -1,0 +1,66 @@
+//! Frames per second of whole camera frames (render + CDR encoding of image, depth, labels,
+//! CameraInfo) on the default greenhouse, the robot in the middle of aisle 0 looking along
+//! the aisle and then at a row, at 1280x720 and 640x480. Single-threaded.
+//! `cargo run --release -p agrisim-fmu-camera --example camera_fps [FRAMES]`.
+
+use agrisim_fmi::{Log, Model, Store, Value};
+use agrisim_fmu_camera::ports::*;
+use agrisim_fmu_camera::Camera;
+use agrisim_greenhouse::{generate, GreenhouseConfig};
+use std::time::Instant;
+
+struct Quiet;
+impl Log for Quiet {
+    fn info(&mut self, _: &str) {}
+    fn warning(&mut self, _: &str) {}
+}
+
+fn main() {
+    let frames: usize = std::env::args()
+        .nth(1)
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(5);
+    let cfg = GreenhouseConfig::from_toml_str("").expect("scene");
+    let gh = generate(&cfg, cfg.seed);
+    let a = &gh.layout.aisles[0];
+    let (x, y) = (0.5 * (a.x_start + a.x_end), a.y);
+    for (w, h) in [(1280, 720), (640, 480)] {
+        for (name, yaw) in [
+            ("along the aisle", 0.0),
+            ("at a row", std::f64::consts::FRAC_PI_2),
+        ] {
+            let mut io = Store::new(Camera::VARIABLES);
+            *io.value_mut(WIDTH) = Value::Int32(w);
+            *io.value_mut(HEIGHT) = Value::Int32(h);
+            io.set_f64(BASE_X, x);
+            io.set_f64(BASE_Y, y);
+            io.set_f64(BASE_YAW, yaw);
+            let mut m = Camera::new();
+            m.initialize(&mut io, 0.0, &mut Quiet).expect("initialize");
+            // One step per frame (step = frame period): every step publishes.
+            m.do_step(&mut io, 0.0, 0.1, &mut Quiet).expect("warm-up");
+            let t = Instant::now();
+            for k in 1..=frames {
+                m.do_step(&mut io, k as f64 * 0.1, 0.1, &mut Quiet)
+                    .expect("step");
+            }
+            let s = t.elapsed().as_secs_f64();
+            assert_eq!(io.i64(IMAGE_SEQ), frames as i64 + 1);
+            println!(
+                "{w}x{h} {name}: {frames} frames in {s:.2} s = {:.2} frames/s ({:.2} M primary rays/s), {:.1} % valid depth",
+                frames as f64 / s,
+                (w as usize * h as usize * frames) as f64 / s * 1e-6,
+                100.0 * io.i32(VALID_DEPTH) as f64 / (w * h) as f64
+            );
+            if w == 640 {
+                let f = m.capture(x, y, yaw);
+                let out = f
+                    .true_depth
+                    .iter()
+                    .filter(|&&z| !(0.105..=10.0).contains(&z))
+                    .count();
+                println!("    no data: {:.1} % out of range (or sky), {:.1} % discontinuity or left band", 100.0 * out as f64 / f.depth.len() as f64, 100.0 * (f.depth.len() - f.valid - out) as f64 / f.depth.len() as f64);
+            }
+        }
+    }
+}

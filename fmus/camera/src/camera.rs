@@ -1,0 +1,242 @@
+//! The `Camera` model: at every frame instant (k / frame_rate on simulation time) renders the
+//! scene from the latest base pose input and publishes colour, depth, CameraInfo and labels.
+//!
+//! The frame due at T is rendered during the step that reaches T, from the pose at the step's
+//! start (the chassis pose at T is not known yet): up to one communication step of lag
+//! (2 cm at 1 m/s with the 0.02 s step). Global shutter; colour and depth are co-registered
+//! (as the driver's aligned depth), one optical frame.
+
+use crate::image;
+use crate::optics::{CameraPose, Intrinsics, Mount};
+use crate::ports::*;
+use crate::render::{self, DepthModel, DepthNoise, Frame, Lighting};
+use crate::scene::{self, Scene};
+use agrisim_fmi::{Log, Model, Store, Var};
+use agrisim_fmu_util::{Rng, Schedule};
+use agrisim_msgs::Message;
+use std::sync::Arc;
+
+pub const MAX_SIDE: i32 = 4096;
+
+#[derive(Clone, Debug)]
+pub struct Config {
+    pub scene: Arc<Scene>,
+    pub intrinsics: Intrinsics,
+    pub period: f64,
+    pub mount: Mount,
+    pub depth: DepthModel,
+    pub light: Lighting,
+    pub labels: bool,
+    pub frame_id: String,
+    /// Base box (length, width, height, clearance).
+    pub base: [f64; 4],
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct Camera {
+    config: Option<Config>,
+    schedule: Schedule,
+    rng: Rng,
+    seq: i64,
+}
+
+fn param(io: &Store, i: usize, ok: impl Fn(f64) -> bool, what: &str) -> Result<f64, String> {
+    let v = io.f64(i);
+    if v.is_finite() && ok(v) {
+        Ok(v)
+    } else {
+        Err(format!(
+            "parameter {} must be {what}, got {v}",
+            VARIABLES[i].name
+        ))
+    }
+}
+
+fn side(io: &Store, i: usize) -> Result<u32, String> {
+    let v = io.i32(i);
+    if (1..=MAX_SIDE).contains(&v) {
+        Ok(v as u32)
+    } else {
+        Err(format!(
+            "parameter {} must be in [1, {MAX_SIDE}], got {v}",
+            VARIABLES[i].name
+        ))
+    }
+}
+
+impl Config {
+    pub fn from_params(io: &Store) -> Result<Config, String> {
+        let any = |_: f64| true;
+        let fov = |v: f64| v > 0.0 && v < 180.0;
+        let width = side(io, WIDTH)?;
+        let height = side(io, HEIGHT)?;
+        let fov_v = param(io, FOV_V, fov, "in (0, 180) deg")?;
+        let fov_h = match param(
+            io,
+            FOV_H,
+            |v| v == 0.0 || fov(v),
+            "0 (square pixels) or in (0, 180) deg",
+        )? {
+            0.0 => {
+                2.0 * (width as f64 / height as f64 * (0.5 * fov_v.to_radians()).tan())
+                    .atan()
+                    .to_degrees()
+            }
+            v => v,
+        };
+        let rate = param(
+            io,
+            FRAME_RATE,
+            |v| v > 0.0 && v <= 1000.0,
+            "in (0, 1000] Hz",
+        )?;
+        let range_min = param(io, RANGE_MIN, |v| v >= 0.0, ">= 0")?;
+        let range_max = param(io, RANGE_MAX, |v| v > range_min, "above range_min")?;
+        let noise = match io.i32(DEPTH_NOISE_MODEL) {
+            0 => DepthNoise::None,
+            1 => DepthNoise::Fixed {
+                sigma: param(io, DEPTH_NOISE_SIGMA, |v| v >= 0.0, ">= 0")?,
+            },
+            2 => DepthNoise::Stereo {
+                subpixel: param(io, SUBPIXEL, |v| v >= 0.0, ">= 0")?,
+            },
+            m => return Err(format!(
+                "parameter depth_noise_model must be 0 (none), 1 (fixed) or 2 (stereo), got {m}"
+            )),
+        };
+        let translation = [
+            param(io, MOUNT_X, any, "finite")?,
+            param(io, MOUNT_Y, any, "finite")?,
+            param(io, MOUNT_Z, any, "finite")?,
+        ];
+        let mount = Mount {
+            translation,
+            roll: param(io, MOUNT_ROLL, any, "finite")?,
+            pitch: param(io, MOUNT_PITCH, any, "finite")?,
+            yaw: param(io, MOUNT_YAW, any, "finite")?,
+        };
+        let light = Lighting::new(
+            param(io, SUN_AZIMUTH, any, "finite")?,
+            param(io, SUN_ELEVATION, |v| v.abs() <= 90.0, "in [-90, 90] deg")?,
+            param(io, AMBIENT, |v| v >= 0.0, ">= 0")?,
+        );
+        let base = [
+            param(io, BASE_LENGTH, |v| v > 0.0, "positive")?,
+            param(io, BASE_WIDTH, |v| v > 0.0, "positive")?,
+            param(io, BASE_HEIGHT, |v| v > 0.0, "positive")?,
+            param(io, BASE_CLEARANCE, |v| v >= 0.0, ">= 0")?,
+        ];
+        Ok(Config {
+            scene: scene::load(io.string(SCENE), io.i32(SCENE_SEED))?,
+            intrinsics: Intrinsics::from_fov(width, height, fov_h, fov_v),
+            period: 1.0 / rate,
+            mount,
+            depth: DepthModel {
+                range: (range_min, range_max),
+                noise,
+                baseline: param(io, BASELINE, |v| v > 0.0, "positive")?,
+                invalid_band: io.bool(INVALID_BAND),
+                edge_ratio: param(io, EDGE_RATIO, |v| v >= 0.0, ">= 0")?,
+            },
+            light,
+            labels: io.bool(LABELS),
+            frame_id: io.string(FRAME_ID).to_string(),
+            base,
+        })
+    }
+}
+
+fn base_pose(io: &Store) -> Result<(f64, f64, f64), String> {
+    let p = (io.f64(BASE_X), io.f64(BASE_Y), io.f64(BASE_YAW));
+    if [p.0, p.1, p.2]
+        .iter()
+        .all(|v| v.is_finite() && v.abs() < 1e6)
+    {
+        Ok(p)
+    } else {
+        Err(format!("robot pose input (base_x, base_y, base_yaw) = ({}, {}, {}) is not finite or beyond 1e6", p.0, p.1, p.2))
+    }
+}
+
+impl Camera {
+    /// Renders a frame with base_link at (x, y, yaw) (advances the noise generator).
+    pub fn capture(&mut self, x: f64, y: f64, yaw: f64) -> Frame {
+        let c = self.config.as_ref().expect("initialized");
+        let robot = scene::base_box(c.scene.object_count() as u32, c.base, x, y, yaw);
+        let pose = CameraPose::new(&c.mount, x, y, yaw);
+        render::render(
+            &c.scene,
+            std::slice::from_ref(&robot),
+            &c.intrinsics,
+            &pose,
+            &c.light,
+            &c.depth,
+            &mut self.rng,
+        )
+    }
+
+    pub fn config(&self) -> Option<&Config> {
+        self.config.as_ref()
+    }
+}
+
+impl Model for Camera {
+    const NAME: &'static str = "Camera";
+    const TOKEN: &'static str = "{7c1e4b2a-93d5-4f08-b6a2-agrisim-camera-1}";
+    const DESCRIPTION: &'static str = "RGB-D camera modelled on the Intel RealSense D435i (1280x720, 87x58 deg, 10 Hz): rgb8 + 32FC1 depth with stereo noise + CameraInfo + instance labels, ray cast at the greenhouse scene";
+    const VARIABLES: &'static [Var] = VARIABLES;
+
+    fn new() -> Self {
+        Self::default()
+    }
+
+    fn initialize(
+        &mut self,
+        io: &mut Store,
+        start_time: f64,
+        _log: &mut dyn Log,
+    ) -> Result<(), String> {
+        let config = Config::from_params(io)?;
+        base_pose(io)?;
+        self.schedule = Schedule::new(1.0 / config.period, start_time)?;
+        self.rng = Rng::new(io.i32(NOISE_SEED) as u32 as u64);
+        self.seq = 0;
+        self.config = Some(config);
+        Ok(())
+    }
+
+    fn do_step(
+        &mut self,
+        io: &mut Store,
+        t: f64,
+        h: f64,
+        _log: &mut dyn Log,
+    ) -> Result<(), String> {
+        let (x, y, yaw) = base_pose(io)?;
+        let Some(stamp) = self.schedule.due(t + h) else {
+            return Ok(());
+        };
+        let frame = self.capture(x, y, yaw);
+        let c = self.config.as_ref().expect("initialized");
+        let (w, hh, id) = (c.intrinsics.width, c.intrinsics.height, c.frame_id.as_str());
+        let info = c.intrinsics.camera_info(stamp, id).to_cdr();
+        let rgb = image::rgb8(stamp, id, w, hh, &frame.rgb).to_cdr();
+        let depth = image::depth_32fc1(stamp, id, w, hh, &frame.depth).to_cdr();
+        let labels = c
+            .labels
+            .then(|| image::labels_32sc1(stamp, id, w, hh, &frame.labels).to_cdr());
+        self.seq += 1;
+        io.set_binary(IMAGE, &rgb);
+        io.set_i64(IMAGE_SEQ, self.seq);
+        io.set_binary(DEPTH, &depth);
+        io.set_i64(DEPTH_SEQ, self.seq);
+        io.set_binary(CAMERA_INFO, &info);
+        io.set_i64(CAMERA_INFO_SEQ, self.seq);
+        if let Some(l) = labels {
+            io.set_binary(LABELS_IMAGE, &l);
+            io.set_i64(LABELS_SEQ, self.seq);
+        }
+        io.set_i32(VALID_DEPTH, frame.valid as i32);
+        Ok(())
+    }
+}

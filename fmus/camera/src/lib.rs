@@ -1,0 +1,22 @@
+//! RGB-D camera FMU (`Camera`) modelled on the Intel RealSense D435i.
+//!
+//! - [`optics`]: intrinsics from the field of view, CameraInfo, the optical frame's pose;
+//! - [`scene`]: the greenhouse (same TOML and seed as the world FMU) plus the robot's base box;
+//! - [`render`]: one ray per pixel, shadow rays toward the sun, labels, and the depth model
+//!   (range clip, discontinuities, left invalid band, fixed or stereo noise);
+//! - [`shading`]: albedo by kind (tomatoes by USDA ripeness stage), Lambert + ambient, sRGB;
+//! - [`image`]: sensor_msgs/Image encodings; [`datasheet`]: the D435i figures and sources;
+//! - [`camera`]: the FMI model; [`ports`]: its variable table.
+
+pub mod camera;
+pub mod datasheet;
+pub mod image;
+pub mod optics;
+pub mod ports;
+pub mod render;
+pub mod scene;
+pub mod shading;
+
+pub use camera::Camera;
+
+agrisim_fmi::export_fmu!(crate::Camera);

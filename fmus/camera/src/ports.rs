@@ -1,0 +1,86 @@
+//! The camera's variable table. Scene parameters and the base box match the Greenhouse (world)
+//! and LiDAR FMUs, so all see the same geometry from the same scenario text.
+
+use crate::datasheet as ds;
+use agrisim_fmi::{Start, Var};
+
+pub const IMAGE_MIME: &str = "application/x-ros2-cdr; type=sensor_msgs/msg/Image";
+pub const CAMERA_INFO_MIME: &str = "application/x-ros2-cdr; type=sensor_msgs/msg/CameraInfo";
+
+agrisim_fmi::variables! { pub VARIABLES {
+    // --- scene ---
+    SCENE = Var::param("scene", Start::String(""))
+        .desc("The keys of the scenario's [greenhouse] table as TOML (no header); empty = the default greenhouse"),
+    SCENE_SEED = Var::param("scene_seed", Start::Int32(-1))
+        .desc("Seed of the greenhouse generator; < 0 = the scene's own seed key (as the world FMU)"),
+    // --- sensor (RealSense D435i defaults) ---
+    NOISE_SEED = Var::param("seed", Start::Int32(0)).desc("Seed of the depth noise (set per run by the orchestrator)"),
+    FRAME_RATE = Var::param("frame_rate", Start::Float64(ds::FRAME_RATE)).unit("Hz").range(0.1, 1000.0)
+        .desc("Frames per second of simulation time"),
+    WIDTH = Var::param("width", Start::Int32(ds::WIDTH as i32)).desc("Image width [px], 1-4096"),
+    HEIGHT = Var::param("height", Start::Int32(ds::HEIGHT as i32)).desc("Image height [px], 1-4096"),
+    FOV_H = Var::param("fov_horizontal", Start::Float64(ds::FOV_H_DEG)).unit("deg").range(0.0, 170.0)
+        .desc("Horizontal field of view (D435i depth: 87 deg); fx = width/2 / tan(fov/2); 0 = square pixels (fx = fy)"),
+    FOV_V = Var::param("fov_vertical", Start::Float64(ds::FOV_V_DEG)).unit("deg").range(1.0, 170.0)
+        .desc("Vertical field of view (D435i depth: 58 deg); fy = height/2 / tan(fov/2)"),
+    RANGE_MIN = Var::param("range_min", Start::Float64(ds::RANGE_MIN)).unit("m").range(0.0, 1000.0)
+        .desc("Near clip of depth (z); nearer pixels are 0 (no data)"),
+    RANGE_MAX = Var::param("range_max", Start::Float64(ds::RANGE_MAX)).unit("m").range(0.01, 1000.0)
+        .desc("Far clip of depth (z); farther pixels are 0 (no data)"),
+    DEPTH_NOISE_MODEL = Var::param("depth_noise_model", Start::Int32(2))
+        .desc("0 none; 1 fixed Gaussian depth_noise_sigma (the paper); 2 stereo: RMS = z^2 subpixel / (fx baseline) (Intel)"),
+    DEPTH_NOISE_SIGMA = Var::param("depth_noise_sigma", Start::Float64(ds::FIXED_SIGMA)).unit("m").range(0.0, 10.0)
+        .desc("Depth noise of model 1, 1 sigma (paper: 0.015 m)"),
+    BASELINE = Var::param("baseline", Start::Float64(ds::BASELINE)).unit("m").range(0.001, 10.0)
+        .desc("Stereo baseline of model 2 and of the left invalid band (D435i: 50 mm)"),
+    SUBPIXEL = Var::param("subpixel", Start::Float64(ds::SUBPIXEL)).range(0.0, 10.0)
+        .desc("Sub-pixel disparity RMS of model 2 [px] (Intel: 0.08 typical)"),
+    INVALID_BAND = Var::param("invalid_band", Start::Boolean(true))
+        .desc("Left-edge invalid band of a left-referenced stereo pair: pixel u is 0 when u < fx baseline / z"),
+    EDGE_RATIO = Var::param("depth_edge_ratio", Start::Float64(0.05)).range(0.0, 100.0)
+        .desc("Depth discontinuities: a pixel whose 4-neighbour is nearer by more than this fraction of its depth is 0; 0 = off"),
+    SUN_AZIMUTH = Var::param("sun_azimuth", Start::Float64(135.0)).unit("deg")
+        .desc("Direction toward the sun in the map frame, counter-clockwise from +x"),
+    SUN_ELEVATION = Var::param("sun_elevation", Start::Float64(50.0)).unit("deg").range(-90.0, 90.0)
+        .desc("Sun elevation above the horizon (<= 0: no direct light)"),
+    AMBIENT = Var::param("ambient", Start::Float64(0.35)).range(0.0, 10.0)
+        .desc("Diffuse (sky) light relative to direct sunlight on a surface facing the sun"),
+    LABELS = Var::param("publish_labels", Start::Boolean(true))
+        .desc("Publish the instance-label image (32SC1: scene object id + 1, 0 = nothing)"),
+    FRAME_ID = Var::param("frame_id", Start::String("camera_color_optical_frame"))
+        .desc("header.frame_id of images and CameraInfo (optical convention: z forward, x right, y down)"),
+    // --- mount of camera_link on base_link (x forward, y left, z up; the optical frame is
+    // z forward, x right, y down relative to it) ---
+    MOUNT_X = Var::param("mount_x", Start::Float64(0.6)).unit("m").desc("Camera position on base_link"),
+    MOUNT_Y = Var::param("mount_y", Start::Float64(0.0)).unit("m"),
+    MOUNT_Z = Var::param("mount_z", Start::Float64(1.2)).unit("m"),
+    MOUNT_ROLL = Var::param("mount_roll", Start::Float64(0.0)).unit("rad")
+        .desc("camera_link orientation on base_link, roll-pitch-yaw about fixed axes (URDF); 0 = looking along base_link x"),
+    MOUNT_PITCH = Var::param("mount_pitch", Start::Float64(0.0)).unit("rad"),
+    MOUNT_YAW = Var::param("mount_yaw", Start::Float64(0.0)).unit("rad"),
+    // --- the robot's own base box ---
+    BASE_LENGTH = Var::param("base_length", Start::Float64(1.2)).unit("m").range(0.01, 20.0)
+        .desc("Robot base box extent along base_link x"),
+    BASE_WIDTH = Var::param("base_width", Start::Float64(0.9)).unit("m").range(0.01, 20.0),
+    BASE_HEIGHT = Var::param("base_height", Start::Float64(0.6)).unit("m").range(0.01, 20.0),
+    BASE_CLEARANCE = Var::param("base_clearance", Start::Float64(0.05)).unit("m").range(0.0, 5.0)
+        .desc("Height of the box bottom above the floor (base_link is on the floor)"),
+    // --- inputs ---
+    BASE_X = Var::input("base_x", 0.0).unit("m").desc("x of base_link in the map frame"),
+    BASE_Y = Var::input("base_y", 0.0).unit("m").desc("y of base_link in the map frame"),
+    BASE_YAW = Var::input("base_yaw", 0.0).unit("rad").desc("Yaw of base_link in the map frame"),
+    // --- outputs ---
+    IMAGE = Var::output_discrete("image", Start::Binary(&[])).mime(IMAGE_MIME)
+        .desc("Latest colour image, sensor_msgs/Image rgb8 (CDR)"),
+    IMAGE_SEQ = Var::output_discrete("image_seq", Start::Int64(0)).desc("Sequence counter of image"),
+    DEPTH = Var::output_discrete("depth", Start::Binary(&[])).mime(IMAGE_MIME)
+        .desc("Latest depth image aligned to the colour image, sensor_msgs/Image 32FC1, z in metres, 0 = no data (REP 118)"),
+    DEPTH_SEQ = Var::output_discrete("depth_seq", Start::Int64(0)).desc("Sequence counter of depth"),
+    CAMERA_INFO = Var::output_discrete("camera_info", Start::Binary(&[])).mime(CAMERA_INFO_MIME)
+        .desc("Calibration of the latest frame: plumb_bob, zero distortion, K from the field of view"),
+    CAMERA_INFO_SEQ = Var::output_discrete("camera_info_seq", Start::Int64(0)).desc("Sequence counter of camera_info"),
+    LABELS_IMAGE = Var::output_discrete("labels", Start::Binary(&[])).mime(IMAGE_MIME)
+        .desc("Latest instance labels, sensor_msgs/Image 32SC1: scene object id + 1 per pixel, 0 = nothing (empty when publish_labels is false)"),
+    LABELS_SEQ = Var::output_discrete("labels_seq", Start::Int64(0)).desc("Sequence counter of labels"),
+    VALID_DEPTH = Var::output_discrete("valid_depth_pixels", Start::Int32(0)).desc("Pixels with depth data in the latest frame"),
+}}

@@ -1,0 +1,120 @@
+//! Colour of a surface: albedo by object kind, Lambert shading under a fixed sun plus ambient
+//! sky light, sRGB output.
+//!
+//! Albedos are plausible sRGB colours (not measurements). Tomato colour follows the six USDA
+//! ripeness stages (USDA "United States Standards for Grades of Fresh Tomatoes", colour
+//! classification): 1 green, 2 breaker, 3 turning, 4 pink, 5 light red, 6 red.
+//!
+//! Radiance = albedo x (ambient + max(0, n.s) x visible) / (1 + ambient): exposure is set so
+//! a sunlit surface facing the sun shows its albedo. Shading is done on linear values and
+//! encoded with the sRGB transfer curve (IEC 61966-2-1).
+
+use agrisim_greenhouse::Kind;
+
+/// Colour of rays that hit nothing (sky), sRGB.
+pub const SKY: [u8; 3] = [170, 200, 235];
+
+/// sRGB colour of a tomato at USDA stage 1..6 (clamped).
+pub fn fruit_srgb(stage: u8) -> [u8; 3] {
+    const STAGES: [[u8; 3]; 6] = [
+        [88, 140, 42],  // 1 green
+        [160, 168, 64], // 2 breaker: first tint
+        [205, 150, 66], // 3 turning
+        [226, 118, 86], // 4 pink
+        [222, 68, 48],  // 5 light red
+        [190, 26, 20],  // 6 red
+    ];
+    STAGES[(stage.clamp(1, 6) - 1) as usize]
+}
+
+pub fn albedo_srgb(kind: Kind) -> [u8; 3] {
+    match kind {
+        Kind::Floor => [150, 145, 135],
+        Kind::Wall | Kind::Roof => [190, 205, 212],
+        Kind::Post | Kind::Gutter => [172, 174, 178],
+        Kind::HeatingPipe => [222, 222, 216],
+        Kind::Stem | Kind::Truss => [96, 128, 52],
+        Kind::Leaf => [58, 112, 38],
+        Kind::Fruit { ripeness } => fruit_srgb(ripeness),
+        Kind::Obstacle => [200, 122, 40],
+        Kind::Robot => [228, 228, 228],
+    }
+}
+
+/// Glass and clear film let sunlight through: they cast no shadow.
+pub fn casts_shadow(kind: Kind) -> bool {
+    !matches!(kind, Kind::Wall | Kind::Roof)
+}
+
+pub fn srgb_to_linear(c: u8) -> f64 {
+    let c = c as f64 / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+pub fn linear_to_srgb(l: f64) -> u8 {
+    let l = l.clamp(0.0, 1.0);
+    let c = if l <= 0.0031308 {
+        12.92 * l
+    } else {
+        1.055 * l.powf(1.0 / 2.4) - 0.055
+    };
+    (c * 255.0).round() as u8
+}
+
+/// Linear albedo per kind, precomputed.
+#[derive(Clone, Debug)]
+pub struct Palette {
+    lut: [f64; 256],
+}
+
+impl Default for Palette {
+    fn default() -> Self {
+        let mut lut = [0.0; 256];
+        for (i, v) in lut.iter_mut().enumerate() {
+            *v = srgb_to_linear(i as u8);
+        }
+        Palette { lut }
+    }
+}
+
+impl Palette {
+    pub fn albedo(&self, kind: Kind) -> [f64; 3] {
+        let c = albedo_srgb(kind);
+        [
+            self.lut[c[0] as usize],
+            self.lut[c[1] as usize],
+            self.lut[c[2] as usize],
+        ]
+    }
+}
+
+/// Shaded sRGB pixel: `cos_sun` = n.s (may be negative), `lit` = the sun is not blocked.
+pub fn shade(albedo: [f64; 3], cos_sun: f64, lit: bool, ambient: f64) -> [u8; 3] {
+    let direct = if lit { cos_sun.max(0.0) } else { 0.0 };
+    let e = (ambient + direct) / (1.0 + ambient);
+    [
+        linear_to_srgb(albedo[0] * e),
+        linear_to_srgb(albedo[1] * e),
+        linear_to_srgb(albedo[2] * e),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn srgb_round_trip_and_ripe_is_red() {
+        for c in 0..=255u8 {
+            assert_eq!(linear_to_srgb(srgb_to_linear(c)), c);
+        }
+        let [r, g, b] = fruit_srgb(6);
+        assert!(r as f64 > 3.0 * g as f64 && r > b);
+        let [r, g, _] = fruit_srgb(1);
+        assert!(g > r);
+    }
+}

@@ -1,0 +1,117 @@
+//! Rigid transforms as plain f64 arrays: the tree only needs compose, rotate and the URDF
+//! roll-pitch-yaw convention, which does not justify a linear-algebra dependency here.
+
+/// A rigid transform: `p_parent = rot * p_child + trans`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pose {
+    /// Row-major rotation matrix.
+    pub rot: [[f64; 3]; 3],
+    pub trans: [f64; 3],
+}
+
+impl Pose {
+    pub const IDENTITY: Pose = Pose {
+        rot: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        trans: [0.0; 3],
+    };
+
+    /// URDF `<origin xyz rpy>`: R = Rz(yaw) Ry(pitch) Rx(roll) (fixed axes x, y, z).
+    pub fn from_xyz_rpy(xyz: [f64; 3], rpy: [f64; 3]) -> Pose {
+        let (sr, cr) = rpy[0].sin_cos();
+        let (sp, cp) = rpy[1].sin_cos();
+        let (sy, cy) = rpy[2].sin_cos();
+        Pose {
+            rot: [
+                [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+                [-sp, cp * sr, cp * cr],
+            ],
+            trans: xyz,
+        }
+    }
+
+    /// Rotation by `angle` about the unit vector `axis` (Rodrigues).
+    pub fn from_axis_angle(axis: [f64; 3], angle: f64) -> Pose {
+        let [x, y, z] = axis;
+        let (s, c) = angle.sin_cos();
+        let t = 1.0 - c;
+        Pose {
+            rot: [
+                [t * x * x + c, t * x * y - s * z, t * x * z + s * y],
+                [t * x * y + s * z, t * y * y + c, t * y * z - s * x],
+                [t * x * z - s * y, t * y * z + s * x, t * z * z + c],
+            ],
+            trans: [0.0; 3],
+        }
+    }
+
+    pub fn from_translation(t: [f64; 3]) -> Pose {
+        Pose {
+            trans: t,
+            ..Pose::IDENTITY
+        }
+    }
+
+    /// `self * other`: `other` expressed in `self`'s parent frame.
+    pub fn mul(&self, other: &Pose) -> Pose {
+        let mut rot = [[0.0; 3]; 3];
+        for (i, row) in rot.iter_mut().enumerate() {
+            for (j, v) in row.iter_mut().enumerate() {
+                *v = (0..3).map(|k| self.rot[i][k] * other.rot[k][j]).sum();
+            }
+        }
+        Pose {
+            rot,
+            trans: self.transform_point(other.trans),
+        }
+    }
+
+    pub fn rotate(&self, v: [f64; 3]) -> [f64; 3] {
+        let r = &self.rot;
+        [0, 1, 2].map(|i| r[i][0] * v[0] + r[i][1] * v[1] + r[i][2] * v[2])
+    }
+
+    pub fn transform_point(&self, p: [f64; 3]) -> [f64; 3] {
+        let r = self.rotate(p);
+        [
+            r[0] + self.trans[0],
+            r[1] + self.trans[1],
+            r[2] + self.trans[2],
+        ]
+    }
+
+    pub fn inverse(&self) -> Pose {
+        let r = &self.rot;
+        let rt = [
+            [r[0][0], r[1][0], r[2][0]],
+            [r[0][1], r[1][1], r[2][1]],
+            [r[0][2], r[1][2], r[2][2]],
+        ];
+        let t = Pose {
+            rot: rt,
+            trans: [0.0; 3],
+        }
+        .rotate(self.trans);
+        Pose {
+            rot: rt,
+            trans: [-t[0], -t[1], -t[2]],
+        }
+    }
+
+    /// Column `i` of the rotation: the child's axis `i` in the parent frame.
+    pub fn axis(&self, i: usize) -> [f64; 3] {
+        [self.rot[0][i], self.rot[1][i], self.rot[2][i]]
+    }
+
+    /// Largest absolute element difference (rotation and translation), for tests and checks.
+    pub fn max_abs_diff(&self, other: &Pose) -> f64 {
+        let mut m: f64 = 0.0;
+        for i in 0..3 {
+            for j in 0..3 {
+                m = m.max((self.rot[i][j] - other.rot[i][j]).abs());
+            }
+            m = m.max((self.trans[i] - other.trans[i]).abs());
+        }
+        m
+    }
+}
