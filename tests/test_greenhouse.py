@@ -71,3 +71,20 @@ def test_scene_export_is_a_glb(tmp_path):
     chunk_len, chunk_type = struct.unpack_from("<I4s", data, 12)
     gltf = json.loads(data[20:20 + chunk_len])
     assert chunk_type == b"JSON" and gltf["asset"]["version"] == "2.0" and gltf["meshes"]
+
+
+def test_snapshot_writes_pictures_of_the_scene(tmp_path):
+    p = run_agrisim("snapshot", "--scenario", str(SCENARIO), "--out", str(tmp_path))
+    for name, (w, h) in {"rgb.png": (1280, 720), "depth.png": (1280, 720), "lidar_top.png": (800, 800)}.items():
+        data = (tmp_path / name).read_bytes()
+        assert data[:8] == b"\x89PNG\r\n\x1a\n", name
+        assert struct.unpack(">II", data[16:24]) == (w, h), name
+        assert str(tmp_path / name) in p.stdout
+    # Decoded independently (zlib + PNG filter 0): the image is not blank.
+    import zlib
+
+    data = (tmp_path / "rgb.png").read_bytes()
+    idat = data[data.index(b"IDAT") + 4 : data.index(b"IEND") - 8]
+    raw = np.frombuffer(zlib.decompress(idat), dtype=np.uint8).reshape(720, 1 + 1280 * 3)
+    assert (raw[:, 0] == 0).all()
+    assert raw[:, 1:].std() > 20

@@ -43,6 +43,15 @@ enum Command {
         #[command(subcommand)]
         command: BenchCommand,
     },
+    /// Pictures of the default view: DIR/rgb.png, DIR/depth.png, DIR/lidar_top.png.
+    Snapshot {
+        #[arg(long, default_value = "models/scenarios/default.toml")]
+        scenario: PathBuf,
+        #[command(flatten)]
+        dirs: Dirs,
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// The greenhouse scene.
     Scene {
         #[command(subcommand)]
@@ -189,6 +198,13 @@ fn real_main() -> Result<()> {
             let opts = run_options(dirs, &target, None, None, BTreeMap::new());
             let report = agrisim::bench::overhead(&s, &opts, steps, &out)?;
             println!("{}", serde_json::to_string_pretty(&report).expect("plain struct serializes"));
+        }
+        Command::Snapshot { scenario, dirs, out } => {
+            let s = Scenario::load(&scenario)?;
+            let opts = run_options(dirs, &target, None, None, BTreeMap::new());
+            for p in agrisim::snapshot::snapshot(&s, &opts, &out)? {
+                println!("{}", p.display());
+            }
         }
         Command::Scene { command: SceneCommand::Export { scenario, out } } => {
             let s = Scenario::load(&scenario)?;
