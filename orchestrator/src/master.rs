@@ -135,26 +135,13 @@ impl Master {
                 continue;
             }
             let (Port::Fmu { comp, var, seq }, Port::Bus { topic }) = (&route.from, &route.to) else { continue };
-            let (comp, var, seq, topic) = (*comp, var.clone(), seq.clone(), topic.clone());
-            let inst = &mut self.system.components[comp].instance;
-            match seq {
-                Some(seq) => {
-                    let Value::I64(n) = value::get(inst, &seq)? else { unreachable!("counter is Int64") };
-                    if n == self.system.routes[r].seen {
-                        continue;
-                    }
-                    self.system.routes[r].seen = n;
-                    let Value::Bin(bytes) = value::get(inst, &var)? else { unreachable!("message port is Binary") };
-                    let ty = self.system.routes[r].message_type.clone().expect("message route has a type");
-                    check_message(&self.system.components[comp].name, &var.name, &ty, &bytes, t_ns)?;
+            let (comp, var, is_message, topic) = (*comp, var.clone(), seq.is_some(), topic.clone());
+            if is_message {
+                if let Some((ty, bytes)) = self.take_message(r, t_ns)? {
                     self.bus.publish_raw(&topic, &ty, t_ns, bytes);
                 }
-                None => {
-                    let v = value::get(inst, &var)?;
-                    if let Some(x) = v.as_f64() {
-                        self.bus.set_scalar(&topic, x);
-                    }
-                }
+            } else if let Some(x) = value::get(&mut self.system.components[comp].instance, &var)?.as_f64() {
+                self.bus.set_scalar(&topic, x);
             }
         }
         Ok(())
@@ -179,26 +166,18 @@ impl Master {
                     (None, _) => self.bus.scalar(&topic).map(|x| scalar_for(&dst_var, x)).transpose()?,
                     _ => None,
                 },
-                Port::Fmu { comp: src, var, seq } => {
-                    let inst = &mut self.system.components[src].instance;
-                    match seq {
-                        Some(seq) => {
-                            let Value::I64(n) = value::get(inst, &seq)? else { unreachable!("counter is Int64") };
-                            if n == route.seen {
-                                None
-                            } else {
-                                self.system.routes[r].seen = n;
-                                let Value::Bin(bytes) = value::get(inst, &var)? else { unreachable!("message port is Binary") };
-                                let ty = self.system.routes[r].message_type.clone().expect("message route has a type");
-                                check_message(&self.system.components[src].name, &var.name, &ty, &bytes, t_ns)?;
-                                let topic = self.system.routes[r].topic.clone();
-                                self.bus.publish_raw(&topic, &ty, t_ns, bytes.clone());
-                                Some(Value::Bin(bytes))
-                            }
+                Port::Fmu { comp: src, var, seq } => match seq {
+                    // FMU-to-FMU messages are recorded on their route's topic too.
+                    Some(_) => match self.take_message(r, t_ns)? {
+                        Some((ty, bytes)) => {
+                            let topic = self.system.routes[r].topic.clone();
+                            self.bus.publish_raw(&topic, &ty, t_ns, bytes.clone());
+                            Some(Value::Bin(bytes))
                         }
-                        None => Some(value::get(inst, &var)?),
-                    }
-                }
+                        None => None,
+                    },
+                    None => Some(value::get(&mut self.system.components[src].instance, &var)?),
+                },
             };
             let Some(value) = value else { continue };
             let inst = &mut self.system.components[dst].instance;
@@ -210,6 +189,24 @@ impl Master {
             }
         }
         Ok(())
+    }
+
+    /// The new message of route `r`'s FMU source, if its counter moved since the route last
+    /// looked, checked against the port's ROS 2 type: (type, CDR bytes).
+    fn take_message(&mut self, r: usize, t_ns: i64) -> Result<Option<(String, Vec<u8>)>> {
+        let route = &self.system.routes[r];
+        let Port::Fmu { comp, var, seq: Some(seq) } = &route.from else { return Ok(None) };
+        let (comp, var, seq) = (*comp, var.clone(), seq.clone());
+        let inst = &mut self.system.components[comp].instance;
+        let Value::I64(n) = value::get(inst, &seq)? else { unreachable!("counter is Int64") };
+        if n == route.seen {
+            return Ok(None);
+        }
+        let Value::Bin(bytes) = value::get(inst, &var)? else { unreachable!("message port is Binary") };
+        let ty = route.message_type.clone().expect("message route has a type");
+        self.system.routes[r].seen = n;
+        check_message(&self.system.components[comp].name, &var.name, &ty, &bytes, t_ns)?;
+        Ok(Some((ty, bytes)))
     }
 
     /// Step 4: records everything published since the last point, /clock and the signals.
