@@ -12,6 +12,7 @@
 //! assert!(hit.distance > 0.1);
 //! ```
 
+pub mod cast_scene;
 pub mod config;
 pub mod generate;
 pub mod gltf;

@@ -25,7 +25,7 @@ fn main() {
     *io.value_mut(SCENE) = Value::String(scene.clone());
     let mut m = Lidar::new();
     m.initialize(&mut io, 0.0, &mut Quiet).expect("initialize");
-    println!("scene: {} objects, generated and prepared in {:.2} s", m.scene().unwrap().object_count, t.elapsed().as_secs_f64());
+    println!("scene: {} objects, generated and prepared in {:.2} s", m.scene().unwrap().object_count(), t.elapsed().as_secs_f64());
     let mut k = 0;
     for (name, [x, y, yaw]) in poses {
         io.set_f64(BASE_X, x);

@@ -19,7 +19,6 @@ use crate::scene::{self, BaseBox, Scene};
 use crate::trajectory::{Pose2, Trajectory};
 use agrisim_fmi::{Log, Model, Store, Var};
 use agrisim_fmu_util::{Rng, Schedule};
-use agrisim_greenhouse::Kind;
 use agrisim_msgs::sensor_msgs::PointCloud2;
 use agrisim_msgs::Message;
 use std::sync::Arc;
@@ -119,7 +118,6 @@ impl Lidar {
         let end_s = end_ns as f64 * 1e-9;
         let stamp_ns = if c.deskewed { end_ns } else { (p.time(n0) * 1e9).round() as i64 };
         let stamp_s = stamp_ns as f64 * 1e-9;
-        let robot_id = base.object.id;
         let end_pose = self.trajectory.at(end_s);
         let mut cloud = CloudBuilder::with_capacity(c.points_per_frame);
         let mut returns = 0;
@@ -143,11 +141,7 @@ impl Lidar {
             let t = (s - stamp_s) as f32;
             match c.scene.caster.cast(origin, d, c.range.0, c.range.1, std::slice::from_ref(&base.object)) {
                 Some(hit) => {
-                    let rho = if hit.object == robot_id {
-                        reflectivity::of_kind(Kind::Robot)
-                    } else {
-                        c.scene.reflectivity.get(hit.object as usize).copied().unwrap_or(0.0)
-                    };
+                    let rho = reflectivity::of_kind(c.scene.kind(hit.object));
                     let cos_incidence = -(hit.normal[0] * d[0] + hit.normal[1] * d[1] + hit.normal[2] * d[2]);
                     let r = hit.distance + self.rng.gauss(c.noise);
                     let xyz = [(d_sensor[0] * r) as f32, (d_sensor[1] * r) as f32, (d_sensor[2] * r) as f32];
@@ -183,7 +177,7 @@ impl Model for Lidar {
         let width = param(io, BASE_WIDTH, |v| v > 0.0, "positive")?;
         let height = param(io, BASE_HEIGHT, |v| v > 0.0, "positive")?;
         let clearance = param(io, BASE_CLEARANCE, |v| v >= 0.0, ">= 0")?;
-        self.base = Some(BaseBox::new(config.scene.object_count as u32, length, width, height, clearance));
+        self.base = Some(BaseBox::new(config.scene.object_count() as u32, length, width, height, clearance));
         self.trajectory = Trajectory::default();
         self.trajectory.push(start_time, pose(io)?, 2.0 * config.frame_period);
         self.schedule = Schedule::new(1.0 / config.frame_period, start_time)?;
