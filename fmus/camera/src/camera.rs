@@ -41,15 +41,7 @@ pub struct Camera {
 }
 
 fn param(io: &Store, i: usize, ok: impl Fn(f64) -> bool, what: &str) -> Result<f64, String> {
-    let v = io.f64(i);
-    if v.is_finite() && ok(v) {
-        Ok(v)
-    } else {
-        Err(format!(
-            "parameter {} must be {what}, got {v}",
-            VARIABLES[i].name
-        ))
-    }
+    agrisim_fmi::checked_f64(io, VARIABLES, i, ok, what)
 }
 
 fn side(io: &Store, i: usize) -> Result<u32, String> {

@@ -24,4 +24,4 @@ pub mod xml;
 
 pub use model::{Causality, Log, Model, ModelError, Start, Var, Variability};
 pub use state::{Mode, Status};
-pub use store::{Store, Value};
+pub use store::{checked_f64, Store, Value};

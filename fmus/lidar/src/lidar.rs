@@ -58,12 +58,7 @@ pub struct Lidar {
 }
 
 fn param(io: &Store, i: usize, ok: impl Fn(f64) -> bool, what: &str) -> Result<f64, String> {
-    let v = io.f64(i);
-    if v.is_finite() && ok(v) {
-        Ok(v)
-    } else {
-        Err(format!("parameter {} must be {what}, got {v}", VARIABLES[i].name))
-    }
+    agrisim_fmi::checked_f64(io, VARIABLES, i, ok, what)
 }
 
 fn pose(io: &Store) -> Result<Pose2, String> {
