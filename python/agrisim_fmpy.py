@@ -24,11 +24,12 @@ from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 
 REPO = Path(__file__).resolve().parents[1]
-FMU_DIR = REPO / "target" / "fmu"
+# AGRISIM_FMU_DIR: check FMUs packed elsewhere (e.g. a private target dir).
+FMU_DIR = Path(os.environ.get("AGRISIM_FMU_DIR", REPO / "target" / "fmu"))
 FMU2_DIR = FMU_DIR / "fmi2"
 DEFAULT_SCENARIO = REPO / "models" / "scenarios" / "base.toml"
 DEFAULT_SSD = REPO / "models" / "systems" / "base.ssd"
-EXPECTED_MODELS = ("ChassisKinematic", "ChassisDynamic", "Lift")
+EXPECTED_MODELS = ("ChassisKinematic", "ChassisDynamic", "Lift", "Arm")
 
 NS = {
     "ssd": "http://ssp-standard.org/SSP1/SystemStructureDescription",

@@ -12,6 +12,10 @@ analytic shape but miss the mesh (or the reverse).
 Needs numpy, pygltflib and open3d (Open3D 0.20 also needs Debian's libusb-1.0-0), e.g.:
     python3 -m venv .venv-bench && .venv-bench/bin/pip install open3d numpy pygltflib
     .venv-bench/bin/python python/bench_raycast.py [--rays N] [--config FILE] [--out DIR] [--no-run]
+
+With --camera the rays are the RGB-D camera's depth rays instead (one per pixel centre of
+1280x720 D435i frames in the middle aisle, from the Rust example `depth_rays` of
+agrisim-fmu-camera; --rays is then ignored, --poses sets the number of frames).
 """
 
 import argparse
@@ -86,9 +90,16 @@ def main():
     ap.add_argument("--config", help="greenhouse TOML (the keys of [greenhouse]); default: the paper's setup")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "bench_raycast"))
     ap.add_argument("--no-run", action="store_true", help="reuse the files of a previous Rust run")
+    ap.add_argument("--camera", action="store_true", help="the camera's depth rays (1280x720 frames) instead of LiDAR rays")
+    ap.add_argument("--poses", type=int, default=2, help="with --camera: frames of rays")
     args = ap.parse_args()
 
-    if not args.no_run:
+    if not args.no_run and args.camera:
+        cmd = ["cargo", "run", "--release", "-q", "-p", "agrisim-fmu-camera", "--example", "depth_rays", "--",
+               "--poses", str(args.poses), "--out", args.out]
+        print("$", " ".join(cmd), flush=True)
+        subprocess.run(cmd, cwd=ROOT, check=True)
+    elif not args.no_run:
         cmd = ["cargo", "run", "--release", "-q", "-p", "agrisim-greenhouse", "--example", "raycast_bench", "--",
                "--rays", str(args.rays), "--out", args.out]
         if args.config:

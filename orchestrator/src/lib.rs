@@ -7,6 +7,7 @@ pub mod bench;
 pub mod bus;
 pub mod error;
 pub mod fmi3;
+pub mod harvest;
 pub mod master;
 pub mod model_description;
 pub mod nav;

@@ -93,6 +93,20 @@ enum BenchCommand {
         #[arg(long)]
         out: PathBuf,
     },
+    /// The dual-arm harvesting experiment: N trials on seeded ripe fruit; DIR/summary.json,
+    /// trials.jsonl, trials/<NNNN>.mcap.
+    Harvest {
+        #[arg(long, default_value = "models/scenarios/harvest.toml")]
+        scenario: PathBuf,
+        #[arg(long, default_value_t = 50)]
+        trials: u64,
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        #[command(flatten)]
+        dirs: Dirs,
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Orchestrator cost per FMU and step, beside the bare fmi3DoStep cost (JSON on stdout).
     Overhead {
         #[arg(long, default_value = "models/scenarios/default.toml")]
@@ -191,6 +205,12 @@ fn real_main() -> Result<()> {
             let s = Scenario::load(&scenario)?;
             let opts = run_options(dirs, &target, None, None, BTreeMap::new());
             let summary = agrisim::bench::nav::bench_nav(&s, &opts, trials, seed, &out, progress_printer())?;
+            println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
+        }
+        Command::Bench { command: BenchCommand::Harvest { scenario, trials, seed, dirs, out } } => {
+            let s = Scenario::load(&scenario)?;
+            let opts = run_options(dirs, &target, None, None, BTreeMap::new());
+            let summary = agrisim::bench::harvest::bench_harvest(&s, &opts, trials, seed, &out, progress_printer())?;
             println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
         }
         Command::Bench { command: BenchCommand::Overhead { scenario, steps, dirs, out } } => {

@@ -55,7 +55,7 @@ pub fn prepare_with(s: &Scenario, o: &RunOptions, mcap: &Path, nodes: Vec<Box<dy
             start.entry(name.to_string()).or_insert(toml::Value::Float(v));
         }
     }
-    let applied = system.apply_parameters(&params, seed, &s.scene_toml())?;
+    let applied = system.apply_parameters(&params, seed, &s.scene_toml(), &s.environment_toml())?;
     let mut recorder = Recorder::create(mcap)?;
     let mut run_info = BTreeMap::from([
         ("scenario".to_string(), s.name.clone()),

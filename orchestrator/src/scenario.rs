@@ -29,6 +29,12 @@ pub struct Scenario {
     /// same scene. Its `seed` (the scene's layout seed) defaults to the scenario's seed.
     #[serde(default)]
     pub greenhouse: toml::Table,
+    /// Sun, weather and render quality (agrisim_greenhouse::environment keys). Passed as TOML
+    /// text to every component with a String parameter `environment` (the camera and the
+    /// LiDAR); changes images and ranges, never the scene's geometry. Absent = the sensors'
+    /// fixed defaults.
+    #[serde(default)]
+    pub environment: Option<toml::Table>,
     /// Navigation benchmark settings.
     #[serde(default)]
     pub nav: NavSettings,
@@ -193,6 +199,10 @@ impl Scenario {
                 return Err(crate::err!("scenario {file}: lift_commands[{i}] is not finite, negative or out of order"));
             }
         }
+        if self.environment.is_some() {
+            agrisim_greenhouse::environment::Environment::from_toml_str(&self.environment_toml())
+                .map_err(|e| crate::err!("scenario {file}: [environment]: {e}"))?;
+        }
         for inj in &self.inject {
             inj.bytes().map_err(|e| crate::err!("scenario {file}: {e}"))?;
         }
@@ -204,6 +214,11 @@ impl Scenario {
         let mut t = self.greenhouse.clone();
         t.entry("seed").or_insert(toml::Value::Integer(self.seed as i64));
         toml::to_string(&t).expect("a TOML table serializes")
+    }
+
+    /// The `[environment]` section as TOML text; empty when the scenario has none.
+    pub fn environment_toml(&self) -> String {
+        self.environment.as_ref().map_or(String::new(), |t| toml::to_string(t).expect("a TOML table serializes"))
     }
 
     /// The system file, resolved against the scenario's directory.
@@ -238,6 +253,16 @@ mod tests {
         let s = Scenario::parse("[system]\nfile = \"a.ssd\"\n", Path::new("dir/x.toml")).unwrap();
         assert_eq!((s.timing.step, s.timing.message_rate), (0.02, 10.0));
         assert_eq!(s.system_path(), Path::new("dir/a.ssd"));
+    }
+
+    #[test]
+    fn environment_is_validated_naming_the_key() {
+        let e = Scenario::parse("[system]\nfile = \"a.ssd\"\n[environment]\nweather = \"fog\"\nhumidity = 140.0\n", Path::new("x.toml")).unwrap_err();
+        assert!(e.0.contains("x.toml") && e.0.contains("environment") && e.0.contains("humidity"), "{e}");
+        let s = Scenario::parse("[system]\nfile = \"a.ssd\"\n[environment]\nweather = \"fog\"\n", Path::new("x.toml")).unwrap();
+        assert_eq!(s.environment_toml().trim(), "weather = \"fog\"");
+        let s = Scenario::parse("[system]\nfile = \"a.ssd\"\n", Path::new("x.toml")).unwrap();
+        assert_eq!(s.environment_toml(), "");
     }
 
     #[test]

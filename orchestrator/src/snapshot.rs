@@ -1,6 +1,8 @@
 //! `agrisim snapshot`: pictures for people. It loads the Camera and Lidar FMUs like any FMI
 //! importer would, places the robot in an aisle of the scenario's greenhouse, and writes the
 //! RGB image, a colour-mapped depth image and a top-down view of one second of LiDAR points.
+//! The scenario's `[environment]` (sun, weather) and `[parameters.camera]` / `[parameters.lidar]`
+//! apply as in a run.
 
 use crate::archive::FmuArchive;
 use crate::error::{Context, Result};
@@ -15,11 +17,22 @@ use std::path::{Path, PathBuf};
 
 const STEP: f64 = 0.02;
 
-fn open(o: &RunOptions, file: &str, name: &str, scene: &str, pose: [f64; 3]) -> Result<(FmuArchive, Instance)> {
+/// Instantiates `file` as component `name`: the scenario's scene and environment, then its
+/// `[parameters.<name>]` overrides (e.g. the camera's resolution), then the robot's pose.
+fn open(s: &Scenario, o: &RunOptions, file: &str, name: &str, pose: [f64; 3]) -> Result<(FmuArchive, Instance)> {
     let a = FmuArchive::open(&o.fmu_dir.join(file), &o.cache_dir)?;
     let mut inst = Instance::instantiate(&a, name, false)?;
     let var = |n: &str| a.md.variable(n).cloned().ok_or_else(|| crate::err!("FMU {file} has no variable '{n}'"));
-    value::set(&mut inst, &var("scene")?, &Value::Str(scene.to_string()))?;
+    value::set(&mut inst, &var("scene")?, &Value::Str(s.scene_toml()))?;
+    let environment = s.environment_toml();
+    if !environment.is_empty() {
+        value::set(&mut inst, &var("environment")?, &Value::Str(environment))?;
+    }
+    for (n, v) in s.parameters.get(name).into_iter().flatten() {
+        let var = var(n)?;
+        let val = value::from_toml(&var, v).ok_or_else(|| crate::err!("scenario parameter {name}.{n}: value {v} does not fit type {}", var.ty.name()))?;
+        value::set(&mut inst, &var, &val)?;
+    }
     for (n, v) in ["base_x", "base_y", "base_yaw"].iter().zip(pose) {
         value::set(&mut inst, &var(n)?, &Value::F64(v))?;
     }
@@ -56,10 +69,9 @@ pub fn snapshot(s: &Scenario, o: &RunOptions, out: &Path) -> Result<Vec<PathBuf>
     let g = crate::scene::generate_scene(s)?;
     let aisle = g.layout.aisles.get(g.layout.aisles.len() / 2).ok_or_else(|| crate::err!("scenario {}: the greenhouse has no aisle", s.path.display()))?;
     let pose = [aisle.x_start + 1.5, aisle.y, 0.0];
-    let scene = s.scene_toml();
     let mut written = vec![];
 
-    let (ca, mut cam) = open(o, "Camera.fmu", "camera", &scene, pose)?;
+    let (ca, mut cam) = open(s, o, "Camera.fmu", "camera", pose)?;
     let mut t = 0.0;
     while get_seq(&ca, &mut cam, "image_seq")? == 0 && t < 1.0 {
         cam.do_step(t, STEP)?;
@@ -77,7 +89,7 @@ pub fn snapshot(s: &Scenario, o: &RunOptions, out: &Path) -> Result<Vec<PathBuf>
 
     // One second of LiDAR frames, top-down, 20 m x 20 m around the robot, coloured by height
     // (points above 2.5 m left out).
-    let (la, mut lidar) = open(o, "Lidar.fmu", "lidar", &scene, pose)?;
+    let (la, mut lidar) = open(s, o, "Lidar.fmu", "lidar", pose)?;
     let mount_z = la.md.variable("mount_z").and_then(|v| v.start.as_deref()?.parse::<f64>().ok()).unwrap_or(1.0);
     let (size, px) = (20.0, 800usize);
     let mut top = vec![245u8; px * px * 3];

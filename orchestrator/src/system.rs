@@ -215,9 +215,10 @@ impl System {
     }
 
     /// Applies parameters: the system file's bindings, then the scenario's overrides, and a
-    /// `seed` derived from the master seed for every component that has one and the scene
-    /// text for every component with a `scene` parameter (unless overridden). Returns what was set, per component, for the run's metadata.
-    pub fn apply_parameters(&mut self, overrides: &BTreeMap<String, BTreeMap<String, toml::Value>>, master_seed: u64, scene: &str) -> Result<BTreeMap<String, BTreeMap<String, String>>> {
+    /// `seed` derived from the master seed for every component that has one, the scene
+    /// text for every component with a `scene` parameter and the environment text (if any) for
+    /// every one with an `environment` parameter (unless overridden). Returns what was set, per component, for the run's metadata.
+    pub fn apply_parameters(&mut self, overrides: &BTreeMap<String, BTreeMap<String, toml::Value>>, master_seed: u64, scene: &str, environment: &str) -> Result<BTreeMap<String, BTreeMap<String, String>>> {
         for name in overrides.keys() {
             if self.component_index(name).is_none() {
                 return Err(crate::err!("scenario parameters for '{name}': no such component in {}", self.structure.path.display()));
@@ -239,6 +240,11 @@ impl System {
             }
             if md.variable("scene").is_some_and(|v| v.ty == VarType::String && v.causality.is_settable_parameter()) {
                 set.insert("scene".into(), Value::Str(scene.to_string()));
+            }
+            // The scenario's [environment] (when it has one) for every component with a String
+            // parameter `environment` (the sensors): light and weather, never geometry.
+            if !environment.is_empty() && md.variable("environment").is_some_and(|v| v.ty == VarType::String && v.causality.is_settable_parameter()) {
+                set.insert("environment".into(), Value::Str(environment.to_string()));
             }
             for (name, v) in &comp.parameters {
                 let var = param(name)?;

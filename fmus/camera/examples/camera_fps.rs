@@ -1,7 +1,9 @@
 //! Frames per second of whole camera frames (render + CDR encoding of image, depth, labels,
 //! CameraInfo) on the default greenhouse, the robot in the middle of aisle 0 looking along
-//! the aisle and then at a row, at 1280x720 and 640x480. Single-threaded.
-//! `cargo run --release -p agrisim-fmu-camera --example camera_fps [FRAMES]`.
+//! the aisle and then at a row, at 1280x720 and 640x480, on 1 and 2 render threads (frames
+//! are identical either way), fixed sun, no environment.
+//! `cargo run --release -p agrisim-fmu-camera --example camera_fps [FRAMES] [ENVIRONMENT] [THREADS]`
+//! (with THREADS: 1280x720 on that many threads only, e.g. to compare CPU and wall time).
 
 use agrisim_fmi::{Log, Model, Store, Value};
 use agrisim_fmu_camera::ports::*;
@@ -20,11 +22,16 @@ fn main() {
         .nth(1)
         .and_then(|s| s.parse().ok())
         .unwrap_or(5);
+    let environment = std::env::args().nth(2).unwrap_or_default();
     let cfg = GreenhouseConfig::from_toml_str("").expect("scene");
     let gh = generate(&cfg, cfg.seed);
     let a = &gh.layout.aisles[0];
     let (x, y) = (0.5 * (a.x_start + a.x_end), a.y);
-    for (w, h) in [(1280, 720), (640, 480)] {
+    let configs: Vec<(i32, i32, i32)> = match std::env::args().nth(3).and_then(|s| s.parse().ok()) {
+        Some(t) => vec![(1280, 720, t)],
+        None => vec![(1280, 720, 1), (1280, 720, 2), (640, 480, 2)],
+    };
+    for (w, h, threads) in configs {
         for (name, yaw) in [
             ("along the aisle", 0.0),
             ("at a row", std::f64::consts::FRAC_PI_2),
@@ -32,6 +39,8 @@ fn main() {
             let mut io = Store::new(Camera::VARIABLES);
             *io.value_mut(WIDTH) = Value::Int32(w);
             *io.value_mut(HEIGHT) = Value::Int32(h);
+            *io.value_mut(RENDER_THREADS) = Value::Int32(threads);
+            *io.value_mut(ENVIRONMENT) = Value::String(environment.clone());
             io.set_f64(BASE_X, x);
             io.set_f64(BASE_Y, y);
             io.set_f64(BASE_YAW, yaw);
@@ -47,7 +56,7 @@ fn main() {
             let s = t.elapsed().as_secs_f64();
             assert_eq!(io.i64(IMAGE_SEQ), frames as i64 + 1);
             println!(
-                "{w}x{h} {name}: {frames} frames in {s:.2} s = {:.2} frames/s ({:.2} M primary rays/s), {:.1} % valid depth",
+                "{w}x{h} {name}, {threads} thread(s): {frames} frames in {s:.2} s = {:.2} frames/s ({:.2} M primary rays/s), {:.1} % valid depth",
                 frames as f64 / s,
                 (w as usize * h as usize * frames) as f64 / s * 1e-6,
                 100.0 * io.i32(VALID_DEPTH) as f64 / (w * h) as f64

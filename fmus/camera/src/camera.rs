@@ -12,6 +12,8 @@ use crate::ports::*;
 use crate::render::{self, DepthModel, DepthNoise, Frame, Lighting};
 use crate::scene::{self, Scene};
 use agrisim_fmi::{Log, Model, Store, Var};
+use agrisim_greenhouse::environment::Environment;
+use agrisim_greenhouse::weather::Conditions;
 use agrisim_fmu_util::{Rng, Schedule};
 use agrisim_msgs::Message;
 use std::sync::Arc;
@@ -27,6 +29,9 @@ pub struct Config {
     pub depth: DepthModel,
     pub light: Lighting,
     pub labels: bool,
+    /// Sun, weather and visibility from the `environment` parameter (None = fixed sun).
+    pub conditions: Option<Conditions>,
+    pub threads: usize,
     pub frame_id: String,
     /// Base box (length, width, height, clearance).
     pub base: [f64; 4],
@@ -107,11 +112,22 @@ impl Config {
             pitch: param(io, MOUNT_PITCH, any, "finite")?,
             yaw: param(io, MOUNT_YAW, any, "finite")?,
         };
-        let light = Lighting::new(
+        let conditions = match io.string(ENVIRONMENT).trim() {
+            "" => None,
+            text => Some(Conditions::of(
+                &Environment::from_toml_str(text).map_err(|e| format!("parameter environment: {e}"))?,
+            )),
+        };
+        let fixed = Lighting::new(
             param(io, SUN_AZIMUTH, any, "finite")?,
             param(io, SUN_ELEVATION, |v| v.abs() <= 90.0, "in [-90, 90] deg")?,
             param(io, AMBIENT, |v| v >= 0.0, ">= 0")?,
         );
+        let light = conditions.as_ref().map_or(fixed, Lighting::from_conditions);
+        let threads = match io.i32(RENDER_THREADS) {
+            t @ 1..=64 => t as usize,
+            t => return Err(format!("parameter render_threads must be in [1, 64], got {t}")),
+        };
         let base = [
             param(io, BASE_LENGTH, |v| v > 0.0, "positive")?,
             param(io, BASE_WIDTH, |v| v > 0.0, "positive")?,
@@ -132,6 +148,8 @@ impl Config {
             },
             light,
             labels: io.bool(LABELS),
+            conditions,
+            threads,
             frame_id: io.string(FRAME_ID).to_string(),
             base,
         })
@@ -153,9 +171,16 @@ fn base_pose(io: &Store) -> Result<(f64, f64, f64), String> {
 impl Camera {
     /// Renders a frame with base_link at (x, y, yaw) (advances the noise generator).
     pub fn capture(&mut self, x: f64, y: f64, yaw: f64) -> Frame {
+        self.capture_on_lift(x, y, yaw, 0.0)
+    }
+
+    /// As [`Camera::capture`] with the camera raised by `lift` metres.
+    pub fn capture_on_lift(&mut self, x: f64, y: f64, yaw: f64, lift: f64) -> Frame {
         let c = self.config.as_ref().expect("initialized");
         let robot = scene::base_box(c.scene.object_count() as u32, c.base, x, y, yaw);
-        let pose = CameraPose::new(&c.mount, x, y, yaw);
+        let mut mount = c.mount;
+        mount.translation[2] += lift;
+        let pose = CameraPose::new(&mount, x, y, yaw);
         render::render(
             &c.scene,
             std::slice::from_ref(&robot),
@@ -164,6 +189,7 @@ impl Camera {
             &c.light,
             &c.depth,
             &mut self.rng,
+            c.threads,
         )
     }
 
@@ -193,6 +219,13 @@ impl Model for Camera {
         self.schedule = Schedule::new(1.0 / config.period, start_time)?;
         self.rng = Rng::new(io.i32(NOISE_SEED) as u32 as u64);
         self.seq = 0;
+        let (zenith, azimuth, visibility) = match &config.conditions {
+            Some(c) => (c.sun.zenith, c.sun.azimuth, c.visibility),
+            None => (90.0 - io.f64(SUN_ELEVATION), io.f64(SUN_AZIMUTH), 0.0),
+        };
+        io.set_f64(SOLAR_ZENITH, zenith);
+        io.set_f64(SOLAR_AZIMUTH, azimuth);
+        io.set_f64(VISIBILITY, visibility);
         self.config = Some(config);
         Ok(())
     }
@@ -205,10 +238,14 @@ impl Model for Camera {
         _log: &mut dyn Log,
     ) -> Result<(), String> {
         let (x, y, yaw) = base_pose(io)?;
+        let lift = io.f64(LIFT_POSITION);
+        if !(lift.is_finite() && lift.abs() < 100.0) {
+            return Err(format!("input lift_position = {lift} is not finite or beyond 100 m"));
+        }
         let Some(stamp) = self.schedule.due(t + h) else {
             return Ok(());
         };
-        let frame = self.capture(x, y, yaw);
+        let frame = self.capture_on_lift(x, y, yaw, lift);
         let c = self.config.as_ref().expect("initialized");
         let (w, hh, id) = (c.intrinsics.width, c.intrinsics.height, c.frame_id.as_str());
         let info = c.intrinsics.camera_info(stamp, id).to_cdr();

@@ -2,9 +2,13 @@
 //!
 //! - [`optics`]: intrinsics from the field of view, CameraInfo, the optical frame's pose;
 //! - [`scene`]: the greenhouse (same TOML and seed as the world FMU) plus the robot's base box;
-//! - [`render`]: one ray per pixel, shadow rays toward the sun, labels, and the depth model
-//!   (range clip, discontinuities, left invalid band, fixed or stereo noise);
-//! - [`shading`]: albedo by kind (tomatoes by USDA ripeness stage), Lambert + ambient, sRGB;
+//! - [`render`]: one ray per pixel on several threads, shadow rays toward the sun (hard or
+//!   soft by render quality), fog, labels, and the depth model (range clip, fog limit,
+//!   discontinuities, left invalid band, fixed or stereo noise keyed per pixel);
+//! - [`shading`]: albedo by kind (tomatoes by USDA ripeness stage), beam + sky + floor light
+//!   at a fixed exposure, sRGB;
+//! - light and weather come from the `environment` parameter through
+//!   `agrisim_greenhouse::{environment, weather, solar}` (NREL SPA sun position);
 //! - [`image`]: sensor_msgs/Image encodings; [`datasheet`]: the D435i figures and sources;
 //! - [`camera`]: the FMI model; [`ports`]: its variable table.
 

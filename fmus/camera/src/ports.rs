@@ -13,6 +13,10 @@ agrisim_fmi::variables! { pub VARIABLES {
         .desc("The keys of the scenario's [greenhouse] table as TOML (no header); empty = the default greenhouse"),
     SCENE_SEED = Var::param("scene_seed", Start::Int32(-1))
         .desc("Seed of the greenhouse generator; < 0 = the scene's own seed key (as the world FMU)"),
+    ENVIRONMENT = Var::param("environment", Start::String(""))
+        .desc("The keys of the scenario's [environment] table as TOML (no header): date, time, place, weather, render quality; empty = the fixed sun of sun_azimuth / sun_elevation / ambient. Changes images, never geometry"),
+    RENDER_THREADS = Var::param("render_threads", Start::Int32(2))
+        .desc("Threads rendering a frame, 1-64 (results do not depend on it)"),
     // --- sensor (RealSense D435i defaults) ---
     NOISE_SEED = Var::param("seed", Start::Int32(0)).desc("Seed of the depth noise (set per run by the orchestrator)"),
     FRAME_RATE = Var::param("frame_rate", Start::Float64(ds::FRAME_RATE)).unit("Hz").range(0.1, 1000.0)
@@ -40,11 +44,11 @@ agrisim_fmi::variables! { pub VARIABLES {
     EDGE_RATIO = Var::param("depth_edge_ratio", Start::Float64(0.05)).range(0.0, 100.0)
         .desc("Depth discontinuities: a pixel whose 4-neighbour is nearer by more than this fraction of its depth is 0; 0 = off"),
     SUN_AZIMUTH = Var::param("sun_azimuth", Start::Float64(135.0)).unit("deg")
-        .desc("Direction toward the sun in the map frame, counter-clockwise from +x"),
+        .desc("Without environment: direction toward the sun in the map frame, counter-clockwise from +x"),
     SUN_ELEVATION = Var::param("sun_elevation", Start::Float64(50.0)).unit("deg").range(-90.0, 90.0)
-        .desc("Sun elevation above the horizon (<= 0: no direct light)"),
+        .desc("Without environment: sun elevation above the horizon (<= 0: no direct light)"),
     AMBIENT = Var::param("ambient", Start::Float64(0.35)).range(0.0, 10.0)
-        .desc("Diffuse (sky) light relative to direct sunlight on a surface facing the sun"),
+        .desc("Without environment: diffuse (sky) light relative to direct sunlight on a surface facing the sun"),
     LABELS = Var::param("publish_labels", Start::Boolean(true))
         .desc("Publish the instance-label image (32SC1: scene object id + 1, 0 = nothing)"),
     FRAME_ID = Var::param("frame_id", Start::String("camera_color_optical_frame"))
@@ -69,6 +73,8 @@ agrisim_fmi::variables! { pub VARIABLES {
     BASE_X = Var::input("base_x", 0.0).unit("m").desc("x of base_link in the map frame"),
     BASE_Y = Var::input("base_y", 0.0).unit("m").desc("y of base_link in the map frame"),
     BASE_YAW = Var::input("base_yaw", 0.0).unit("rad").desc("Yaw of base_link in the map frame"),
+    LIFT_POSITION = Var::input("lift_position", 0.0).unit("m")
+        .desc("Lift joint position, added to mount_z (connect it when the camera rides on the lift, as on the robot: camera_link at (0.32, 0, 0.60 + lift) on base_link)"),
     // --- outputs ---
     IMAGE = Var::output_discrete("image", Start::Binary(&[])).mime(IMAGE_MIME)
         .desc("Latest colour image, sensor_msgs/Image rgb8 (CDR)"),
@@ -82,5 +88,11 @@ agrisim_fmi::variables! { pub VARIABLES {
     LABELS_IMAGE = Var::output_discrete("labels", Start::Binary(&[])).mime(IMAGE_MIME)
         .desc("Latest instance labels, sensor_msgs/Image 32SC1: scene object id + 1 per pixel, 0 = nothing (empty when publish_labels is false)"),
     LABELS_SEQ = Var::output_discrete("labels_seq", Start::Int64(0)).desc("Sequence counter of labels"),
+    SOLAR_ZENITH = Var::output_discrete("solar_zenith", Start::Float64(0.0)).unit("deg")
+        .desc("With environment: the sun's topocentric zenith angle with refraction (NREL SPA); else 90 - sun_elevation"),
+    SOLAR_AZIMUTH = Var::output_discrete("solar_azimuth", Start::Float64(0.0)).unit("deg")
+        .desc("With environment: the sun's compass azimuth, clockwise from north (NREL SPA); else the map angle sun_azimuth"),
+    VISIBILITY = Var::output_discrete("visibility", Start::Float64(0.0)).unit("m")
+        .desc("Meteorological visibility of the environment (Koschmieder, 3.912 / extinction); 0 = no environment (clear air)"),
     VALID_DEPTH = Var::output_discrete("valid_depth_pixels", Start::Int32(0)).desc("Pixels with depth data in the latest frame"),
 }}

@@ -1,12 +1,15 @@
 //! One frame: a primary ray per pixel (centre of the pixel) against the scene, then the
 //! colour (shadow ray toward the sun), the instance label and the depth with the stereo
-//! sensor's failure modes and noise. Single-threaded, so frames are bit-reproducible.
+//! sensor's failure modes and noise. Rows are rendered on several threads; every pixel's
+//! result (noise included) depends on the pixel alone, so frames are bit-reproducible.
 
 use crate::optics::{mat_vec, CameraPose, Intrinsics, Vec3};
 use crate::scene::Scene;
 use crate::shading::{self, Palette};
 use agrisim_fmu_util::Rng;
-use agrisim_greenhouse::Object;
+use agrisim_greenhouse::environment::{Quality, Weather};
+use agrisim_greenhouse::weather::Conditions;
+use agrisim_greenhouse::{Hit, Object};
 
 /// Depth noise (issue 5 item 2).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -49,22 +52,125 @@ pub fn invalid_band_width(fx: f64, baseline: f64, z: f64) -> f64 {
     fx * baseline / z
 }
 
+/// How shadows of the direct beam are computed (render quality).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shadows {
+    /// No shadow rays: every surface facing the sun gets the beam (through one cover layer).
+    None,
+    /// One shadow ray toward the sun's centre.
+    Hard,
+    /// `n` shadow rays spread over the sun's disc (angular radius 0.2666 deg): penumbrae.
+    Soft(u32),
+}
+
+/// Fog or haze between the camera and a surface (Koschmieder): the surface's colour fades
+/// toward the airlight with transmittance exp(-beta d); stereo matching needs contrast, so
+/// depth is lost beyond `depth_limit` (10 % contrast left: ln(10) / beta).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Fog {
+    pub beta: f64,
+    /// Linear RGB of the airlight (the fog lit by the diffuse light).
+    pub colour: [f64; 3],
+    pub depth_limit: f64,
+}
+
+impl Fog {
+    pub fn new(beta: f64, colour: [f64; 3]) -> Fog {
+        Fog { beta, colour, depth_limit: 10f64.ln() / beta }
+    }
+}
+
+/// Irradiances are relative to the camera's fixed exposure: a white Lambertian surface under
+/// irradiance 1 shows white. See [`shading`] for the sum.
 #[derive(Clone, Debug)]
 pub struct Lighting {
     /// Unit vector toward the sun in the map frame.
     pub sun: Vec3,
     /// The sun is above the horizon.
     pub sun_up: bool,
-    pub ambient: f64,
+    /// Direct beam on a surface facing the sun, before the cover.
+    pub direct: f64,
+    /// Diffuse light on an upward surface (inside the cover).
+    pub diffuse: f64,
+    /// Light reflected by the floor onto downward surfaces.
+    pub ground: f64,
+    /// Diffuse light weighted by the sky view factor (1 + n_z) / 2; false = from all around.
+    pub sky_view: bool,
+    /// Transmittance of each glass or film layer a shadow ray crosses.
+    pub cover_tau: f64,
+    pub shadows: Shadows,
+    /// 2x2 supersampled colour (depth and labels stay one ray per pixel centre).
+    pub supersample: bool,
+    /// Linear RGB of rays that hit nothing.
+    pub sky: [f64; 3],
+    /// Primary rays see through glass and film (colour only; depth and labels keep the first
+    /// hit): the radiance behind, times this transmittance per layer. None = opaque cover.
+    pub cover_see_through: Option<f64>,
+    pub fog: Option<Fog>,
 }
 
 impl Lighting {
+    /// Without an environment: the sun at a fixed azimuth (counter-clockwise from map +x) and
+    /// elevation, `ambient` diffuse light relative to the beam, exposed so that a surface
+    /// facing the sun shows its albedo; hard shadows, glass passes all light.
     pub fn new(azimuth_deg: f64, elevation_deg: f64, ambient: f64) -> Lighting {
         let (a, e) = (azimuth_deg.to_radians(), elevation_deg.to_radians());
+        let p = Palette::default();
         Lighting {
             sun: [e.cos() * a.cos(), e.cos() * a.sin(), e.sin()],
             sun_up: elevation_deg > 0.0,
-            ambient,
+            direct: 1.0 / (1.0 + ambient),
+            diffuse: ambient / (1.0 + ambient),
+            ground: 0.0,
+            sky_view: false,
+            cover_tau: 1.0,
+            shadows: Shadows::Hard,
+            supersample: false,
+            sky: shading::SKY.map(|c| p.linear(c)),
+            cover_see_through: None,
+            fog: None,
+        }
+    }
+
+    /// From the environment's sun, weather and cover at the fixed exposure
+    /// [`shading::EXPOSURE`] (W/m2 that render white).
+    pub fn from_conditions(c: &Conditions) -> Lighting {
+        let e = shading::EXPOSURE;
+        let sun = c.sun_direction();
+        let cos_z = sun[2].max(0.0);
+        let direct = c.dni / e;
+        let diffuse = c.tau_diffuse * c.dhi / e;
+        let global_inside = c.tau_direct * direct * cos_z + diffuse;
+        let p = Palette::default();
+        let floor = p.albedo(agrisim_greenhouse::Kind::Floor);
+        let floor_albedo = (floor[0] + floor[1] + floor[2]) / 3.0;
+        // The sky outside, seen through the cover: an isotropic sky of diffuse irradiance DHI
+        // has radiance DHI / pi, which a white Lambertian surface under the whole sky matches:
+        // in exposure units its luminance is DHI / EXPOSURE. Blue when clear, grey otherwise.
+        let tint = match c.weather {
+            Weather::Clear => shading::SKY.map(|v| p.linear(v)),
+            _ => [1.0, 1.0, 1.0],
+        };
+        let y = 0.2126 * tint[0] + 0.7152 * tint[1] + 0.0722 * tint[2];
+        let sky = tint.map(|v| v / y * c.dhi / e);
+        let (shadows, supersample) = match c.quality {
+            Quality::Low => (Shadows::None, false),
+            Quality::Medium => (Shadows::Hard, false),
+            Quality::High => (Shadows::Soft(5), true),
+        };
+        Lighting {
+            sun,
+            sun_up: c.sun.elevation > 0.0,
+            direct,
+            diffuse,
+            ground: floor_albedo * global_inside,
+            sky_view: true,
+            cover_tau: c.tau_direct,
+            shadows,
+            supersample,
+            sky,
+            cover_see_through: Some(c.tau_diffuse),
+            fog: (c.extinction > 0.0).then(|| Fog::new(c.extinction, [0.9 * global_inside; 3])),
         }
     }
 }
@@ -86,9 +192,14 @@ pub struct Frame {
 const FAR: f64 = 1000.0;
 /// Offset of secondary rays off a surface [m].
 const EPS: f64 = 1e-6;
+/// Rows per work chunk; chunks are dealt to threads round-robin.
+const CHUNK_ROWS: usize = 8;
 
-/// Renders one frame. `dynamic` are moving objects (the robot's base box); their ids must not
-/// collide with scene ids. `rng` draws the depth noise.
+/// Renders one frame on `threads` threads (>= 1). `dynamic` are moving objects (the robot's
+/// base box); their ids must not collide with scene ids. `rng` gives the frame's noise key
+/// (one draw per frame); each pixel's depth noise is then drawn from that key and the pixel
+/// index alone, so the frame is the same whatever the number of threads.
+#[allow(clippy::too_many_arguments)]
 pub fn render(
     scene: &Scene,
     dynamic: &[Object],
@@ -97,73 +208,218 @@ pub fn render(
     light: &Lighting,
     depth: &DepthModel,
     rng: &mut Rng,
+    threads: usize,
 ) -> Frame {
     let (w, h) = (k.width as usize, k.height as usize);
     let n = w * h;
-    let palette = Palette::default();
     let mut f = Frame {
-        rgb: Vec::with_capacity(3 * n),
+        rgb: vec![0; 3 * n],
         depth: vec![0.0; n],
         true_depth: vec![0.0; n],
         labels: vec![0; n],
         valid: 0,
     };
-    for v in 0..h {
-        for u in 0..w {
-            let d_opt = k.ray(u as f64, v as f64);
-            let d = mat_vec(&pose.rotation, d_opt);
-            let i = v * w + u;
-            match scene.caster.cast(pose.origin, d, 0.0, FAR, dynamic) {
-                Some(hit) => {
-                    f.true_depth[i] = (hit.distance * d_opt[2]) as f32;
-                    f.labels[i] = hit.object as i32 + 1;
-                    let mut nrm = hit.normal;
-                    if nrm[0] * d[0] + nrm[1] * d[1] + nrm[2] * d[2] > 0.0 {
-                        nrm = [-nrm[0], -nrm[1], -nrm[2]];
-                    }
-                    let cos_sun =
-                        nrm[0] * light.sun[0] + nrm[1] * light.sun[1] + nrm[2] * light.sun[2];
-                    let lit = light.sun_up && cos_sun > 0.0 && {
-                        let p = [
-                            pose.origin[0] + hit.distance * d[0] + EPS * nrm[0],
-                            pose.origin[1] + hit.distance * d[1] + EPS * nrm[1],
-                            pose.origin[2] + hit.distance * d[2] + EPS * nrm[2],
-                        ];
-                        sunlit(scene, dynamic, p, light.sun)
-                    };
-                    let c = shading::shade(
-                        palette.albedo(scene.kind(hit.object)),
-                        cos_sun,
-                        lit,
-                        light.ambient,
-                    );
-                    f.rgb.extend_from_slice(&c);
-                }
-                None => f.rgb.extend_from_slice(&shading::SKY),
-            }
+    let ctx = Ctx { scene, dynamic, k, pose, light, palette: Palette::default() };
+    let threads = threads.clamp(1, h.div_ceil(CHUNK_ROWS).max(1));
+    let chunks = f
+        .rgb
+        .chunks_mut(3 * w * CHUNK_ROWS)
+        .zip(f.true_depth.chunks_mut(w * CHUNK_ROWS))
+        .zip(f.labels.chunks_mut(w * CHUNK_ROWS))
+        .enumerate();
+    if threads == 1 {
+        for (c, ((rgb, z), l)) in chunks {
+            ctx.rows(c * CHUNK_ROWS, rgb, z, l);
         }
+    } else {
+        let mut work: Vec<Vec<_>> = (0..threads).map(|_| Vec::new()).collect();
+        for (c, parts) in chunks {
+            work[c % threads].push((c, parts));
+        }
+        let ctx = &ctx;
+        std::thread::scope(|s| {
+            for list in work {
+                s.spawn(move || {
+                    for (c, ((rgb, z), l)) in list {
+                        ctx.rows(c * CHUNK_ROWS, rgb, z, l);
+                    }
+                });
+            }
+        });
     }
-    apply_depth_model(&mut f, k, depth, rng);
+    apply_depth_model(&mut f, k, depth, light.fog.map(|g| g.depth_limit), rng.next_u64());
     f
 }
 
-/// The shadow ray: nothing opaque between `p` and the sun (glass passes light).
-fn sunlit(scene: &Scene, dynamic: &[Object], mut p: Vec3, s: Vec3) -> bool {
+/// What every pixel needs.
+struct Ctx<'a> {
+    scene: &'a Scene,
+    dynamic: &'a [Object],
+    k: &'a Intrinsics,
+    pose: &'a CameraPose,
+    light: &'a Lighting,
+    palette: Palette,
+}
+
+/// Sub-pixel offsets of 2x2 supersampling.
+const SUB: [(f64, f64); 4] = [(-0.25, -0.25), (0.25, -0.25), (-0.25, 0.25), (0.25, 0.25)];
+
+impl Ctx<'_> {
+    /// Renders rows from `v0` into the row-major slices (as many rows as they hold).
+    fn rows(&self, v0: usize, rgb: &mut [u8], z: &mut [f32], labels: &mut [i32]) {
+        let w = self.k.width as usize;
+        for (j, zi) in z.iter_mut().enumerate() {
+            let (u, v) = ((j % w) as f64, (v0 + j / w) as f64);
+            let d_opt = self.k.ray(u, v);
+            let d = mat_vec(&self.pose.rotation, d_opt);
+            let hit = self.scene.caster.cast(self.pose.origin, d, 0.0, FAR, self.dynamic);
+            if let Some(hit) = &hit {
+                *zi = (hit.distance * d_opt[2]) as f32;
+                labels[j] = hit.object as i32 + 1;
+            }
+            let lin = if self.light.supersample {
+                let mut acc = [0.0; 3];
+                for (du, dv) in SUB {
+                    let ds = mat_vec(&self.pose.rotation, self.k.ray(u + du, v + dv));
+                    let hs = self.scene.caster.cast(self.pose.origin, ds, 0.0, FAR, self.dynamic);
+                    let c = self.radiance(ds, hs.as_ref());
+                    (0..3).for_each(|i| acc[i] += 0.25 * c[i]);
+                }
+                acc
+            } else {
+                self.radiance(d, hit.as_ref())
+            };
+            rgb[3 * j..3 * j + 3].copy_from_slice(&lin.map(shading::linear_to_srgb));
+        }
+    }
+
+    /// Linear RGB seen along `d` (map frame) given its first hit.
+    fn radiance(&self, d: Vec3, hit: Option<&Hit>) -> [f64; 3] {
+        let l = self.light;
+        let mut hit = hit.cloned();
+        let mut through = 1.0;
+        // Through up to 4 layers of glass or film (colour only); fog and haze fill the
+        // greenhouse up to its cover (the air outside is not modelled).
+        let mut inside = f64::INFINITY;
+        if let Some(tau) = l.cover_see_through {
+            for _ in 0..4 {
+                match &hit {
+                    Some(h) if !shading::casts_shadow(self.scene.kind(h.object)) => {
+                        through *= tau;
+                        inside = inside.min(h.distance);
+                        hit = self.scene.caster.cast(self.pose.origin, d, h.distance + 1e-4, FAR, self.dynamic);
+                    }
+                    _ => break,
+                }
+            }
+        }
+        let Some(hit) = hit else {
+            let sky = l.sky.map(|v| v * through);
+            return match l.fog {
+                Some(f) => {
+                    let t = (-f.beta * inside).exp();
+                    [0, 1, 2].map(|i| sky[i] * t + f.colour[i] * (1.0 - t))
+                }
+                None => sky,
+            };
+        };
+        let mut nrm = hit.normal;
+        if nrm[0] * d[0] + nrm[1] * d[1] + nrm[2] * d[2] > 0.0 {
+            nrm = [-nrm[0], -nrm[1], -nrm[2]];
+        }
+        let cos_sun = nrm[0] * l.sun[0] + nrm[1] * l.sun[1] + nrm[2] * l.sun[2];
+        let o = self.pose.origin;
+        let p = [
+            o[0] + hit.distance * d[0] + EPS * nrm[0],
+            o[1] + hit.distance * d[1] + EPS * nrm[1],
+            o[2] + hit.distance * d[2] + EPS * nrm[2],
+        ];
+        let beam = if l.sun_up && cos_sun > 0.0 { self.beam(p) } else { 0.0 };
+        let e = shading::irradiance(l, cos_sun, beam, nrm[2]) * through;
+        let a = self.palette.albedo(self.scene.kind(hit.object));
+        let c = [a[0] * e, a[1] * e, a[2] * e];
+        match l.fog {
+            Some(f) => {
+                let t = (-f.beta * hit.distance.min(inside)).exp();
+                [0, 1, 2].map(|i| c[i] * t + f.colour[i] * (1.0 - t))
+            }
+            None => c,
+        }
+    }
+
+    /// Fraction of the sun's beam reaching `p` (0 = shadow; cover layers attenuate).
+    fn beam(&self, p: Vec3) -> f64 {
+        let l = self.light;
+        match l.shadows {
+            Shadows::None => l.cover_tau,
+            Shadows::Hard => transmitted(self.scene, self.dynamic, p, l.sun, l.cover_tau),
+            Shadows::Soft(n) => {
+                let n = n.max(1);
+                let sum: f64 = (0..n)
+                    .map(|i| transmitted(self.scene, self.dynamic, p, sun_disc_sample(l.sun, i, n), l.cover_tau))
+                    .sum();
+                sum / n as f64
+            }
+        }
+    }
+}
+
+/// Angular radius of the sun's disc [rad] (0.2666 deg).
+const SUN_RADIUS: f64 = 0.2666 * std::f64::consts::PI / 180.0;
+
+/// Direction `i` of `n` fixed points on the sun's disc: the centre, then a ring at 0.7 of the
+/// radius (deterministic, no noise).
+fn sun_disc_sample(s: Vec3, i: u32, n: u32) -> Vec3 {
+    if i == 0 || n == 1 {
+        return s;
+    }
+    // An orthonormal basis around s.
+    let a = if s[2].abs() < 0.9 { [0.0, 0.0, 1.0] } else { [1.0, 0.0, 0.0] };
+    let e1 = normalize(cross(s, a));
+    let e2 = cross(s, e1);
+    let phi = 2.0 * std::f64::consts::PI * (i - 1) as f64 / (n - 1) as f64;
+    let r = 0.7 * SUN_RADIUS;
+    let (sp, cp) = phi.sin_cos();
+    normalize([0, 1, 2].map(|k| s[k] + r * (cp * e1[k] + sp * e2[k])))
+}
+
+fn cross(a: Vec3, b: Vec3) -> Vec3 {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+fn normalize(v: Vec3) -> Vec3 {
+    let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    [v[0] / n, v[1] / n, v[2] / n]
+}
+
+/// The shadow ray: 0 if something opaque lies between `p` and the sun, else `tau` per glass
+/// or film layer crossed.
+fn transmitted(scene: &Scene, dynamic: &[Object], mut p: Vec3, s: Vec3, tau: f64) -> f64 {
+    let mut t_all = 1.0;
     for _ in 0..16 {
         match scene.caster.cast(p, s, EPS, FAR, dynamic) {
-            None => return true,
-            Some(hit) if shading::casts_shadow(scene.kind(hit.object)) => return false,
+            None => return t_all,
+            Some(hit) if shading::casts_shadow(scene.kind(hit.object)) => return 0.0,
             Some(hit) => {
+                t_all *= tau;
                 let t = hit.distance + 1e-4;
                 p = [p[0] + t * s[0], p[1] + t * s[1], p[2] + t * s[2]];
             }
         }
     }
-    false
+    0.0
 }
 
-/// Range clip, discontinuities, left band, noise: true_depth -> depth.
-pub fn apply_depth_model(f: &mut Frame, k: &Intrinsics, m: &DepthModel, rng: &mut Rng) {
+/// SplitMix64's finalizer: a bijective 64-bit mix.
+fn mix64(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// Range clip, fog limit (along the ray), discontinuities, left band, noise: true_depth ->
+/// depth. Pixel i's noise is drawn from a generator seeded by mix(key, i).
+pub fn apply_depth_model(f: &mut Frame, k: &Intrinsics, m: &DepthModel, fog_limit: Option<f64>, key: u64) {
     let (w, h) = (k.width as usize, k.height as usize);
     let zt = &f.true_depth;
     f.valid = 0;
@@ -172,6 +428,9 @@ pub fn apply_depth_model(f: &mut Frame, k: &Intrinsics, m: &DepthModel, rng: &mu
             let i = v * w + u;
             let z = zt[i] as f64;
             let mut ok = z > 0.0 && z >= m.range.0 && z <= m.range.1;
+            if let (true, Some(limit)) = (ok, fog_limit) {
+                ok = z / k.ray(u as f64, v as f64)[2] <= limit;
+            }
             if ok && m.invalid_band && (u as f64) < invalid_band_width(k.fx, m.baseline, z) {
                 ok = false;
             }
@@ -190,6 +449,7 @@ pub fn apply_depth_model(f: &mut Frame, k: &Intrinsics, m: &DepthModel, rng: &mu
                 }
             }
             f.depth[i] = if ok {
+                let mut rng = Rng::new(mix64(key ^ mix64(i as u64)));
                 let zm = z + rng.gauss(m.noise.sigma(z, k.fx, m.baseline));
                 if zm > 0.0 {
                     f.valid += 1;

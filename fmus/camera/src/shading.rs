@@ -1,13 +1,15 @@
-//! Colour of a surface: albedo by object kind, Lambert shading under a fixed sun plus ambient
-//! sky light, sRGB output.
+//! Colour of a surface: albedo by object kind, Lambert shading under the sun's beam plus
+//! diffuse sky and floor light, at a fixed exposure, sRGB output.
 //!
 //! Albedos are plausible sRGB colours (not measurements). Tomato colour follows the six USDA
 //! ripeness stages (USDA "United States Standards for Grades of Fresh Tomatoes", colour
 //! classification): 1 green, 2 breaker, 3 turning, 4 pink, 5 light red, 6 red.
 //!
-//! Radiance = albedo x (ambient + max(0, n.s) x visible) / (1 + ambient): exposure is set so
-//! a sunlit surface facing the sun shows its albedo. Shading is done on linear values and
-//! encoded with the sRGB transfer curve (IEC 61966-2-1).
+//! Radiance = albedo x irradiance / exposure ([`irradiance`]): the sun's beam x cos(incidence)
+//! x its unblocked fraction, plus diffuse sky light and light from the floor. Without an
+//! environment the exposure is set so that a sunlit surface facing the sun shows its albedo;
+//! with one, it is fixed at [`EXPOSURE`] W/m2, so dusk and cloud darken the image. Shading is
+//! done on linear values and encoded with the sRGB transfer curve (IEC 61966-2-1).
 
 use agrisim_greenhouse::Kind;
 
@@ -82,6 +84,11 @@ impl Default for Palette {
 }
 
 impl Palette {
+    /// Linear value of an sRGB code.
+    pub fn linear(&self, c: u8) -> f64 {
+        self.lut[c as usize]
+    }
+
     pub fn albedo(&self, kind: Kind) -> [f64; 3] {
         let c = albedo_srgb(kind);
         [
@@ -92,15 +99,18 @@ impl Palette {
     }
 }
 
-/// Shaded sRGB pixel: `cos_sun` = n.s (may be negative), `lit` = the sun is not blocked.
-pub fn shade(albedo: [f64; 3], cos_sun: f64, lit: bool, ambient: f64) -> [u8; 3] {
-    let direct = if lit { cos_sun.max(0.0) } else { 0.0 };
-    let e = (ambient + direct) / (1.0 + ambient);
-    [
-        linear_to_srgb(albedo[0] * e),
-        linear_to_srgb(albedo[1] * e),
-        linear_to_srgb(albedo[2] * e),
-    ]
+/// Irradiance [W/m2] that the fixed exposure renders as white: a white surface facing a
+/// clear noon sun through glass is just below clipping.
+pub const EXPOSURE: f64 = 1000.0;
+
+/// Relative irradiance on a surface with normal z-component `n_z`: the beam (`beam` = its
+/// unblocked fraction, after cover layers) times cos(incidence), diffuse sky light (weighted
+/// by the sky view factor (1 + n_z) / 2 when `sky_view`), and light from the floor on
+/// downward faces ((1 - n_z) / 2).
+pub fn irradiance(l: &crate::render::Lighting, cos_sun: f64, beam: f64, n_z: f64) -> f64 {
+    let direct = l.direct * beam * cos_sun.max(0.0);
+    let sky = if l.sky_view { 0.5 * (1.0 + n_z) } else { 1.0 };
+    direct + l.diffuse * sky + l.ground * 0.5 * (1.0 - n_z)
 }
 
 #[cfg(test)]

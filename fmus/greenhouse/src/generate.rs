@@ -173,6 +173,7 @@ fn plant(b: &mut Builder, cfg: &GreenhouseConfig, seed: u64, r: usize, p: usize,
     let nt = cfg.trusses_per_plant;
     let [f_lo, f_hi] = cfg.fruit_height;
     let reach = (half_env - 0.02).max(0.05); // how far from the row line a truss extends
+    let mut placed: Vec<([f64; 3], f64)> = vec![];
     for t in 0..nt {
         let side = if t % 2 == 0 { 1.0 } else { -1.0 };
         let zt = f_lo + 0.08 + (t as f64 + rng.range(0.3, 0.7)) / nt as f64 * (f_hi - f_lo);
@@ -198,6 +199,12 @@ fn plant(b: &mut Builder, cfg: &GreenhouseConfig, seed: u64, r: usize, p: usize,
             let (xl, xh) = ((x - 0.5 * cfg.plant_spacing).max(x_row + radius), (x + 0.5 * cfg.plant_spacing).min(x_row + cfg.row_length - radius));
             fx = if xl <= xh { fx.clamp(xl, xh) } else { x };
             let stage = rng.weighted(&cfg.ripeness) as u8 + 1;
+            // Fruit of a truss hang at different levels instead of interpenetrating: a fruit
+            // that would overlap one already on this plant hangs just below it.
+            // (Rarely the bottom of the band is reached: then just above the one it touches,
+            // still under the truss; failing that, where it was.)
+            let fz = hang_clear(&placed, [fx, fy, fz], radius, -1.0, f_lo, zt - radius).or_else(|| hang_clear(&placed, [fx, fy, fz], radius, 1.0, f_lo, zt - radius)).unwrap_or(fz);
+            placed.push(([fx, fy, fz], radius));
             b.push(
                 format!("row{r}/plant{p}/fruit{t}_{f}"),
                 Kind::Fruit { ripeness: stage },
@@ -206,6 +213,35 @@ fn plant(b: &mut Builder, cfg: &GreenhouseConfig, seed: u64, r: usize, p: usize,
             );
         }
     }
+}
+
+/// Gap kept between neighbouring fruit [m].
+const FRUIT_GAP: f64 = 0.003;
+
+/// The height nearest `c[2]` in direction `dir` (-1 down, +1 up) where a fruit of radius `r`
+/// at (c[0], c[1]) overlaps none of `placed` (moving past each one it would touch,
+/// repeatedly); `None` if that leaves [`z_min`, `z_max`].
+fn hang_clear(placed: &[([f64; 3], f64)], c: [f64; 3], r: f64, dir: f64, z_min: f64, z_max: f64) -> Option<f64> {
+    let mut z = c[2];
+    for _ in 0..=placed.len() {
+        let mut moved = false;
+        for &(q, rq) in placed {
+            let need = r + rq + FRUIT_GAP;
+            let h2 = (q[0] - c[0]).powi(2) + (q[1] - c[1]).powi(2);
+            if h2 >= need * need {
+                continue;
+            }
+            let v = (need * need - h2).sqrt();
+            if (z - q[2]).abs() < v {
+                z = q[2] + dir * v;
+                moved = true;
+            }
+        }
+        if !moved {
+            break;
+        }
+    }
+    (z >= z_min && z <= z_max.max(c[2])).then_some(z)
 }
 
 /// Random box obstacles in the active aisles, each touching one row envelope so that the

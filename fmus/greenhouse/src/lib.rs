@@ -1,6 +1,8 @@
 //! Tomato greenhouse scene for agrisim: configuration (`[greenhouse]` of a scenario), a
 //! deterministic generator, the layout the navigation stack uses, exact ray casting over a
-//! BVH, a static occupancy map, and glTF export.
+//! BVH, a static occupancy map, and glTF export; for the sensors also the sun's position (NREL
+//! SPA, [`solar`]), the scenario's `[environment]` ([`environment`]) and what it means for
+//! light and visibility ([`weather`]).
 //!
 //! ```
 //! use agrisim_greenhouse::{generate, GreenhouseConfig, RayCaster};
@@ -14,6 +16,7 @@
 
 pub mod cast_scene;
 pub mod config;
+pub mod environment;
 pub mod generate;
 pub mod gltf;
 pub mod layout;
@@ -22,6 +25,9 @@ pub mod occupancy;
 pub mod raycast;
 pub mod rng;
 pub mod scene;
+pub mod solar;
+pub mod solar_terms;
+pub mod weather;
 
 pub use config::{GreenhouseConfig, ObstacleConfig};
 pub use generate::{generate, Greenhouse};

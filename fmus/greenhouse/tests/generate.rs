@@ -203,3 +203,29 @@ fn rows_160_generate() {
         mn[1] >= -0.5 && mx[1] <= 420.5 && mn[0] >= -0.5 && mx[0] <= 70.5
     }));
 }
+
+#[test]
+fn fruit_of_a_plant_do_not_interpenetrate() {
+    let c = GreenhouseConfig::default();
+    let g = generate(&c, c.seed);
+    let mut by_plant: std::collections::BTreeMap<String, Vec<([f64; 3], f64)>> = Default::default();
+    for o in &g.objects {
+        if let (Kind::Fruit { .. }, agrisim_greenhouse::Shape::Sphere { radius }) = (o.kind, o.shape) {
+            let plant = o.name.rsplit_once('/').unwrap().0.to_string();
+            by_plant.entry(plant).or_default().push((o.placement.translation, radius));
+        }
+    }
+    let (mut pairs, mut overlapping) = (0, 0);
+    for fruit in by_plant.values() {
+        for (i, (a, ra)) in fruit.iter().enumerate() {
+            for (b, rb) in &fruit[i + 1..] {
+                pairs += 1;
+                let d = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+                overlapping += (d < ra + rb - 1e-9) as usize;
+            }
+        }
+    }
+    // A handful may keep their place when neither hanging lower nor higher fits the band.
+    assert!(overlapping * 1000 < pairs, "{overlapping} of {pairs} fruit pairs interpenetrate");
+    eprintln!("{overlapping} of {pairs} same-plant fruit pairs interpenetrate");
+}

@@ -18,6 +18,8 @@ use crate::reflectivity;
 use crate::scene::{self, BaseBox, Scene};
 use crate::trajectory::{Pose2, Trajectory};
 use agrisim_fmi::{Log, Model, Store, Var};
+use agrisim_greenhouse::environment::Environment;
+use agrisim_greenhouse::weather::Conditions;
 use agrisim_fmu_util::{Rng, Schedule};
 use agrisim_msgs::sensor_msgs::PointCloud2;
 use agrisim_msgs::Message;
@@ -39,6 +41,9 @@ struct Config {
     frame_id: String,
     deskewed: bool,
     drop_no_return: bool,
+    /// Extinction coefficient of the air [1/m] (0 = clear).
+    extinction: f64,
+    visibility: f64,
 }
 
 /// What one captured frame produced.
@@ -86,6 +91,14 @@ impl Config {
         let el_max = param(io, ELEVATION_MAX, |v| v.abs() < 90.0 && v > el_min, "within (-90, 90) deg and above elevation_min")?;
         let translation = [param(io, MOUNT_X, any, "finite")?, param(io, MOUNT_Y, any, "finite")?, param(io, MOUNT_Z, any, "finite")?];
         let mount = Mount::new(translation, param(io, MOUNT_ROLL, any, "finite")?, param(io, MOUNT_PITCH, any, "finite")?, param(io, MOUNT_YAW, any, "finite")?);
+        let (extinction, visibility) = match io.string(ENVIRONMENT).trim() {
+            "" => (0.0, 0.0),
+            text => {
+                let env = Environment::from_toml_str(text).map_err(|e| format!("parameter environment: {e}"))?;
+                let c = Conditions::of(&env);
+                (c.extinction, c.visibility)
+            }
+        };
         Ok(Config {
             scene: scene::load(io.string(SCENE), io.i32(SEED))?,
             pattern: ScanPattern::mid360(point_rate, el_min.to_radians(), el_max.to_radians()),
@@ -97,8 +110,21 @@ impl Config {
             frame_id: io.string(FRAME_ID).to_string(),
             deskewed: io.bool(DESKEWED),
             drop_no_return: io.bool(DROP_NO_RETURN),
+            extinction,
+            visibility,
         })
     }
+}
+
+/// The detection test in attenuating air. The datasheet range `range_max` is where the
+/// reference target's echo (10 % reflectivity, normal incidence) meets the detection
+/// threshold in clear air; the echo falls as 1 / r^2 (extended Lambertian target) and as
+/// exp(-2 beta r) through fog, rain or haze (there and back, Koschmieder's beta), so a return
+/// at range r is detected while exp(-2 beta r) (range_max / r)^2 >= 1. Reflectivity and
+/// incidence are not part of the test (as in clear air, where every hit within range_max
+/// returns). beta = 0 leaves the clear-air behaviour exactly.
+pub fn detected(r: f64, range_max: f64, beta: f64) -> bool {
+    beta == 0.0 || (-2.0 * beta * r).exp() * (range_max / r).powi(2) >= 1.0
 }
 
 impl Lidar {
@@ -134,7 +160,8 @@ impl Lidar {
             let m = yaw_rotate(sin, cos, c.mount.translation);
             let origin = [pose.x + m[0], pose.y + m[1], m[2]];
             let t = (s - stamp_s) as f32;
-            match c.scene.caster.cast(origin, d, c.range.0, c.range.1, std::slice::from_ref(&base.object)) {
+            let hit = c.scene.caster.cast(origin, d, c.range.0, c.range.1, std::slice::from_ref(&base.object));
+            match hit.filter(|h| detected(h.distance, c.range.1, c.extinction)) {
                 Some(hit) => {
                     let rho = reflectivity::of_kind(c.scene.kind(hit.object));
                     let cos_incidence = -(hit.normal[0] * d[0] + hit.normal[1] * d[1] + hit.normal[2] * d[2]);
@@ -180,6 +207,7 @@ impl Model for Lidar {
         self.schedule.due(start_time);
         self.rng = Rng::new(io.i32(NOISE_SEED) as u32 as u64);
         self.seq = 0;
+        io.set_f64(VISIBILITY, config.visibility);
         self.config = Some(config);
         Ok(())
     }

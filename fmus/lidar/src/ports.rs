@@ -13,6 +13,8 @@ agrisim_fmi::variables! { pub VARIABLES {
         .desc("The keys of the scenario's [greenhouse] table as TOML (no header); empty = the default greenhouse"),
     SEED = Var::param("scene_seed", Start::Int32(-1))
         .desc("Seed of the greenhouse generator; < 0 = the scene's own seed key (as the world FMU)"),
+    ENVIRONMENT = Var::param("environment", Start::String(""))
+        .desc("The keys of the scenario's [environment] table as TOML (no header); fog, rain and haze attenuate returns (two-way Koschmieder extinction); empty = clear air, no attenuation"),
     // --- sensor (Livox MID-360 defaults) ---
     NOISE_SEED = Var::param("seed", Start::Int32(0)).desc("Seed of the range noise (set per run by the orchestrator)"),
     FRAME_RATE = Var::param("frame_rate", Start::Float64(ds::FRAME_RATE)).unit("Hz").range(0.1, 1000.0)
@@ -58,6 +60,8 @@ agrisim_fmi::variables! { pub VARIABLES {
         .desc("The latest frame as sensor_msgs/PointCloud2 (CDR) in lidar_link: float32 x, y, z, intensity, t"),
     POINTS_SEQ = Var::output_discrete("points_seq", Start::Int64(0)).desc("Sequence counter of points"),
     POINTS_IN_FRAME = Var::output_discrete("points_in_frame", Start::Int32(0)).desc("Points in the latest cloud"),
+    VISIBILITY = Var::output_discrete("visibility", Start::Float64(0.0)).unit("m")
+        .desc("Meteorological visibility of the environment; 0 = no environment (clear air)"),
     RETURNS_IN_FRAME = Var::output_discrete("returns_in_frame", Start::Int32(0))
         .desc("Points of the latest cloud that are returns (the others are no-return placeholders)"),
 }}

@@ -65,3 +65,78 @@ ros_message! {
         pub goal: crate::geometry_msgs::PoseStamped,
     }
 }
+
+ros_message! {
+    /// `agrisim_msgs/msg/GripperState`: the parallel gripper's measured gap and force.
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct GripperState = "agrisim_msgs/msg/GripperState" {
+        pub header: Header,
+        /// Finger gap in m.
+        pub position: f64,
+        /// Grip force in N.
+        pub effort: f64,
+        pub stalled: bool,
+        pub reached_goal: bool,
+    }
+}
+
+ros_message! {
+    /// `agrisim_msgs/msg/TrajectoryStatus`: the arm's trajectory executor state, counters,
+    /// the reason of the last rejection and tracking error of the last/current trajectory.
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct TrajectoryStatus = "agrisim_msgs/msg/TrajectoryStatus" {
+        pub header: Header,
+        pub state: u8,
+        pub trajectory_count: u64,
+        pub rejected_count: u64,
+        pub reason: String,
+        pub rms_tracking_error: f64,
+        pub max_tracking_error: f64,
+    }
+}
+
+impl TrajectoryStatus {
+    pub const IDLE: u8 = 0;
+    pub const EXECUTING: u8 = 1;
+    pub const SUCCEEDED: u8 = 2;
+    pub const REJECTED: u8 = 3;
+}
+
+ros_message! {
+    /// `agrisim_msgs/msg/CollisionObject`: one primitive obstacle of a planning scene;
+    /// `kind` is floor, post, stem, leaf, fruit, ...
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct CollisionObject = "agrisim_msgs/msg/CollisionObject" {
+        pub id: String,
+        pub kind: String,
+        pub primitive: crate::shape_msgs::SolidPrimitive,
+        pub pose: crate::geometry_msgs::Pose,
+    }
+}
+
+ros_message! {
+    /// `agrisim_msgs/msg/PlanningScene`: the obstacles the planner avoids, in
+    /// `header.frame_id`.
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct PlanningScene = "agrisim_msgs/msg/PlanningScene" {
+        pub header: Header,
+        pub objects: Vec<CollisionObject>,
+    }
+}
+
+ros_message! {
+    /// `agrisim_msgs/msg/HarvestStatus`: stage and outcome of the harvest state machine;
+    /// `failure_category` is "", planning, grasp, handover, placement, timeout or collision.
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct HarvestStatus = "agrisim_msgs/msg/HarvestStatus" {
+        pub header: Header,
+        pub stage: String,
+        pub target_id: i32,
+        pub target_name: String,
+        pub outcome: String,
+        pub failure_category: String,
+        pub detail: String,
+        /// Motions planned so far (wall times stay out of the log: byte-identical runs).
+        pub plans: u32,
+    }
+}

@@ -65,3 +65,46 @@ impl Time {
         self.sec as f64 + self.nanosec as f64 * 1e-9
     }
 }
+
+ros_message! {
+    /// `builtin_interfaces/msg/Duration`: same layout and normalisation as [`Time`]
+    /// (-1.7 s = `{sec: -2, nanosec: 300_000_000}`); e.g. a trajectory point's
+    /// `time_from_start`.
+    #[derive(Debug, Default, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    pub struct Duration = "builtin_interfaces/msg/Duration" {
+        pub sec: i32,
+        pub nanosec: u32,
+    }
+}
+
+impl Duration {
+    pub const fn new(sec: i32, nanosec: u32) -> Self {
+        Self { sec, nanosec }
+    }
+
+    /// From integer nanoseconds, exact; saturates like [`Time::from_nanos`].
+    pub fn from_nanos(nanos: i64) -> Self {
+        let t = Time::from_nanos(nanos);
+        Self::new(t.sec, t.nanosec)
+    }
+
+    /// From seconds, rounded to the nearest nanosecond; `None` for a non-finite value.
+    pub fn from_secs_f64(secs: f64) -> Option<Self> {
+        if !secs.is_finite() {
+            return None;
+        }
+        let nanos = (secs * NANOS_PER_SEC as f64).round();
+        Some(Self::from_nanos(nanos.clamp(i64::MIN as f64, i64::MAX as f64) as i64))
+    }
+
+    /// Total nanoseconds. Uses the raw fields, so a non-normalised `nanosec >= 1e9`
+    /// (invalid, but decodable) still gives a defined value.
+    pub fn to_nanos(&self) -> i64 {
+        self.sec as i64 * NANOS_PER_SEC + self.nanosec as i64
+    }
+
+    /// Seconds as `f64`.
+    pub fn as_secs_f64(&self) -> f64 {
+        self.sec as f64 + self.nanosec as f64 * 1e-9
+    }
+}

@@ -3,7 +3,10 @@
 
 use crate::cdr::CdrError;
 use crate::message::Message;
-use crate::{agrisim, builtin_interfaces, geometry_msgs, nav_msgs, rosgraph_msgs, sensor_msgs, std_msgs, tf2_msgs};
+use crate::{
+    agrisim, builtin_interfaces, control_msgs, geometry_msgs, nav_msgs, rosgraph_msgs, sensor_msgs,
+    shape_msgs, std_msgs, tf2_msgs, trajectory_msgs,
+};
 
 /// `Some(Ok(()))` when `bytes` decode as `type_name` (`pkg/msg/Type`), `Some(Err)` when they
 /// do not, `None` when the type is not one this crate defines.
@@ -44,6 +47,18 @@ pub fn check_cdr(type_name: &str, bytes: &[u8]) -> Option<Result<(), CdrError>> 
         "sensor_msgs/msg/Image" => ok::<sensor_msgs::Image>(bytes),
         "sensor_msgs/msg/RegionOfInterest" => ok::<sensor_msgs::RegionOfInterest>(bytes),
         "sensor_msgs/msg/CameraInfo" => ok::<sensor_msgs::CameraInfo>(bytes),
+        "builtin_interfaces/msg/Duration" => ok::<builtin_interfaces::Duration>(bytes),
+        "trajectory_msgs/msg/JointTrajectoryPoint" => ok::<trajectory_msgs::JointTrajectoryPoint>(bytes),
+        "trajectory_msgs/msg/JointTrajectory" => ok::<trajectory_msgs::JointTrajectory>(bytes),
+        "control_msgs/msg/GripperCommand" => ok::<control_msgs::GripperCommand>(bytes),
+        "geometry_msgs/msg/Point32" => ok::<geometry_msgs::Point32>(bytes),
+        "geometry_msgs/msg/Polygon" => ok::<geometry_msgs::Polygon>(bytes),
+        "shape_msgs/msg/SolidPrimitive" => ok::<shape_msgs::SolidPrimitive>(bytes),
+        "agrisim_msgs/msg/GripperState" => ok::<agrisim::GripperState>(bytes),
+        "agrisim_msgs/msg/TrajectoryStatus" => ok::<agrisim::TrajectoryStatus>(bytes),
+        "agrisim_msgs/msg/CollisionObject" => ok::<agrisim::CollisionObject>(bytes),
+        "agrisim_msgs/msg/PlanningScene" => ok::<agrisim::PlanningScene>(bytes),
+        "agrisim_msgs/msg/HarvestStatus" => ok::<agrisim::HarvestStatus>(bytes),
         _ => None,
     }
 }

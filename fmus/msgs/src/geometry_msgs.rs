@@ -161,3 +161,22 @@ ros_message! {
         pub poses: Vec<Pose>,
     }
 }
+
+ros_message! {
+    /// `geometry_msgs/msg/Point32`: a position in single precision (polygon vertices).
+    #[derive(Debug, Default, Clone, Copy, PartialEq)]
+    pub struct Point32 = "geometry_msgs/msg/Point32" {
+        pub x: f32,
+        pub y: f32,
+        pub z: f32,
+    }
+}
+
+ros_message! {
+    /// `geometry_msgs/msg/Polygon`: vertices, the last connected to the first. Needed as
+    /// the `polygon` field of `shape_msgs/SolidPrimitive`.
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct Polygon = "geometry_msgs/msg/Polygon" {
+        pub points: Vec<Point32>,
+    }
+}

@@ -30,12 +30,15 @@ pub mod schema;
 
 pub mod agrisim;
 pub mod builtin_interfaces;
+pub mod control_msgs;
 pub mod geometry_msgs;
 pub mod nav_msgs;
 pub mod rosgraph_msgs;
 pub mod sensor_msgs;
+pub mod shape_msgs;
 pub mod std_msgs;
 pub mod tf2_msgs;
+pub mod trajectory_msgs;
 
 pub use check::check_cdr;
 pub use cdr::{CdrError, CdrField, CdrReader, CdrWriter, CDR_LE_HEADER};

@@ -63,6 +63,18 @@ msg_table! {
     "sensor_msgs" / "Image",
     "sensor_msgs" / "RegionOfInterest",
     "sensor_msgs" / "CameraInfo",
+    "builtin_interfaces" / "Duration",
+    "trajectory_msgs" / "JointTrajectoryPoint",
+    "trajectory_msgs" / "JointTrajectory",
+    "control_msgs" / "GripperCommand",
+    "geometry_msgs" / "Point32",
+    "geometry_msgs" / "Polygon",
+    "shape_msgs" / "SolidPrimitive",
+    "agrisim_msgs" / "GripperState",
+    "agrisim_msgs" / "TrajectoryStatus",
+    "agrisim_msgs" / "CollisionObject",
+    "agrisim_msgs" / "PlanningScene",
+    "agrisim_msgs" / "HarvestStatus",
 }
 
 /// Every type this crate knows, as `pkg/msg/Type`.

@@ -32,7 +32,7 @@ fn samples_cover_every_type() {
     let sampled: BTreeSet<&str> = all_samples().iter().map(|s| s.type_name).collect();
     let all: BTreeSet<&str> = all_type_names().iter().copied().collect();
     assert_eq!(sampled, all);
-    assert_eq!(all.len(), 32);
+    assert_eq!(all.len(), 44);
 }
 
 #[test]
@@ -502,4 +502,28 @@ fn garbage_never_panics() {
         "fuzz never produced a decodable message: generator too weak"
     );
     eprintln!("fuzz: {cases} decodes, {ok} succeeded, no panic");
+}
+
+#[test]
+fn duration_helpers_are_exact() {
+    use agrisim_msgs::builtin_interfaces::Duration;
+    assert_eq!(Duration::from_nanos(-1_700_000_000), Duration::new(-2, 300_000_000));
+    assert_eq!(Duration::from_secs_f64(1.7), Some(Duration::new(1, 700_000_000)));
+    assert_eq!(Duration::from_secs_f64(f64::NAN), None);
+    assert_eq!(Duration::new(2, 5).to_nanos(), 2_000_000_005);
+    assert_eq!(Duration::new(1, 500_000_000).as_secs_f64(), 1.5);
+}
+
+#[test]
+fn golden_solid_primitive_box() {
+    use agrisim_msgs::shape_msgs::SolidPrimitive;
+    let b = SolidPrimitive::new_box(1.0, 2.0, 3.0).to_cdr();
+    let mut expected = CDR_LE_HEADER.to_vec();
+    expected.extend_from_slice(&[1, 0, 0, 0]); // type + pad to 4
+    expected.extend_from_slice(&3u32.to_le_bytes()); // dimensions count, ends at rel 8
+    for v in [1.0f64, 2.0, 3.0] {
+        expected.extend_from_slice(&v.to_le_bytes());
+    }
+    expected.extend_from_slice(&0u32.to_le_bytes()); // polygon.points count
+    assert_eq!(b, expected);
 }

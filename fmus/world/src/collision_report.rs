@@ -1,7 +1,12 @@
 //! The `agrisim_msgs/CollisionState` message: the current contacts with the object's id, name
-//! and kind, so a benchmark can tell "hit a post" from "brushed a leaf".
+//! and kind and the robot link, so a benchmark can tell "hit a post" from "brushed a leaf".
+//!
+//! Arm-arm contacts use the same fields: `robot_link` is the left-arm link, `object_name` the
+//! right-arm link, `object_kind` is [`ARM_KIND`] and `object_id` is [`ARM_OBJECT_ID`] (no
+//! scene object has it). The category of a contact follows from `object_kind` alone (see
+//! [`crate::contacts`]).
 
-use crate::contacts::RobotContact;
+use crate::contacts::{Other, RobotContact};
 use crate::geometry::{point_msg, vector_msg};
 use crate::scene_world::SceneWorld;
 use agrisim_greenhouse::scene::Kind;
@@ -9,8 +14,10 @@ use agrisim_msgs::agrisim::{CollisionState, Contact};
 use agrisim_msgs::builtin_interfaces::Time;
 use agrisim_msgs::std_msgs::Header;
 
-/// The robot link every contact is reported on until the arm links join the world.
-pub const BASE_LINK: &str = "base_link";
+/// `object_kind` of an arm-arm contact.
+pub const ARM_KIND: &str = "robot_arm";
+/// `object_id` of an arm-arm contact.
+pub const ARM_OBJECT_ID: u32 = u32::MAX;
 
 /// Stable lower-case label of a kind (the `object_kind` field).
 pub fn kind_label(kind: Kind) -> &'static str {
@@ -39,12 +46,18 @@ pub fn collision_state(world: &SceneWorld, contacts: &[RobotContact], stamp_ns: 
         contacts: contacts
             .iter()
             .map(|c| {
-                let o = &world.objects[c.object];
+                let (object_id, object_name, object_kind) = match c.other {
+                    Other::Object(i) => {
+                        let o = &world.objects[i];
+                        (o.id, o.name.clone(), kind_label(o.kind).to_string())
+                    }
+                    Other::Part(j) => (ARM_OBJECT_ID, world.parts[j].link.clone(), ARM_KIND.to_string()),
+                };
                 Contact {
-                    object_id: o.id,
-                    object_name: o.name.clone(),
-                    object_kind: kind_label(o.kind).to_string(),
-                    robot_link: BASE_LINK.to_string(),
+                    object_id,
+                    object_name,
+                    object_kind,
+                    robot_link: world.parts[c.part].link.clone(),
                     position: point_msg(c.point),
                     normal: vector_msg(c.normal),
                     depth: c.depth as f64,

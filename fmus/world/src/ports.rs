@@ -1,12 +1,14 @@
 //! The Greenhouse FMU's variable table: scene parameters, the robot pose coming in from the
 //! other FMUs, contact and clearance outputs, and ground-truth fruit poses.
 
+use crate::robot_model::{OPEN_WIDTH, READY_POSE};
 use agrisim_fmi::{Start, Var};
 
 /// MIME types of the message ports (FMI 3 Binary variables carrying ROS 2 CDR).
 pub const COLLISION_STATE_MIME: &str = "application/x-ros2-cdr; type=agrisim_msgs/msg/CollisionState";
 pub const POSE_ARRAY_MIME: &str = "application/x-ros2-cdr; type=geometry_msgs/msg/PoseArray";
 pub const POSE_STAMPED_MIME: &str = "application/x-ros2-cdr; type=geometry_msgs/msg/PoseStamped";
+pub const PLANNING_SCENE_MIME: &str = "application/x-ros2-cdr; type=agrisim_msgs/msg/PlanningScene";
 
 agrisim_fmi::variables! { pub VARIABLES {
     // --- scene (fixed parameters) ---
@@ -35,14 +37,14 @@ agrisim_fmi::variables! { pub VARIABLES {
     BASE_Y = Var::input("base_y", 0.0).unit("m").desc("y of base_link in the map frame"),
     BASE_YAW = Var::input("base_yaw", 0.0).unit("rad").desc("Yaw of base_link in the map frame"),
     LIFT_POSITION = Var::input("lift_position", 0.0).unit("m")
-        .desc("Lift extension (reserved for the arm links; not yet part of the robot geometry)"),
+        .desc("Lift extension (URDF lift_joint, clamped to its limits): raises the lift carriage and both arms"),
     TARGET_FRUIT = Var::input_discrete("target_fruit", Start::Int32(-1))
         .desc("Index into the fruit list (order of fruit_poses) whose pose is the target; -1 = none"),
     // --- outputs: contacts and clearance ---
     COLLISION = Var::output_discrete("collision", Start::Boolean(false))
-        .desc("The robot touches or penetrates any scene object (floor excluded)"),
+        .desc("Any robot contact now: a scene object (floor excluded for the base box; carried, falling and placed fruit excluded) or arm vs arm"),
     COLLISION_COUNT = Var::output_discrete("collision_count", Start::Int32(0))
-        .desc("Cumulative number of contact onsets (an object coming into contact with the robot)"),
+        .desc("Cumulative contact onsets, all categories (sum of contact_robot_plant, contact_robot_structure, contact_arm_arm)"),
     MIN_CLEARANCE = Var::output("min_clearance").unit("m")
         .desc("Distance from the base box to the nearest scene object within the base's height band, capped at clearance_cap"),
     COLLISION_STATE = Var::output_discrete("collision_state", Start::Binary(&[])).mime(COLLISION_STATE_MIME)
@@ -64,4 +66,58 @@ agrisim_fmi::variables! { pub VARIABLES {
     TARGET = Var::output_discrete("target", Start::Binary(&[])).mime(POSE_STAMPED_MIME)
         .desc("geometry_msgs/PoseStamped of the target fruit (frame map), at fruit_rate and when target_fruit changes"),
     TARGET_SEQ = Var::output_discrete("target_seq", Start::Int64(0)).desc("Sequence counter of target"),
+    // --- harvest physics (appended: earlier value references stay as they were) ---
+    LEFT_Q1 = Var::input("left_q1", READY_POSE[0]).unit("rad").desc("left_joint1 angle (default: Franka ready pose; clamped to the URDF limits)"),
+    LEFT_Q2 = Var::input("left_q2", READY_POSE[1]).unit("rad").desc("left_joint2 angle"),
+    LEFT_Q3 = Var::input("left_q3", READY_POSE[2]).unit("rad").desc("left_joint3 angle"),
+    LEFT_Q4 = Var::input("left_q4", READY_POSE[3]).unit("rad").desc("left_joint4 angle"),
+    LEFT_Q5 = Var::input("left_q5", READY_POSE[4]).unit("rad").desc("left_joint5 angle"),
+    LEFT_Q6 = Var::input("left_q6", READY_POSE[5]).unit("rad").desc("left_joint6 angle"),
+    LEFT_Q7 = Var::input("left_q7", READY_POSE[6]).unit("rad").desc("left_joint7 angle"),
+    RIGHT_Q1 = Var::input("right_q1", READY_POSE[0]).unit("rad").desc("right_joint1 angle (default: Franka ready pose; clamped to the URDF limits)"),
+    RIGHT_Q2 = Var::input("right_q2", READY_POSE[1]).unit("rad").desc("right_joint2 angle"),
+    RIGHT_Q3 = Var::input("right_q3", READY_POSE[2]).unit("rad").desc("right_joint3 angle"),
+    RIGHT_Q4 = Var::input("right_q4", READY_POSE[3]).unit("rad").desc("right_joint4 angle"),
+    RIGHT_Q5 = Var::input("right_q5", READY_POSE[4]).unit("rad").desc("right_joint5 angle"),
+    RIGHT_Q6 = Var::input("right_q6", READY_POSE[5]).unit("rad").desc("right_joint6 angle"),
+    RIGHT_Q7 = Var::input("right_q7", READY_POSE[6]).unit("rad").desc("right_joint7 angle"),
+    LEFT_FINGER_WIDTH = Var::input("left_finger_width", OPEN_WIDTH).unit("m")
+        .desc("Gap between the left gripper's finger pads (each finger joint = width / 2; clamped to 0..0.08)"),
+    RIGHT_FINGER_WIDTH = Var::input("right_finger_width", OPEN_WIDTH).unit("m")
+        .desc("Gap between the right gripper's finger pads"),
+    GRASP_TOLERANCE = Var::param("grasp_tolerance", Start::Float64(0.003)).unit("m").range(0.0, 0.05)
+        .desc("Attach: gap <= fruit diameter + this, and the fruit centre within the finger pads widened by this"),
+    RELEASE_MARGIN = Var::param("release_margin", Start::Float64(0.005)).unit("m").range(0.0, 0.05)
+        .desc("Release: gap > fruit diameter + this"),
+    PHYSICS_DT = Var::param("physics_dt", Start::Float64(0.005)).unit("s").range(1e-4, 0.1)
+        .desc("Largest rapier substep while a released fruit falls"),
+    LEFT_GRASP_WIDTH = Var::output("left_grasp_width").unit("m")
+        .desc("Diameter of the fruit between the left fingers (where the gripper stalls), 0 when empty"),
+    RIGHT_GRASP_WIDTH = Var::output("right_grasp_width").unit("m")
+        .desc("Diameter of the fruit between the right fingers, 0 when empty"),
+    LEFT_HELD_ID = Var::output_discrete("left_held_id", Start::Int32(-1))
+        .desc("Scene object id of the fruit the left gripper holds (as target_id), -1 when none"),
+    RIGHT_HELD_ID = Var::output_discrete("right_held_id", Start::Int32(-1))
+        .desc("Scene object id of the fruit the right gripper holds, -1 when none"),
+    PICKED_COUNT = Var::output_discrete("picked_count", Start::Int32(0))
+        .desc("Fruit detached from their plants by a grasp (cumulative)"),
+    PLACED_COUNT = Var::output_discrete("placed_count", Start::Int32(0))
+        .desc("Released fruit that came to rest inside the harvest box (cumulative)"),
+    DROPPED_COUNT = Var::output_discrete("dropped_count", Start::Int32(0))
+        .desc("Releases that ended on the floor or at rest outside the box (cumulative)"),
+    LAST_PLACED_ID = Var::output_discrete("last_placed_id", Start::Int32(-1))
+        .desc("Scene object id of the fruit placed last, -1 before the first"),
+    CONTACT_ROBOT_PLANT = Var::output_discrete("contact_robot_plant", Start::Int32(0))
+        .desc("Cumulative onsets of robot contact with stems, leaves, trusses, fruit on the crop (expected; not a failure)"),
+    CONTACT_ROBOT_STRUCTURE = Var::output_discrete("contact_robot_structure", Start::Int32(0))
+        .desc("Cumulative onsets of robot contact with posts, pipes, gutters, walls, obstacles, floor (a collision failure)"),
+    CONTACT_ARM_ARM = Var::output_discrete("contact_arm_arm", Start::Int32(0))
+        .desc("Cumulative onsets of left-arm vs right-arm link contact (a collision failure)"),
+    PLANNING_SCENE_RADIUS = Var::param("planning_scene_radius", Start::Float64(2.5)).unit("m").range(0.0, 1000.0)
+        .desc("planning_scene lists the objects whose bounding box comes this close (horizontally) to base_link"),
+    PLANNING_SCENE_RATE = Var::param("planning_scene_rate", Start::Float64(1.0)).unit("Hz").range(0.001, 1e6)
+        .desc("Publication rate of planning_scene"),
+    PLANNING_SCENE = Var::output_discrete("planning_scene", Start::Binary(&[])).mime(PLANNING_SCENE_MIME)
+        .desc("agrisim_msgs/PlanningScene: scene objects near the robot as primitives (frame map; ids = scene object ids), at planning_scene_rate"),
+    PLANNING_SCENE_SEQ = Var::output_discrete("planning_scene_seq", Start::Int64(0)).desc("Sequence counter of planning_scene"),
 }}

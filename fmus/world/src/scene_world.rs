@@ -1,13 +1,17 @@
 //! The greenhouse held in a rapier world: every scene object a collider whose `user_data` is
-//! its index in [`SceneWorld::objects`], every fruit its own rigid body (fixed for now, so
-//! harvesting can later detach it and let it fall), the robot base a kinematic body.
+//! its index in [`SceneWorld::objects`], every fruit its own rigid body (fixed while on its
+//! plant; kinematic while held or placed; dynamic while falling), the robot base and links
+//! kinematic bodies.
 //!
-//! Only collision detection runs so far (rapier's `CollisionPipeline`: broad phase kept current,
-//! no integration). The sets are the ones a `PhysicsPipeline` steps, so harvest physics can
-//! switch fruit to dynamic bodies without rebuilding anything.
+//! While nothing is dynamic a step only teleports the kinematic bodies and runs rapier's
+//! `CollisionPipeline` (broad phase kept current, no integration): the navigation case stays
+//! as cheap as before the arms existed. While a released fruit falls, the step runs the
+//! `PhysicsPipeline` in substeps of at most `max_dt`, the kinematic bodies interpolated
+//! across them so what they push gets their velocity.
 
 use crate::base_box::BaseBox;
 use crate::geometry::{pose_of, shape_of};
+use crate::robot_links::{LinkBody, RobotPart};
 use agrisim_greenhouse::scene::{Kind, Object};
 use rapier3d::prelude::*;
 
@@ -29,7 +33,14 @@ pub struct Fruit {
     /// Index into [`SceneWorld::objects`].
     pub object: usize,
     pub body: RigidBodyHandle,
+    pub radius: f64,
 }
+
+/// Tomato density [kg/m^3] (about water's): a falling fruit's mass for rapier.
+pub const FRUIT_DENSITY: f32 = 1000.0;
+
+/// Standard gravity [m/s^2].
+pub const GRAVITY: f32 = 9.81;
 
 /// The robot base: a kinematic body with one box collider.
 #[derive(Clone, Debug)]
@@ -40,13 +51,13 @@ pub struct Robot {
     pub base: BaseBox,
 }
 
-/// rapier's collision pipeline holds only scratch buffers: a copy of the world (an FMU state)
-/// starts with fresh ones.
-struct Scratch(CollisionPipeline);
+/// rapier's pipelines hold only scratch buffers and caches: a copy of the world (an FMU
+/// state) starts with fresh ones.
+struct Scratch(CollisionPipeline, PhysicsPipeline);
 
 impl Clone for Scratch {
     fn clone(&self) -> Self {
-        Scratch(CollisionPipeline::new())
+        Scratch(CollisionPipeline::new(), PhysicsPipeline::new())
     }
 }
 
@@ -61,6 +72,14 @@ pub struct SceneWorld {
     pub objects: Vec<SceneObject>,
     pub fruit: Vec<Fruit>,
     pub robot: Robot,
+    /// The URDF links (empty until [`SceneWorld::add_robot_links`]).
+    pub links: Vec<LinkBody>,
+    /// Every robot collider: part 0 is the base box, then the link primitives.
+    pub parts: Vec<RobotPart>,
+    impulse_joints: ImpulseJointSet,
+    multibody_joints: MultibodyJointSet,
+    soft_bodies: SoftBodySet,
+    ccd: CCDSolver,
     scratch: Scratch,
 }
 
@@ -78,7 +97,12 @@ impl SceneWorld {
             let builder = ColliderBuilder::new(shape).user_data(index as u128);
             let collider = if matches!(o.kind, Kind::Fruit { .. }) {
                 let body = bodies.insert(RigidBodyBuilder::fixed().pose(pose).user_data(o.id as u128));
-                fruit.push(Fruit { object: index, body });
+                let radius = match o.shape {
+                    agrisim_greenhouse::scene::Shape::Sphere { radius } => radius,
+                    _ => return Err(describe("a fruit must be a sphere".into())),
+                };
+                fruit.push(Fruit { object: index, body, radius });
+                let builder = builder.density(FRUIT_DENSITY).friction(0.7).restitution(0.2);
                 colliders.insert_with_parent(builder.position(offset), body, &mut bodies)
             } else {
                 // Static structure: colliders without a body are fixed for rapier, and cost
@@ -103,18 +127,71 @@ impl SceneWorld {
             objects: table,
             fruit,
             robot: Robot { body, collider, shape, base },
-            scratch: Scratch(CollisionPipeline::new()),
+            links: Vec::new(),
+            parts: Vec::new(),
+            impulse_joints: ImpulseJointSet::new(),
+            multibody_joints: MultibodyJointSet::new(),
+            soft_bodies: SoftBodySet::default(),
+            ccd: CCDSolver::new(),
+            scratch: Scratch(CollisionPipeline::new(), PhysicsPipeline::new()),
         };
         world.refresh();
         Ok(world)
     }
 
-    /// Moves the robot base to `pose` (map frame) and brings collision detection up to date.
-    /// (A teleport: once a `PhysicsPipeline` steps the world, `set_next_kinematic_position`
-    /// gives pushed fruit the robot's velocity instead.)
-    pub fn move_robot(&mut self, pose: Pose) {
-        self.bodies[self.robot.body].set_position(pose, true);
-        self.refresh();
+    /// Puts kinematic bodies at their new poses for the end of a step of `h` seconds. With
+    /// `dynamic` (something falls) the physics runs in `ceil(h / max_dt)` substeps under
+    /// gravity, the kinematic bodies moving linearly across them; otherwise they teleport.
+    /// `awake` lists further kinematic bodies falling things may land on (carried and placed
+    /// fruit): rapier's solver only sees kinematic bodies that are awake.
+    pub fn advance(&mut self, moves: &[(RigidBodyHandle, Pose)], awake: &[RigidBodyHandle], h: f64, dynamic: bool, max_dt: f64) {
+        if !dynamic {
+            for &(body, pose) in moves {
+                self.bodies[body].set_position(pose, true);
+            }
+            self.refresh();
+            return;
+        }
+        let n = (h / max_dt).ceil().clamp(1.0, 10_000.0) as usize;
+        let start: Vec<Pose> = moves.iter().map(|&(b, _)| *self.bodies[b].position()).collect();
+        let mut params = self.params;
+        params.dt = (h / n as f64) as Real;
+        for k in 1..=n {
+            let s = k as Real / n as Real;
+            for (&(body, to), from) in moves.iter().zip(&start) {
+                let pose = if k == n { to } else { from.lerp(&to, s) };
+                self.bodies[body].set_next_kinematic_position(pose);
+            }
+            // rapier's solver only sees kinematic bodies that are awake: a resting robot
+            // part would let falling fruit pass through it.
+            self.bodies[self.robot.body].wake_up(true);
+            for link in &self.links {
+                self.bodies[link.body].wake_up(true);
+            }
+            for &body in awake {
+                self.bodies[body].wake_up(true);
+            }
+            self.scratch.1.step(
+                Vector::new(0.0, 0.0, -GRAVITY),
+                &params,
+                &mut self.islands,
+                &mut self.broad_phase,
+                &mut self.narrow_phase,
+                &mut self.bodies,
+                &mut self.colliders,
+                &mut self.impulse_joints,
+                &mut self.multibody_joints,
+                &mut self.soft_bodies,
+                &mut self.ccd,
+                &(),
+                &(),
+            );
+        }
+    }
+
+    /// Index into the fruit list of scene object `object`, if it is a fruit.
+    pub fn fruit_of_object(&self, object: usize) -> Option<usize> {
+        self.fruit.binary_search_by_key(&object, |f| f.object).ok()
     }
 
     /// Broad and narrow phase after bodies moved.

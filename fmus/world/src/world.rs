@@ -1,28 +1,70 @@
-//! The `Greenhouse` model: builds the scene at initialization, then each step moves the robot
-//! base to its input pose and reports contacts, clearance and ground truth.
+//! The `Greenhouse` model: builds the scene and the robot at initialization, then each step
+//! moves the robot base and links to their input pose (FK of lift, arm joints and fingers),
+//! applies the harvest rules (grasp, carry, release, fall, place), and reports contacts,
+//! clearance, harvest counters and ground truth.
 
 use crate::base_box::BaseBox;
 use crate::clearance::min_clearance;
 use crate::collision_report::collision_state;
-use crate::contacts::{robot_contacts, ContactTracker};
+use crate::contacts::{robot_contacts, Category, ContactTracker};
 use crate::ground_truth::{fruit_poses, Target};
+use crate::harvest::{Harvest, HarvestParams};
+use crate::planning_scene::planning_scene;
 use crate::ports::*;
+use crate::robot_links::{base_pose, to_rapier};
+use crate::robot_model::{Coords, RobotModel, Side};
 use crate::scene_world::SceneWorld;
 use agrisim_fmi::{Log, Model, Store, Var};
 use agrisim_fmu_util::{to_ns, Schedule};
 use agrisim_greenhouse::config::GreenhouseConfig;
 use agrisim_msgs::Message;
-use rapier3d::prelude::Pose;
+use agrisim_robot::Pose as RPose;
+use rapier3d::prelude::{Pose, RigidBodyHandle};
+use std::sync::Arc;
+
+const LEFT_Q: [usize; 7] = [LEFT_Q1, LEFT_Q2, LEFT_Q3, LEFT_Q4, LEFT_Q5, LEFT_Q6, LEFT_Q7];
+const RIGHT_Q: [usize; 7] = [RIGHT_Q1, RIGHT_Q2, RIGHT_Q3, RIGHT_Q4, RIGHT_Q5, RIGHT_Q6, RIGHT_Q7];
+
+/// The robot's kinematic state as last applied to the world.
+#[derive(Clone)]
+struct RobotState {
+    model: Arc<RobotModel>,
+    coords: Coords,
+    /// (x, y, yaw) of base_link in the map frame.
+    planar: [f64; 3],
+    /// Every link in base_link (FK of `coords`).
+    link_in_base: Vec<RPose>,
+    hand_links: [usize; 2],
+    box_link: usize,
+    /// harvest_box_link in the map frame at the end of the last step.
+    box_pose: RPose,
+    physics_dt: f64,
+}
+
+impl RobotState {
+    fn hands(&self, base: &RPose) -> [RPose; 2] {
+        self.hand_links.map(|i| base.mul(&self.link_in_base[i]))
+    }
+}
 
 /// Everything that exists once the scene is built.
 #[derive(Clone)]
 struct Running {
     world: SceneWorld,
+    robot: RobotState,
+    harvest: Harvest,
+    /// Kinematic moves of one step (kept to reuse its allocation).
+    moves: Vec<(RigidBodyHandle, Pose)>,
+    /// Kinematic fruit to keep awake while something falls (reused allocation).
+    awake: Vec<RigidBodyHandle>,
     tracker: ContactTracker,
     band: [f64; 2],
     clearance_cap: f64,
     collision_schedule: Schedule,
     fruit_schedule: Schedule,
+    scene_schedule: Schedule,
+    scene_radius: f64,
+    scene_seq: i64,
     collision_seq: i64,
     fruit_seq: i64,
     target_seq: i64,
@@ -56,12 +98,42 @@ pub fn scene_config(io: &Store) -> Result<(GreenhouseConfig, u64), String> {
     Ok((cfg, seed))
 }
 
-fn robot_pose(io: &Store, base: &BaseBox) -> Result<Pose, String> {
+fn planar_input(io: &Store) -> Result<[f64; 3], String> {
     let (x, y, yaw) = (io.f64(BASE_X), io.f64(BASE_Y), io.f64(BASE_YAW));
     if [x, y, yaw].iter().all(|v| v.is_finite() && v.abs() < 1e6) {
-        Ok(base.pose(x, y, yaw))
+        Ok([x, y, yaw])
     } else {
         Err(format!("robot pose input (base_x, base_y, base_yaw) = ({x}, {y}, {yaw}) is not finite or beyond 1e6"))
+    }
+}
+
+/// Lift, arm joints and finger gaps from the inputs. Non-finite values are errors; finite
+/// ones are clamped to the URDF limits by FK, the gaps here to the fingers' travel.
+fn coords_input(io: &Store, model: &RobotModel) -> Result<Coords, String> {
+    let mut c = Coords { lift: io.f64(LIFT_POSITION), ..Coords::default() };
+    for (side, vrs) in [(Side::Left, LEFT_Q), (Side::Right, RIGHT_Q)] {
+        for (i, &vr) in vrs.iter().enumerate() {
+            c.arms[side as usize][i] = io.f64(vr);
+        }
+    }
+    c.widths = [io.f64(LEFT_FINGER_WIDTH), io.f64(RIGHT_FINGER_WIDTH)];
+    let all = std::iter::once(c.lift).chain(c.arms.iter().flatten().copied()).chain(c.widths);
+    if let Some(bad) = all.zip(0..).find(|(v, _)| !v.is_finite()) {
+        return Err(format!("robot joint input #{} (lift, left_q1..7, right_q1..7, widths) is not finite: {}", bad.1, bad.0));
+    }
+    for side in Side::BOTH {
+        let s = side as usize;
+        c.widths[s] = c.widths[s].clamp(0.0, model.pads[s].max_width());
+    }
+    Ok(c)
+}
+
+fn positive_param(io: &Store, i: usize, max: f64) -> Result<f64, String> {
+    let v = io.f64(i);
+    if v.is_finite() && v >= 0.0 && v <= max {
+        Ok(v)
+    } else {
+        Err(format!("parameter {} must be in [0, {max}], got {v}", VARIABLES[i].name))
     }
 }
 
@@ -74,17 +146,85 @@ impl Running {
     /// Contacts, clearance, ground truth and due messages for time `t`.
     fn report(&mut self, io: &mut Store, t: f64) {
         self.report_contacts(io, t);
+        self.report_harvest(io);
         self.report_ground_truth(io, t);
+        if let Some(stamp) = self.scene_schedule.due(t) {
+            let [x, y, _] = self.robot.planar;
+            self.scene_seq += 1;
+            io.set_binary(PLANNING_SCENE, &planning_scene(&self.world, &self.harvest, [x, y], self.scene_radius, stamp).to_cdr());
+            io.set_i64(PLANNING_SCENE_SEQ, self.scene_seq);
+        }
+    }
+
+    fn report_harvest(&mut self, io: &mut Store) {
+        let (w, h) = (&self.world, &self.harvest);
+        let id = |f: Option<usize>| f.map_or(-1, |f| w.objects[w.fruit[f].object].id.min(i32::MAX as u32) as i32);
+        io.set_f64(LEFT_GRASP_WIDTH, h.grasp_width(w, Side::Left));
+        io.set_f64(RIGHT_GRASP_WIDTH, h.grasp_width(w, Side::Right));
+        io.set_i32(LEFT_HELD_ID, id(h.grippers[Side::Left as usize].held));
+        io.set_i32(RIGHT_HELD_ID, id(h.grippers[Side::Right as usize].held));
+        let count = |n: u32| n.min(i32::MAX as u32) as i32;
+        io.set_i32(PICKED_COUNT, count(h.picked));
+        io.set_i32(PLACED_COUNT, count(h.placed));
+        io.set_i32(DROPPED_COUNT, count(h.dropped));
+        io.set_i32(LAST_PLACED_ID, id(h.last_placed));
+    }
+
+    /// One step of `h` seconds with the robot inputs in `io`: kinematics, harvest rules,
+    /// physics, settling.
+    fn advance(&mut self, io: &Store, h: f64) -> Result<(), String> {
+        let planar = planar_input(io)?;
+        let coords = coords_input(io, &self.robot.model)?;
+        let r = &mut self.robot;
+        let (base_moved, joints_moved) = (planar != r.planar, coords != r.coords);
+        if joints_moved {
+            r.model.fk(&coords, &mut r.link_in_base);
+            r.coords = coords;
+        }
+        r.planar = planar;
+        let base = base_pose(planar[0], planar[1], planar[2]);
+        let hands = r.hands(&base);
+        let box_pose = base.mul(&r.link_in_base[r.box_link]);
+        self.harvest.grip(&mut self.world, &r.model.pads, &hands, coords.widths, h);
+        self.moves.clear();
+        if base_moved {
+            let body = self.world.robot.base.pose(planar[0], planar[1], planar[2]);
+            self.moves.push((self.world.robot.body, body));
+        }
+        if base_moved || joints_moved {
+            for link in &mut self.world.links {
+                let pose = to_rapier(&base.mul(&r.link_in_base[link.link]));
+                if pose != link.pose {
+                    link.pose = pose;
+                    self.moves.push((link.body, pose));
+                }
+            }
+        }
+        self.harvest.fruit_moves(&self.world, &hands, &box_pose, &mut self.moves);
+        let dynamic = self.harvest.any_falling();
+        if dynamic {
+            self.harvest.kinematic_fruit(&self.world, &mut self.awake);
+        }
+        self.world.advance(&self.moves, &self.awake, h, dynamic, r.physics_dt);
+        let box_vel: [f64; 3] = std::array::from_fn(|i| (box_pose.trans[i] - r.box_pose.trans[i]) / h);
+        self.harvest.settle(&mut self.world, &r.model.box_interior, &box_pose, box_vel, h);
+        r.box_pose = box_pose;
+        Ok(())
     }
 
     fn report_contacts(&mut self, io: &mut Store, t: f64) {
-        let contacts = robot_contacts(&self.world);
+        let contacts = robot_contacts(&self.world, &self.harvest);
         let changed = self.tracker.update(&contacts);
+        let count = |n: u64| n.min(i32::MAX as u64) as i32;
         io.set_bool(COLLISION, !contacts.is_empty());
-        io.set_i32(COLLISION_COUNT, self.tracker.onsets().min(i32::MAX as u64) as i32);
+        io.set_i32(COLLISION_COUNT, count(self.tracker.onsets()));
+        io.set_i32(CONTACT_ROBOT_PLANT, count(self.tracker.onsets_in(Category::Plant)));
+        io.set_i32(CONTACT_ROBOT_STRUCTURE, count(self.tracker.onsets_in(Category::Structure)));
+        io.set_i32(CONTACT_ARM_ARM, count(self.tracker.onsets_in(Category::ArmArm)));
         // Anything touching the box lies in its band: clearance 0, whatever f32 rounding in
         // the distance query says (it can differ from the contact query by ~1e-5 m).
-        let clearance = if contacts.is_empty() { min_clearance(&self.world, self.band, self.clearance_cap) } else { 0.0 };
+        let base_touches = contacts.iter().any(|c| c.part == 0);
+        let clearance = if !base_touches { min_clearance(&self.world, self.band, self.clearance_cap) } else { 0.0 };
         io.set_f64(MIN_CLEARANCE, clearance);
         let due = self.collision_schedule.due(t);
         if changed || due.is_some() {
@@ -141,10 +281,40 @@ impl Model for GreenhouseWorld {
         }
         let collision_schedule = schedule(io, COLLISION_RATE, start_time)?;
         let fruit_schedule = schedule(io, FRUIT_RATE, start_time)?;
-        let pose = robot_pose(io, &base)?;
+        let params = HarvestParams {
+            grasp_tolerance: positive_param(io, GRASP_TOLERANCE, 0.05)?,
+            release_margin: positive_param(io, RELEASE_MARGIN, 0.05)?,
+        };
+        let physics_dt = positive_param(io, PHYSICS_DT, 0.1)?;
+        let scene_schedule = schedule(io, PLANNING_SCENE_RATE, start_time)?;
+        let scene_radius = positive_param(io, PLANNING_SCENE_RADIUS, 1000.0)?;
+        if physics_dt < 1e-4 {
+            return Err(format!("parameter physics_dt must be at least 1e-4 s, got {physics_dt}"));
+        }
+        let planar = planar_input(io)?;
+        let model = Arc::new(RobotModel::load()?);
+        let coords = coords_input(io, &model)?;
+        let mut link_in_base = Vec::new();
+        model.fk(&coords, &mut link_in_base);
+        let link = |name: &str| model.link_index(name).ok_or(format!("robot URDF: no link {name}"));
+        let hand_links = [link("left_hand")?, link("right_hand")?];
+        let box_link = link("harvest_box_link")?;
         let (cfg, seed) = scene_config(io)?;
         let greenhouse = agrisim_greenhouse::generate(&cfg, seed);
-        let world = SceneWorld::build(&greenhouse.objects, base, pose)?;
+        let mut world = SceneWorld::build(&greenhouse.objects, base, base.pose(planar[0], planar[1], planar[2]))?;
+        let base_link = base_pose(planar[0], planar[1], planar[2]);
+        world.add_robot_links(&model, &base_link, &link_in_base)?;
+        let robot = RobotState {
+            box_pose: base_link.mul(&link_in_base[box_link]),
+            model,
+            coords,
+            planar,
+            link_in_base,
+            hand_links,
+            box_link,
+            physics_dt,
+        };
+        let harvest = Harvest::new(params, coords.widths, robot.hands(&base_link));
         log.info(&format!(
             "greenhouse: {} rows, {} objects, {} fruit (seed {seed})",
             cfg.rows,
@@ -154,11 +324,18 @@ impl Model for GreenhouseWorld {
         io.set_i32(FRUIT_COUNT, world.fruit.len().min(i32::MAX as usize) as i32);
         let mut run = Box::new(Running {
             world,
+            robot,
+            harvest,
+            moves: Vec::new(),
+            awake: Vec::new(),
             tracker: ContactTracker::default(),
             band: base.band(),
             clearance_cap: cap,
             collision_schedule,
             fruit_schedule,
+            scene_schedule,
+            scene_radius,
+            scene_seq: 0,
             collision_seq: 0,
             fruit_seq: 0,
             target_seq: 0,
@@ -174,8 +351,7 @@ impl Model for GreenhouseWorld {
             return Err(format!("communication step {h} s must be positive and finite"));
         }
         let run = self.run.as_mut().ok_or("do_step before initialization")?;
-        let pose = robot_pose(io, &run.world.robot.base)?;
-        run.world.move_robot(pose);
+        run.advance(io, h)?;
         run.report(io, t + h);
         Ok(())
     }

@@ -1,6 +1,8 @@
 //! Benchmarks: the master's overhead, and the many-trial evaluations (navigation) with honest
 //! statistics and every trial recorded.
 
+pub mod harvest;
+pub mod harvest_targets;
 pub mod nav;
 pub mod overhead;
 pub mod report;

@@ -4,8 +4,14 @@
 //! single IEEE operation on both sides) and to exercise alignment after strings.
 #![allow(dead_code)]
 
-use agrisim_msgs::agrisim::{CollisionState, Contact, FmuStatus, NavigationStatus, Signals};
-use agrisim_msgs::builtin_interfaces::Time;
+use agrisim_msgs::agrisim::{
+    CollisionObject, CollisionState, Contact, FmuStatus, GripperState, HarvestStatus,
+    NavigationStatus, PlanningScene, Signals, TrajectoryStatus,
+};
+use agrisim_msgs::builtin_interfaces::{Duration, Time};
+use agrisim_msgs::control_msgs::GripperCommand;
+use agrisim_msgs::shape_msgs::SolidPrimitive;
+use agrisim_msgs::trajectory_msgs::{JointTrajectory, JointTrajectoryPoint};
 use agrisim_msgs::geometry_msgs::*;
 use agrisim_msgs::nav_msgs::{MapMetaData, OccupancyGrid, Odometry, Path};
 use agrisim_msgs::rosgraph_msgs::Clock;
@@ -170,7 +176,140 @@ fn contact(id: u32, name: &str, link: &str) -> Contact {
     }
 }
 
+fn traj_point(positions: Vec<f64>, velocities: Vec<f64>, sec: i32, nanosec: u32) -> JointTrajectoryPoint {
+    JointTrajectoryPoint {
+        positions,
+        velocities,
+        accelerations: vec![],
+        effort: vec![],
+        time_from_start: Duration::new(sec, nanosec),
+    }
+}
+
+fn p32(x: f32, y: f32, z: f32) -> Point32 {
+    Point32 { x, y, z }
+}
+
+fn stem_object() -> CollisionObject {
+    CollisionObject {
+        id: "stem_3".into(),
+        kind: "stem".into(),
+        primitive: SolidPrimitive::cylinder(1.5, 0.0125),
+        pose: pose(2.0, -0.75, 0.75, Quaternion::IDENTITY),
+    }
+}
+
+fn prism() -> SolidPrimitive {
+    SolidPrimitive {
+        r#type: SolidPrimitive::PRISM,
+        dimensions: vec![0.5],
+        polygon: Polygon { points: vec![p32(0.0, 0.0, 0.0), p32(1.0, 0.0, 0.0), p32(0.0, 1.0, 0.0)] },
+    }
+}
+
+/// Samples of the arm/manipulation types (issue 4).
+fn manipulation_samples() -> Vec<Sample> {
+    vec![
+        sample("duration", Duration::new(3, 250_000_000)),
+        sample("duration_negative", Duration::new(-2, 300_000_000)),
+        sample(
+            "joint_trajectory_point",
+            JointTrajectoryPoint {
+                positions: vec![0.5, -1.25, 0.0],
+                velocities: vec![0.125, 0.0, -0.5],
+                accelerations: vec![1.0, 2.0, 3.0],
+                effort: vec![],
+                time_from_start: Duration::new(1, 500_000_000),
+            },
+        ),
+        sample(
+            "joint_trajectory",
+            JointTrajectory {
+                header: hdr(5, 0, "base_link"),
+                joint_names: vec!["left_joint1".into(), "left_joint2".into()],
+                points: vec![
+                    traj_point(vec![0.0, 0.25], vec![], 0, 0),
+                    traj_point(vec![0.5, -0.25], vec![0.0, 0.0], 2, 5),
+                ],
+            },
+        ),
+        sample("joint_trajectory_empty", JointTrajectory::default()),
+        sample("gripper_command", GripperCommand { position: 0.04, max_effort: 70.0 }),
+        sample("point32", p32(1.5, -0.25, 0.125)),
+        sample(
+            "polygon",
+            Polygon { points: vec![p32(0.0, 0.0, 0.0), p32(1.0, 0.0, 0.5), p32(0.0, -1.0, 0.25)] },
+        ),
+        sample("solid_primitive_box", SolidPrimitive::new_box(0.1, 0.2, 0.3)),
+        sample("solid_primitive_prism", prism()),
+        sample(
+            "gripper_state",
+            GripperState {
+                header: hdr(4, 20_000_000, "left_hand"),
+                position: 0.035,
+                effort: 70.0,
+                stalled: true,
+                reached_goal: false,
+            },
+        ),
+        sample(
+            "trajectory_status",
+            TrajectoryStatus {
+                header: hdr(6, 0, "left"),
+                state: TrajectoryStatus::REJECTED,
+                trajectory_count: 3,
+                rejected_count: 1,
+                reason: "point 2: time_from_start not strictly increasing".into(),
+                rms_tracking_error: 0.0025,
+                max_tracking_error: 0.0078125,
+            },
+        ),
+        sample("collision_object", stem_object()),
+        sample(
+            "planning_scene",
+            PlanningScene {
+                header: hdr(7, 500_000_000, "base_link"),
+                objects: vec![
+                    stem_object(),
+                    CollisionObject {
+                        id: "floor".into(),
+                        kind: "floor".into(),
+                        primitive: SolidPrimitive::new_box(10.0, 10.0, 0.01),
+                        pose: pose(0.0, 0.0, -0.005, Quaternion::IDENTITY),
+                    },
+                    CollisionObject {
+                        id: "fruit_12".into(),
+                        kind: "fruit".into(),
+                        primitive: SolidPrimitive::sphere(0.035),
+                        pose: pose(0.75, 0.5, 1.25, Quaternion::IDENTITY),
+                    },
+                ],
+            },
+        ),
+        sample("planning_scene_empty", PlanningScene::default()),
+        sample(
+            "harvest_status",
+            HarvestStatus {
+                header: hdr(30, 0, "map"),
+                stage: "handover".into(),
+                target_id: 12,
+                target_name: "fruit_12".into(),
+                outcome: "failure".into(),
+                failure_category: "handover".into(),
+                detail: "right gripper stalled at 0 m".into(),
+                plans: 7,
+            },
+        ),
+    ]
+}
+
 pub fn all_samples() -> Vec<Sample> {
+    let mut all = base_samples();
+    all.extend(manipulation_samples());
+    all
+}
+
+fn base_samples() -> Vec<Sample> {
     let h = std::f64::consts::FRAC_1_SQRT_2; // 0.7071067811865476
     vec![
         sample("time", Time::new(1_700_000_000, 123_456_789)),

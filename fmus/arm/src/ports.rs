@@ -1,0 +1,70 @@
+//! The Arm FMU's variable table. One FMU serves both arms: `side` selects the URDF joints.
+
+use agrisim_fmi::{Start, Var};
+use agrisim_msgs::agrisim::{GripperState, TrajectoryStatus};
+use agrisim_msgs::control_msgs::GripperCommand;
+use agrisim_msgs::sensor_msgs::JointState;
+use agrisim_msgs::trajectory_msgs::JointTrajectory;
+
+agrisim_fmi::variables! { pub VARIABLES {
+    // --- parameters ---
+    SIDE = Var::param("side", Start::String("left"))
+        .desc("Which arm: \"left\" or \"right\" (joints {side}_joint1..7, {side}_finger_joint1/2 of the URDF)"),
+    Q_INIT = Var::param("q_init", Start::String(""))
+        .desc("Initial joint positions \"q1,...,q7\" in rad; empty: the ready pose 0,-pi/4,0,-3pi/4,0,pi/2,pi/4"),
+    KP = Var::param("kp", Start::String(""))
+        .desc("Joint stiffness \"k1,...,k7\" in N m/rad; empty: libfranka example gains 600,600,600,600,250,150,50"),
+    KD = Var::param("kd", Start::String(""))
+        .desc("Joint damping \"d1,...,d7\" in N m s/rad; empty: libfranka example gains 50,50,50,50,30,25,15"),
+    INERTIA_SCALE = Var::param("ctrl_inertia_scale", Start::Float64(0.9)).range(0.0, 10.0)
+        .desc("Controller's inertia estimate / plant inertia (model mismatch)"),
+    COULOMB_SCALE = Var::param("ctrl_coulomb_scale", Start::Float64(1.2)).range(0.0, 10.0)
+        .desc("Controller's Coulomb friction estimate / plant Coulomb friction"),
+    VISCOUS_SCALE = Var::param("ctrl_viscous_scale", Start::Float64(0.7)).range(0.0, 10.0)
+        .desc("Controller's viscous friction estimate / plant viscous friction"),
+    JOINT_STATE_RATE = Var::param("joint_state_rate", Start::Float64(50.0)).unit("Hz").range(0.001, 1000.0)
+        .desc("Publication rate of joint_states and gripper_state on simulation time"),
+    STATUS_RATE = Var::param("status_rate", Start::Float64(10.0)).unit("Hz").range(0.001, 1000.0)
+        .desc("Periodic publication rate of trajectory_status (also published on every change)"),
+    GRIPPER_SPEED = Var::param("gripper_speed", Start::Float64(0.1)).unit("m/s").range(1e-6, 10.0)
+        .desc("Finger gap speed"),
+    GRIPPER_WIDTH0 = Var::param("gripper_width0", Start::Float64(0.08)).unit("m").range(0.0, 0.08)
+        .desc("Initial finger gap"),
+    POSITION_NOISE = Var::param("position_noise", Start::Float64(0.0)).unit("rad").range(0.0, 1.0)
+        .desc("Std. deviation of encoder noise added to joint_states positions (not to q1..q7)"),
+    SEED = Var::param("seed", Start::Int32(0)).desc("Seed of the encoder noise"),
+    // --- inputs ---
+    TRAJECTORY = Var::input_discrete("trajectory", Start::Binary(&[])).mime(JointTrajectory::MIME_TYPE)
+        .desc("trajectory_msgs/JointTrajectory (CDR); taken when trajectory_seq changes"),
+    TRAJECTORY_SEQ = Var::input_discrete("trajectory_seq", Start::Int64(0)).desc("Sequence counter of trajectory"),
+    GRIPPER_COMMAND = Var::input_discrete("gripper_command", Start::Binary(&[])).mime(GripperCommand::MIME_TYPE)
+        .desc("control_msgs/GripperCommand (CDR): position = finger gap in m, max_effort in N"),
+    GRIPPER_COMMAND_SEQ = Var::input_discrete("gripper_command_seq", Start::Int64(0)).desc("Sequence counter of gripper_command"),
+    GRASP_WIDTH = Var::input("grasp_width", 0.0).unit("m")
+        .desc("Width of the object between the fingers (world FMU); 0 = none. Closing fingers stop there"),
+    // --- outputs ---
+    Q1 = Var::output("q1").unit("rad").desc("Actual joint 1 position"),
+    Q2 = Var::output("q2").unit("rad"),
+    Q3 = Var::output("q3").unit("rad"),
+    Q4 = Var::output("q4").unit("rad"),
+    Q5 = Var::output("q5").unit("rad"),
+    Q6 = Var::output("q6").unit("rad"),
+    Q7 = Var::output("q7").unit("rad"),
+    FINGER_WIDTH = Var::output("finger_width").unit("m").desc("Finger gap (each finger joint is half of it)"),
+    TRACKING_ERROR_RMS = Var::output("tracking_error_rms").unit("rad")
+        .desc("RMS joint tracking error over the current/last accepted trajectory (all joints)"),
+    STATUS = Var::output_discrete("status", Start::Int32(0))
+        .desc("0 ok (idle or done), 1 executing, 2 last trajectory rejected"),
+    JOINT_STATES = Var::output_discrete("joint_states", Start::Binary(&[])).mime(JointState::MIME_TYPE)
+        .desc("sensor_msgs/JointState: 7 arm joints + 2 finger joints, position/velocity/effort"),
+    JOINT_STATES_SEQ = Var::output_discrete("joint_states_seq", Start::Int64(0)),
+    TRAJECTORY_STATUS = Var::output_discrete("trajectory_status", Start::Binary(&[])).mime(TrajectoryStatus::MIME_TYPE)
+        .desc("agrisim_msgs/TrajectoryStatus, on change and at status_rate"),
+    TRAJECTORY_STATUS_SEQ = Var::output_discrete("trajectory_status_seq", Start::Int64(0)),
+    GRIPPER_STATE = Var::output_discrete("gripper_state", Start::Binary(&[])).mime(GripperState::MIME_TYPE)
+        .desc("agrisim_msgs/GripperState, with joint_states"),
+    GRIPPER_STATE_SEQ = Var::output_discrete("gripper_state_seq", Start::Int64(0)),
+}}
+
+/// The joint position outputs in joint order.
+pub const Q: [usize; 7] = [Q1, Q2, Q3, Q4, Q5, Q6, Q7];

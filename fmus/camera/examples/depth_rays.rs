@@ -1,0 +1,93 @@
+//! The camera's primary (depth) rays on the default greenhouse, timed on one thread, and
+//! written for python/bench_raycast.py --camera to cast the same rays with Open3D.
+//!
+//! `cargo run --release -p agrisim-fmu-camera --example depth_rays -- [--out DIR] [--poses N]`
+//!
+//! Rays: one per pixel centre of a 1280x720 D435i frame (87 x 58 deg) from N poses along the
+//! middle aisle (alternately looking along the aisle and at a row), as the camera casts them.
+//! With --out: DIR/scene.glb, DIR/rays.npy (float32 origin + direction), DIR/dist.npy (float64
+//! hit distance, inf = none) and DIR/rust.json, the files bench_raycast.py reads.
+
+use agrisim_fmu_camera::optics::{mat_vec, CameraPose, Intrinsics, Mount};
+use agrisim_greenhouse::{generate, gltf, GreenhouseConfig, RayCaster};
+use std::time::Instant;
+
+const FAR: f64 = 1000.0;
+
+fn arg(name: &str) -> Option<String> {
+    let a: Vec<String> = std::env::args().collect();
+    a.iter().position(|x| x == name).and_then(|i| a.get(i + 1).cloned())
+}
+
+/// A version 1.0 .npy file: header padded to 64 bytes, then the raw little-endian data.
+fn write_npy(path: &std::path::Path, descr: &str, shape: &[usize], data: &[u8]) {
+    let shape = match shape {
+        [n] => format!("({n},)"),
+        s => format!("({})", s.iter().map(|v| v.to_string()).collect::<Vec<_>>().join(", ")),
+    };
+    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(' ');
+    }
+    header.push('\n');
+    let mut out = b"\x93NUMPY\x01\x00".to_vec();
+    out.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    out.extend_from_slice(header.as_bytes());
+    out.extend_from_slice(data);
+    std::fs::write(path, out).expect("write npy");
+}
+
+fn main() {
+    let poses: usize = arg("--poses").map_or(2, |s| s.parse().expect("--poses N"));
+    let cfg = GreenhouseConfig::default();
+    let gh = generate(&cfg, cfg.seed);
+    let rc = RayCaster::new(&gh.objects);
+    let k = Intrinsics::from_fov(1280, 720, 87.0, 58.0);
+    let mount = Mount { translation: [0.32, 0.0, 0.8], roll: 0.0, pitch: 0.0, yaw: 0.0 };
+    let a = &gh.layout.aisles[gh.layout.aisles.len() / 2];
+    let mut rays: Vec<[f32; 6]> = Vec::with_capacity(poses * 1280 * 720);
+    for p in 0..poses {
+        let x = a.x_start + 1.5 + (a.x_end - a.x_start - 3.0) * p as f64 / poses.max(2) as f64;
+        let yaw = if p % 2 == 0 { 0.0 } else { std::f64::consts::FRAC_PI_2 };
+        let pose = CameraPose::new(&mount, x, a.y, yaw);
+        for v in 0..720 {
+            for u in 0..1280 {
+                let d = mat_vec(&pose.rotation, k.ray(u as f64, v as f64));
+                let o = pose.origin;
+                rays.push([o[0], o[1], o[2], d[0], d[1], d[2]].map(|c| c as f32));
+            }
+        }
+    }
+    let cast = |r: &[f32; 6]| {
+        let o = [r[0] as f64, r[1] as f64, r[2] as f64];
+        let d = [r[3] as f64, r[4] as f64, r[5] as f64];
+        rc.cast(o, d, 0.0, FAR, &[]).map_or(f64::INFINITY, |h| h.distance)
+    };
+    // Best of three passes (the machine is shared).
+    let mut dist = Vec::new();
+    let mut secs = f64::INFINITY;
+    for _ in 0..3 {
+        let t = Instant::now();
+        dist = rays.iter().map(cast).collect();
+        secs = secs.min(t.elapsed().as_secs_f64());
+    }
+    let n = rays.len();
+    let hits = dist.iter().filter(|d| d.is_finite()).count();
+    println!("camera depth rays  {n} ({poses} frames of 1280x720), hits {:.1} %", 100.0 * hits as f64 / n as f64);
+    println!("rays/s             {:.3e} (single thread, best of 3)", n as f64 / secs);
+    if let Some(dir) = arg("--out") {
+        let dir = std::path::PathBuf::from(dir);
+        std::fs::create_dir_all(&dir).expect("out dir");
+        gltf::write_glb(&gh.objects, &dir.join("scene.glb")).expect("glb");
+        let rb: Vec<u8> = rays.iter().flat_map(|r| r.iter().flat_map(|v| v.to_le_bytes())).collect();
+        write_npy(&dir.join("rays.npy"), "<f4", &[n, 6], &rb);
+        let db: Vec<u8> = dist.iter().flat_map(|v| v.to_le_bytes()).collect();
+        write_npy(&dir.join("dist.npy"), "<f8", &[n], &db);
+        std::fs::write(
+            dir.join("rust.json"),
+            format!("{{\"rays\": {n}, \"seconds\": {secs}, \"rays_per_s\": {}, \"objects\": {}, \"min_range\": 0.0, \"max_range\": {FAR}}}\n", n as f64 / secs, gh.objects.len()),
+        )
+        .expect("json");
+        println!("wrote              {}/{{scene.glb,rays.npy,dist.npy,rust.json}}", dir.display());
+    }
+}

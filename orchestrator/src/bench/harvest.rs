@@ -1,0 +1,304 @@
+//! `agrisim bench harvest`: the paper's dual-arm harvesting experiment, many trials, every
+//! one recorded.
+//!
+//! Each trial starts the harvest system afresh with the robot in an aisle short of a seeded
+//! ripe target fruit (see [`super::harvest_targets`]); the harvest node positions the base
+//! and the lift, plans and executes grasp, handover and placement. Success is judged on
+//! ground truth from the world FMU: the target fruit was placed in the box, no collision
+//! (robot against structure, arm against arm, base against anything), within the time
+//! limit. Planning success means every motion the trial asked for was planned.
+
+use super::harvest_targets::{draw, eligible, HarvestTarget};
+use super::nav::trial_seed;
+use super::stats::{percentile, wilson, Z95};
+use crate::error::{Context, Result};
+use crate::harvest::{Failure, HarvestNode, Outcome, PlanRecord};
+use crate::master::Master;
+use crate::nav::{Localizer, NavConfig};
+use crate::nodes::{FaultInjector, MapServer, Node, OdomTf};
+use crate::run::{prepare_with, RunOptions};
+use crate::scenario::Scenario;
+use crate::value::{self, Value};
+use agrisim_fmu_util::Rng;
+use agrisim_msgs::agrisim::CollisionState;
+use agrisim_greenhouse::occupancy::OccupancyMap;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::Path;
+use std::time::Instant;
+
+/// Simulated-time limit of one harvest [s].
+pub const TRIAL_TIMEOUT: f64 = 120.0;
+
+#[derive(Debug, Clone, Serialize)]
+pub struct HarvestTrial {
+    pub trial: u64,
+    pub seed: u64,
+    pub fruit_index: usize,
+    pub fruit_id: u32,
+    pub fruit_name: String,
+    pub fruit: [f64; 3],
+    pub start: [f64; 3],
+    pub outcome: &'static str,
+    /// Failure category: planning, grasp, handover, placement, timeout, collision, error.
+    pub failure: Option<String>,
+    pub failed_stage: Option<String>,
+    pub detail: String,
+    pub planning_ok: bool,
+    pub plans: usize,
+    /// Wall time of each plan [s] (IK + RRT-Connect + shortcut + time parameterization).
+    pub planning_times: Vec<f64>,
+    pub time_to_harvest: Option<f64>,
+    pub placed_count: i64,
+    pub contacts: BTreeMap<String, i64>,
+    /// RMS joint tracking error of the last trajectory of each arm [rad].
+    pub tracking_rms: [f64; 2],
+    pub sim_time: f64,
+    pub wall_time: f64,
+    pub mcap: String,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct HarvestSummary {
+    pub scenario: String,
+    pub seed: u64,
+    pub trials: u64,
+    pub successes: u64,
+    pub success_rate: f64,
+    pub wilson95: [f64; 2],
+    pub planning_successes: u64,
+    pub planning_success_rate: f64,
+    pub planning_wilson95: [f64; 2],
+    /// Harvest successes among the trials whose planning succeeded.
+    pub conditional_success_rate: f64,
+    pub conditional_wilson95: [f64; 2],
+    pub failures: BTreeMap<String, u64>,
+    pub plans: u64,
+    pub planning_time_p50: Option<f64>,
+    pub planning_time_p95: Option<f64>,
+    pub planning_time_max: Option<f64>,
+    pub tracking_rms_mean: f64,
+    pub time_to_harvest_mean: Option<f64>,
+    pub rtf: f64,
+    pub sim_time: f64,
+    pub wall_time: f64,
+}
+
+fn read(m: &mut Master, comp: usize, name: &str) -> Result<f64> {
+    let c = &mut m.system.components[comp];
+    let v = c.archive.md.variable(name).cloned().ok_or_else(|| crate::err!("FMU '{}' has no variable '{name}' (harvest benchmark)", c.name))?;
+    match value::get(&mut c.instance, &v)? {
+        Value::F64(x) => Ok(x),
+        Value::Bool(b) => Ok(b as u8 as f64),
+        Value::I32(i) => Ok(i as f64),
+        Value::I64(i) => Ok(i as f64),
+        other => Err(crate::err!("FMU '{}': {name} is {other:?}, expected a number", c.name)),
+    }
+}
+
+/// Contact counters of the world FMU that end a trial as a collision.
+pub const COLLISION_COUNTERS: [&str; 2] = ["contact_robot_structure", "contact_arm_arm"];
+/// Counted but expected: leaves and trusses brush the arm.
+pub const SOFT_COUNTERS: [&str; 1] = ["contact_robot_plant"];
+
+/// Everything a trial needs that does not change between trials.
+pub struct HarvestSetup {
+    pub layout: agrisim_greenhouse::Layout,
+    pub map: OccupancyMap,
+    pub candidates: Vec<HarvestTarget>,
+}
+
+impl HarvestSetup {
+    pub fn new(s: &Scenario) -> Result<HarvestSetup> {
+        let g = crate::scene::generate_scene(s)?;
+        let planned: Vec<_> = g.objects.iter().filter(|o| o.kind != agrisim_greenhouse::Kind::Obstacle).cloned().collect();
+        let map = OccupancyMap::from_objects(&planned, super::nav::MAP_RESOLUTION, super::nav::MAP_BAND, g.layout.bounds);
+        let candidates = eligible(&g.objects, &g.layout);
+        if candidates.is_empty() {
+            return Err(crate::err!("scenario {}: no ripe fruit faces an aisle at a harvestable height", s.path.display()));
+        }
+        Ok(HarvestSetup { layout: g.layout, map, candidates })
+    }
+}
+
+/// Runs one trial into `mcap`.
+pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index: u64, seed: u64, mcap: &Path) -> Result<HarvestTrial> {
+    let wall = Instant::now();
+    let mut rng = Rng::new(seed);
+    let target = draw(&setup.candidates, &setup.layout, &mut rng).expect("candidates checked non-empty");
+    let mut s = s.clone();
+    let chassis = s.parameters.entry("chassis".into()).or_default();
+    for (k, v) in ["x0", "y0", "yaw0"].iter().zip(target.start) {
+        chassis.insert(k.to_string(), toml::Value::Float(v));
+    }
+    let mut nav_cfg = NavConfig::for_start(target.start);
+    nav_cfg.embedded_localizer = false;
+    let node = HarvestNode::new(target.fruit_index, target.side, seed);
+    let log = node.log();
+    let nodes: Vec<Box<dyn Node>> = vec![
+        Box::new(MapServer::new(&setup.map)),
+        Box::new(OdomTf::default()),
+        Box::new(Localizer::new(&nav_cfg)),
+        Box::new(node),
+        Box::new(FaultInjector::new(&s.inject)),
+    ];
+    let opts = RunOptions { seed: Some(seed), ..o.clone() };
+    let mut m = prepare_with(&s, &opts, mcap, nodes)?;
+    let idx = |name: &str| m.system.component_index(name).ok_or_else(|| crate::err!("harvest benchmark: the system has no component '{name}'"));
+    let (world, arm_l, arm_r) = (idx("world")?, idx("arm_left")?, idx("arm_right")?);
+    let max_ticks = (TRIAL_TIMEOUT / s.timing.step).round() as u64;
+    let mut judged: Option<(Option<Failure>, String)> = None;
+    let mut time_to_harvest = None;
+    let mut collision_seen = 0;
+    let result: Result<()> = (|| {
+        for k in 1..=max_ticks {
+            m.advance()?;
+            // The base must touch nothing; the arms may brush plants (counted, not failures).
+            if let Some(cs) = m.bus.take_new::<CollisionState>("/collision", &mut collision_seen)? {
+                if let Some(c) = cs.contacts.iter().find(|c| c.robot_link == "base_link") {
+                    judged = Some((Some(Failure::Collision), format!("the base touched {} ({})", c.object_name, c.object_kind)));
+                    return Ok(());
+                }
+            }
+            for c in COLLISION_COUNTERS {
+                if read(&mut m, world, c)? > 0.0 {
+                    judged = Some((Some(Failure::Collision), c.to_string()));
+                    return Ok(());
+                }
+            }
+            let out = log.borrow().outcome.clone();
+            if let Some(out) = out {
+                let Outcome { success, failure, detail, .. } = out;
+                if success {
+                    time_to_harvest = Some(k as f64 * s.timing.step);
+                }
+                judged = Some((failure, detail));
+                return Ok(());
+            }
+        }
+        judged = Some((Some(Failure::Timeout), format!("no outcome within {TRIAL_TIMEOUT} s")));
+        Ok(())
+    })();
+    let sim_time = m.time();
+    let plans: Vec<PlanRecord> = log.borrow().plans.clone();
+    let failed_stage = log.borrow().outcome.as_ref().filter(|o| !o.success).map(|o| o.stage.name().to_string());
+    let mut contacts = BTreeMap::new();
+    let mut placed = 0;
+    let mut tracking = [0.0; 2];
+    let mut probe = || -> Result<()> {
+        for c in COLLISION_COUNTERS.iter().chain(SOFT_COUNTERS.iter()) {
+            contacts.insert(c.to_string(), read(&mut m, world, c)? as i64);
+        }
+        placed = read(&mut m, world, "placed_count")? as i64;
+        let placed_id = read(&mut m, world, "last_placed_id")? as i64;
+        if placed > 0 && placed_id != target.object_id as i64 {
+            placed = 0;
+        }
+        tracking = [read(&mut m, arm_l, "tracking_error_rms")?, read(&mut m, arm_r, "tracking_error_rms")?];
+        Ok(())
+    };
+    let probed = probe();
+    let (mut failure, mut detail) = match (result, probed) {
+        (Ok(()), Ok(())) => {
+            m.finish_point()?;
+            let (f, d) = judged.expect("set on every exit");
+            (f.map(|f| f.name().to_string()), d)
+        }
+        (Err(e), _) | (Ok(()), Err(e)) => {
+            m.record_failure(&e);
+            (Some("error".to_string()), e.to_string())
+        }
+    };
+    m.recorder_finish()?;
+    // Ground truth has the last word: the node believing in success is not enough.
+    if failure.is_none() && placed == 0 {
+        failure = Some(Failure::Placement.name().into());
+        detail = "the node reported success but the world has not placed the target fruit".into();
+    }
+    let planning_ok = plans.iter().all(|p| p.ok) && failure.as_deref() != Some("planning");
+    Ok(HarvestTrial {
+        trial: index,
+        seed,
+        fruit_index: target.fruit_index,
+        fruit_id: target.object_id,
+        fruit_name: target.name.clone(),
+        fruit: target.center,
+        start: target.start,
+        outcome: if failure.is_none() { "success" } else { "failure" },
+        failed_stage: failure.as_ref().and(failed_stage),
+        failure,
+        detail,
+        planning_ok,
+        plans: plans.len(),
+        planning_times: plans.iter().map(|p| p.wall).collect(),
+        time_to_harvest,
+        placed_count: placed,
+        contacts,
+        tracking_rms: tracking,
+        sim_time,
+        wall_time: wall.elapsed().as_secs_f64(),
+        mcap: mcap.file_name().map(|f| format!("trials/{}", f.to_string_lossy())).unwrap_or_default(),
+    })
+}
+
+/// Runs `trials` trials and writes trials.jsonl, summary.json and trials/*.mcap.
+pub fn bench_harvest(s: &Scenario, o: &RunOptions, trials: u64, seed: u64, out: &Path, mut progress: impl FnMut(u64, u64)) -> Result<HarvestSummary> {
+    let dir = out.join("trials");
+    std::fs::create_dir_all(&dir).context(|| format!("cannot create {}", dir.display()))?;
+    let setup = HarvestSetup::new(s)?;
+    let jsonl_path = out.join("trials.jsonl");
+    let mut jsonl = std::fs::File::create(&jsonl_path).context(|| format!("cannot create {}", jsonl_path.display()))?;
+    let mut results = vec![];
+    for i in 0..trials {
+        let ts = trial_seed(seed, i);
+        let trial = run_trial(s, o, &setup, i, ts, &dir.join(format!("{i:04}.mcap")))?;
+        writeln!(jsonl, "{}", serde_json::to_string(&trial).expect("plain struct")).context(|| jsonl_path.display().to_string())?;
+        results.push(trial);
+        progress(i + 1, trials);
+    }
+    let summary = summarize(s, seed, &results);
+    let sp = out.join("summary.json");
+    std::fs::write(&sp, serde_json::to_string_pretty(&summary).expect("plain struct") + "\n").context(|| sp.display().to_string())?;
+    Ok(summary)
+}
+
+pub fn summarize(s: &Scenario, seed: u64, results: &[HarvestTrial]) -> HarvestSummary {
+    let n = results.len() as u64;
+    let ok = results.iter().filter(|t| t.outcome == "success").count() as u64;
+    let planned = results.iter().filter(|t| t.planning_ok).count() as u64;
+    let ok_given_planned = results.iter().filter(|t| t.planning_ok && t.outcome == "success").count() as u64;
+    let mut failures = BTreeMap::new();
+    for t in results.iter().filter_map(|t| t.failure.as_ref()) {
+        *failures.entry(t.clone()).or_insert(0) += 1;
+    }
+    let mut times: Vec<f64> = results.iter().flat_map(|t| t.planning_times.iter().copied()).collect();
+    times.sort_by(f64::total_cmp);
+    let sim: f64 = results.iter().map(|t| t.sim_time).sum();
+    let wall: f64 = results.iter().map(|t| t.wall_time).sum();
+    let tth: Vec<f64> = results.iter().filter_map(|t| t.time_to_harvest).collect();
+    let rate = |a: u64, b: u64| if b == 0 { 0.0 } else { a as f64 / b as f64 };
+    HarvestSummary {
+        scenario: s.name.clone(),
+        seed,
+        trials: n,
+        successes: ok,
+        success_rate: rate(ok, n),
+        wilson95: wilson(ok, n, Z95),
+        planning_successes: planned,
+        planning_success_rate: rate(planned, n),
+        planning_wilson95: wilson(planned, n, Z95),
+        conditional_success_rate: rate(ok_given_planned, planned),
+        conditional_wilson95: wilson(ok_given_planned, planned, Z95),
+        failures,
+        plans: times.len() as u64,
+        planning_time_p50: percentile(&times, 0.5),
+        planning_time_p95: percentile(&times, 0.95),
+        planning_time_max: times.last().copied(),
+        tracking_rms_mean: if n == 0 { 0.0 } else { results.iter().map(|t| 0.5 * (t.tracking_rms[0] + t.tracking_rms[1])).sum::<f64>() / n as f64 },
+        time_to_harvest_mean: if tth.is_empty() { None } else { Some(tth.iter().sum::<f64>() / tth.len() as f64) },
+        rtf: if wall > 0.0 { sim / wall } else { 0.0 },
+        sim_time: sim,
+        wall_time: wall,
+    }
+}

@@ -1,0 +1,156 @@
+//! Where the harvest puts the base, the lift and the grippers, in base_link (REP 105: x
+//! forward, y left, z up). Figures are the robot's (models/robot/generate_urdf.py); the test
+//! below checks them against the URDF so the two cannot drift apart.
+
+use agrisim_robot::Pose;
+
+/// Arm base (link0) x on base_link [m] (lift carriage centre).
+pub const SHOULDER_X: f64 = 0.2;
+/// Arm bases left/right of the carriage centre [m].
+pub const ARM_Y: f64 = 0.25;
+/// Arm base height at lift 0 [m].
+pub const ARM_Z0: f64 = 0.475;
+/// Panda shoulder (joint 2) above the arm base [m] (DH d1).
+pub const SHOULDER_UP: f64 = 0.333;
+/// Lift range [m].
+pub const LIFT_MAX: f64 = 0.8;
+/// Where the fruit is relative to the grasping arm's base when the base is in place [m]:
+/// sideways (a horizontal approach still works 0.1 m closer, at the pre-grasp), ahead of the
+/// arm (straight sideways at shoulder height the Panda's wrist meets its own shoulder and IK
+/// fails), and below the shoulder.
+pub const REACH_LATERAL: f64 = 0.6;
+pub const REACH_AHEAD: f64 = 0.2;
+pub const REACH_BELOW_SHOULDER: f64 = 0.1;
+/// Pre-grasp stand-off along the approach axis [m].
+pub const PRE_GRASP: f64 = 0.1;
+/// Retreat after the grasp: back toward the aisle, and up [m].
+pub const RETREAT: [f64; 2] = [0.14, 0.02];
+/// Lift height during handover and placement [m].
+pub const LIFT_TRANSFER: f64 = 0.3;
+/// Handover point relative to the arm bases' midpoint (x forward, z above the arm bases) [m].
+pub const HANDOVER: [f64; 2] = [0.42, 0.30];
+/// Harvest box: centre of its opening on base_link and the drop height above it [m]
+/// (rear enclosure at x -0.35, crate 0.4 x 0.6 x 0.25 on a 0.72 m deck).
+pub const BOX_TOP: [f64; 3] = [-0.35, 0.0, 0.97];
+pub const DROP_ABOVE: f64 = 0.13;
+/// Gripper opening for approach [m] (Franka Hand maximum).
+pub const OPEN_WIDTH: f64 = 0.08;
+
+/// Base pose (x, y, yaw) in the map frame that puts a fruit at `fruit` (map) within reach
+/// of the arm on `side` (+1 left, -1 right): facing +x along the aisle.
+pub fn standoff(fruit: [f64; 3], side: f64) -> [f64; 3] {
+    [fruit[0] - SHOULDER_X - REACH_AHEAD, fruit[1] - side * (ARM_Y + REACH_LATERAL), 0.0]
+}
+
+/// Lift height that brings the shoulder level with a fruit at height `z` [m].
+pub fn lift_for(z: f64) -> f64 {
+    (z - ARM_Z0 - SHOULDER_UP + REACH_BELOW_SHOULDER).clamp(0.0, LIFT_MAX)
+}
+
+/// A TCP goal: position plus the approach axis (tool z). `x_axis` fixes the roll (finger
+/// closing direction is tool y); `None` leaves the roll about the approach axis free.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TcpGoal {
+    pub position: [f64; 3],
+    pub approach: [f64; 3],
+    pub x_axis: Option<[f64; 3]>,
+}
+
+impl TcpGoal {
+    /// The goal shifted along its approach axis by `d` (negative = back off).
+    pub fn along(&self, d: f64) -> TcpGoal {
+        let p = self.position;
+        let a = self.approach;
+        TcpGoal { position: [p[0] + d * a[0], p[1] + d * a[1], p[2] + d * a[2]], ..*self }
+    }
+
+    /// A full pose with the given roll vector (x axis, made orthogonal to the approach).
+    pub fn pose_with_x(&self, x_hint: [f64; 3]) -> Pose {
+        let z = normalize(self.approach);
+        let d = dot(x_hint, z);
+        let x = normalize([x_hint[0] - d * z[0], x_hint[1] - d * z[1], x_hint[2] - d * z[2]]);
+        let y = cross(z, x);
+        Pose { rot: [[x[0], y[0], z[0]], [x[1], y[1], z[1]], [x[2], y[2], z[2]]], trans: self.position }
+    }
+}
+
+/// Grasp of a fruit at `c` (base frame) from the aisle by the arm on `side`: horizontal
+/// approach into the row, roll free (the planner picks fingers that miss the truss).
+pub fn grasp(c: [f64; 3], side: f64) -> TcpGoal {
+    TcpGoal { position: c, approach: [0.0, side, 0.0], x_axis: None }
+}
+
+/// Handover point (base frame) at lift `lift`.
+pub fn handover_point(lift: f64) -> [f64; 3] {
+    [SHOULDER_X + HANDOVER[0], 0.0, ARM_Z0 + lift + HANDOVER[1]]
+}
+
+/// The giving arm (on `side`) presents the fruit with its approach axis toward the other
+/// arm and the fingers closing vertically; the taking arm comes from the other side with
+/// fingers closing horizontally, so the two hands' fingers never meet.
+pub fn handover_goals(point: [f64; 3], giver_side: f64) -> (TcpGoal, TcpGoal) {
+    // Giver: tool z = -side y; tool y (fingers) = z up, so tool x = y cross z.
+    let zg = [0.0, -giver_side, 0.0];
+    let xg = cross([0.0, 0.0, 1.0], zg);
+    let giver = TcpGoal { position: point, approach: zg, x_axis: Some(xg) };
+    // Taker: tool z = +side y; tool y (fingers) = x forward.
+    let zt = [0.0, giver_side, 0.0];
+    let xt = cross([1.0, 0.0, 0.0], zt);
+    let taker = TcpGoal { position: point, approach: zt, x_axis: Some(xt) };
+    (giver, taker)
+}
+
+/// Drop pose above the harvest box: pointing down, roll free.
+pub fn drop_goal() -> TcpGoal {
+    TcpGoal { position: [BOX_TOP[0], BOX_TOP[1], BOX_TOP[2] + DROP_ABOVE], approach: [0.0, 0.0, -1.0], x_axis: None }
+}
+
+/// Whether a point (base frame) lies inside the harvest box's opening footprint, below its rim.
+pub fn in_box(p: [f64; 3]) -> bool {
+    (p[0] - BOX_TOP[0]).abs() < 0.19 && (p[1] - BOX_TOP[1]).abs() < 0.29 && p[2] < BOX_TOP[2] && p[2] > BOX_TOP[2] - 0.26
+}
+
+pub fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+pub fn normalize(a: [f64; 3]) -> [f64; 3] {
+    let n = dot(a, a).sqrt();
+    [a[0] / n, a[1] / n, a[2] / n]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use agrisim_robot::Robot;
+    use std::collections::BTreeMap;
+
+    #[test]
+    fn figures_match_the_urdf() {
+        let robot = Robot::from_urdf_str(include_str!("../../../models/robot/agrisim_robot.urdf")).unwrap();
+        let fk = robot.fk(&BTreeMap::new()).unwrap();
+        let l0 = fk["left_link0"].trans;
+        assert!((l0[0] - SHOULDER_X).abs() < 1e-9 && (l0[1] - ARM_Y).abs() < 1e-9 && (l0[2] - ARM_Z0).abs() < 1e-9, "{l0:?}");
+        let r0 = fk["right_link0"].trans;
+        assert!((r0[1] + ARM_Y).abs() < 1e-9);
+        let b = fk["harvest_box_link"].trans;
+        assert!((b[0] - BOX_TOP[0]).abs() < 1e-9 && (b[1] - BOX_TOP[1]).abs() < 1e-9 && (b[2] + 0.25 - BOX_TOP[2]).abs() < 1e-9, "{b:?}");
+    }
+
+    #[test]
+    fn handover_fingers_are_crossed() {
+        let (g, t) = handover_goals([0.6, 0.0, 1.2], 1.0);
+        let pg = g.pose_with_x(g.x_axis.unwrap());
+        let pt = t.pose_with_x(t.x_axis.unwrap());
+        // Finger directions (tool y) orthogonal; approach axes opposite.
+        let yg = [pg.rot[0][1], pg.rot[1][1], pg.rot[2][1]];
+        let yt = [pt.rot[0][1], pt.rot[1][1], pt.rot[2][1]];
+        assert!(dot(yg, yt).abs() < 1e-12);
+        assert!((dot(g.approach, t.approach) + 1.0).abs() < 1e-12);
+        assert!((yg[2] - 1.0).abs() < 1e-12, "giver fingers close vertically");
+    }
+}

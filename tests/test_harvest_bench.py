@@ -1,0 +1,98 @@
+"""`agrisim bench harvest` end to end on the default greenhouse with a few trials: the files
+it promises, the statistics recomputed independently, the stages reported on
+/harvest/status, and every trial's MCAP decoding with mcap-ros2-support (JointTrajectory,
+JointState, GripperCommand, PlanningScene, HarvestStatus)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from conftest import REPO, run_agrisim
+
+SCENARIO = REPO / "models" / "scenarios" / "harvest.toml"
+TRIALS = 3
+STAGES = ["select_target", "position_base", "pre_grasp", "approach", "grasp", "retreat",
+          "handover_pose", "handover", "transfer", "release"]
+
+
+@pytest.fixture(scope="module")
+def bench(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("harvest")
+    run_agrisim("bench", "harvest", "--scenario", str(SCENARIO), "--trials", str(TRIALS), "--seed", "3", "--out", str(out))
+    return out
+
+
+def wilson(k: int, n: int, z: float = 1.959963984540054) -> tuple[float, float]:
+    if n == 0:
+        return 0.0, 1.0
+    p = k / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def trials(bench: Path) -> list[dict]:
+    return [json.loads(l) for l in (bench / "trials.jsonl").read_text().splitlines()]
+
+
+def test_files_and_summary(bench):
+    ts = trials(bench)
+    assert [t["trial"] for t in ts] == list(range(TRIALS))
+    for t in ts:
+        assert t["outcome"] in ("success", "failure")
+        assert (t["failure"] is None) == (t["outcome"] == "success")
+        assert t["failure"] in (None, "planning", "grasp", "handover", "placement", "timeout", "collision", "error")
+        assert (bench / t["mcap"]).exists()
+        assert len(t["planning_times"]) == t["plans"]
+    s = json.loads((bench / "summary.json").read_text())
+    k = sum(t["outcome"] == "success" for t in ts)
+    p = sum(t["planning_ok"] for t in ts)
+    kp = sum(t["planning_ok"] and t["outcome"] == "success" for t in ts)
+    assert s["trials"] == TRIALS and s["successes"] == k and s["planning_successes"] == p
+    for key, (a, b) in (("wilson95", (k, TRIALS)), ("planning_wilson95", (p, TRIALS)), ("conditional_wilson95", (kp, p))):
+        lo, hi = wilson(a, b)
+        assert abs(s[key][0] - lo) < 1e-12 and abs(s[key][1] - hi) < 1e-12, key
+    assert sum(s["failures"].values()) == TRIALS - k
+    times = sorted(x for t in ts for x in t["planning_times"])
+    assert s["plans"] == len(times)
+    if times:
+        assert s["planning_time_max"] == times[-1]
+        assert times[0] <= s["planning_time_p50"] <= s["planning_time_p95"] <= times[-1]
+
+
+def test_harvests_succeed_with_ground_truth_placement(bench):
+    ts = trials(bench)
+    assert all(t["outcome"] == "success" for t in ts), [(t["failure"], t["failed_stage"], t["detail"]) for t in ts]
+    for t in ts:
+        assert t["placed_count"] == 1
+        assert t["contacts"]["contact_robot_structure"] == 0 and t["contacts"]["contact_arm_arm"] == 0
+        assert 0 < t["tracking_rms"][0] < 0.05 and 0 < t["tracking_rms"][1] < 0.05
+
+
+def test_trial_mcap_decodes_and_reports_every_stage(bench):
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+
+    t = trials(bench)[0]
+    stages, types = [], set()
+    with open(bench / t["mcap"], "rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        for schema, channel, message, decoded in reader.iter_decoded_messages():
+            types.add(schema.name)
+            if channel.topic == "/harvest/status" and decoded.outcome == "running":
+                stages.append(decoded.stage)
+            if channel.topic == "/left_arm/joint_trajectory" or channel.topic == "/right_arm/joint_trajectory":
+                assert len(decoded.joint_names) == 7 and decoded.points
+                for a, b in zip(decoded.points, decoded.points[1:]):
+                    ta = a.time_from_start.sec + 1e-9 * a.time_from_start.nanosec
+                    tb = b.time_from_start.sec + 1e-9 * b.time_from_start.nanosec
+                    assert tb > ta
+    assert {"trajectory_msgs/JointTrajectory", "sensor_msgs/JointState", "control_msgs/GripperCommand",
+            "agrisim_msgs/PlanningScene", "agrisim_msgs/HarvestStatus", "agrisim_msgs/GripperState",
+            "agrisim_msgs/TrajectoryStatus"} <= types
+    if t["outcome"] == "success":
+        assert [s for s in STAGES if s in stages] == STAGES, stages
