@@ -1,31 +1,30 @@
-"""Shared fixtures of the end-to-end tests: the built CLI and the packed FMUs."""
+"""Shared fixtures of the end-to-end tests: the built CLI (python/agrisim_fmpy.py), the packed
+FMUs, and a decoder of recorded topics."""
 
 from __future__ import annotations
 
-import os
-import subprocess
+import sys
 from pathlib import Path
 
 import pytest
+from mcap.reader import make_reader
+from mcap_ros2.decoder import DecoderFactory
 
 REPO = Path(__file__).resolve().parents[1]
 FMU_DIR = REPO / "target" / "fmu"
+# The helpers in python/ (the CLI runner, scenario_variant) are shared with the FMPy checks
+# and the benchmark scripts.
+sys.path.insert(0, str(REPO / "python"))
+
+from agrisim_fmpy import agrisim_bin, agrisim_run, run_agrisim  # noqa: E402,F401
 
 
-def agrisim_bin() -> Path:
-    exe = Path(os.environ.get("AGRISIM_BIN", REPO / "target" / "release" / "agrisim"))
-    if not exe.is_absolute():
-        exe = REPO / exe
-    assert exe.exists(), f"{exe} missing: run scripts/setup (cargo build --release && agrisim fmu pack)"
-    return exe
-
-
-def run_agrisim(*args: str, check: bool = True) -> subprocess.CompletedProcess:
-    """Runs the CLI from the repository root; returns the completed process."""
-    p = subprocess.run([str(agrisim_bin()), *args], cwd=REPO, capture_output=True, text=True)
-    if check and p.returncode != 0:
-        raise AssertionError(f"agrisim {' '.join(args)} failed ({p.returncode}):\n{p.stderr}")
-    return p
+def decoded_messages(path: Path, topic: str) -> list:
+    """The messages of one topic of an MCAP, decoded with mcap-ros2-support (the independent
+    reader): (schema name, log time [ns], message) in log order."""
+    with open(path, "rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        return [(s.name, m.log_time, msg) for s, _, m, msg in reader.iter_decoded_messages(topics=[topic])]
 
 
 @pytest.fixture(scope="session")

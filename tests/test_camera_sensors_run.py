@@ -1,7 +1,8 @@
 """`agrisim run` of the full sensor suite (models/systems/sensors.ssd) at a small camera
 resolution: the camera's Image (rgb8, 32FC1 depth, 32SC1 labels) and CameraInfo decode with
 mcap-ros2-support, K matches the field of view, and depth reprojected with that K is
-consistent with the images' own sizes and the range limits."""
+consistent with the images' own sizes and the range limits; LiDAR, IMU and both arms'
+JointState run beside it."""
 
 from __future__ import annotations
 
@@ -10,10 +11,8 @@ import struct
 from pathlib import Path
 
 import pytest
-from mcap.reader import make_reader
-from mcap_ros2.decoder import DecoderFactory
-
-from conftest import REPO, run_agrisim
+from conftest import REPO, agrisim_run, decoded_messages
+from scenario_variant import write_variant
 
 W, H = 160, 90
 
@@ -21,20 +20,13 @@ W, H = 160, 90
 @pytest.fixture(scope="module")
 def sensors_run(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("sensors")
-    text = (REPO / "models" / "scenarios" / "sensors.toml").read_text()
-    ssd = (REPO / "models" / "systems" / "sensors.ssd").resolve()
-    text = text.replace('file = "../systems/sensors.ssd"', f'file = "{ssd}"')
-    text += f"\n[parameters.camera]\nwidth = {W}\nheight = {H}\n"
-    scenario = out / "sensors_small.toml"
-    scenario.write_text(text)
-    run_agrisim("run", "--scenario", str(scenario), "--duration", "0.5", "--out", str(out))
-    return out / "run.mcap"
+    scenario = write_variant(REPO / "models" / "scenarios" / "sensors.toml", out,
+                             f"[parameters.camera]\nwidth = {W}\nheight = {H}\n", name="sensors_small.toml")
+    return agrisim_run(out, "--duration", "0.5", scenario=scenario)
 
 
 def messages(path: Path, topic: str):
-    with open(path, "rb") as f:
-        reader = make_reader(f, decoder_factories=[DecoderFactory()])
-        return [(s.name, m) for s, c, _, m in reader.iter_decoded_messages(topics=[topic])]
+    return [(schema, msg) for schema, _, msg in decoded_messages(path, topic)]
 
 
 def test_image_and_camera_info_decode(sensors_run):
@@ -72,3 +64,21 @@ def test_image_and_camera_info_decode(sensors_run):
 def test_lidar_and_imu_run_beside_the_camera(sensors_run):
     assert len(messages(sensors_run, "/points")) >= 4
     assert len(messages(sensors_run, "/imu")) >= 4
+
+
+# The arms' q_init in sensors.ssd (as harvest.ssd): no trajectory arrives, so they hold it.
+Q_INIT = [0.0, -0.3, 0.0, -2.356, 0.0, 1.571, 0.785]
+
+
+@pytest.mark.parametrize("side", ["left", "right"])
+def test_joint_states_of_both_arms_decode(sensors_run, side):
+    states = messages(sensors_run, f"/{side}_arm/joint_states")
+    assert len(states) >= 4
+    assert {s for s, _ in states} == {"sensor_msgs/msg/JointState"}
+    names = [f"{side}_joint{i}" for i in range(1, 8)] + [f"{side}_finger_joint1", f"{side}_finger_joint2"]
+    for _, js in states:
+        assert list(js.name) == names
+        assert len(js.position) == len(js.velocity) == len(js.effort) == 9
+        assert all(math.isfinite(v) for v in list(js.position) + list(js.velocity) + list(js.effort))
+        assert list(js.position[:7]) == pytest.approx(Q_INIT, abs=0.05)
+        assert 0.0 <= js.position[7] == js.position[8] <= 0.04

@@ -10,10 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from mcap.reader import make_reader
-from mcap_ros2.decoder import DecoderFactory
-
-from conftest import REPO, run_agrisim
+from conftest import REPO, agrisim_run, decoded_messages, run_agrisim
 
 SCENARIO = REPO / "models" / "scenarios" / "default.toml"
 
@@ -21,14 +18,11 @@ SCENARIO = REPO / "models" / "scenarios" / "default.toml"
 @pytest.fixture(scope="module")
 def gh_run(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("gh")
-    run_agrisim("run", "--scenario", str(SCENARIO), "--duration", "4", "--out", str(out))
-    return out / "run.mcap"
+    return agrisim_run(out, "--duration", "4", scenario=SCENARIO)
 
 
 def messages(path: Path, topic: str):
-    with open(path, "rb") as f:
-        reader = make_reader(f, decoder_factories=[DecoderFactory()])
-        return [(m.log_time, msg) for _, _, m, msg in reader.iter_decoded_messages(topics=[topic])]
+    return [(t, msg) for _, t, msg in decoded_messages(path, topic)]
 
 
 def test_lidar_frames_decode_with_20000_points(gh_run):

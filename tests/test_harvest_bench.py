@@ -91,8 +91,15 @@ def test_trial_mcap_decodes_and_reports_every_stage(bench):
                     ta = a.time_from_start.sec + 1e-9 * a.time_from_start.nanosec
                     tb = b.time_from_start.sec + 1e-9 * b.time_from_start.nanosec
                     assert tb > ta
-    assert {"trajectory_msgs/JointTrajectory", "sensor_msgs/JointState", "control_msgs/GripperCommand",
-            "agrisim_msgs/PlanningScene", "agrisim_msgs/HarvestStatus", "agrisim_msgs/GripperState",
-            "agrisim_msgs/TrajectoryStatus"} <= types
+    assert {"trajectory_msgs/msg/JointTrajectory", "sensor_msgs/msg/JointState", "control_msgs/msg/GripperCommand",
+            "agrisim_msgs/msg/PlanningScene", "agrisim_msgs/msg/HarvestStatus", "agrisim_msgs/msg/GripperState",
+            "agrisim_msgs/msg/TrajectoryStatus"} <= types
     if t["outcome"] == "success":
         assert [s for s in STAGES if s in stages] == STAGES, stages
+
+
+def test_same_seed_gives_byte_identical_trial(bench, tmp_path):
+    again = tmp_path / "again"
+    run_agrisim("bench", "harvest", "--scenario", str(SCENARIO), "--trials", "1", "--seed", "3", "--out", str(again))
+    first = trials(bench)[0]
+    assert (again / "trials" / "0000.mcap").read_bytes() == (bench / first["mcap"]).read_bytes()

@@ -101,17 +101,7 @@ impl Config {
                 "parameter depth_noise_model must be 0 (none), 1 (fixed) or 2 (stereo), got {m}"
             )),
         };
-        let translation = [
-            param(io, MOUNT_X, any, "finite")?,
-            param(io, MOUNT_Y, any, "finite")?,
-            param(io, MOUNT_Z, any, "finite")?,
-        ];
-        let mount = Mount {
-            translation,
-            roll: param(io, MOUNT_ROLL, any, "finite")?,
-            pitch: param(io, MOUNT_PITCH, any, "finite")?,
-            yaw: param(io, MOUNT_YAW, any, "finite")?,
-        };
+        let mount = SENSOR_PORTS.mount(io)?;
         let conditions = match io.string(ENVIRONMENT).trim() {
             "" => None,
             text => Some(Conditions::of(
@@ -128,14 +118,9 @@ impl Config {
             t @ 1..=64 => t as usize,
             t => return Err(format!("parameter render_threads must be in [1, 64], got {t}")),
         };
-        let base = [
-            param(io, BASE_LENGTH, |v| v > 0.0, "positive")?,
-            param(io, BASE_WIDTH, |v| v > 0.0, "positive")?,
-            param(io, BASE_HEIGHT, |v| v > 0.0, "positive")?,
-            param(io, BASE_CLEARANCE, |v| v >= 0.0, ">= 0")?,
-        ];
+        let base = SENSOR_PORTS.base_box(io)?;
         Ok(Config {
-            scene: scene::load(io.string(SCENE), io.i32(SCENE_SEED))?,
+            scene: SENSOR_PORTS.scene(io)?,
             intrinsics: Intrinsics::from_fov(width, height, fov_h, fov_v),
             period: 1.0 / rate,
             mount,
@@ -153,18 +138,6 @@ impl Config {
             frame_id: io.string(FRAME_ID).to_string(),
             base,
         })
-    }
-}
-
-fn base_pose(io: &Store) -> Result<(f64, f64, f64), String> {
-    let p = (io.f64(BASE_X), io.f64(BASE_Y), io.f64(BASE_YAW));
-    if [p.0, p.1, p.2]
-        .iter()
-        .all(|v| v.is_finite() && v.abs() < 1e6)
-    {
-        Ok(p)
-    } else {
-        Err(format!("robot pose input (base_x, base_y, base_yaw) = ({}, {}, {}) is not finite or beyond 1e6", p.0, p.1, p.2))
     }
 }
 
@@ -215,7 +188,7 @@ impl Model for Camera {
         _log: &mut dyn Log,
     ) -> Result<(), String> {
         let config = Config::from_params(io)?;
-        base_pose(io)?;
+        SENSOR_PORTS.base_pose(io)?;
         self.schedule = Schedule::new(1.0 / config.period, start_time)?;
         self.rng = Rng::new(io.i32(NOISE_SEED) as u32 as u64);
         self.seq = 0;
@@ -237,7 +210,7 @@ impl Model for Camera {
         h: f64,
         _log: &mut dyn Log,
     ) -> Result<(), String> {
-        let (x, y, yaw) = base_pose(io)?;
+        let (x, y, yaw) = SENSOR_PORTS.base_pose(io)?;
         let lift = io.f64(LIFT_POSITION);
         if !(lift.is_finite() && lift.abs() < 100.0) {
             return Err(format!("input lift_position = {lift} is not finite or beyond 100 m"));

@@ -108,14 +108,8 @@ pub fn rpy(roll: f64, pitch: f64, yaw: f64) -> Mat3 {
 /// (right) = -y, optical y (down) = -z, optical z (forward) = +x. Columns are the optical axes.
 pub const OPTICAL_IN_BODY: Mat3 = [[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]];
 
-/// Mount of camera_link on base_link.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Mount {
-    pub translation: Vec3,
-    pub roll: f64,
-    pub pitch: f64,
-    pub yaw: f64,
-}
+/// Mount of camera_link on base_link (the shared sensor mount parameters).
+pub use agrisim_greenhouse::sensor_ports::Mount;
 
 /// The optical frame in the map: origin and rotation (optical -> map).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,5 +1,6 @@
-//! The camera's variable table. Scene parameters and the base box match the Greenhouse (world)
-//! and LiDAR FMUs, so all see the same geometry from the same scenario text.
+//! The camera's variable table. Scene parameters, mount, base box and base pose inputs are the
+//! shared sensor ports (`agrisim_greenhouse::sensor_ports`, as the LiDAR FMU's), so all
+//! sensors and the world see the same geometry from the same scenario text.
 
 use crate::datasheet as ds;
 use agrisim_fmi::{Start, Var};
@@ -7,12 +8,11 @@ use agrisim_fmi::{Start, Var};
 pub const IMAGE_MIME: &str = "application/x-ros2-cdr; type=sensor_msgs/msg/Image";
 pub const CAMERA_INFO_MIME: &str = "application/x-ros2-cdr; type=sensor_msgs/msg/CameraInfo";
 
-agrisim_fmi::variables! { pub VARIABLES {
-    // --- scene ---
-    SCENE = Var::param("scene", Start::String(""))
-        .desc("The keys of the scenario's [greenhouse] table as TOML (no header); empty = the default greenhouse"),
-    SCENE_SEED = Var::param("scene_seed", Start::Int32(-1))
-        .desc("Seed of the greenhouse generator; < 0 = the scene's own seed key (as the world FMU)"),
+// camera_link on base_link (x forward, y left, z up; the optical frame is z forward, x right,
+// y down relative to it).
+agrisim_greenhouse::sensor_variables! { pub VARIABLES {
+  mount: "camera_link" (0.6, 0.0, 1.2),
+  params: {
     ENVIRONMENT = Var::param("environment", Start::String(""))
         .desc("The keys of the scenario's [environment] table as TOML (no header): date, time, place, weather, render quality; empty = the fixed sun of sun_azimuth / sun_elevation / ambient. Changes images, never geometry"),
     RENDER_THREADS = Var::param("render_threads", Start::Int32(2))
@@ -53,26 +53,9 @@ agrisim_fmi::variables! { pub VARIABLES {
         .desc("Publish the instance-label image (32SC1: scene object id + 1, 0 = nothing)"),
     FRAME_ID = Var::param("frame_id", Start::String("camera_color_optical_frame"))
         .desc("header.frame_id of images and CameraInfo (optical convention: z forward, x right, y down)"),
-    // --- mount of camera_link on base_link (x forward, y left, z up; the optical frame is
-    // z forward, x right, y down relative to it) ---
-    MOUNT_X = Var::param("mount_x", Start::Float64(0.6)).unit("m").desc("Camera position on base_link"),
-    MOUNT_Y = Var::param("mount_y", Start::Float64(0.0)).unit("m"),
-    MOUNT_Z = Var::param("mount_z", Start::Float64(1.2)).unit("m"),
-    MOUNT_ROLL = Var::param("mount_roll", Start::Float64(0.0)).unit("rad")
-        .desc("camera_link orientation on base_link, roll-pitch-yaw about fixed axes (URDF); 0 = looking along base_link x"),
-    MOUNT_PITCH = Var::param("mount_pitch", Start::Float64(0.0)).unit("rad"),
-    MOUNT_YAW = Var::param("mount_yaw", Start::Float64(0.0)).unit("rad"),
-    // --- the robot's own base box ---
-    BASE_LENGTH = Var::param("base_length", Start::Float64(1.2)).unit("m").range(0.01, 20.0)
-        .desc("Robot base box extent along base_link x"),
-    BASE_WIDTH = Var::param("base_width", Start::Float64(0.9)).unit("m").range(0.01, 20.0),
-    BASE_HEIGHT = Var::param("base_height", Start::Float64(0.6)).unit("m").range(0.01, 20.0),
-    BASE_CLEARANCE = Var::param("base_clearance", Start::Float64(0.05)).unit("m").range(0.0, 5.0)
-        .desc("Height of the box bottom above the floor (base_link is on the floor)"),
-    // --- inputs ---
-    BASE_X = Var::input("base_x", 0.0).unit("m").desc("x of base_link in the map frame"),
-    BASE_Y = Var::input("base_y", 0.0).unit("m").desc("y of base_link in the map frame"),
-    BASE_YAW = Var::input("base_yaw", 0.0).unit("rad").desc("Yaw of base_link in the map frame"),
+  },
+  ports: {
+    // --- inputs (and base_x, base_y, base_yaw) ---
     LIFT_POSITION = Var::input("lift_position", 0.0).unit("m")
         .desc("Lift joint position, added to mount_z (connect it when the camera rides on the lift, as on the robot: camera_link at (0.32, 0, 0.60 + lift) on base_link)"),
     // --- outputs ---
@@ -95,4 +78,5 @@ agrisim_fmi::variables! { pub VARIABLES {
     VISIBILITY = Var::output_discrete("visibility", Start::Float64(0.0)).unit("m")
         .desc("Meteorological visibility of the environment (Koschmieder, 3.912 / extinction); 0 = no environment (clear air)"),
     VALID_DEPTH = Var::output_discrete("valid_depth_pixels", Start::Int32(0)).desc("Pixels with depth data in the latest frame"),
+  },
 }}

@@ -54,6 +54,11 @@ fn light() -> Lighting {
     Lighting::new(180.0, 30.0, 0.35)
 }
 
+/// A frame of `scene` alone (no robot objects), noise seeded with `seed`, on 2 threads.
+fn shoot(scene: &Scene, k: &Intrinsics, pose: &CameraPose, light: &Lighting, depth: DepthModel, seed: u64) -> render::Frame {
+    render::render(scene, &[], k, pose, light, &depth, &mut Rng::new(seed), 2)
+}
+
 #[test]
 fn depth_reprojects_onto_the_wall() {
     let k = Intrinsics::from_fov(320, 180, 87.0, 58.0);
@@ -61,16 +66,7 @@ fn depth_reprojects_onto_the_wall() {
     for z in [0.5, 2.0, 7.5] {
         let scene = wall_scene(z);
         // Noise-free: every pixel reprojects exactly onto the wall's face.
-        let f = render::render(
-            &scene,
-            &[],
-            &k,
-            &pose,
-            &light(),
-            &model(DepthNoise::None, false, 0.05),
-            &mut Rng::new(1),
-            2,
-        );
+        let f = shoot(&scene, &k, &pose, &light(), model(DepthNoise::None, false, 0.05), 1);
         assert_eq!(f.valid, 320 * 180);
         for v in (0..180).step_by(7) {
             for u in (0..320).step_by(5) {
@@ -84,16 +80,7 @@ fn depth_reprojects_onto_the_wall() {
             }
         }
         // With the stereo model: within 5 sigma of the surface.
-        let f = render::render(
-            &scene,
-            &[],
-            &k,
-            &pose,
-            &light(),
-            &model(DepthNoise::Stereo { subpixel: 0.08 }, true, 0.05),
-            &mut Rng::new(2),
-            2,
-        );
+        let f = shoot(&scene, &k, &pose, &light(), model(DepthNoise::Stereo { subpixel: 0.08 }, true, 0.05), 2);
         let sigma = z * z * 0.08 / (k.fx * 0.05);
         let mut checked = 0;
         for (i, &d) in f.depth.iter().enumerate() {
@@ -115,16 +102,7 @@ fn out_of_range_is_zero() {
     let k = Intrinsics::from_fov(64, 36, 87.0, 58.0);
     let pose = CameraPose::new(&MOUNT, 0.0, 0.0, 0.0);
     for z in [0.05, 12.0] {
-        let f = render::render(
-            &wall_scene(z),
-            &[],
-            &k,
-            &pose,
-            &light(),
-            &model(DepthNoise::None, false, 0.0),
-            &mut Rng::new(1),
-            2,
-        );
+        let f = shoot(&wall_scene(z), &k, &pose, &light(), model(DepthNoise::None, false, 0.0), 1);
         assert_eq!(f.valid, 0, "z {z}");
         assert!(f.depth.iter().all(|&d| d == 0.0));
         assert!(
@@ -136,16 +114,7 @@ fn out_of_range_is_zero() {
 
 fn measured_sigma(noise: DepthNoise, z: f64, k: &Intrinsics) -> f64 {
     let pose = CameraPose::new(&MOUNT, 0.0, 0.0, 0.0);
-    let f = render::render(
-        &wall_scene(z),
-        &[],
-        k,
-        &pose,
-        &light(),
-        &model(noise, false, 0.0),
-        &mut Rng::new(99),
-        2,
-    );
+    let f = shoot(&wall_scene(z), k, &pose, &light(), model(noise, false, 0.0), 99);
     let errs: Vec<f64> = f
         .depth
         .iter()
@@ -182,16 +151,7 @@ fn left_invalid_band_matches_the_formula() {
     let k = Intrinsics::from_fov(640, 360, 87.0, 58.0);
     let pose = CameraPose::new(&MOUNT, 0.0, 0.0, 0.0);
     for z in [0.5, 1.0, 3.0] {
-        let f = render::render(
-            &wall_scene(z),
-            &[],
-            &k,
-            &pose,
-            &light(),
-            &model(DepthNoise::None, true, 0.05),
-            &mut Rng::new(1),
-            2,
-        );
+        let f = shoot(&wall_scene(z), &k, &pose, &light(), model(DepthNoise::None, true, 0.05), 1);
         let want = invalid_band_width(k.fx, 0.05, z);
         for v in [0, 100, 359] {
             let row = &f.depth[v * 640..(v + 1) * 640];
@@ -230,16 +190,7 @@ fn depth_discontinuities_are_invalid() {
     let scene = Scene::from_objects(&objects);
     let k = Intrinsics::from_fov(320, 180, 87.0, 58.0);
     let pose = CameraPose::new(&MOUNT, 0.0, 0.0, 0.0);
-    let f = render::render(
-        &scene,
-        &[],
-        &k,
-        &pose,
-        &light(),
-        &model(DepthNoise::None, false, 0.05),
-        &mut Rng::new(1),
-        2,
-    );
+    let f = shoot(&scene, &k, &pose, &light(), model(DepthNoise::None, false, 0.05), 1);
     let row = 90 * 320;
     let post: Vec<usize> = (0..320).filter(|&u| f.labels[row + u] == 2).collect();
     let (first, last) = (post[0], *post.last().unwrap());
@@ -278,16 +229,7 @@ fn labels_name_fruit_and_ripe_fruit_is_red() {
     let mut green_n = 0;
     for side in [yaw, -yaw] {
         let pose = CameraPose::new(&MOUNT, x, y, side);
-        let f = render::render(
-            &scene,
-            &[],
-            &k,
-            &pose,
-            &Lighting::new(0.0, 90.0, 0.35),
-            &model(DepthNoise::None, false, 0.0),
-            &mut Rng::new(1),
-            2,
-        );
+        let f = shoot(&scene, &k, &pose, &Lighting::new(0.0, 90.0, 0.35), model(DepthNoise::None, false, 0.0), 1);
         for (i, &l) in f.labels.iter().enumerate() {
             if l <= 0 {
                 continue;
@@ -373,16 +315,7 @@ fn shadows_follow_the_sun() {
     };
     let pose = CameraPose::new(&mount, 3.0, 0.0, 0.0); // straight down onto the block
     let px = |az: f64, p: [f64; 3]| {
-        let f = render::render(
-            &scene,
-            &[],
-            &k,
-            &pose,
-            &Lighting::new(az, 30.0, 0.35),
-            &model(DepthNoise::None, false, 0.0),
-            &mut Rng::new(1),
-            2,
-        );
+        let f = shoot(&scene, &k, &pose, &Lighting::new(az, 30.0, 0.35), model(DepthNoise::None, false, 0.0), 1);
         // Project the floor point into the image.
         let rel = [
             p[0] - pose.origin[0],

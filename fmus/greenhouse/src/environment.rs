@@ -82,27 +82,17 @@ struct Raw {
 /// A validated environment with defaults filled in.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Environment {
-    pub year: i32,
-    pub month: u32,
-    pub day: u32,
-    pub hour: u32,
-    pub minute: u32,
-    pub second: f64,
-    pub utc_offset: f64,
-    pub latitude: f64,
-    pub longitude: f64,
-    pub elevation: f64,
+    /// When and where, as SPA takes it: date, local time, UTC offset, place, and the
+    /// temperature and pressure that bend the sun's elevation (Delta T estimated from the
+    /// date). One struct, so the sun's input is not a second copy of these keys.
+    pub solar: SolarInput,
     pub weather: Weather,
     /// Meteorological visibility [m] if given (else the weather's).
     pub visibility: Option<f64>,
     /// [mm/h]
     pub rain_rate: f64,
-    /// [deg C]
-    pub temperature: f64,
     /// Relative humidity [%].
     pub humidity: f64,
-    /// [hPa]
-    pub pressure: f64,
     pub covering: Covering,
     pub map_x_bearing: f64,
     pub quality: Quality,
@@ -209,46 +199,35 @@ impl Environment {
             Some(v) => Some(range("visibility", v, 1.0, 1.0e6)?),
             None => None,
         };
+        let utc_offset = range("utc_offset", r.utc_offset.unwrap_or(2.0), -12.0, 14.0)?;
+        let rain_rate = range("rain_rate", r.rain_rate.unwrap_or(if weather == Weather::Rain { 8.0 } else { 0.0 }), 0.0, 500.0)?;
+        let temperature = range("temperature", r.temperature.unwrap_or(20.0), -60.0, 60.0)?;
+        let humidity = range("humidity", r.humidity.unwrap_or(70.0), 0.0, 100.0)?;
+        let pressure = range("pressure", r.pressure.unwrap_or(p_std), 300.0, 1100.0)?;
         Ok(Environment {
-            year,
-            month,
-            day,
-            hour,
-            minute,
-            second,
-            utc_offset: range("utc_offset", r.utc_offset.unwrap_or(2.0), -12.0, 14.0)?,
-            latitude,
-            longitude,
-            elevation,
+            solar: SolarInput {
+                year,
+                month,
+                day,
+                hour,
+                minute,
+                second,
+                utc_offset,
+                latitude,
+                longitude,
+                elevation,
+                pressure,
+                temperature,
+                delta_t: delta_t_estimate(year, month),
+            },
             weather,
             visibility,
-            rain_rate: range("rain_rate", r.rain_rate.unwrap_or(if weather == Weather::Rain { 8.0 } else { 0.0 }), 0.0, 500.0)?,
-            temperature: range("temperature", r.temperature.unwrap_or(20.0), -60.0, 60.0)?,
-            humidity: range("humidity", r.humidity.unwrap_or(70.0), 0.0, 100.0)?,
-            pressure: range("pressure", r.pressure.unwrap_or(p_std), 300.0, 1100.0)?,
+            rain_rate,
+            humidity,
             covering: r.covering.unwrap_or(Covering::Glass),
             map_x_bearing: range("map_x_bearing", r.map_x_bearing.unwrap_or(90.0), -360.0, 360.0)?,
             quality: r.render_quality.unwrap_or(Quality::Medium),
         })
-    }
-
-    /// The SPA input of this environment (Delta T estimated from the date).
-    pub fn solar_input(&self) -> SolarInput {
-        SolarInput {
-            year: self.year,
-            month: self.month,
-            day: self.day,
-            hour: self.hour,
-            minute: self.minute,
-            second: self.second,
-            utc_offset: self.utc_offset,
-            latitude: self.latitude,
-            longitude: self.longitude,
-            elevation: self.elevation,
-            pressure: self.pressure,
-            temperature: self.temperature,
-            delta_t: delta_t_estimate(self.year, self.month),
-        }
     }
 }
 
@@ -276,9 +255,9 @@ mod tests {
     #[test]
     fn season_picks_a_date_by_hemisphere() {
         let n = Environment::from_toml_str("season = \"winter\"").unwrap();
-        assert_eq!((n.month, n.day), (12, 21));
+        assert_eq!((n.solar.month, n.solar.day), (12, 21));
         let s = Environment::from_toml_str("season = \"winter\"\nlatitude = -33.9").unwrap();
-        assert_eq!((s.month, s.day), (6, 21));
+        assert_eq!((s.solar.month, s.solar.day), (6, 21));
         assert!(Environment::from_toml_str("season = \"winter\"\ndate = \"2025-01-01\"").is_err());
     }
 }

@@ -25,6 +25,7 @@ pub mod occupancy;
 pub mod raycast;
 pub mod rng;
 pub mod scene;
+pub mod sensor_ports;
 pub mod solar;
 pub mod solar_terms;
 pub mod weather;

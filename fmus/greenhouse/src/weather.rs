@@ -73,7 +73,7 @@ pub fn rain_extinction(rate: f64) -> f64 {
 
 impl Conditions {
     pub fn of(env: &Environment) -> Conditions {
-        let sun = solar_position(&env.solar_input());
+        let sun = solar_position(&env.solar);
         let (dni_clear, ghi_clear) = clear_sky(sun.zenith);
         let cz = sun.zenith.to_radians().cos().max(0.0);
         let (dni, dhi) = match env.weather {

@@ -15,7 +15,7 @@ use crate::frame::{yaw_rotate, Mount};
 use crate::pattern::ScanPattern;
 use crate::ports::*;
 use crate::reflectivity;
-use crate::scene::{self, BaseBox, Scene};
+use crate::scene::{BaseBox, Scene};
 use crate::trajectory::{Pose2, Trajectory};
 use agrisim_fmi::{Log, Model, Store, Var};
 use agrisim_greenhouse::environment::Environment;
@@ -67,17 +67,12 @@ fn param(io: &Store, i: usize, ok: impl Fn(f64) -> bool, what: &str) -> Result<f
 }
 
 fn pose(io: &Store) -> Result<Pose2, String> {
-    let p = Pose2 { x: io.f64(BASE_X), y: io.f64(BASE_Y), yaw: io.f64(BASE_YAW) };
-    if [p.x, p.y, p.yaw].iter().all(|v| v.is_finite() && v.abs() < 1e6) {
-        Ok(p)
-    } else {
-        Err(format!("robot pose input (base_x, base_y, base_yaw) = ({}, {}, {}) is not finite or beyond 1e6", p.x, p.y, p.yaw))
-    }
+    let (x, y, yaw) = SENSOR_PORTS.base_pose(io)?;
+    Ok(Pose2 { x, y, yaw })
 }
 
 impl Config {
     fn from_params(io: &Store) -> Result<Config, String> {
-        let any = |_: f64| true;
         let positive = |v: f64| v > 0.0;
         let frame_rate = param(io, FRAME_RATE, positive, "positive")?;
         let point_rate = param(io, POINT_RATE, positive, "positive")?;
@@ -89,8 +84,8 @@ impl Config {
         let range_max = param(io, RANGE_MAX, |v| v > range_min, "above range_min")?;
         let el_min = param(io, ELEVATION_MIN, |v| v.abs() < 90.0, "within (-90, 90) deg")?;
         let el_max = param(io, ELEVATION_MAX, |v| v.abs() < 90.0 && v > el_min, "within (-90, 90) deg and above elevation_min")?;
-        let translation = [param(io, MOUNT_X, any, "finite")?, param(io, MOUNT_Y, any, "finite")?, param(io, MOUNT_Z, any, "finite")?];
-        let mount = Mount::new(translation, param(io, MOUNT_ROLL, any, "finite")?, param(io, MOUNT_PITCH, any, "finite")?, param(io, MOUNT_YAW, any, "finite")?);
+        let m = SENSOR_PORTS.mount(io)?;
+        let mount = Mount::new(m.translation, m.roll, m.pitch, m.yaw);
         let (extinction, visibility) = match io.string(ENVIRONMENT).trim() {
             "" => (0.0, 0.0),
             text => {
@@ -100,7 +95,7 @@ impl Config {
             }
         };
         Ok(Config {
-            scene: scene::load(io.string(SCENE), io.i32(SEED))?,
+            scene: SENSOR_PORTS.scene(io)?,
             pattern: ScanPattern::mid360(point_rate, el_min.to_radians(), el_max.to_radians()),
             points_per_frame: points_per_frame as usize,
             frame_period: 1.0 / frame_rate,
@@ -195,10 +190,7 @@ impl Model for Lidar {
 
     fn initialize(&mut self, io: &mut Store, start_time: f64, _log: &mut dyn Log) -> Result<(), String> {
         let config = Config::from_params(io)?;
-        let length = param(io, BASE_LENGTH, |v| v > 0.0, "positive")?;
-        let width = param(io, BASE_WIDTH, |v| v > 0.0, "positive")?;
-        let height = param(io, BASE_HEIGHT, |v| v > 0.0, "positive")?;
-        let clearance = param(io, BASE_CLEARANCE, |v| v >= 0.0, ">= 0")?;
+        let [length, width, height, clearance] = SENSOR_PORTS.base_box(io)?;
         self.base = Some(BaseBox::new(config.scene.object_count() as u32, length, width, height, clearance));
         self.trajectory = Trajectory::default();
         self.trajectory.push(start_time, pose(io)?, 2.0 * config.frame_period);

@@ -80,6 +80,16 @@ pub fn grasp(c: [f64; 3], side: f64) -> TcpGoal {
     TcpGoal { position: c, approach: [0.0, side, 0.0], x_axis: None }
 }
 
+/// Tilt of the alternative approaches from below and from above [rad].
+pub const APPROACH_TILT: f64 = 0.44;
+
+/// Grasps to try in order: horizontal, then from below and from above (a fruit hanging just
+/// above or below the target blocks the palm of a horizontal approach).
+pub fn grasp_candidates(c: [f64; 3], side: f64) -> Vec<TcpGoal> {
+    let (s, k) = APPROACH_TILT.sin_cos();
+    [0.0, 1.0, -1.0].iter().map(|&up| TcpGoal { position: c, approach: [0.0, side * if up == 0.0 { 1.0 } else { k }, up * s], x_axis: None }).collect()
+}
+
 /// Handover point (base frame) at lift `lift`.
 pub fn handover_point(lift: f64) -> [f64; 3] {
     [SHOULDER_X + HANDOVER[0], 0.0, ARM_Z0 + lift + HANDOVER[1]]
@@ -100,9 +110,16 @@ pub fn handover_goals(point: [f64; 3], giver_side: f64) -> (TcpGoal, TcpGoal) {
     (giver, taker)
 }
 
-/// Drop pose above the harvest box: pointing down, roll free.
-pub fn drop_goal() -> TcpGoal {
-    TcpGoal { position: [BOX_TOP[0], BOX_TOP[1], BOX_TOP[2] + DROP_ABOVE], approach: [0.0, 0.0, -1.0], x_axis: None }
+/// Drop poses above the harvest box, pointing down, roll free, in order of preference: the
+/// centre of the opening first, then toward its corners and higher up.
+pub fn drop_goals() -> Vec<TcpGoal> {
+    let mut v = vec![];
+    for dz in [0.0, 0.1] {
+        for (dx, dy) in [(0.0, 0.0), (0.08, 0.12), (0.08, -0.12), (-0.08, 0.12), (-0.08, -0.12)] {
+            v.push(TcpGoal { position: [BOX_TOP[0] + dx, BOX_TOP[1] + dy, BOX_TOP[2] + DROP_ABOVE + dz], approach: [0.0, 0.0, -1.0], x_axis: None });
+        }
+    }
+    v
 }
 
 /// Whether a point (base frame) lies inside the harvest box's opening footprint, below its rim.

@@ -104,6 +104,8 @@ pub struct Motion {
     held: [Option<f64>; 2],
     /// Safety margin of the sphere checks [m] (the exact check has none).
     padding: f64,
+    /// The straight approach (joint path, pre-grasp first) checked by the last pre-grasp plan.
+    approach: Option<(Arm, Vec<[f64; DOF]>)>,
 }
 
 impl Motion {
@@ -120,6 +122,7 @@ impl Motion {
             ignore_target: false,
             held: [None, None],
             padding: agrisim_manip::checker::DEFAULT_PADDING,
+            approach: None,
         }
     }
 
@@ -257,10 +260,11 @@ impl Motion {
         self.plan_to_configs(arm, lift, start, &goals, other)
     }
 
-    /// Free-space motion to a stand-off `standoff` m before a grasp whose roll is free: the
-    /// goal set holds pre-grasp configurations whose grasp configuration (same orientation,
-    /// reached by the straight approach) is valid too, over rolls every 30 degrees, so the
-    /// fingers that would hit the truss or a neighbour are never chosen.
+    /// Free-space motion to a stand-off `standoff` m before a grasp: the goal set holds
+    /// pre-grasp configurations whose grasp configuration (same orientation, reached by the
+    /// straight approach) is valid too, over rolls every 30 degrees when the roll is free
+    /// (so fingers that would hit a neighbour are never chosen), else the given roll and its
+    /// opposite.
     pub fn plan_pregrasp(&mut self, arm: Arm, lift: f64, start: [f64; DOF], grasp: &TcpGoal, standoff: f64, other: [f64; DOF]) -> Result<Planned, String> {
         let mut rng = std::mem::replace(&mut self.rng, Rng::new(0));
         let goals = {
@@ -272,12 +276,21 @@ impl Motion {
             let up = if z[2].abs() < 0.9 { [0.0, 0.0, 1.0] } else { [1.0, 0.0, 0.0] };
             let x0 = super::geometry::normalize(super::geometry::cross(super::geometry::cross(z, up), z));
             let y0 = super::geometry::cross(z, x0);
+            // Rolls to try: every 30 degrees when free; a given roll and its opposite (the
+            // same finger line) otherwise.
+            let rolls: Vec<(u32, [f64; 3])> = match grasp.x_axis {
+                Some(x) => vec![(0, x), (180, [-x[0], -x[1], -x[2]])],
+                None => (0..ROLLS)
+                    .map(|k| {
+                        let (sa, ca) = (k as f64 * std::f64::consts::TAU / ROLLS as f64).sin_cos();
+                        ((k * 360 / ROLLS) as u32, [ca * x0[0] + sa * y0[0], ca * x0[1] + sa * y0[1], ca * x0[2] + sa * y0[2]])
+                    })
+                    .collect(),
+            };
             let mut goals: Vec<[f64; DOF]> = vec![];
             let mut backout: Vec<String> = vec![];
-            for k in 0..ROLLS {
-                let a = k as f64 * std::f64::consts::TAU / ROLLS as f64;
-                let (sa, ca) = a.sin_cos();
-                let x = [ca * x0[0] + sa * y0[0], ca * x0[1] + sa * y0[1], ca * x0[2] + sa * y0[2]];
+            let mut approaches: Vec<Vec<[f64; DOF]>> = vec![];
+            for &(deg, x) in &rolls {
                 let g = TcpGoal { x_axis: Some(x), ..*grasp };
                 let at_grasp = ik.goal_set(&target_of(&g), &start, &mut rng, 2, GOAL_SET.1, 2 * IK_BUDGET.1, |q| checker.is_valid(q));
                 for qg in at_grasp {
@@ -285,27 +298,26 @@ impl Motion {
                     // pre-grasp and grasp configurations are joined by a valid straight line.
                     let back = Vector3::new(-standoff * z[0], -standoff * z[1], -standoff * z[2]);
                     match cartesian_path(&checker, &qg, back, CARTESIAN_STEP, 0.3, 0.02) {
-                        Ok(path) => {
+                        Ok(mut path) => {
                             let qp = *path.last().expect("start at least");
                             if goals.iter().all(|o| agrisim_manip::ik::dist(o, &qp) > 1e-3) {
                                 goals.push(qp);
+                                path.reverse();
+                                approaches.push(path);
                             }
                         }
-                        Err(e) => backout.push(format!("roll {}: {e}", 30 * k)),
+                        Err(e) => backout.push(format!("roll {deg}: {e}")),
                     }
                 }
             }
             // Say why when nothing worked: what the grasp configuration touches.
             let why = if goals.is_empty() {
                 let mut why = Vec::new();
-                for k in 0..ROLLS {
-                    let a = k as f64 * std::f64::consts::TAU / ROLLS as f64;
-                    let (sa, ca) = a.sin_cos();
-                    let x = [ca * x0[0] + sa * y0[0], ca * x0[1] + sa * y0[1], ca * x0[2] + sa * y0[2]];
+                for &(deg, x) in &rolls {
                     let g = TcpGoal { x_axis: Some(x), ..*grasp };
                     match ik.solve(&target_of(&g), &start, &mut rng, IK_BUDGET.1) {
-                        None => why.push(format!("roll {}: no IK", 30 * k)),
-                        Some(q) => why.push(format!("roll {}: {}", 30 * k, checker.contact(&q).map(|c| c.describe(&ctx)).unwrap_or_else(|| "free?".into()))),
+                        None => why.push(format!("roll {deg}: no IK")),
+                        Some(q) => why.push(format!("roll {deg}: {}", checker.contact(&q).map(|c| c.describe(&ctx)).unwrap_or_else(|| "free?".into()))),
                     }
                 }
                 why.extend(backout);
@@ -313,17 +325,46 @@ impl Motion {
             } else {
                 String::new()
             };
-            (goals, why)
+            (goals, why, approaches)
         };
-        let (goals, why) = goals;
+        let (goals, why, approaches) = goals;
         self.rng = rng;
         if goals.is_empty() {
             return Err(format!("no collision-free IK solution for a grasp at ({:.3}, {:.3}, {:.3}) in base_link with any roll ({why})", grasp.position[0], grasp.position[1], grasp.position[2]));
         }
-        // Nearest goals first: the planner tries the direct edge to them in order.
-        let mut goals = goals;
-        goals.sort_by(|a, b| agrisim_manip::ik::dist(a, &start).total_cmp(&agrisim_manip::ik::dist(b, &start)));
-        self.plan_to_configs(arm, lift, start, &goals, other)
+        // Nearest goals first: the planner tries the direct edge to them in order. The
+        // approach from the goal reached is kept for plan_linear.
+        let mut order: Vec<usize> = (0..goals.len()).collect();
+        order.sort_by(|&a, &b| agrisim_manip::ik::dist(&goals[a], &start).total_cmp(&agrisim_manip::ik::dist(&goals[b], &start)));
+        let sorted: Vec<[f64; DOF]> = order.iter().map(|&i| goals[i]).collect();
+        let planned = self.plan_to_configs(arm, lift, start, &sorted, other)?;
+        let reached = order.iter().map(|&i| i).find(|&i| goals[i] == planned.goal_q);
+        self.approach = reached.map(|i| (arm, approaches[i].clone()));
+        Ok(planned)
+    }
+
+    /// The first of `goals` [`Self::plan_free`] reaches, with its index.
+    pub fn plan_free_any(&mut self, arm: Arm, lift: f64, start: [f64; DOF], goals: &[TcpGoal], other: [f64; DOF]) -> Result<(usize, Planned), String> {
+        let mut errors = vec![];
+        for (i, g) in goals.iter().enumerate() {
+            match self.plan_free(arm, lift, start, g, other) {
+                Ok(p) => return Ok((i, p)),
+                Err(e) => errors.push(format!("goal {i}: {e}")),
+            }
+        }
+        Err(errors.join("; "))
+    }
+
+    /// The first of `grasps` [`Self::plan_pregrasp`] reaches, with its index.
+    pub fn plan_pregrasp_any(&mut self, arm: Arm, lift: f64, start: [f64; DOF], grasps: &[TcpGoal], standoff: f64, other: [f64; DOF]) -> Result<(usize, Planned), String> {
+        let mut errors = vec![];
+        for (i, g) in grasps.iter().enumerate() {
+            match self.plan_pregrasp(arm, lift, start, g, standoff, other) {
+                Ok(p) => return Ok((i, p)),
+                Err(e) => errors.push(format!("approach {i}: {e}")),
+            }
+        }
+        Err(errors.join("; "))
     }
 
     /// Free-space motion back to [`HOME`].
@@ -353,6 +394,16 @@ impl Motion {
     /// by ruckig as one jerk-limited motion when that stays on the line, else by TOPP-RA on a
     /// spline through the waypoints; then the line, collision and exact checks.
     pub fn plan_linear(&mut self, arm: Arm, lift: f64, start: [f64; DOF], goal: &TcpGoal, other: [f64; DOF]) -> Result<Planned, String> {
+        // The approach the pre-grasp plan checked, if this is it: the same joint path.
+        if let Some((a, path)) = &self.approach {
+            let same_start = path.first().is_some_and(|p| agrisim_manip::ik::dist(p, &start) < 1e-6);
+            let end = path.last().map(|q| self.model(arm).fk(lift, q).trans);
+            let same_end = end.is_some_and(|e| (0..3).all(|i| (e[i] - goal.position[i]).abs() < 5e-3));
+            if *a == arm && same_start && same_end {
+                let wps = path.clone();
+                return self.time_line(arm, lift, start, wps, goal.position, other);
+            }
+        }
         let model = &self.arms[arm.index()];
         let from = model.fk(lift, &start).trans;
         let to = goal.position;
@@ -372,6 +423,16 @@ impl Motion {
                 return Err(format!("Cartesian move: {e}{what}"));
             }
         };
+        self.time_line(arm, lift, start, wps, to, other)
+    }
+
+    /// Times joint waypoints that move the TCP along a straight line to `to` (ruckig when
+    /// that stays on the line, else TOPP-RA), then the line, collision and exact checks.
+    fn time_line(&self, arm: Arm, lift: f64, start: [f64; DOF], wps: Vec<[f64; DOF]>, to: [f64; 3], other: [f64; DOF]) -> Result<Planned, String> {
+        let model = self.model(arm);
+        let from = model.fk(lift, &start).trans;
+        let ctx = self.context(arm, lift, other);
+        let checker = Checker::new(ctx);
         let end = *wps.last().expect("start at least");
         let on_line = |samples: &Sampled| -> Result<Vec<[f64; DOF]>, String> {
             let path: Vec<[f64; DOF]> = samples.q.iter().map(|v| std::array::from_fn(|i| v[i])).collect();

@@ -51,6 +51,8 @@ const REGRASP_OFFSETS: [f64; 2] = [0.012, -0.024];
 const HANDOVER_OFFSETS: [f64; 2] = [0.015, -0.015];
 /// Sphere-check margin of the taker's final approach [m]: the hands meet by design there.
 const HANDOVER_PADDING: f64 = 0.002;
+/// How far the giver backs off along its approach after letting go [m].
+const GIVER_BACKOFF: f64 = 0.06;
 
 /// What the node knows of one arm, from its messages.
 #[derive(Debug, Clone, Default)]
@@ -75,6 +77,8 @@ pub struct PlanRecord {
     pub arm: &'static str,
     pub ok: bool,
     pub kind: &'static str,
+    /// A failure has a fallback (e.g. backing off in a straight line before going home).
+    pub optional: bool,
     /// Wall time of IK + planning + time parameterization [s].
     pub wall: f64,
     pub detail: String,
@@ -117,6 +121,8 @@ pub struct HarvestNode {
     attempts: u32,
     grasp_offset: [f64; 3],
     grasp_point: [f64; 3],
+    /// The approach the pre-grasp plan chose (position: the target as first seen).
+    grasp: TcpGoal,
     handover_attempts: u32,
     handover_offset: f64,
     release_ns: i64,
@@ -160,6 +166,7 @@ impl HarvestNode {
             attempts: 0,
             grasp_offset: [0.0; 3],
             grasp_point: [0.0; 3],
+            grasp: geo::grasp([0.0; 3], side),
             handover_attempts: 0,
             handover_offset: 0.0,
             release_ns: 0,
@@ -294,8 +301,17 @@ impl HarvestNode {
         Some([c * dx + s * dy, -s * dx + c * dy, t[2]])
     }
 
+    /// A plan whose failure has a fallback (it does not fail the harvest).
+    fn record_optional(&mut self, arm: Arm, kind: &'static str, r: &std::result::Result<Planned, String>, wall: f64) {
+        self.record(arm, kind, r, wall);
+        if let Some(p) = self.log.borrow_mut().plans.last_mut() {
+            p.optional = true;
+        }
+    }
+
     fn record(&mut self, arm: Arm, kind: &'static str, r: &std::result::Result<Planned, String>, wall: f64) {
         self.log.borrow_mut().plans.push(PlanRecord {
+            optional: false,
             stage: self.stage.name(),
             arm: arm.name(),
             ok: r.is_ok(),
@@ -325,12 +341,25 @@ impl HarvestNode {
         }
     }
 
-    fn move_pregrasp(&mut self, arm: Arm, grasp: &TcpGoal, t_ns: i64, bus: &mut Bus) -> bool {
+    /// Plans to the stand-off of the first reachable grasp of `grasps`; returns its index.
+    fn move_pregrasp(&mut self, arm: Arm, grasps: &[TcpGoal], t_ns: i64, bus: &mut Bus) -> Option<usize> {
         let (start, other) = (self.q(arm), self.q(arm.other()));
         let wall = std::time::Instant::now();
-        let r = self.motion.plan_pregrasp(arm, self.lift, start, grasp, geo::PRE_GRASP, other);
+        let r = self.motion.plan_pregrasp_any(arm, self.lift, start, grasps, geo::PRE_GRASP, other);
         let wall = wall.elapsed().as_secs_f64();
+        let chosen = r.as_ref().ok().map(|(i, _)| *i);
+        let r = r.map(|(_, p)| p);
         self.record(arm, "pregrasp", &r, wall);
+        self.send_or_fail(arm, r, t_ns, bus).then_some(chosen).flatten()
+    }
+
+    /// Plans to the first reachable goal of `goals`.
+    fn move_any(&mut self, arm: Arm, goals: &[TcpGoal], t_ns: i64, bus: &mut Bus) -> bool {
+        let (start, other) = (self.q(arm), self.q(arm.other()));
+        let wall = std::time::Instant::now();
+        let r = self.motion.plan_free_any(arm, self.lift, start, goals, other).map(|(_, p)| p);
+        let wall = wall.elapsed().as_secs_f64();
+        self.record(arm, "free", &r, wall);
         self.send_or_fail(arm, r, t_ns, bus)
     }
 
@@ -467,7 +496,10 @@ impl HarvestNode {
                     let Some(c) = self.target_base() else { return };
                     self.motion.ignore_target(false);
                     self.planned = true;
-                    self.move_pregrasp(giver, &geo::grasp(c, self.side), t_ns, bus);
+                    let candidates = geo::grasp_candidates(c, self.side);
+                    if let Some(i) = self.move_pregrasp(giver, &candidates, t_ns, bus) {
+                        self.grasp = candidates[i];
+                    }
                 } else if self.arm_done(giver, t_ns, bus) == Some(true) {
                     self.enter(Stage::Approach, t_ns, bus, "");
                 }
@@ -477,7 +509,7 @@ impl HarvestNode {
                     let Some(c) = self.target_base() else { return };
                     let o = self.grasp_offset;
                     self.grasp_point = [c[0] + o[0], c[1] + o[1], c[2] + o[2]];
-                    let goal = geo::grasp(self.grasp_point, self.side);
+                    let goal = TcpGoal { position: self.grasp_point, ..self.grasp };
                     self.move_arm(giver, &goal, true, t_ns, bus);
                 } else if self.arm_done(giver, t_ns, bus) == Some(true) {
                     self.enter(Stage::Grasp, t_ns, bus, "");
@@ -508,7 +540,7 @@ impl HarvestNode {
                         self.phase = 1;
                     }
                     1 if self.view(giver).gripper.as_ref().is_some_and(|g| g.position > geo::OPEN_WIDTH - 0.005) => {
-                        let goal = geo::grasp(self.grasp_point, self.side).along(-geo::PRE_GRASP);
+                        let goal = TcpGoal { position: self.grasp_point, ..self.grasp }.along(-geo::PRE_GRASP);
                         if self.move_arm(giver, &goal, true, t_ns, bus) {
                             self.phase = 2;
                         }
@@ -527,7 +559,7 @@ impl HarvestNode {
             }
             Stage::Retreat => {
                 if first {
-                    let g = geo::grasp(self.grasp_point, self.side).along(-geo::RETREAT[0]);
+                    let g = TcpGoal { position: self.grasp_point, ..self.grasp }.along(-geo::RETREAT[0]);
                     let goal = TcpGoal { position: [g.position[0], g.position[1], g.position[2] + geo::RETREAT[1]], ..g };
                     // The fruit now belongs to the hand: it is no obstacle.
                     self.motion.ignore_target(true);
@@ -563,8 +595,13 @@ impl HarvestNode {
                         }
                     }
                     2 if self.arm_done(giver, t_ns, bus) == Some(true) => {
+                        // The taker's stand-off is chosen so its straight approach to the
+                        // fruit is valid too; the hands meet by design, the exact check decides.
                         let (_, t) = geo::handover_goals(geo::handover_point(self.lift), self.side);
-                        if self.move_arm(taker, &t.along(-geo::PRE_GRASP), false, t_ns, bus) {
+                        self.motion.set_padding(HANDOVER_PADDING);
+                        let ok = self.move_pregrasp(taker, &[t], t_ns, bus).is_some();
+                        self.motion.set_padding(agrisim_manip::checker::DEFAULT_PADDING);
+                        if ok {
                             self.phase = 3;
                         }
                     }
@@ -577,7 +614,7 @@ impl HarvestNode {
                 match { self.phase } {
                     0 => {
                         self.motion.set_padding(HANDOVER_PADDING);
-                        let ok = self.move_arm(taker, &t.along(self.handover_offset), true, t_ns, bus);
+                        let ok = self.move_arm(taker, &TcpGoal { x_axis: None, ..t.along(self.handover_offset) }, true, t_ns, bus);
                         self.motion.set_padding(agrisim_manip::checker::DEFAULT_PADDING);
                         if ok {
                             self.phase = 1;
@@ -612,14 +649,22 @@ impl HarvestNode {
                                 self.fail(Failure::Handover, t_ns, bus, "the fruit fell during the exchange".into());
                                 return;
                             }
+                            // The giver backs off if a straight line allows it; otherwise
+                            // its plan home (next stage) starts right here.
                             let (g, _) = geo::handover_goals(geo::handover_point(self.lift), self.side);
-                            if self.move_arm(giver, &g.along(-geo::PRE_GRASP), true, t_ns, bus) {
-                                self.enter(Stage::Transfer, t_ns, bus, "fruit handed over");
+                            let goal = TcpGoal { x_axis: None, ..g.along(-GIVER_BACKOFF) };
+                            let (start, other) = (self.q(giver), self.q(taker));
+                            let wall = std::time::Instant::now();
+                            let r = self.motion.plan_linear(giver, self.lift, start, &goal, other);
+                            self.record_optional(giver, "linear", &r, wall.elapsed().as_secs_f64());
+                            if let Ok(p) = r {
+                                self.send(giver, p, t_ns, bus);
                             }
+                            self.enter(Stage::Transfer, t_ns, bus, "fruit handed over");
                         }
                     }
                     4 if self.view(taker).gripper.as_ref().is_some_and(|g| g.position > geo::OPEN_WIDTH - 0.005) => {
-                        if self.move_arm(taker, &t.along(-0.04), true, t_ns, bus) {
+                        if self.move_arm(taker, &TcpGoal { x_axis: None, ..t.along(-0.04) }, true, t_ns, bus) {
                             self.phase = 5;
                         }
                     }
@@ -641,7 +686,7 @@ impl HarvestNode {
                     }
                 }
                 1 if self.arm_done(giver, t_ns, bus) == Some(true) => {
-                    if self.move_arm(taker, &geo::drop_goal(), false, t_ns, bus) {
+                    if self.move_any(taker, &geo::drop_goals(), t_ns, bus) {
                         self.phase = 2;
                     }
                 }
