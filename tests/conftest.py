@@ -3,6 +3,7 @@ FMUs, and a decoder of recorded topics."""
 
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 
@@ -17,6 +18,17 @@ FMU_DIR = REPO / "target" / "fmu"
 sys.path.insert(0, str(REPO / "python"))
 
 from agrisim_fmpy import agrisim_bin, agrisim_run, run_agrisim  # noqa: E402,F401
+
+
+def wilson(k: int, n: int, z: float = 1.959963984540054) -> tuple[float, float]:
+    """Wilson score interval (Wilson 1927), written from the formula: the benchmarks' own
+    statistics are checked against it."""
+    if n == 0:
+        return 0.0, 1.0
+    p = k / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return max(0.0, centre - half), min(1.0, centre + half)
 
 
 def decoded_messages(path: Path, topic: str) -> list:

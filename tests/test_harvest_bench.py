@@ -6,12 +6,11 @@ JointState, GripperCommand, PlanningScene, HarvestStatus)."""
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
 import pytest
 
-from conftest import REPO, run_agrisim
+from conftest import REPO, run_agrisim, wilson
 
 SCENARIO = REPO / "models" / "scenarios" / "harvest.toml"
 TRIALS = 3
@@ -24,15 +23,6 @@ def bench(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("harvest")
     run_agrisim("bench", "harvest", "--scenario", str(SCENARIO), "--trials", str(TRIALS), "--seed", "3", "--out", str(out))
     return out
-
-
-def wilson(k: int, n: int, z: float = 1.959963984540054) -> tuple[float, float]:
-    if n == 0:
-        return 0.0, 1.0
-    p = k / n
-    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return max(0.0, centre - half), min(1.0, centre + half)
 
 
 def trials(bench: Path) -> list[dict]:

@@ -5,12 +5,11 @@ trial's MCAP decoding with rosbags."""
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
 import pytest
 
-from conftest import REPO, run_agrisim
+from conftest import REPO, run_agrisim, wilson
 
 SCENARIO = REPO / "models" / "scenarios" / "default.toml"
 TRIALS = 3
@@ -21,13 +20,6 @@ def bench(tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("nav")
     run_agrisim("bench", "nav", "--scenario", str(SCENARIO), "--trials", str(TRIALS), "--seed", "7", "--out", str(out))
     return out
-
-
-def wilson(k: int, n: int, z: float = 1.959963984540054) -> tuple[float, float]:
-    p = k / n
-    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    return max(0.0, centre - half), min(1.0, centre + half)
 
 
 def test_files_and_summary(bench):

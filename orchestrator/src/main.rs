@@ -6,7 +6,7 @@ use agrisim::scenario::Scenario;
 use clap::{Parser, Subcommand};
 use std::collections::BTreeMap;
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -80,33 +80,11 @@ enum FmuCommand {
 #[derive(Subcommand)]
 enum BenchCommand {
     /// The navigation experiment: N trials to seeded targets; DIR/summary.json, trials.jsonl,
-    /// trials/<NNNN>.mcap, report.html.
-    Nav {
-        #[arg(long, default_value = "models/scenarios/default.toml")]
-        scenario: PathBuf,
-        #[arg(long, default_value_t = 50)]
-        trials: u64,
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        #[command(flatten)]
-        dirs: Dirs,
-        #[arg(long)]
-        out: PathBuf,
-    },
+    /// trials/<NNNN>.mcap, report.html (default scenario: models/scenarios/default.toml).
+    Nav(TrialArgs),
     /// The dual-arm harvesting experiment: N trials on seeded ripe fruit; DIR/summary.json,
-    /// trials.jsonl, trials/<NNNN>.mcap.
-    Harvest {
-        #[arg(long, default_value = "models/scenarios/harvest.toml")]
-        scenario: PathBuf,
-        #[arg(long, default_value_t = 50)]
-        trials: u64,
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        #[command(flatten)]
-        dirs: Dirs,
-        #[arg(long)]
-        out: PathBuf,
-    },
+    /// trials.jsonl, trials/<NNNN>.mcap (default scenario: models/scenarios/harvest.toml).
+    Harvest(TrialArgs),
     /// Orchestrator cost per FMU and step, beside the bare fmi3DoStep cost (JSON on stdout).
     Overhead {
         #[arg(long, default_value = "models/scenarios/default.toml")]
@@ -120,6 +98,22 @@ enum BenchCommand {
     },
 }
 
+/// What a many-trial benchmark takes.
+#[derive(clap::Args)]
+struct TrialArgs {
+    /// Scenario file (default: the benchmark's own).
+    #[arg(long)]
+    scenario: Option<PathBuf>,
+    #[arg(long, default_value_t = 50)]
+    trials: u64,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    #[command(flatten)]
+    dirs: Dirs,
+    #[arg(long)]
+    out: PathBuf,
+}
+
 #[derive(Subcommand)]
 enum SceneCommand {
     /// Write the scenario's greenhouse as binary glTF (.glb) for any 3D viewer.
@@ -131,7 +125,7 @@ enum SceneCommand {
     },
 }
 
-#[derive(clap::Args)]
+#[derive(clap::Args, Clone)]
 struct Dirs {
     /// Directory of packed FMUs (default: target/fmu next to this executable's build directory).
     #[arg(long)]
@@ -191,6 +185,12 @@ fn main() -> ExitCode {
     }
 }
 
+/// The scenario (or the benchmark's default) and run options of a many-trial benchmark.
+fn trial_setup(a: &TrialArgs, default_scenario: &str, target: &Path) -> Result<(Scenario, RunOptions)> {
+    let s = Scenario::load(a.scenario.as_deref().unwrap_or(Path::new(default_scenario)))?;
+    Ok((s, run_options(a.dirs.clone(), target, None, None, BTreeMap::new())))
+}
+
 fn real_main() -> Result<()> {
     let cli = Cli::parse();
     let (exe_dir, target) = build_dirs();
@@ -201,16 +201,14 @@ fn real_main() -> Result<()> {
             let summary = agrisim::run::run(&s, &opts, &out, progress_printer())?;
             println!("{} steps ({} s simulated) -> {}", summary.steps, summary.simulated, summary.mcap.display());
         }
-        Command::Bench { command: BenchCommand::Nav { scenario, trials, seed, dirs, out } } => {
-            let s = Scenario::load(&scenario)?;
-            let opts = run_options(dirs, &target, None, None, BTreeMap::new());
-            let summary = agrisim::bench::nav::bench_nav(&s, &opts, trials, seed, &out, progress_printer())?;
+        Command::Bench { command: BenchCommand::Nav(a) } => {
+            let (s, opts) = trial_setup(&a, "models/scenarios/default.toml", &target)?;
+            let summary = agrisim::bench::nav::bench_nav(&s, &opts, a.trials, a.seed, &a.out, progress_printer())?;
             println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
         }
-        Command::Bench { command: BenchCommand::Harvest { scenario, trials, seed, dirs, out } } => {
-            let s = Scenario::load(&scenario)?;
-            let opts = run_options(dirs, &target, None, None, BTreeMap::new());
-            let summary = agrisim::bench::harvest::bench_harvest(&s, &opts, trials, seed, &out, progress_printer())?;
+        Command::Bench { command: BenchCommand::Harvest(a) } => {
+            let (s, opts) = trial_setup(&a, "models/scenarios/harvest.toml", &target)?;
+            let summary = agrisim::bench::harvest::bench_harvest(&s, &opts, a.trials, a.seed, &a.out, progress_printer())?;
             println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
         }
         Command::Bench { command: BenchCommand::Overhead { scenario, steps, dirs, out } } => {

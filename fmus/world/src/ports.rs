@@ -1,8 +1,12 @@
 //! The Greenhouse FMU's variable table: scene parameters, the robot pose coming in from the
-//! other FMUs, contact and clearance outputs, and ground-truth fruit poses.
+//! other FMUs, contact and clearance outputs, and ground-truth fruit poses. The scene
+//! parameters, the base box and the base pose inputs are the sensor FMUs' declarations
+//! (`agrisim_greenhouse::sensor_ports`), so every FMU reads the same scene and base box from
+//! the same scenario keys with the same defaults and ranges; only descriptions are the world's.
 
 use crate::robot_model::{OPEN_WIDTH, READY_POSE};
 use agrisim_fmi::{Start, Var};
+use agrisim_greenhouse::sensor_ports;
 
 /// MIME types of the message ports (FMI 3 Binary variables carrying ROS 2 CDR).
 pub const COLLISION_STATE_MIME: &str = "application/x-ros2-cdr; type=agrisim_msgs/msg/CollisionState";
@@ -12,18 +16,14 @@ pub const PLANNING_SCENE_MIME: &str = "application/x-ros2-cdr; type=agrisim_msgs
 
 agrisim_fmi::variables! { pub VARIABLES {
     // --- scene (fixed parameters) ---
-    SCENE = Var::param("scene", Start::String(""))
-        .desc("The keys of the scenario's [greenhouse] table as TOML (no header); empty = the default greenhouse"),
-    SEED = Var::param("scene_seed", Start::Int32(-1))
+    SCENE = sensor_ports::SCENE,
+    SEED = sensor_ports::SCENE_SEED
         .desc("Seed of the greenhouse generator (plants, fruit, random obstacles); < 0 = the scene's own seed key"),
     // --- robot base box (fixed parameters) ---
-    BASE_LENGTH = Var::param("base_length", Start::Float64(1.2)).unit("m").range(0.01, 20.0)
-        .desc("Robot base box extent along base_link x"),
-    BASE_WIDTH = Var::param("base_width", Start::Float64(0.9)).unit("m").range(0.01, 20.0)
-        .desc("Robot base box extent along base_link y"),
-    BASE_HEIGHT = Var::param("base_height", Start::Float64(0.6)).unit("m").range(0.01, 20.0)
-        .desc("Robot base box extent along z"),
-    BASE_CLEARANCE = Var::param("base_clearance", Start::Float64(0.05)).unit("m").range(0.0, 5.0)
+    BASE_LENGTH = sensor_ports::BASE_BOX[0],
+    BASE_WIDTH = sensor_ports::BASE_BOX[1].desc("Robot base box extent along base_link y"),
+    BASE_HEIGHT = sensor_ports::BASE_BOX[2].desc("Robot base box extent along z"),
+    BASE_CLEARANCE = sensor_ports::BASE_BOX[3]
         .desc("Height of the box bottom above the floor; the box spans the navigation height band"),
     CLEARANCE_CAP = Var::param("clearance_cap", Start::Float64(5.0)).unit("m").range(0.01, 1000.0)
         .desc("min_clearance reports at most this distance (nothing nearer than the cap)"),
@@ -33,9 +33,9 @@ agrisim_fmi::variables! { pub VARIABLES {
     FRUIT_RATE = Var::param("fruit_rate", Start::Float64(1.0)).unit("Hz").range(0.001, 1e6)
         .desc("Publication rate of fruit_poses and target"),
     // --- inputs: robot pose (ground truth of the chassis and lift FMUs) ---
-    BASE_X = Var::input("base_x", 0.0).unit("m").desc("x of base_link in the map frame"),
-    BASE_Y = Var::input("base_y", 0.0).unit("m").desc("y of base_link in the map frame"),
-    BASE_YAW = Var::input("base_yaw", 0.0).unit("rad").desc("Yaw of base_link in the map frame"),
+    BASE_X = sensor_ports::BASE_POSE[0],
+    BASE_Y = sensor_ports::BASE_POSE[1],
+    BASE_YAW = sensor_ports::BASE_POSE[2],
     LIFT_POSITION = Var::input("lift_position", 0.0).unit("m")
         .desc("Lift extension (URDF lift_joint, clamped to its limits): raises the lift carriage and both arms"),
     TARGET_FRUIT = Var::input_discrete("target_fruit", Start::Int32(-1))

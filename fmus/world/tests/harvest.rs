@@ -258,6 +258,27 @@ fn close(sim: &mut Sim, c: &mut Coords, side: Side) -> Option<f64> {
     held_at
 }
 
+/// Opens the left gripper fully at `c` (the fruit it holds is released); returns the inputs
+/// now applied.
+fn open_left(sim: &mut Sim, planar: [f64; 3], c: &Coords) -> Coords {
+    let mut open = *c;
+    open.widths[0] = 0.08;
+    sim.set(planar, &open);
+    open
+}
+
+/// Steps until the counter output `counter` is non-zero or `max` steps have passed, calling
+/// `each` with the step number after every step; returns the steps taken.
+fn step_until(sim: &mut Sim, counter: usize, max: usize, mut each: impl FnMut(&Sim, usize)) -> usize {
+    let mut steps = 0;
+    while sim.io.i32(counter) == 0 && steps < max {
+        sim.step();
+        steps += 1;
+        each(sim, steps);
+    }
+    steps
+}
+
 /// Moves the inputs linearly from `a` to `b` over `n` steps.
 fn glide(sim: &mut Sim, planar: [f64; 3], a: &Coords, b: &Coords, n: usize, mut each: impl FnMut(&Sim, &Coords)) {
     for k in 1..=n {
@@ -305,17 +326,12 @@ fn grasp_carry_and_place_in_the_box() {
     let c = over;
 
     // Open: it falls into the box and is placed.
-    let mut open = c;
-    open.widths[0] = 0.08;
-    sim.set(planar, &open);
-    let mut steps = 0;
-    while sim.io.i32(PLACED_COUNT) == 0 && steps < 150 {
-        sim.step();
-        steps += 1;
+    let open = open_left(&mut sim, planar, &c);
+    let steps = step_until(&mut sim, PLACED_COUNT, 150, |sim, steps| {
         if steps == 1 {
             assert_eq!((sim.io.i32(LEFT_HELD_ID), sim.io.f64(LEFT_GRASP_WIDTH)), (-1, 0.0), "released");
         }
-    }
+    });
     assert_eq!(sim.io.i32(PLACED_COUNT), 1, "placed within 3 s");
     assert_eq!(sim.io.i32(LAST_PLACED_ID), sim.fruit_id(f));
     assert_eq!(sim.io.i32(DROPPED_COUNT), 0);
@@ -356,14 +372,8 @@ fn released_elsewhere_falls_to_the_floor_in_the_analytic_time() {
     sim.step();
     let z0 = sim.fruit_centre(f)[2];
     let r = sim.diameter(f) / 2.0;
-    let mut open = out;
-    open.widths[0] = 0.08;
-    sim.set(planar, &open);
-    let mut steps = 0;
-    while sim.io.i32(DROPPED_COUNT) == 0 && steps < 200 {
-        sim.step();
-        steps += 1;
-    }
+    open_left(&mut sim, planar, &out);
+    let steps = step_until(&mut sim, DROPPED_COUNT, 200, |_, _| {});
     assert_eq!(sim.io.i32(DROPPED_COUNT), 1);
     assert_eq!(sim.io.i32(PLACED_COUNT), 0);
     let fall = z0 - r - 0.005; // landing = lowest point within 5 mm of the floor
@@ -643,9 +653,7 @@ fn a_second_fruit_lands_on_the_first_in_the_box() {
         close(&mut sim, &mut c, Side::Left).expect("held");
         let over = over_the_box(&model, &c);
         glide(&mut sim, planar, &c, &over, 40, |_, _| {});
-        let mut open = over;
-        open.widths[0] = 0.08;
-        sim.set(planar, &open);
+        open_left(&mut sim, planar, &over);
         for _ in 0..100 {
             sim.step();
         }

@@ -6,14 +6,11 @@
 use agrisim_manip::{ik, kdl, ArmModel, Ik, Rng, Side, Target};
 use std::time::Instant;
 
-fn arg(name: &str, default: u64) -> u64 {
-    let a: Vec<String> = std::env::args().collect();
-    a.iter()
-        .position(|x| x == name)
-        .and_then(|i| a.get(i + 1))
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
+mod common;
+use common::arg;
+
+/// One IK solver under test: target and seed configuration -> solution.
+type Solver<'a> = dyn FnMut(&Target, &[f64; 7]) -> Option<[f64; 7]> + 'a;
 
 fn stats(t: &mut [f64]) -> (f64, f64) {
     t.sort_by(f64::total_cmp);
@@ -46,9 +43,7 @@ fn main() {
         })
         .collect();
     let ik = Ik::new(&arm, lift);
-    let report = |name: &str,
-                  f: &mut dyn FnMut(&Target, &[f64; 7]) -> Option<[f64; 7]>,
-                  cases: &[(Target, [f64; 7])]| {
+    let report = |name: &str, f: &mut Solver, cases: &[(Target, [f64; 7])]| {
         let mut ok = 0;
         let mut times = Vec::with_capacity(n);
         for (t, s) in cases {

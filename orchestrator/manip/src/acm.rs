@@ -25,6 +25,7 @@ pub struct Acm {
 
 impl Acm {
     /// Samples `n` configurations of `arm` (its kinematics and sphere model must be set).
+    #[allow(clippy::needless_range_loop)] // body pairs (a, b) index the hit matrix and the sphere ranges
     pub fn sample(arm: &ArmModel, parts: &[BodyPart], n: usize) -> Acm {
         let mut rng = Rng::new(ACM_SEED);
         let mut pair_hits = [[0usize; NBODIES]; NBODIES];

@@ -215,11 +215,11 @@ impl ArmModel {
         }
         let mut finger = [(Isometry3::identity(), Vector3::zeros()); 2];
         let mut finger_limits = None;
-        for k in 0..2 {
+        for (k, f) in finger.iter_mut().enumerate() {
             let j = robot
                 .joint(&format!("{p}finger_joint{}", k + 1))
                 .ok_or("no finger joint")?;
-            finger[k] = (to_iso(&j.origin), Vector3::from(j.axis));
+            *f = (to_iso(&j.origin), Vector3::from(j.axis));
             finger_limits = j.limits;
         }
         let colliders: Vec<_> = BODY_NAMES

@@ -242,6 +242,8 @@ impl<'a> Checker<'a> {
 
     /// The first contact found at `q` (search order: self, fixed body, other arm,
     /// environment), or `None`.
+    // Body indices are the contact's identity and index several parallel arrays at once.
+    #[allow(clippy::needless_range_loop)]
     pub fn contact(&self, q: &[f64; DOF]) -> Option<Contact> {
         self.checks.set(self.checks.get() + 1);
         let ctx = &self.ctx;
@@ -292,26 +294,14 @@ impl<'a> Checker<'a> {
         }
         let scene = ctx.scene;
         for b in 0..NBODIES {
-            let mut hit = None;
-            scene.near(&bounds[b].0, bounds[b].1 + pad, |i| {
-                let o = &scene.objects()[i];
-                if o.kind == ObstacleKind::Target && b >= HAND {
-                    return false;
-                }
+            let (c, r) = (&bounds[b].0, bounds[b].1 + pad);
+            let hit = object_contact(scene, b, c, r, |i| {
                 let p = scene.prim(i);
-                if p.overlaps_sphere(&bounds[b].0, bounds[b].1 + pad)
+                p.overlaps_sphere(c, r)
                     && s[rng(b)].iter().any(|(c, r)| p.overlaps_sphere(c, r + pad))
-                {
-                    hit = Some(i);
-                    return true;
-                }
-                false
             });
-            if let Some(i) = hit {
-                return Some(Contact {
-                    body: b,
-                    hit: Hit::Object(i),
-                });
+            if hit.is_some() {
+                return hit;
             }
         }
         if let Some(h) = ctx.held {
@@ -379,20 +369,8 @@ impl<'a> Checker<'a> {
             }
         }
         let scene = ctx.scene;
-        let mut hit = None;
-        scene.near(&f.0, f.1 + pad, |i| {
-            if scene.objects()[i].kind != ObstacleKind::Solid {
-                return false;
-            }
-            if scene.prim(i).overlaps_sphere(&f.0, f.1 + pad) {
-                hit = Some(i);
-                return true;
-            }
-            false
-        });
-        hit.map(|i| Contact {
-            body: HELD,
-            hit: Hit::Object(i),
+        object_contact(scene, HELD, &f.0, f.1 + pad, |i| {
+            scene.prim(i).overlaps_sphere(&f.0, f.1 + pad)
         })
     }
 
@@ -402,6 +380,37 @@ impl<'a> Checker<'a> {
         let n = steps(a, b, resolution);
         (1..=n).all(|k| self.is_valid(&lerp(a, b, k as f64 / n as f64)))
     }
+}
+
+/// Whether `body` (an arm body or `HELD`) must not touch an object of this kind: solid
+/// objects block everything, the target fruit only the arm links (hands and fingers grasp
+/// it, a held fruit may touch it), soft ones nothing.
+fn blocks(kind: ObstacleKind, body: usize) -> bool {
+    match kind {
+        ObstacleKind::Solid => true,
+        ObstacleKind::Target => body < HAND,
+        ObstacleKind::Soft => false,
+    }
+}
+
+/// The first scene object near the sphere (`c`, `r`) that `body` must not touch and
+/// `touches` says it does, as a contact. Shared by the sphere checker and the exact one,
+/// which differ only in the narrow-phase test.
+pub(crate) fn object_contact(
+    scene: &Scene,
+    body: usize,
+    c: &Point3<f64>,
+    r: f64,
+    mut touches: impl FnMut(usize) -> bool,
+) -> Option<Contact> {
+    scene
+        .near(c, r, |i| {
+            blocks(scene.objects()[i].kind, body) && touches(i)
+        })
+        .map(|i| Contact {
+            body,
+            hit: Hit::Object(i),
+        })
 }
 
 /// Number of segments so that no joint moves more than `resolution` per segment.

@@ -5,9 +5,8 @@
 //! one; what it can catch is motion between the coarser samples of the planner's edges.
 
 use crate::chain::{join, ArmModel, DOF, HAND, NBODIES};
-use crate::checker::{lerp, steps, Contact, Context, Hit, HELD};
+use crate::checker::{lerp, object_contact, steps, Contact, Context, Hit, HELD};
 use crate::prim::Prim;
-use crate::scene::ObstacleKind;
 use agrisim_robot::Shape;
 use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
 use parry3d::math::{Pose as PPose, Rotation, Vector as PVec};
@@ -128,12 +127,14 @@ pub fn exact_check(ctx: &Context, path: &[[f64; DOF]], resolution: f64) -> Resul
     Ok(())
 }
 
+/// One part of the other arm: (body, shape, body pose, body bounding sphere centre, radius).
+type OtherPart = (usize, Part, Isometry3<f64>, Point3<f64>, f64);
+
 struct Exact<'a> {
     ctx: &'a Context<'a>,
     arm: Vec<Vec<Part>>,
     body: Vec<(usize, Part, Prim)>,
-    /// Other arm: (body, shape, body pose, body bounding sphere centre and radius).
-    other: Vec<(usize, Part, Isometry3<f64>, Point3<f64>, f64)>,
+    other: Vec<OtherPart>,
     objects: Vec<Part>,
     /// The other arm's held sphere in the world.
     other_held: Option<(Part, Isometry3<f64>)>,
@@ -195,6 +196,8 @@ impl<'a> Exact<'a> {
         }
     }
 
+    // Body indices are the contact's identity and index several parallel arrays at once.
+    #[allow(clippy::needless_range_loop)]
     fn contact(&self, q: &[f64; DOF]) -> Option<Contact> {
         let ctx = self.ctx;
         let a = ctx.arm;
@@ -254,26 +257,13 @@ impl<'a> Exact<'a> {
         for b in 0..NBODIES {
             let bs = &a.spheres.bounds[b];
             let c = pose[b] * bs.center;
-            let mut hit = None;
-            ctx.scene.near(&c, bs.radius, |i| {
-                let o = &ctx.scene.objects()[i];
-                if o.kind == ObstacleKind::Target && b >= HAND {
-                    return false;
-                }
-                if self.arm[b]
+            let hit = object_contact(ctx.scene, b, &c, bs.radius, |i| {
+                self.arm[b]
                     .iter()
                     .any(|p| touch(p, &pose[b], &self.objects[i], &id))
-                {
-                    hit = Some(i);
-                    return true;
-                }
-                false
             });
-            if let Some(i) = hit {
-                return Some(Contact {
-                    body: b,
-                    hit: Hit::Object(i),
-                });
+            if hit.is_some() {
+                return hit;
             }
         }
         if let Some((oh, opose)) = &self.other_held {
@@ -313,23 +303,10 @@ impl<'a> Exact<'a> {
                     });
                 }
             }
-            let mut hit = None;
-            ctx.scene
-                .near(&Point3::from(hp.translation.vector), h.radius, |i| {
-                    if ctx.scene.objects()[i].kind == ObstacleKind::Solid
-                        && touch(&f, &hp, &self.objects[i], &id)
-                    {
-                        hit = Some(i);
-                        return true;
-                    }
-                    false
-                });
-            if let Some(i) = hit {
-                return Some(Contact {
-                    body: HELD,
-                    hit: Hit::Object(i),
-                });
-            }
+            let c = Point3::from(hp.translation.vector);
+            return object_contact(ctx.scene, HELD, &c, h.radius, |i| {
+                touch(&f, &hp, &self.objects[i], &id)
+            });
         }
         None
     }

@@ -118,7 +118,7 @@ impl<'a> Ik<'a> {
             };
             let x0 = pb.clamp(&Vec8::from(x0));
             let n = left.min(ATTEMPT_ITERS);
-            let (x, used, ok) = if attempt % 2 == 0 {
+            let (x, used, ok) = if attempt.is_multiple_of(2) {
                 pb.levenberg_marquardt(x0, n)
             } else {
                 pb.active_set_gn(x0, n)
@@ -137,6 +137,7 @@ impl<'a> Ik<'a> {
     /// Euclidean) accepted by `valid` (e.g. collision-free), found within `budget` total
     /// iterations. The first search starts from `seed`, so the solution nearest the current
     /// arm state tends to come first. Always at the fixed lift `self.lift`.
+    #[allow(clippy::too_many_arguments)] // public API the harvest node calls
     pub fn goal_set(
         &self,
         target: &Target,

@@ -137,24 +137,28 @@ impl Scene {
     }
 
     /// Calls `f` with the index of every non-soft object whose cells overlap the sphere's
-    /// bounding box (possibly more than once); stops early when `f` returns true.
-    pub(crate) fn near(&self, c: &Point3<f64>, r: f64, mut f: impl FnMut(usize) -> bool) -> bool {
+    /// bounding box (possibly more than once) and returns the first index for which `f` is
+    /// true (grid order, so deterministic), stopping there.
+    pub(crate) fn near(
+        &self,
+        c: &Point3<f64>,
+        r: f64,
+        mut f: impl FnMut(usize) -> bool,
+    ) -> Option<usize> {
         let g = &self.grid;
-        let Some((c0, c1)) = g.range(&(c - Vector3::repeat(r)), &(c + Vector3::repeat(r))) else {
-            return false;
-        };
+        let (c0, c1) = g.range(&(c - Vector3::repeat(r)), &(c + Vector3::repeat(r)))?;
         for z in c0[2]..=c1[2] {
             for y in c0[1]..=c1[1] {
                 for x in c0[0]..=c1[0] {
                     for &i in &g.cells[(z * g.dims[1] + y) * g.dims[0] + x] {
                         if f(i as usize) {
-                            return true;
+                            return Some(i as usize);
                         }
                     }
                 }
             }
         }
-        false
+        None
     }
 }
 

@@ -201,16 +201,18 @@ fn cartesian_approach_is_a_straight_line_and_stops_at_obstacles() {
     let scene = Scene::empty();
     let checker = Checker::new(Context::new(&left, 0.3, &scene));
     let p0 = left.fk_iso(0.3, &READY);
-    // 10 cm forward along x.
-    let path = cartesian_path(
-        &checker,
-        &READY,
-        Vector3::new(0.1, 0.0, 0.0),
-        0.005,
-        0.2,
-        0.02,
-    )
-    .expect("free line");
+    // 10 cm forward along x from the ready pose.
+    let forward = |checker: &Checker| {
+        cartesian_path(
+            checker,
+            &READY,
+            Vector3::new(0.1, 0.0, 0.0),
+            0.005,
+            0.2,
+            0.02,
+        )
+    };
+    let path = forward(&checker).expect("free line");
     assert_eq!(path.len(), 21);
     for (k, q) in path.iter().enumerate() {
         let p = left.fk_iso(0.3, q);
@@ -228,15 +230,7 @@ fn cartesian_approach_is_a_straight_line_and_stops_at_obstacles() {
         ObstacleKind::Solid,
     )]);
     let checker = Checker::new(Context::new(&left, 0.3, &wall));
-    let e = cartesian_path(
-        &checker,
-        &READY,
-        Vector3::new(0.1, 0.0, 0.0),
-        0.005,
-        0.2,
-        0.02,
-    )
-    .unwrap_err();
+    let e = forward(&checker).unwrap_err();
     assert!(e.fraction > 0.2 && e.fraction < 0.9, "{e}");
     assert!(e.partial.iter().all(|q| checker.is_valid(q)));
 }

@@ -13,12 +13,10 @@ use super::nav::trial_seed;
 use super::stats::{percentile, wilson, Z95};
 use crate::error::{Context, Result};
 use crate::harvest::{Failure, HarvestNode, Outcome, PlanRecord};
-use crate::master::Master;
 use crate::nav::{Localizer, NavConfig};
 use crate::nodes::{FaultInjector, MapServer, Node, OdomTf};
 use crate::run::{prepare_with, RunOptions};
 use crate::scenario::Scenario;
-use crate::value::{self, Value};
 use agrisim_fmu_util::Rng;
 use agrisim_msgs::agrisim::CollisionState;
 use agrisim_greenhouse::occupancy::OccupancyMap;
@@ -85,18 +83,6 @@ pub struct HarvestSummary {
     pub wall_time: f64,
 }
 
-fn read(m: &mut Master, comp: usize, name: &str) -> Result<f64> {
-    let c = &mut m.system.components[comp];
-    let v = c.archive.md.variable(name).cloned().ok_or_else(|| crate::err!("FMU '{}' has no variable '{name}' (harvest benchmark)", c.name))?;
-    match value::get(&mut c.instance, &v)? {
-        Value::F64(x) => Ok(x),
-        Value::Bool(b) => Ok(b as u8 as f64),
-        Value::I32(i) => Ok(i as f64),
-        Value::I64(i) => Ok(i as f64),
-        other => Err(crate::err!("FMU '{}': {name} is {other:?}, expected a number", c.name)),
-    }
-}
-
 /// Contact counters of the world FMU that end a trial as a collision.
 pub const COLLISION_COUNTERS: [&str; 2] = ["contact_robot_structure", "contact_arm_arm"];
 /// Counted but expected: leaves and trusses brush the arm.
@@ -112,8 +98,7 @@ pub struct HarvestSetup {
 impl HarvestSetup {
     pub fn new(s: &Scenario) -> Result<HarvestSetup> {
         let g = crate::scene::generate_scene(s)?;
-        let planned: Vec<_> = g.objects.iter().filter(|o| o.kind != agrisim_greenhouse::Kind::Obstacle).cloned().collect();
-        let map = OccupancyMap::from_objects(&planned, super::nav::MAP_RESOLUTION, super::nav::MAP_BAND, g.layout.bounds);
+        let map = super::nav::building_plan(&g);
         let candidates = eligible(&g.objects, &g.layout);
         if candidates.is_empty() {
             return Err(crate::err!("scenario {}: no ripe fruit faces an aisle at a harvestable height", s.path.display()));
@@ -162,7 +147,7 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index: u64,
                 }
             }
             for c in COLLISION_COUNTERS {
-                if read(&mut m, world, c)? > 0.0 {
+                if super::read_number(&mut m, world, c)? > 0.0 {
                     judged = Some((Some(Failure::Collision), c.to_string()));
                     return Ok(());
                 }
@@ -188,14 +173,14 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index: u64,
     let mut tracking = [0.0; 2];
     let mut probe = || -> Result<()> {
         for c in COLLISION_COUNTERS.iter().chain(SOFT_COUNTERS.iter()) {
-            contacts.insert(c.to_string(), read(&mut m, world, c)? as i64);
+            contacts.insert(c.to_string(), super::read_number(&mut m, world, c)? as i64);
         }
-        placed = read(&mut m, world, "placed_count")? as i64;
-        let placed_id = read(&mut m, world, "last_placed_id")? as i64;
+        placed = super::read_number(&mut m, world, "placed_count")? as i64;
+        let placed_id = super::read_number(&mut m, world, "last_placed_id")? as i64;
         if placed > 0 && placed_id != target.object_id as i64 {
             placed = 0;
         }
-        tracking = [read(&mut m, arm_l, "tracking_error_rms")?, read(&mut m, arm_r, "tracking_error_rms")?];
+        tracking = [super::read_number(&mut m, arm_l, "tracking_error_rms")?, super::read_number(&mut m, arm_r, "tracking_error_rms")?];
         Ok(())
     };
     let probed = probe();

@@ -10,11 +10,9 @@ use super::report::{render, TrialTrace};
 use super::stats::{wilson, Z95};
 use super::targets::draw_target;
 use crate::error::{Context, Result};
-use crate::master::Master;
 use crate::nodes::{FaultInjector, GoalPublisher, MapServer, Node, OdomTf};
 use crate::run::{prepare_with, RunOptions};
 use crate::scenario::Scenario;
-use crate::value::{self, Value};
 use agrisim_fmu_util::Rng;
 use agrisim_greenhouse::occupancy::OccupancyMap;
 use agrisim_msgs::agrisim::NavigationStatus;
@@ -71,17 +69,6 @@ pub fn trial_seed(master: u64, i: u64) -> u64 {
     r.next_u64()
 }
 
-fn read_f64(m: &mut Master, comp: usize, name: &str) -> Result<f64> {
-    let c = &mut m.system.components[comp];
-    let v = c.archive.md.variable(name).cloned().ok_or_else(|| crate::err!("FMU '{}' has no variable '{name}' (nav benchmark)", c.name))?;
-    match value::get(&mut c.instance, &v)? {
-        Value::F64(x) => Ok(x),
-        Value::Bool(b) => Ok(b as u8 as f64),
-        Value::I32(i) => Ok(i as f64),
-        other => Err(crate::err!("FMU '{}': {name} is {other:?}, expected a number", c.name)),
-    }
-}
-
 /// Everything a trial needs that does not change between trials.
 pub struct NavSetup {
     pub layout: agrisim_greenhouse::Layout,
@@ -96,11 +83,17 @@ pub struct NavSetup {
 impl NavSetup {
     pub fn new(s: &Scenario) -> Result<NavSetup> {
         let g = crate::scene::generate_scene(s)?;
-        let planned: Vec<_> = g.objects.iter().filter(|o| o.kind != agrisim_greenhouse::Kind::Obstacle).cloned().collect();
-        let map = OccupancyMap::from_objects(&planned, MAP_RESOLUTION, MAP_BAND, g.layout.bounds);
+        let map = building_plan(&g);
         let truth = OccupancyMap::from_objects(&g.objects, MAP_RESOLUTION, MAP_BAND, g.layout.bounds);
         Ok(NavSetup { layout: g.layout, objects: g.objects, map, truth })
     }
+}
+
+/// The static map the robot is given: the building plan at [`MAP_RESOLUTION`], without
+/// obstacles (those it must find with its LiDAR).
+pub fn building_plan(g: &agrisim_greenhouse::Greenhouse) -> OccupancyMap {
+    let planned: Vec<_> = g.objects.iter().filter(|o| o.kind != agrisim_greenhouse::Kind::Obstacle).cloned().collect();
+    OccupancyMap::from_objects(&planned, MAP_RESOLUTION, MAP_BAND, g.layout.bounds)
 }
 
 /// Runs one trial into `mcap`.
@@ -124,7 +117,7 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &NavSetup, index: u64, see
     let world = m.system.component_index("world").ok_or_else(|| crate::err!("nav benchmark: the system has no component 'world'"))?;
     let step = s.timing.step;
     let max_ticks = (nav.trial_timeout / step).round() as u64;
-    let mut path = vec![[read_f64(&mut m, chassis, "x")?, read_f64(&mut m, chassis, "y")?]];
+    let mut path = vec![[super::read_number(&mut m, chassis, "x")?, super::read_number(&mut m, chassis, "y")?]];
     let (mut length, mut clearance) = (0.0, f64::INFINITY);
     let mut status_seen = 0;
     let mut outcome: Option<(bool, Option<String>)> = None;
@@ -132,12 +125,12 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &NavSetup, index: u64, see
     let result: Result<()> = (|| {
         for k in 1..=max_ticks {
             m.advance()?;
-            let (x, y) = (read_f64(&mut m, chassis, "x")?, read_f64(&mut m, chassis, "y")?);
+            let (x, y) = (super::read_number(&mut m, chassis, "x")?, super::read_number(&mut m, chassis, "y")?);
             let last = *path.last().expect("non-empty");
             length += (x - last[0]).hypot(y - last[1]);
             path.push([x, y]);
-            clearance = clearance.min(read_f64(&mut m, world, "min_clearance")?);
-            if read_f64(&mut m, world, "collision")? != 0.0 {
+            clearance = clearance.min(super::read_number(&mut m, world, "min_clearance")?);
+            if super::read_number(&mut m, world, "collision")? != 0.0 {
                 outcome = Some((false, Some("collision".into())));
                 return Ok(());
             }

@@ -321,77 +321,50 @@ impl HarvestNode {
         });
     }
 
-    /// Plans and sends one arm motion; a planning failure ends the harvest.
-    fn move_arm(&mut self, arm: Arm, goal: &TcpGoal, linear: bool, t_ns: i64, bus: &mut Bus) -> bool {
-        let other = self.q(arm.other());
-        let start = self.q(arm);
+    /// Plans one motion of `arm` with `plan` (given the motion planner, lift, start and the
+    /// other arm's joints), records its wall time, and sends it; a planning failure ends the
+    /// harvest. Returns the index of the goal reached (for planners with several).
+    fn plan_and_send(&mut self, arm: Arm, kind: &'static str, t_ns: i64, bus: &mut Bus, plan: impl FnOnce(&mut Motion, f64, [f64; 7], [f64; 7]) -> std::result::Result<(usize, Planned), String>) -> Option<usize> {
+        let (start, other) = (self.q(arm), self.q(arm.other()));
         let wall = std::time::Instant::now();
-        let r = if linear { self.motion.plan_linear(arm, self.lift, start, goal, other) } else { self.motion.plan_free(arm, self.lift, start, goal, other) };
+        let r = plan(&mut self.motion, self.lift, start, other);
         let wall = wall.elapsed().as_secs_f64();
-        self.record(arm, if linear { "linear" } else { "free" }, &r, wall);
+        let chosen = r.as_ref().ok().map(|(i, _)| *i);
+        let r = r.map(|(_, p)| p);
+        self.record(arm, kind, &r, wall);
         match r {
             Ok(p) => {
                 self.send(arm, p, t_ns, bus);
-                true
+                chosen
             }
             Err(e) => {
                 self.fail(Failure::Planning, t_ns, bus, format!("{} arm, {}: {e}", arm.name(), self.stage.name()));
-                false
+                None
             }
         }
+    }
+
+    /// A free (RRT-Connect) or straight-line motion to `goal`.
+    fn move_arm(&mut self, arm: Arm, goal: &TcpGoal, linear: bool, t_ns: i64, bus: &mut Bus) -> bool {
+        let kind = if linear { "linear" } else { "free" };
+        self.plan_and_send(arm, kind, t_ns, bus, |m, lift, start, other| {
+            if linear { m.plan_linear(arm, lift, start, goal, other) } else { m.plan_free(arm, lift, start, goal, other) }.map(|p| (0, p))
+        })
+        .is_some()
     }
 
     /// Plans to the stand-off of the first reachable grasp of `grasps`; returns its index.
     fn move_pregrasp(&mut self, arm: Arm, grasps: &[TcpGoal], t_ns: i64, bus: &mut Bus) -> Option<usize> {
-        let (start, other) = (self.q(arm), self.q(arm.other()));
-        let wall = std::time::Instant::now();
-        let r = self.motion.plan_pregrasp_any(arm, self.lift, start, grasps, geo::PRE_GRASP, other);
-        let wall = wall.elapsed().as_secs_f64();
-        let chosen = r.as_ref().ok().map(|(i, _)| *i);
-        let r = r.map(|(_, p)| p);
-        self.record(arm, "pregrasp", &r, wall);
-        self.send_or_fail(arm, r, t_ns, bus).then_some(chosen).flatten()
+        self.plan_and_send(arm, "pregrasp", t_ns, bus, |m, lift, start, other| m.plan_pregrasp_any(arm, lift, start, grasps, geo::PRE_GRASP, other))
     }
 
     /// Plans to the first reachable goal of `goals`.
     fn move_any(&mut self, arm: Arm, goals: &[TcpGoal], t_ns: i64, bus: &mut Bus) -> bool {
-        let (start, other) = (self.q(arm), self.q(arm.other()));
-        let wall = std::time::Instant::now();
-        let r = self.motion.plan_free_any(arm, self.lift, start, goals, other).map(|(_, p)| p);
-        let wall = wall.elapsed().as_secs_f64();
-        self.record(arm, "free", &r, wall);
-        self.send_or_fail(arm, r, t_ns, bus)
-    }
-
-    fn send_or_fail(&mut self, arm: Arm, r: std::result::Result<Planned, String>, t_ns: i64, bus: &mut Bus) -> bool {
-        match r {
-            Ok(p) => {
-                self.send(arm, p, t_ns, bus);
-                true
-            }
-            Err(e) => {
-                self.fail(Failure::Planning, t_ns, bus, format!("{} arm, {}: {e}", arm.name(), self.stage.name()));
-                false
-            }
-        }
+        self.plan_and_send(arm, "free", t_ns, bus, |m, lift, start, other| m.plan_free_any(arm, lift, start, goals, other)).is_some()
     }
 
     fn move_home(&mut self, arm: Arm, t_ns: i64, bus: &mut Bus) -> bool {
-        let (start, other) = (self.q(arm), self.q(arm.other()));
-        let wall = std::time::Instant::now();
-        let r = self.motion.plan_home(arm, self.lift, start, other);
-        let wall = wall.elapsed().as_secs_f64();
-        self.record(arm, "home", &r, wall);
-        match r {
-            Ok(p) => {
-                self.send(arm, p, t_ns, bus);
-                true
-            }
-            Err(e) => {
-                self.fail(Failure::Planning, t_ns, bus, format!("{} arm home: {e}", arm.name()));
-                false
-            }
-        }
+        self.plan_and_send(arm, "home", t_ns, bus, |m, lift, start, other| m.plan_home(arm, lift, start, other).map(|p| (0, p))).is_some()
     }
 
     fn send(&mut self, arm: Arm, p: Planned, t_ns: i64, bus: &mut Bus) {

@@ -171,6 +171,7 @@ fn second_derivatives(h: &[f64], y: &[f64], end: SplineEnd) -> Vec<f64> {
     let n = y.len();
     let d: Vec<f64> = (0..n - 1).map(|k| (y[k + 1] - y[k]) / h[k]).collect();
     let mut m = vec![0.0; n];
+    let mut t = Tridiagonal::default();
     match end {
         SplineEnd::NotAKnot if n == 2 => {}
         SplineEnd::NotAKnot if n == 3 => {
@@ -180,81 +181,84 @@ fn second_derivatives(h: &[f64], y: &[f64], end: SplineEnd) -> Vec<f64> {
         SplineEnd::NotAKnot => {
             // Unknowns M_1..M_{n-2}; M_0 and M_{n-1} eliminated with the not-a-knot conditions
             // M_0 = ((h0 + h1) M_1 - h0 M_2) / h1 and the mirror image at the end.
+            t.push_interior(h, &d);
             let u = n - 2;
-            let (mut sub, mut dia, mut sup, mut rhs) =
-                (vec![0.0; u], vec![0.0; u], vec![0.0; u], vec![0.0; u]);
-            for r in 0..u {
-                let k = r + 1;
-                sub[r] = h[k - 1];
-                dia[r] = 2.0 * (h[k - 1] + h[k]);
-                sup[r] = h[k];
-                rhs[r] = 6.0 * (d[k] - d[k - 1]);
-            }
             let (h0, h1) = (h[0], h[1]);
-            dia[0] += h0 * (h0 + h1) / h1;
-            sup[0] -= h0 * h0 / h1;
+            t.dia[0] += h0 * (h0 + h1) / h1;
+            t.sup[0] -= h0 * h0 / h1;
             let (ha, hb) = (h[n - 3], h[n - 2]);
-            dia[u - 1] += hb * (ha + hb) / ha;
-            sub[u - 1] -= hb * hb / ha;
-            let inner = solve_tridiagonal(&sub, &dia, &sup, &rhs);
-            m[1..n - 1].copy_from_slice(&inner);
+            t.dia[u - 1] += hb * (ha + hb) / ha;
+            t.sub[u - 1] -= hb * hb / ha;
+            m[1..n - 1].copy_from_slice(&t.solve());
             m[0] = ((h0 + h1) * m[1] - h0 * m[2]) / h1;
             m[n - 1] = ((ha + hb) * m[n - 2] - hb * m[n - 3]) / ha;
         }
         SplineEnd::Clamped => {
-            let (mut sub, mut dia, mut sup, mut rhs) =
-                (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
-            dia[0] = 2.0 * h[0];
-            sup[0] = h[0];
-            rhs[0] = 6.0 * d[0];
-            for k in 1..n - 1 {
-                sub[k] = h[k - 1];
-                dia[k] = 2.0 * (h[k - 1] + h[k]);
-                sup[k] = h[k];
-                rhs[k] = 6.0 * (d[k] - d[k - 1]);
-            }
-            sub[n - 1] = h[n - 2];
-            dia[n - 1] = 2.0 * h[n - 2];
-            rhs[n - 1] = -6.0 * d[n - 2];
-            m = solve_tridiagonal(&sub, &dia, &sup, &rhs);
+            t.push(0.0, 2.0 * h[0], h[0], 6.0 * d[0]);
+            t.push_interior(h, &d);
+            t.push(h[n - 2], 2.0 * h[n - 2], 0.0, -6.0 * d[n - 2]);
+            m = t.solve();
         }
         SplineEnd::Natural => {
             if n > 2 {
-                let u = n - 2;
-                let (mut sub, mut dia, mut sup, mut rhs) =
-                    (vec![0.0; u], vec![0.0; u], vec![0.0; u], vec![0.0; u]);
-                for r in 0..u {
-                    let k = r + 1;
-                    sub[r] = h[k - 1];
-                    dia[r] = 2.0 * (h[k - 1] + h[k]);
-                    sup[r] = h[k];
-                    rhs[r] = 6.0 * (d[k] - d[k - 1]);
-                }
-                let inner = solve_tridiagonal(&sub, &dia, &sup, &rhs);
-                m[1..n - 1].copy_from_slice(&inner);
+                t.push_interior(h, &d);
+                m[1..n - 1].copy_from_slice(&t.solve());
             }
         }
     }
     m
 }
 
-/// Thomas algorithm; the systems above are diagonally dominant, so no pivoting is needed.
-fn solve_tridiagonal(sub: &[f64], dia: &[f64], sup: &[f64], rhs: &[f64]) -> Vec<f64> {
-    let n = dia.len();
-    let mut c = vec![0.0; n];
-    let mut x = vec![0.0; n];
-    let mut beta = dia[0];
-    c[0] = sup[0] / beta;
-    x[0] = rhs[0] / beta;
-    for i in 1..n {
-        beta = dia[i] - sub[i] * c[i - 1];
-        c[i] = sup[i] / beta;
-        x[i] = (rhs[i] - sub[i] * x[i - 1]) / beta;
+/// A tridiagonal system, one row per unknown: `sub[i] x[i-1] + dia[i] x[i] + sup[i] x[i+1]
+/// = rhs[i]` (`sub[0]` and the last `sup` are unused).
+#[derive(Default)]
+struct Tridiagonal {
+    sub: Vec<f64>,
+    dia: Vec<f64>,
+    sup: Vec<f64>,
+    rhs: Vec<f64>,
+}
+
+impl Tridiagonal {
+    fn push(&mut self, sub: f64, dia: f64, sup: f64, rhs: f64) {
+        self.sub.push(sub);
+        self.dia.push(dia);
+        self.sup.push(sup);
+        self.rhs.push(rhs);
     }
-    for i in (0..n - 1).rev() {
-        x[i] -= c[i] * x[i + 1];
+
+    /// The moment equations of the interior knots k = 1..n-2 (`h`, `d`: interval lengths
+    /// and slopes, n - 1 each); every end condition shares them.
+    fn push_interior(&mut self, h: &[f64], d: &[f64]) {
+        for k in 1..h.len() {
+            self.push(
+                h[k - 1],
+                2.0 * (h[k - 1] + h[k]),
+                h[k],
+                6.0 * (d[k] - d[k - 1]),
+            );
+        }
     }
-    x
+
+    /// Thomas algorithm; the systems above are diagonally dominant, so no pivoting is needed.
+    fn solve(&self) -> Vec<f64> {
+        let (sub, dia, sup, rhs) = (&self.sub, &self.dia, &self.sup, &self.rhs);
+        let n = dia.len();
+        let mut c = vec![0.0; n];
+        let mut x = vec![0.0; n];
+        let mut beta = dia[0];
+        c[0] = sup[0] / beta;
+        x[0] = rhs[0] / beta;
+        for i in 1..n {
+            beta = dia[i] - sub[i] * c[i - 1];
+            c[i] = sup[i] / beta;
+            x[i] = (rhs[i] - sub[i] * x[i - 1]) / beta;
+        }
+        for i in (0..n - 1).rev() {
+            x[i] -= c[i] * x[i + 1];
+        }
+        x
+    }
 }
 
 impl JointPath for CubicSplinePath {
