@@ -14,7 +14,7 @@ use super::stats::{percentile, wilson, Z95};
 use crate::error::{Context, Result};
 use crate::harvest::{Failure, HarvestNode, Outcome, PlanRecord};
 use crate::nav::{Localizer, NavConfig};
-use crate::nodes::{FaultInjector, MapServer, Node, OdomTf};
+use crate::nodes::{FaultInjector, MapServer, Node, OdomTf, RobotStatePublisher};
 use crate::run::{prepare_with, RunOptions};
 use crate::scenario::Scenario;
 use agrisim_fmu_util::Rng;
@@ -125,6 +125,7 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index: u64,
         Box::new(MapServer::new(&setup.map)),
         Box::new(OdomTf::default()),
         Box::new(Localizer::new(&nav_cfg)),
+        Box::new(RobotStatePublisher::agrisim()),
         Box::new(node),
         Box::new(FaultInjector::new(&s.inject)),
     ];

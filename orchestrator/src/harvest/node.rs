@@ -702,7 +702,9 @@ impl Node for HarvestNode {
     fn step(&mut self, t_ns: i64, bus: &mut Bus) -> Result<()> {
         self.read(bus)?;
         if self.target_name.is_empty() {
+            // First exchange: report the first stage like every later one.
             self.target_name = format!("fruit[{}]", self.fruit_index);
+            self.enter(Stage::SelectTarget, t_ns, bus, &format!("fruit {} of the world's list", self.fruit_index));
         }
         self.run_stage(t_ns, bus);
         Ok(())

@@ -6,12 +6,14 @@ mod fault_injector;
 mod goal_publisher;
 mod map_server;
 mod odom_tf;
+mod robot_state;
 
 pub use command_script::CommandScript;
 pub use fault_injector::FaultInjector;
 pub use goal_publisher::GoalPublisher;
 pub use map_server::{grid_message, MapServer};
 pub use odom_tf::OdomTf;
+pub use robot_state::RobotStatePublisher;
 
 use crate::bus::Bus;
 use crate::error::Result;
