@@ -112,7 +112,7 @@ impl Motion {
     pub fn new(seed: u64) -> Motion {
         Motion {
             arms: [ArmModel::new(Arm::Left.side()), ArmModel::new(Arm::Right.side())],
-            rng: Rng::new(seed ^ 0x4841_5256_4553_54),
+            rng: Rng::new(seed ^ 0x0048_4152_5645_5354), // "HARVEST"
             planner: Planner::default(),
             timing: TimingConfig::panda(SEND_DT),
             obstacles: vec![],
@@ -338,7 +338,7 @@ impl Motion {
         order.sort_by(|&a, &b| agrisim_manip::ik::dist(&goals[a], &start).total_cmp(&agrisim_manip::ik::dist(&goals[b], &start)));
         let sorted: Vec<[f64; DOF]> = order.iter().map(|&i| goals[i]).collect();
         let planned = self.plan_to_configs(arm, lift, start, &sorted, other)?;
-        let reached = order.iter().map(|&i| i).find(|&i| goals[i] == planned.goal_q);
+        let reached = order.iter().copied().find(|&i| goals[i] == planned.goal_q);
         self.approach = reached.map(|i| (arm, approaches[i].clone()));
         Ok(planned)
     }

@@ -63,7 +63,6 @@ struct ArmView {
     seen: [u64; 3],
     /// Accepted-trajectory count that means "the last one I sent", and when it should end.
     pending: Option<(u64, i64, [f64; 7])>,
-    sent: u64,
     /// The last trajectory's final point: where the arm's controller holds it. Plans start
     /// here, not at the measured joints (which lag by the tracking error, and the arm
     /// refuses a first point away from its commanded position).
@@ -372,7 +371,6 @@ impl HarvestNode {
         msg.header.stamp = Time::from_nanos(t_ns);
         bus.publish(&arm.topic("joint_trajectory"), t_ns, &msg);
         let v = &mut self.arms[arm.index()];
-        v.sent += 1;
         let expect = v.status.trajectory_count + 1;
         v.pending = Some((expect, t_ns + (p.duration * 1e9) as i64, p.goal_q));
         v.commanded = Some(p.goal_q);
@@ -400,6 +398,11 @@ impl HarvestNode {
         } else {
             Some(false)
         }
+    }
+
+    /// The sub-step, copied out so match guards may call `&mut self` methods.
+    fn phase_now(&self) -> u8 {
+        self.phase
     }
 
     fn holding(&self, arm: Arm) -> bool {
@@ -507,7 +510,7 @@ impl HarvestNode {
                 // The fruit is not where the TCP went (localization error): open, back off to
                 // the pre-grasp and come in again shifted across the finger pads, the
                 // direction in which the grasp tolerates least.
-                match { self.phase } {
+                match self.phase_now() {
                     0 => {
                         self.gripper(giver, geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
                         self.phase = 1;
@@ -549,8 +552,7 @@ impl HarvestNode {
                 // Lift to the transfer height, then the giver presents the fruit, then the
                 // taker comes to its pre-handover pose: one arm moves at a time, so each plans
                 // against the other's actual configuration.
-                let phase = self.phase;
-                match phase {
+                match self.phase_now() {
                     0 => {
                         // Lift to the transfer height unless an arm would meet the robot on the way.
                         let q = [self.q(Arm::Left), self.q(Arm::Right)];
@@ -584,7 +586,7 @@ impl HarvestNode {
             }
             Stage::Handover => {
                 let (_, t) = geo::handover_goals(geo::handover_point(self.lift), self.side);
-                match { self.phase } {
+                match self.phase_now() {
                     0 => {
                         self.motion.set_padding(HANDOVER_PADDING);
                         let ok = self.move_arm(taker, &TcpGoal { x_axis: None, ..t.along(self.handover_offset) }, true, t_ns, bus);
@@ -650,7 +652,7 @@ impl HarvestNode {
                     _ => {}
                 }
             }
-            Stage::Transfer => match { self.phase } {
+            Stage::Transfer => match self.phase_now() {
                 // The giver retreats (sent when entering), goes home, then the taker carries
                 // the fruit over the box.
                 0 if self.arm_done(giver, t_ns, bus) == Some(true) => {
