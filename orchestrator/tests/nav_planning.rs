@@ -6,20 +6,7 @@ use agrisim::nav::astar::{astar, plan, PlannerConfig};
 use agrisim::nav::costmap::{inflation_cost, GlobalCostmap, InflationConfig, INSCRIBED, LETHAL};
 use agrisim::nav::map::{GridGeom, StaticMap};
 use agrisim::nav::Pose2;
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E3779B97F4A7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-}
+use agrisim_fmu_util::Rng;
 
 /// Reference: Dijkstra by repeated linear scan for the cheapest open cell (no heap, no
 /// heuristic), 8-connected, diagonal moves need both side cells enterable.
@@ -62,7 +49,7 @@ fn dijkstra(w: usize, h: usize, res: f64, cost: &[u8], s: usize, g: usize, wt: f
 
 #[test]
 fn astar_is_optimal_against_dijkstra() {
-    let mut rng = Rng(7);
+    let mut rng = Rng::new(7);
     let (mut compared, mut unreachable) = (0, 0);
     for trial in 0..300 {
         let (w, h) = (3 + rng.below(14) as usize, 3 + rng.below(14) as usize);

@@ -27,6 +27,12 @@ impl Rng {
         ((self.next_u64() >> 11) as f64 + 1.0) * (1.0 / (1u64 << 53) as f64)
     }
 
+    /// Uniform integer in 0..n (n > 0; the modulo bias is below 2^-40 for the small n of
+    /// tests and samplers).
+    pub fn below(&mut self, n: u64) -> u64 {
+        self.next_u64() % n
+    }
+
     /// Standard normal deviate.
     pub fn normal(&mut self) -> f64 {
         if let Some(z) = self.spare.take() {

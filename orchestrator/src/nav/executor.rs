@@ -212,7 +212,6 @@ impl Executor {
         };
         let d_goal = pose.dist(&goal.pose);
         let use_yaw = goal.use_yaw && ec.yaw_goal_tolerance.is_some();
-        let yaw_tol = ec.yaw_goal_tolerance.unwrap_or(f64::INFINITY);
 
         if self.state == State::Recovering {
             match self.backup {
@@ -244,20 +243,8 @@ impl Executor {
                 self.set(State::Following, "");
                 self.anchor = (pose, t_ns);
             } else {
-                let err = wrap_angle(goal.pose.yaw - pose.yaw);
-                if !use_yaw || err.abs() <= yaw_tol {
-                    self.finish(State::Succeeded, "", t_ns);
-                    out.cmd = Some(Velocity::ZERO);
-                    return out;
-                }
-                if (t_ns - self.rotate_start_ns) as f64 * 1e-9 > 2.0 * ec.progress_timeout {
-                    self.finish(State::Failed, "stuck", t_ns);
-                    out.cmd = Some(Velocity::ZERO);
-                    return out;
-                }
-                let cmd = self.rotate(&pose, &goal, err, &world);
-                self.last_cmd = cmd;
-                out.cmd = Some(cmd);
+                let stuck = (t_ns - self.rotate_start_ns) as f64 * 1e-9 > 2.0 * ec.progress_timeout;
+                out.cmd = Some(self.settle_yaw(&pose, &goal, &world, t_ns, stuck));
                 return out;
             }
         }
@@ -271,15 +258,7 @@ impl Executor {
         if d_goal <= ec.xy_latch_tolerance || (stalled && d_goal <= ec.xy_goal_tolerance) {
             self.set(State::Rotating, "");
             self.rotate_start_ns = t_ns;
-            let err = wrap_angle(goal.pose.yaw - pose.yaw);
-            if !use_yaw || err.abs() <= yaw_tol {
-                self.finish(State::Succeeded, "", t_ns);
-                out.cmd = Some(Velocity::ZERO);
-                return out;
-            }
-            let cmd = self.rotate(&pose, &goal, err, &world);
-            self.last_cmd = cmd;
-            out.cmd = Some(cmd);
+            out.cmd = Some(self.settle_yaw(&pose, &goal, &world, t_ns, false));
             return out;
         }
         if stalled {
@@ -326,6 +305,25 @@ impl Executor {
     /// The rotate phase's command: turn in place if the footprint sweeps clear of obstacles
     /// on the way to the goal yaw, else let the local planner turn and shift at once (goal as
     /// carrot, goal yaw as heading) so a long base can still turn near a row.
+    /// At the goal position: succeeded when the yaw is right (or not asked for), failed when
+    /// `stuck`, else the command that turns toward the goal yaw.
+    fn settle_yaw(&mut self, pose: &Pose2, goal: &Goal, world: &World, t_ns: i64, stuck: bool) -> Velocity {
+        let ec = &self.cfg.executor;
+        let use_yaw = goal.use_yaw && ec.yaw_goal_tolerance.is_some();
+        let err = wrap_angle(goal.pose.yaw - pose.yaw);
+        if !use_yaw || err.abs() <= ec.yaw_goal_tolerance.unwrap_or(f64::INFINITY) {
+            self.finish(State::Succeeded, "", t_ns);
+            return Velocity::ZERO;
+        }
+        if stuck {
+            self.finish(State::Failed, "stuck", t_ns);
+            return Velocity::ZERO;
+        }
+        let cmd = self.rotate(pose, goal, err, world);
+        self.last_cmd = cmd;
+        cmd
+    }
+
     fn rotate(&self, pose: &Pose2, goal: &Goal, err: f64, world: &World) -> Velocity {
         let c = &self.cfg.controller;
         let steps = ((err.abs() / 0.05).ceil() as usize).max(1);
