@@ -235,7 +235,7 @@ def ticks_of(period: float, step: float) -> int:
 
 
 # --------------------------------------------------------------------------------------------
-# The master algorithm, re-implemented from orchestrator/src/master.rs
+# The master algorithm, re-implemented from orchestrator/cosim/src/master.rs
 
 
 @dataclass
@@ -284,7 +284,7 @@ class BusReplay:
 
 
 class MasterReplay:
-    """Drives FMU3Slaves exactly like orchestrator/src/master.rs, with the system inputs taken
+    """Drives FMU3Slaves exactly like orchestrator/cosim/src/master.rs, with the system inputs taken
     from a recorded run, and collects what the orchestrator records about the FMUs."""
 
     def __init__(self, ssd: Path, rec: Recording, fmu_overrides: dict[str, str] | None = None):

@@ -2,7 +2,7 @@
 
 `agrisim run` records a run; here the same FMUs are driven through FMPy's low-level FMU3Slave
 by an independent implementation of the master algorithm (python/agrisim_fmpy.py, written
-from orchestrator/src/master.rs: integer ticks, Jacobi exchange, message routes only when a
+from orchestrator/cosim/src/master.rs: integer ticks, Jacobi exchange, message routes only when a
 counter moved, 10 Hz message instants), fed with the recorded system inputs (/cmd_vel raw CDR
 at its log times, /agrisim/scalars) and the recorded parameters (MCAP metadata). Every FMU's
 scalar inputs and outputs must match /fmu/<component>/signals to 1e-9 at every tick, and the

@@ -330,6 +330,15 @@ EXPECTED.update({
         "detail": "right gripper stalled at 0 m",
         "plans": 7,
     },
+    "plan_result": {
+        "header": hdr(12, 500_000_000, "map"),
+        "stage": "pre_grasp",
+        "arm": "left",
+        "kind": "pregrasp",
+        "ok": False,
+        "optional": False,
+        "detail": "no IK solution for any of 6 grasps",
+    },
 })
 
 # control_msgs is not in rosbags' stores; its definition (ros-controls/control_msgs,

@@ -7,14 +7,16 @@
 //! (as the driver's aligned depth), one optical frame.
 
 use crate::image;
+use crate::lighting::Lighting;
 use crate::optics::{CameraPose, Intrinsics, Mount};
 use crate::ports::*;
-use crate::render::{self, DepthModel, DepthNoise, Frame, Lighting};
+use crate::render::{self, DepthModel, DepthNoise, Frame};
 use crate::scene::{self, Scene};
 use agrisim_fmi::{Log, Model, Store, Var};
+use agrisim_fmu_util::Schedule;
 use agrisim_greenhouse::environment::Environment;
 use agrisim_greenhouse::weather::Conditions;
-use agrisim_fmu_util::{Rng, Schedule};
+use agrisim_math::Rng;
 use agrisim_msgs::Message;
 use std::sync::Arc;
 

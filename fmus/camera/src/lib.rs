@@ -5,8 +5,9 @@
 //! - [`render`]: one ray per pixel on several threads, shadow rays toward the sun (hard or
 //!   soft by render quality), fog, labels, and the depth model (range clip, fog limit,
 //!   discontinuities, left invalid band, fixed or stereo noise keyed per pixel);
-//! - [`shading`]: albedo by kind (tomatoes by USDA ripeness stage), beam + sky + floor light
-//!   at a fixed exposure, sRGB;
+//! - [`lighting`]: the sun's beam, sky and floor light, cover, shadows and fog of a frame, and
+//!   the irradiance sum on a surface;
+//! - [`shading`]: albedo by kind (tomatoes by USDA ripeness stage), the fixed exposure, sRGB;
 //! - light and weather come from the `environment` parameter through
 //!   `agrisim_greenhouse::{environment, weather, solar}` (NREL SPA sun position);
 //! - [`image`]: sensor_msgs/Image encodings; [`datasheet`]: the D435i figures and sources;
@@ -15,6 +16,7 @@
 pub mod camera;
 pub mod datasheet;
 pub mod image;
+pub mod lighting;
 pub mod optics;
 pub mod ports;
 pub mod render;

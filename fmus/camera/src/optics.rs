@@ -109,7 +109,7 @@ pub fn rpy(roll: f64, pitch: f64, yaw: f64) -> Mat3 {
 pub const OPTICAL_IN_BODY: Mat3 = [[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]];
 
 /// Mount of camera_link on base_link (the shared sensor mount parameters).
-pub use agrisim_greenhouse::sensor_ports::Mount;
+pub use agrisim_sensor_ports::Mount;
 
 /// The optical frame in the map: origin and rotation (optical -> map).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,5 +1,5 @@
 //! The camera's variable table. Scene parameters, mount, base box and base pose inputs are the
-//! shared sensor ports (`agrisim_greenhouse::sensor_ports`, as the LiDAR FMU's), so all
+//! shared sensor ports (`agrisim_sensor_ports`, as the LiDAR FMU's), so all
 //! sensors and the world see the same geometry from the same scenario text.
 
 use crate::datasheet as ds;
@@ -10,7 +10,7 @@ pub const CAMERA_INFO_MIME: &str = "application/x-ros2-cdr; type=sensor_msgs/msg
 
 // camera_link on base_link (x forward, y left, z up; the optical frame is z forward, x right,
 // y down relative to it).
-agrisim_greenhouse::sensor_variables! { pub VARIABLES {
+agrisim_sensor_ports::sensor_variables! { pub VARIABLES {
   mount: "camera_link" (0.6, 0.0, 1.2),
   params: {
     ENVIRONMENT = Var::param("environment", Start::String(""))

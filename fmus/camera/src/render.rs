@@ -3,13 +3,12 @@
 //! sensor's failure modes and noise. Rows are rendered on several threads; every pixel's
 //! result (noise included) depends on the pixel alone, so frames are bit-reproducible.
 
+use crate::lighting::{self, Lighting, Shadows};
 use crate::optics::{mat_vec, CameraPose, Intrinsics, Vec3};
 use crate::scene::Scene;
 use crate::shading::{self, Palette};
-use agrisim_fmu_util::Rng;
-use agrisim_greenhouse::environment::{Quality, Weather};
-use agrisim_greenhouse::weather::Conditions;
 use agrisim_greenhouse::{Hit, Object};
+use agrisim_math::Rng;
 
 /// Depth noise (issue 5 item 2).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -50,129 +49,6 @@ pub struct DepthModel {
 /// Width in pixels of the left invalid band for a surface at depth `z` (Intel's formula).
 pub fn invalid_band_width(fx: f64, baseline: f64, z: f64) -> f64 {
     fx * baseline / z
-}
-
-/// How shadows of the direct beam are computed (render quality).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Shadows {
-    /// No shadow rays: every surface facing the sun gets the beam (through one cover layer).
-    None,
-    /// One shadow ray toward the sun's centre.
-    Hard,
-    /// `n` shadow rays spread over the sun's disc (angular radius 0.2666 deg): penumbrae.
-    Soft(u32),
-}
-
-/// Fog or haze between the camera and a surface (Koschmieder): the surface's colour fades
-/// toward the airlight with transmittance exp(-beta d); stereo matching needs contrast, so
-/// depth is lost beyond `depth_limit` (10 % contrast left: ln(10) / beta).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Fog {
-    pub beta: f64,
-    /// Linear RGB of the airlight (the fog lit by the diffuse light).
-    pub colour: [f64; 3],
-    pub depth_limit: f64,
-}
-
-impl Fog {
-    pub fn new(beta: f64, colour: [f64; 3]) -> Fog {
-        Fog { beta, colour, depth_limit: 10f64.ln() / beta }
-    }
-}
-
-/// Irradiances are relative to the camera's fixed exposure: a white Lambertian surface under
-/// irradiance 1 shows white. See [`shading`] for the sum.
-#[derive(Clone, Debug)]
-pub struct Lighting {
-    /// Unit vector toward the sun in the map frame.
-    pub sun: Vec3,
-    /// The sun is above the horizon.
-    pub sun_up: bool,
-    /// Direct beam on a surface facing the sun, before the cover.
-    pub direct: f64,
-    /// Diffuse light on an upward surface (inside the cover).
-    pub diffuse: f64,
-    /// Light reflected by the floor onto downward surfaces.
-    pub ground: f64,
-    /// Diffuse light weighted by the sky view factor (1 + n_z) / 2; false = from all around.
-    pub sky_view: bool,
-    /// Transmittance of each glass or film layer a shadow ray crosses.
-    pub cover_tau: f64,
-    pub shadows: Shadows,
-    /// 2x2 supersampled colour (depth and labels stay one ray per pixel centre).
-    pub supersample: bool,
-    /// Linear RGB of rays that hit nothing.
-    pub sky: [f64; 3],
-    /// Primary rays see through glass and film (colour only; depth and labels keep the first
-    /// hit): the radiance behind, times this transmittance per layer. None = opaque cover.
-    pub cover_see_through: Option<f64>,
-    pub fog: Option<Fog>,
-}
-
-impl Lighting {
-    /// Without an environment: the sun at a fixed azimuth (counter-clockwise from map +x) and
-    /// elevation, `ambient` diffuse light relative to the beam, exposed so that a surface
-    /// facing the sun shows its albedo; hard shadows, glass passes all light.
-    pub fn new(azimuth_deg: f64, elevation_deg: f64, ambient: f64) -> Lighting {
-        let (a, e) = (azimuth_deg.to_radians(), elevation_deg.to_radians());
-        let p = Palette::default();
-        Lighting {
-            sun: [e.cos() * a.cos(), e.cos() * a.sin(), e.sin()],
-            sun_up: elevation_deg > 0.0,
-            direct: 1.0 / (1.0 + ambient),
-            diffuse: ambient / (1.0 + ambient),
-            ground: 0.0,
-            sky_view: false,
-            cover_tau: 1.0,
-            shadows: Shadows::Hard,
-            supersample: false,
-            sky: shading::SKY.map(|c| p.linear(c)),
-            cover_see_through: None,
-            fog: None,
-        }
-    }
-
-    /// From the environment's sun, weather and cover at the fixed exposure
-    /// [`shading::EXPOSURE`] (W/m2 that render white).
-    pub fn from_conditions(c: &Conditions) -> Lighting {
-        let e = shading::EXPOSURE;
-        let sun = c.sun_direction();
-        let cos_z = sun[2].max(0.0);
-        let direct = c.dni / e;
-        let diffuse = c.tau_diffuse * c.dhi / e;
-        let global_inside = c.tau_direct * direct * cos_z + diffuse;
-        let p = Palette::default();
-        let floor = p.albedo(agrisim_greenhouse::Kind::Floor);
-        let floor_albedo = (floor[0] + floor[1] + floor[2]) / 3.0;
-        // The sky outside, seen through the cover: an isotropic sky of diffuse irradiance DHI
-        // has radiance DHI / pi, which a white Lambertian surface under the whole sky matches:
-        // in exposure units its luminance is DHI / EXPOSURE. Blue when clear, grey otherwise.
-        let tint = match c.weather {
-            Weather::Clear => shading::SKY.map(|v| p.linear(v)),
-            _ => [1.0, 1.0, 1.0],
-        };
-        let y = 0.2126 * tint[0] + 0.7152 * tint[1] + 0.0722 * tint[2];
-        let sky = tint.map(|v| v / y * c.dhi / e);
-        let (shadows, supersample) = match c.quality {
-            Quality::Low => (Shadows::None, false),
-            Quality::Medium => (Shadows::Hard, false),
-            Quality::High => (Shadows::Soft(5), true),
-        };
-        Lighting {
-            sun,
-            sun_up: c.sun.elevation > 0.0,
-            direct,
-            diffuse,
-            ground: floor_albedo * global_inside,
-            sky_view: true,
-            cover_tau: c.tau_direct,
-            shadows,
-            supersample,
-            sky,
-            cover_see_through: Some(c.tau_diffuse),
-            fog: (c.extinction > 0.0).then(|| Fog::new(c.extinction, [0.9 * global_inside; 3])),
-        }
-    }
 }
 
 /// What one frame produced, row-major, `width x height`.
@@ -335,7 +211,7 @@ impl Ctx<'_> {
             o[2] + hit.distance * d[2] + EPS * nrm[2],
         ];
         let beam = if l.sun_up && cos_sun > 0.0 { self.beam(p) } else { 0.0 };
-        let e = shading::irradiance(l, cos_sun, beam, nrm[2]) * through;
+        let e = lighting::irradiance(l, cos_sun, beam, nrm[2]) * through;
         let a = self.palette.albedo(self.scene.kind(hit.object));
         let c = [a[0] * e, a[1] * e, a[2] * e];
         match l.fog {

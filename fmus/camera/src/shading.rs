@@ -5,7 +5,7 @@
 //! ripeness stages (USDA "United States Standards for Grades of Fresh Tomatoes", colour
 //! classification): 1 green, 2 breaker, 3 turning, 4 pink, 5 light red, 6 red.
 //!
-//! Radiance = albedo x irradiance / exposure ([`irradiance`]): the sun's beam x cos(incidence)
+//! Radiance = albedo x irradiance / exposure ([`irradiance`](crate::lighting::irradiance)): the sun's beam x cos(incidence)
 //! x its unblocked fraction, plus diffuse sky light and light from the floor. Without an
 //! environment the exposure is set so that a sunlit surface facing the sun shows its albedo;
 //! with one, it is fixed at [`EXPOSURE`] W/m2, so dusk and cloud darken the image. Shading is
@@ -102,16 +102,6 @@ impl Palette {
 /// Irradiance [W/m2] that the fixed exposure renders as white: a white surface facing a
 /// clear noon sun through glass is just below clipping.
 pub const EXPOSURE: f64 = 1000.0;
-
-/// Relative irradiance on a surface with normal z-component `n_z`: the beam (`beam` = its
-/// unblocked fraction, after cover layers) times cos(incidence), diffuse sky light (weighted
-/// by the sky view factor (1 + n_z) / 2 when `sky_view`), and light from the floor on
-/// downward faces ((1 - n_z) / 2).
-pub fn irradiance(l: &crate::render::Lighting, cos_sun: f64, beam: f64, n_z: f64) -> f64 {
-    let direct = l.direct * beam * cos_sun.max(0.0);
-    let sky = if l.sky_view { 0.5 * (1.0 + n_z) } else { 1.0 };
-    direct + l.diffuse * sky + l.ground * 0.5 * (1.0 - n_z)
-}
 
 #[cfg(test)]
 mod tests {

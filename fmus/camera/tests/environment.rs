@@ -3,15 +3,16 @@
 //! only, and frames independent of the number of render threads.
 
 use agrisim_fmi::{Log, Model, Store, Value};
+use agrisim_fmu_camera::lighting::Lighting;
 use agrisim_fmu_camera::optics::{CameraPose, Intrinsics, Mount};
 use agrisim_fmu_camera::ports::*;
-use agrisim_fmu_camera::render::{self, DepthModel, DepthNoise, Lighting};
+use agrisim_fmu_camera::render::{self, DepthModel, DepthNoise};
 use agrisim_fmu_camera::scene::Scene;
 use agrisim_fmu_camera::{image, Camera};
-use agrisim_fmu_util::Rng;
 use agrisim_greenhouse::environment::Environment;
 use agrisim_greenhouse::weather::Conditions;
 use agrisim_greenhouse::{generate, GreenhouseConfig, Kind, Object, Placement, Shape};
+use agrisim_math::Rng;
 use agrisim_msgs::sensor_msgs::Image;
 use agrisim_msgs::Message;
 

@@ -2,13 +2,14 @@
 //! formulas, colour and labels of fruit, determinism, and the FMI model's messages.
 
 use agrisim_fmi::{Log, Model, Store, Value};
+use agrisim_fmu_camera::lighting::Lighting;
 use agrisim_fmu_camera::optics::{CameraPose, Intrinsics, Mount};
 use agrisim_fmu_camera::ports::*;
-use agrisim_fmu_camera::render::{self, invalid_band_width, DepthModel, DepthNoise, Lighting};
+use agrisim_fmu_camera::render::{self, invalid_band_width, DepthModel, DepthNoise};
 use agrisim_fmu_camera::scene::Scene;
 use agrisim_fmu_camera::{image, Camera};
-use agrisim_fmu_util::Rng;
 use agrisim_greenhouse::{generate, GreenhouseConfig, Kind, Object, Placement, Shape};
+use agrisim_math::Rng;
 use agrisim_msgs::sensor_msgs::{CameraInfo, Image};
 use agrisim_msgs::Message;
 

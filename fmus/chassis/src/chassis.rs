@@ -3,13 +3,13 @@
 //! and the base actually move (kinematic or dynamic), so the two models differ only there.
 
 use crate::command::CommandIntake;
-use crate::noise::Rng;
 use crate::odometry::WheelOdometry;
 use crate::ports::*;
 use crate::schedule::Schedule;
-use crate::se2::{Pose2, Twist2};
+use crate::se2::{integrate, Twist2};
 use crate::wheels::{approach, WheelLayout, WheelState};
 use agrisim_fmi::{Log, Model, Store, Var};
+use agrisim_math::{Pose2, Rng};
 use agrisim_msgs::Message;
 
 /// Limits and geometry read from the parameters at initialization.
@@ -196,7 +196,7 @@ impl<D: Drive> Model for Chassis<D> {
         let layout = *self.layout();
         let input = StepInput { layout: &layout, reference: &reference, ramp: &ramp, h, rng: &mut self.rng, io };
         let out = self.drive.step(&mut self.wheels, self.twist, input);
-        self.pose.integrate(out.mean, h);
+        integrate(&mut self.pose, out.mean, h);
         self.twist = out.end;
         let (enc, steer) = (io.f64(ENC_NOISE), io.f64(STEER_NOISE));
         self.odom.update(&layout, &out.wheel_travel, enc, steer, &mut self.rng, h);

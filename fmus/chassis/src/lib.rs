@@ -13,7 +13,7 @@ pub mod ports;
 pub mod se2;
 pub mod wheels;
 
-pub use agrisim_fmu_util::{noise, schedule};
+pub use agrisim_fmu_util::schedule;
 
 pub use dynamic::ChassisDynamic;
 pub use kinematic::ChassisKinematic;

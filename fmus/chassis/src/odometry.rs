@@ -1,8 +1,8 @@
 //! Wheel odometry: dead reckoning from (noisy) wheel encoder readings, and its message.
 
-use crate::noise::Rng;
-use crate::se2::{Pose2, Twist2};
+use crate::se2::{integrate, Twist2};
 use crate::wheels::WheelLayout;
+use agrisim_math::{Pose2, Rng};
 use agrisim_msgs::builtin_interfaces::Time;
 use agrisim_msgs::geometry_msgs::{Point, Pose, PoseWithCovariance, Quaternion, Twist, TwistWithCovariance, Vector3};
 use agrisim_msgs::nav_msgs::Odometry;
@@ -27,7 +27,7 @@ impl WheelOdometry {
             (speed * angle.cos(), speed * angle.sin())
         });
         self.twist = layout.forward_from_velocities(&read);
-        self.pose.integrate(self.twist, h);
+        integrate(&mut self.pose, self.twist, h);
     }
 
     pub fn message(&self, stamp_ns: i64) -> Odometry {

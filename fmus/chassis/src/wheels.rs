@@ -1,7 +1,8 @@
 //! Four independently steered and driven wheels: inverse kinematics (twist -> per-wheel
 //! steering angle and speed) and forward kinematics (actual wheel states -> twist).
 
-use crate::se2::{wrap_angle, Twist2};
+use crate::se2::Twist2;
+use agrisim_math::wrap_angle_euclid;
 use std::f64::consts::PI;
 
 /// Wheel order used everywhere (ports, arrays): front-left, front-right, rear-left, rear-right.
@@ -49,7 +50,7 @@ impl WheelLayout {
                 return WheelState { steer: current[i].steer, spin: 0.0 };
             }
             let a = vy.atan2(vx);
-            let candidates = [(a, speed), (wrap_angle(a + PI), -speed), (wrap_angle(a - PI), -speed)];
+            let candidates = [(a, speed), (wrap_angle_euclid(a + PI), -speed), (wrap_angle_euclid(a - PI), -speed)];
             candidates
                 .into_iter()
                 .filter(|(s, _)| s.abs() <= steer_max + 1e-12)
@@ -129,7 +130,7 @@ mod tests {
     #[test]
     fn inverse_then_forward_is_identity() {
         let l = layout();
-        let mut rng = crate::noise::Rng::new(3);
+        let mut rng = agrisim_math::Rng::new(3);
         for _ in 0..10_000 {
             let t = Twist2 { vx: rng.normal(), vy: rng.normal(), wz: rng.normal() };
             let cur: [WheelState; 4] = std::array::from_fn(|_| WheelState { steer: (rng.uniform() - 0.5) * PI, spin: 0.0 });

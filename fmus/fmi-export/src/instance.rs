@@ -9,10 +9,11 @@ use std::panic::catch_unwind;
 
 use crate::ctype::CType;
 use crate::logger::Logger;
-use crate::model::{Model, Var};
+use crate::model::Model;
 use crate::registry::Api;
 use crate::state::{settable, Mode};
 use crate::store::{Store, Value};
+use crate::var::Var;
 
 /// Where a value reference points.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -20,8 +20,10 @@ pub mod state;
 mod store;
 pub mod testing;
 mod units;
+mod var;
 pub mod xml;
 
-pub use model::{Causality, Log, Model, ModelError, Start, Var, Variability};
+pub use model::{Log, Model, ModelError};
 pub use state::{Mode, Status};
 pub use store::{checked_f64, Store, Value};
+pub use var::{Causality, Start, Var, Variability};

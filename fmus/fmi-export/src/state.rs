@@ -8,7 +8,7 @@
 //! standards say the simulation must not continue after an error, so the only ways out are a
 //! restored FMU state, `Reset` or `FreeInstance`. `Fatal` is terminal (only `FreeInstance`).
 
-use crate::model::{Causality, Var, Variability};
+use crate::var::{Causality, Var, Variability};
 
 /// Return status of every FMI function. Values 0..=4 coincide for `fmi3Status` and
 /// `fmi2Status` (FMI 2's `fmi2Pending` = 5 is never returned: steps are synchronous).

@@ -1,6 +1,6 @@
 //! Current values of all of a model's variables, indexed like its variable table.
 
-use crate::model::{Start, Var};
+use crate::var::{Start, Var};
 
 /// One variable's current value.
 #[derive(Clone, Debug, PartialEq)]
@@ -128,7 +128,7 @@ impl Store {
 /// A Float64 parameter that must be finite and pass `ok`; the error names the variable and
 /// says what was expected (`what`, e.g. "positive"), so every model reports bad parameters
 /// the same way.
-pub fn checked_f64(io: &Store, vars: &[crate::model::Var], i: usize, ok: impl Fn(f64) -> bool, what: &str) -> Result<f64, String> {
+pub fn checked_f64(io: &Store, vars: &[Var], i: usize, ok: impl Fn(f64) -> bool, what: &str) -> Result<f64, String> {
     let v = io.f64(i);
     if v.is_finite() && ok(v) {
         Ok(v)

@@ -64,22 +64,20 @@ mod spec2 {
     pub const GET_STATUS: Mask = STEP | TERMINATED | ERROR;
 }
 
-/// Small deterministic PRNG (SplitMix64): no dependencies, reproducible per seed.
-pub struct Rng(u64);
+/// The harness' draws, on the workspace's generator (`agrisim_math::Rng`, noise flavour):
+/// reproducible per seed; indices are `usize` (`below(0)` is 0), plus percent chances and
+/// special float and integer values.
+pub struct FuzzRng(agrisim_math::Rng);
 
-impl Rng {
-    pub fn new(seed: u64) -> Rng {
-        Rng(seed ^ 0x9E37_79B9_7F4A_7C15)
+impl FuzzRng {
+    pub fn new(seed: u64) -> FuzzRng {
+        FuzzRng(agrisim_math::Rng::new(seed))
     }
     pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        self.0.next_u64()
     }
     pub fn below(&mut self, n: usize) -> usize {
-        (self.next_u64() % n.max(1) as u64) as usize
+        self.0.below(n.max(1) as u64) as usize
     }
     pub fn chance(&mut self, percent: u64) -> bool {
         self.next_u64() % 100 < percent
@@ -179,13 +177,13 @@ struct Keep {
     bytes: Vec<Vec<u8>>,
 }
 
-fn garbage_ptr(rng: &mut Rng) -> *mut c_void {
+fn garbage_ptr(rng: &mut FuzzRng) -> *mut c_void {
     // Never dereferenced by a correct layer: only compared against its registries.
     (0x1000 + (rng.next_u64() % 0xFFFF_0000) * 8) as *mut c_void
 }
 
 /// Value references: mostly ones accepting `T`, sometimes any, sometimes unknown.
-fn pick_vrs<M: Model, T: CType>(rng: &mut Rng, fmi2_only: bool) -> Vec<u32> {
+fn pick_vrs<M: Model, T: CType>(rng: &mut FuzzRng, fmi2_only: bool) -> Vec<u32> {
     let n = match rng.below(6) {
         0 => 0,
         1 => 2 + rng.below(3),
@@ -224,13 +222,13 @@ fn all_match<M: Model, T: CType>(vrs: &[u32], fmi2_only: bool) -> bool {
 
 /// Random C values for the setters.
 trait Gen: CType {
-    fn gen(rng: &mut Rng, keep: &mut Keep) -> Self::C;
+    fn gen(rng: &mut FuzzRng, keep: &mut Keep) -> Self::C;
 }
 
 macro_rules! gen_int {
     ($($m:ident),*) => {$(
         impl Gen for ctype::$m {
-            fn gen(rng: &mut Rng, _: &mut Keep) -> Self::C {
+            fn gen(rng: &mut FuzzRng, _: &mut Keep) -> Self::C {
                 rng.int() as Self::C
             }
         }
@@ -239,22 +237,22 @@ macro_rules! gen_int {
 gen_int!(Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, UInt64, Bool2);
 
 impl Gen for ctype::Float64 {
-    fn gen(rng: &mut Rng, _: &mut Keep) -> f64 {
+    fn gen(rng: &mut FuzzRng, _: &mut Keep) -> f64 {
         rng.f64()
     }
 }
 impl Gen for ctype::Float32 {
-    fn gen(rng: &mut Rng, _: &mut Keep) -> f32 {
+    fn gen(rng: &mut FuzzRng, _: &mut Keep) -> f32 {
         rng.f64() as f32
     }
 }
 impl Gen for ctype::Bool3 {
-    fn gen(rng: &mut Rng, _: &mut Keep) -> u8 {
+    fn gen(rng: &mut FuzzRng, _: &mut Keep) -> u8 {
         rng.pick(&[0, 1, 1, 2, 255])
     }
 }
 impl Gen for ctype::Str {
-    fn gen(rng: &mut Rng, keep: &mut Keep) -> *const c_char {
+    fn gen(rng: &mut FuzzRng, keep: &mut Keep) -> *const c_char {
         let s = match rng.below(8) {
             0 => return std::ptr::null(),
             1 => CString::new(vec![0xC3u8, 0x28]).unwrap_or_default(), // invalid UTF-8
@@ -266,7 +264,7 @@ impl Gen for ctype::Str {
     }
 }
 impl Gen for ctype::Bin {
-    fn gen(rng: &mut Rng, keep: &mut Keep) -> (usize, *const u8) {
+    fn gen(rng: &mut FuzzRng, keep: &mut Keep) -> (usize, *const u8) {
         match rng.below(8) {
             0 => (1 + rng.below(4), std::ptr::null()),
             1 => (0, std::ptr::null()),
@@ -281,7 +279,7 @@ impl Gen for ctype::Bin {
 }
 
 /// Array sizes for a get/set: (nValues, NULL values array?) and whether they are right.
-fn sizes(rng: &mut Rng, n_vr: usize) -> (usize, bool, bool) {
+fn sizes(rng: &mut FuzzRng, n_vr: usize) -> (usize, bool, bool) {
     match rng.below(12) {
         0 => (n_vr + 1, false, false),
         1 if n_vr > 0 => (n_vr - 1, false, false),
@@ -295,7 +293,7 @@ fn zeroed<T>(n: usize) -> Vec<T> {
     (0..n).map(|_| unsafe { std::mem::zeroed() }).collect()
 }
 
-unsafe fn get3<M: Model, T: CType>(rng: &mut Rng, inst: *mut c_void, function: &'static str, mode: Mode) -> Outcome {
+unsafe fn get3<M: Model, T: CType>(rng: &mut FuzzRng, inst: *mut c_void, function: &'static str, mode: Mode) -> Outcome {
     let vrs = pick_vrs::<M, T>(rng, false);
     let (n_values, null_values, right) = sizes(rng, vrs.len());
     let mut values: Vec<T::C> = zeroed(n_values.max(vrs.len()) + 1);
@@ -306,7 +304,7 @@ unsafe fn get3<M: Model, T: CType>(rng: &mut Rng, inst: *mut c_void, function: &
     Outcome { function, mask: spec3::GET, status, must, then: Then::Nothing }
 }
 
-unsafe fn set3<M: Model, T: Gen>(rng: &mut Rng, inst: *mut c_void, function: &'static str) -> Outcome {
+unsafe fn set3<M: Model, T: Gen>(rng: &mut FuzzRng, inst: *mut c_void, function: &'static str) -> Outcome {
     let vrs = pick_vrs::<M, T>(rng, false);
     let (n_values, null_values, right) = sizes(rng, vrs.len());
     let mut keep = Keep::default();
@@ -333,7 +331,7 @@ const UNSUPPORTED3: &[&str] = &[
     "fmi3ActivateModelPartition",
 ];
 
-unsafe fn random_call3<M: Model>(rng: &mut Rng, inst: *mut c_void, sh: &Shadow) -> Outcome {
+unsafe fn random_call3<M: Model>(rng: &mut FuzzRng, inst: *mut c_void, sh: &Shadow) -> Outcome {
     use spec3 as m;
     let o = |function, mask, status, must, then| Outcome { function, mask, status, must, then };
     match rng.below(22) {
@@ -475,7 +473,7 @@ unsafe fn random_call3<M: Model>(rng: &mut Rng, inst: *mut c_void, sh: &Shadow) 
 }
 
 /// A state pointer: live (true), freed, garbage or NULL (false).
-fn pick_state(rng: &mut Rng, sh: &Shadow) -> (*mut c_void, bool) {
+fn pick_state(rng: &mut FuzzRng, sh: &Shadow) -> (*mut c_void, bool) {
     match rng.below(10) {
         0 => (std::ptr::null_mut(), false),
         1 => (garbage_ptr(rng), false),
@@ -563,7 +561,7 @@ unsafe fn check<M: Model>(o: &Outcome, sh: &mut Shadow, inst: *mut c_void, logs:
 /// Runs `cases` random FMI 3.0 call sequences against `M` (see the module docs).
 pub fn fuzz_fmi3<M: Model>(seed: u64, cases: usize) {
     assert_valid_table::<M>();
-    let mut rng = Rng::new(seed);
+    let mut rng = FuzzRng::new(seed);
     let token = CString::new(M::TOKEN).unwrap_or_default();
     for case in 0..cases {
         let mut logs = Box::new(Logs::default());
@@ -643,7 +641,7 @@ const UNSUPPORTED2: &[&str] = &[
     "fmi2CancelStep",
 ];
 
-unsafe fn get2<M: Model, T: CType>(rng: &mut Rng, c: *mut c_void, function: &'static str, mode: Mode) -> Outcome {
+unsafe fn get2<M: Model, T: CType>(rng: &mut FuzzRng, c: *mut c_void, function: &'static str, mode: Mode) -> Outcome {
     let vrs = pick_vrs::<M, T>(rng, true);
     let null = rng.chance(8) && !vrs.is_empty();
     let mut values: Vec<T::C> = zeroed(vrs.len() + 1);
@@ -660,7 +658,7 @@ unsafe fn get2<M: Model, T: CType>(rng: &mut Rng, c: *mut c_void, function: &'st
     Outcome { function, mask: spec2::GET, status, must, then: Then::Nothing }
 }
 
-unsafe fn set2<M: Model, T: Gen>(rng: &mut Rng, c: *mut c_void, function: &'static str) -> Outcome {
+unsafe fn set2<M: Model, T: Gen>(rng: &mut FuzzRng, c: *mut c_void, function: &'static str) -> Outcome {
     let vrs = pick_vrs::<M, T>(rng, true);
     let null = rng.chance(8) && !vrs.is_empty();
     let mut keep = Keep::default();
@@ -671,7 +669,7 @@ unsafe fn set2<M: Model, T: Gen>(rng: &mut Rng, c: *mut c_void, function: &'stat
     Outcome { function, mask: spec2::SET, status, must, then: Then::Nothing }
 }
 
-unsafe fn random_call2<M: Model>(rng: &mut Rng, c: *mut c_void, sh: &Shadow) -> Outcome {
+unsafe fn random_call2<M: Model>(rng: &mut FuzzRng, c: *mut c_void, sh: &Shadow) -> Outcome {
     use spec2 as m;
     let o = |function, mask, status, must, then| Outcome { function, mask, status, must, then };
     match rng.below(22) {
@@ -742,7 +740,7 @@ unsafe fn random_call2<M: Model>(rng: &mut Rng, c: *mut c_void, sh: &Shadow) -> 
 /// Runs `cases` random FMI 2.0 call sequences against `M` (see the module docs).
 pub fn fuzz_fmi2<M: Model>(seed: u64, cases: usize) {
     assert_valid_table::<M>();
-    let mut rng = Rng::new(seed);
+    let mut rng = FuzzRng::new(seed);
     let guid = CString::new(M::TOKEN).unwrap_or_default();
     for case in 0..cases {
         let mut logs = Box::new(Logs::default());

@@ -13,8 +13,9 @@ use std::collections::BTreeSet;
 use std::fmt::Write;
 
 use crate::logger::LOG_CATEGORIES;
-use crate::model::{Causality, Model, Start, Var, Variability};
+use crate::model::Model;
 use crate::units::{base_unit, EXPONENT_NAMES};
+use crate::var::{Causality, Start, Var, Variability};
 
 /// Escapes text for an XML attribute value. Characters XML 1.0 cannot carry become U+FFFD.
 pub fn escape(s: &str) -> String {

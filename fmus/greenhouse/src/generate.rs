@@ -12,8 +12,8 @@
 
 use crate::config::GreenhouseConfig;
 use crate::layout::Layout;
-use crate::rng::Rng;
 use crate::scene::{quat_axis_angle, quat_mul, Kind, Object, Placement, Shape};
+use agrisim_math::Rng;
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// A generated greenhouse: the objects and the layout they were built from.
@@ -187,7 +187,7 @@ fn plant(b: &mut Builder, cfg: &GreenhouseConfig, seed: u64, r: usize, p: usize,
         b.push(format!("row{r}/plant{p}/truss{t}"), Kind::Truss, truss, Placement { translation: c, rotation: rot });
         let nf = cfg.fruit_per_truss;
         for f in 0..nf {
-            let radius = cfg.fruit_radius * (1.0 + cfg.fruit_radius_spread * rng.normal()).clamp(0.6, 1.4);
+            let radius = cfg.fruit_radius * (1.0 + cfg.fruit_radius_spread * rng.scene_normal()).clamp(0.6, 1.4);
             let d = len * (0.35 + 0.65 * (f as f64 + 0.5) / nf.max(1) as f64);
             let mut fx = sx + cy_ * d + rng.range(-0.02, 0.02);
             let mut fy = sy + sy_ * d + rng.range(-0.02, 0.02);
@@ -269,8 +269,8 @@ fn random_obstacles(b: &mut Builder, cfg: &GreenhouseConfig, seed: u64, layout: 
     for i in 0..cfg.random_obstacles {
         let mut rng = Rng::stream(seed, &[OBSTACLE, i as u64]);
         for _ in 0..200 {
-            let a = &layout.aisles[rng.below(layout.aisles.len() as u64) as usize];
-            let side = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+            let a = &layout.aisles[rng.scene_below(layout.aisles.len() as u64) as usize];
+            let side = if rng.scene_uniform() < 0.5 { -1.0 } else { 1.0 };
             let [s_lo, s_hi] = cfg.random_obstacle_size;
             let (sx, sy) = (rng.range(s_lo, s_hi), rng.range(s_lo, s_hi));
             let hz = rng.range(cfg.random_obstacle_height[0], cfg.random_obstacle_height[1]);
@@ -286,7 +286,7 @@ fn random_obstacles(b: &mut Builder, cfg: &GreenhouseConfig, seed: u64, layout: 
                 continue;
             }
             let y = a.y + side * 0.5 * (a.width - sy);
-            let yaw = if rng.uniform() < 0.5 { 0.0 } else { PI };
+            let yaw = if rng.scene_uniform() < 0.5 { 0.0 } else { PI };
             taken.push((a.index, x - 0.5 * sx, x + 0.5 * sx));
             let shape = Shape::Box { half: [0.5 * sx, 0.5 * sy, 0.5 * hz] };
             b.push(format!("random_obstacle{i}"), Kind::Obstacle, shape, Placement::yawed([x, y, 0.5 * hz], yaw));

@@ -1,8 +1,8 @@
 //! The BVH caster must agree exactly with a brute-force scan over all objects.
 
 use agrisim_greenhouse::raycast::cast_brute_force;
-use agrisim_greenhouse::rng::Rng;
 use agrisim_greenhouse::{generate, GreenhouseConfig, Kind, Object, Placement, RayCaster, Shape};
+use agrisim_math::Rng;
 
 fn unit(v: [f64; 3]) -> [f64; 3] {
     let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
@@ -10,7 +10,7 @@ fn unit(v: [f64; 3]) -> [f64; 3] {
 }
 
 fn random_dir(rng: &mut Rng) -> [f64; 3] {
-    unit([rng.normal(), rng.normal(), rng.normal()])
+    unit([rng.scene_normal(), rng.scene_normal(), rng.scene_normal()])
 }
 
 fn small_scene() -> (GreenhouseConfig, Vec<Object>) {
@@ -27,7 +27,7 @@ fn small_scene() -> (GreenhouseConfig, Vec<Object>) {
 fn bvh_equals_brute_force_on_random_rays() {
     let (cfg, objs) = small_scene();
     let rc = RayCaster::new(&objs);
-    let mut rng = Rng::new(42);
+    let mut rng = Rng::scene(42);
     let mut hits = 0;
     for k in 0..20_000 {
         // Mix of origins: anywhere in the hall, and LiDAR-like ones in the aisles.
@@ -59,7 +59,7 @@ fn axis_aligned_rays_agree_too() {
     // Axis-aligned directions hit the zero-component paths of the slab tests.
     let (cfg, objs) = small_scene();
     let rc = RayCaster::new(&objs);
-    let mut rng = Rng::new(3);
+    let mut rng = Rng::scene(3);
     let dirs = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
     for k in 0..6000 {
         let o = [rng.range(0.0, cfg.length), rng.range(0.0, cfg.width), rng.range(0.0, 3.0)];
@@ -132,7 +132,7 @@ fn random_solids(rng: &mut Rng, n: usize) -> Vec<Object> {
                 1 => Shape::Box { half: [rng.range(0.01, 0.8), rng.range(0.01, 0.8), rng.range(0.01, 0.8)] },
                 _ => Shape::Cylinder { radius: rng.range(0.005, 0.4), half_height: rng.range(0.02, 1.5) },
             };
-            let axis = unit([rng.normal(), rng.normal(), rng.normal()]);
+            let axis = unit([rng.scene_normal(), rng.scene_normal(), rng.scene_normal()]);
             // A third stay axis-aligned (the specialised code paths).
             let angle = if i % 7 < 2 { 0.0 } else if i % 7 == 2 { std::f64::consts::FRAC_PI_2 } else { rng.range(-3.2, 3.2) };
             let axis = if i % 7 == 2 { [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]][i % 3] } else { axis };
@@ -161,7 +161,7 @@ fn sdf(o: &Object, p: [f64; 3]) -> f64 {
 
 #[test]
 fn random_solids_match_brute_force_and_geometry() {
-    let mut rng = Rng::new(11);
+    let mut rng = Rng::scene(11);
     let objs = random_solids(&mut rng, 400);
     let rc = RayCaster::new(&objs);
     let mut hits = 0;

@@ -11,7 +11,7 @@
 //! for averaging times of 50-1000 s and within 4 % for 10-3000 s (analytic check below).
 
 use crate::gauss_markov::GaussMarkov;
-use agrisim_fmu_util::Rng;
+use agrisim_math::Rng;
 
 /// Shortest and longest correlation time of the bank [s], and processes per decade.
 pub const SHORTEST: f64 = 1.0;

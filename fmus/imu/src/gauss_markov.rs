@@ -10,7 +10,7 @@
 //! nothing visible (the process moves about 1 % of its spread in that time) and makes the
 //! slow processes of the flicker bank nearly free at a 200 Hz sample rate.
 
-use agrisim_fmu_util::Rng;
+use agrisim_math::Rng;
 
 #[derive(Clone, Debug, Default)]
 pub struct GaussMarkov {

@@ -13,7 +13,7 @@
 
 use crate::flicker::FlickerBias;
 use crate::gauss_markov::GaussMarkov;
-use agrisim_fmu_util::Rng;
+use agrisim_math::Rng;
 
 /// Noise figures of one sensor (the same for its three axes).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

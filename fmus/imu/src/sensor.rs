@@ -4,7 +4,7 @@
 use crate::frame::{Quat, Vec3};
 use crate::motion::{Mount, Truth};
 use crate::noise::{NoiseParams, TriadNoise};
-use agrisim_fmu_util::Rng;
+use agrisim_math::Rng;
 
 /// Most samples computed in one communication step. Beyond it the step jumps to its last
 /// sample: the noise processes are advanced exactly over the gap, so the published sample has

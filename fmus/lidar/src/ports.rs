@@ -1,5 +1,5 @@
 //! The LiDAR's variable table. Scene parameters, mount, base box and base pose inputs are the
-//! shared sensor ports (`agrisim_greenhouse::sensor_ports`, as the camera FMU's), so all
+//! shared sensor ports (`agrisim_sensor_ports`, as the camera FMU's), so all
 //! sensors and the world see the same geometry from the same scenario text.
 
 use crate::datasheet as ds;
@@ -9,7 +9,7 @@ use agrisim_fmi::{Start, Var};
 pub const POINTS_MIME: &str = "application/x-ros2-cdr; type=sensor_msgs/msg/PointCloud2";
 
 // lidar_link on base_link (default: on top of the robot).
-agrisim_greenhouse::sensor_variables! { pub VARIABLES {
+agrisim_sensor_ports::sensor_variables! { pub VARIABLES {
   mount: "lidar_link" (0.0, 0.0, 1.0),
   params: {
     ENVIRONMENT = Var::param("environment", Start::String(""))

@@ -6,14 +6,8 @@
 //! pose at the end of the current step is not known yet: points of the last step lag by up to
 //! one step (2 cm at 1 m/s with the 0.02 s step).
 
+use agrisim_math::Pose2;
 use std::collections::VecDeque;
-
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Pose2 {
-    pub x: f64,
-    pub y: f64,
-    pub yaw: f64,
-}
 
 #[derive(Clone, Debug, Default)]
 pub struct Trajectory {

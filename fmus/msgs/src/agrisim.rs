@@ -140,3 +140,18 @@ ros_message! {
         pub plans: u32,
     }
 }
+
+ros_message! {
+    /// `agrisim_msgs/msg/PlanResult`: one motion plan a task node asked for and its result;
+    /// `optional` plans have a fallback, so their failure does not fail the task.
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct PlanResult = "agrisim_msgs/msg/PlanResult" {
+        pub header: Header,
+        pub stage: String,
+        pub arm: String,
+        pub kind: String,
+        pub ok: bool,
+        pub optional: bool,
+        pub detail: String,
+    }
+}

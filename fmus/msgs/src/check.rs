@@ -59,6 +59,7 @@ pub fn check_cdr(type_name: &str, bytes: &[u8]) -> Option<Result<(), CdrError>> 
         "agrisim_msgs/msg/CollisionObject" => ok::<agrisim::CollisionObject>(bytes),
         "agrisim_msgs/msg/PlanningScene" => ok::<agrisim::PlanningScene>(bytes),
         "agrisim_msgs/msg/HarvestStatus" => ok::<agrisim::HarvestStatus>(bytes),
+        "agrisim_msgs/msg/PlanResult" => ok::<agrisim::PlanResult>(bytes),
         _ => None,
     }
 }

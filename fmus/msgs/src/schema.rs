@@ -75,6 +75,7 @@ msg_table! {
     "agrisim_msgs" / "CollisionObject",
     "agrisim_msgs" / "PlanningScene",
     "agrisim_msgs" / "HarvestStatus",
+    "agrisim_msgs" / "PlanResult",
 }
 
 /// Every type this crate knows, as `pkg/msg/Type`.

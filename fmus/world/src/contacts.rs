@@ -18,8 +18,8 @@
 //! Fruit being carried, falling or placed in the box are the robot's load: not contacts.
 
 use crate::harvest::Harvest;
-use crate::robot_links::Group;
 use crate::robot_model::Side;
+use crate::robot_parts::Group;
 use crate::scene_world::{is_ground, SceneWorld};
 use agrisim_greenhouse::scene::Kind;
 use rapier3d::parry::bounding_volume::{Aabb, BoundingVolume};

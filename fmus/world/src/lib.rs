@@ -21,6 +21,7 @@ pub mod planning_scene;
 pub mod ports;
 pub mod robot_links;
 pub mod robot_model;
+pub mod robot_parts;
 pub mod scene_world;
 pub mod world;
 

@@ -1,12 +1,12 @@
 //! The Greenhouse FMU's variable table: scene parameters, the robot pose coming in from the
 //! other FMUs, contact and clearance outputs, and ground-truth fruit poses. The scene
 //! parameters, the base box and the base pose inputs are the sensor FMUs' declarations
-//! (`agrisim_greenhouse::sensor_ports`), so every FMU reads the same scene and base box from
+//! (`agrisim_sensor_ports`), so every FMU reads the same scene and base box from
 //! the same scenario keys with the same defaults and ranges; only descriptions are the world's.
 
 use crate::robot_model::{OPEN_WIDTH, READY_POSE};
 use agrisim_fmi::{Start, Var};
-use agrisim_greenhouse::sensor_ports;
+use agrisim_sensor_ports as sensor_ports;
 
 /// MIME types of the message ports (FMI 3 Binary variables carrying ROS 2 CDR).
 pub const COLLISION_STATE_MIME: &str = "application/x-ros2-cdr; type=agrisim_msgs/msg/CollisionState";

@@ -6,6 +6,7 @@
 //! links are left out: they lie inside or below it, and wheels touch the floor by design.
 
 use crate::robot_model::{RobotModel, Side};
+use crate::robot_parts::{Group, LinkBody, RobotPart};
 use crate::scene_world::SceneWorld;
 use agrisim_robot::{Pose as RPose, Shape};
 use rapier3d::prelude::*;
@@ -13,34 +14,6 @@ use rapier3d::prelude::*;
 /// `user_data` of link colliders: this plus the part index (scene objects carry their index,
 /// far below; the base box carries [`crate::scene_world::ROBOT_TAG`]).
 pub const PART_TAG: u128 = 1 << 64;
-
-/// Which rigid group a robot collider belongs to: arm-arm contacts are left vs right links.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-pub enum Group {
-    /// Chassis, enclosure, harvest box, mast, lift, sensors.
-    Body,
-    Arm(Side),
-}
-
-/// One robot collider as contact reports see it.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RobotPart {
-    pub collider: ColliderHandle,
-    /// URDF link name (`base_link` for the base box).
-    pub link: String,
-    pub group: Group,
-    /// Whether touching the floor counts (not for the base box: its bottom is the ride height).
-    pub floor_counts: bool,
-}
-
-/// A link's kinematic body and the map-frame pose it was last put at.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LinkBody {
-    /// Index into [`RobotModel::link_names`].
-    pub link: usize,
-    pub body: RigidBodyHandle,
-    pub pose: Pose,
-}
 
 /// Links without world colliders: base_link (the base box stands for it) and the wheel units.
 pub fn skipped_link(name: &str) -> bool {

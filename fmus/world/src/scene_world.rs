@@ -11,7 +11,7 @@
 
 use crate::base_box::BaseBox;
 use crate::geometry::{pose_of, shape_of};
-use crate::robot_links::{LinkBody, RobotPart};
+use crate::robot_parts::{LinkBody, RobotPart};
 use agrisim_greenhouse::scene::{Kind, Object};
 use rapier3d::prelude::*;
 

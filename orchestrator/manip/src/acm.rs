@@ -6,9 +6,10 @@
 //! Pairs with the other arm are never disabled.
 
 use crate::body::BodyPart;
-use crate::chain::{ArmModel, HAND, NBODIES};
-use crate::checker::{bodies_touch, world_spheres};
-use agrisim_fmu_util::Rng;
+use crate::layout::{HAND, NBODIES};
+use crate::spheres::bodies_touch;
+use agrisim_math::Rng;
+use nalgebra::Point3;
 
 /// Samples used to build the matrix.
 pub const ACM_SAMPLES: usize = 20_000;
@@ -24,21 +25,26 @@ pub struct Acm {
 }
 
 impl Acm {
-    /// Samples `n` configurations of `arm` (its kinematics and sphere model must be set).
+    /// Samples `n` configurations of an arm against the fixed-body `parts`. `pose` draws one
+    /// configuration (joints, lift, finger opening) from the generator it is given, writes the
+    /// arm's spheres there into the buffer (body after body, `offsets` being the sphere
+    /// model's per-body ranges) and returns the lift; the arm's kinematics and sphere model
+    /// must be set ([`ArmModel::from_robot`](crate::chain::ArmModel::from_robot) passes them).
     #[allow(clippy::needless_range_loop)] // body pairs (a, b) index the hit matrix and the sphere ranges
-    pub fn sample(arm: &ArmModel, parts: &[BodyPart], n: usize) -> Acm {
+    pub fn sample(
+        parts: &[BodyPart],
+        n: usize,
+        offsets: [usize; NBODIES + 1],
+        mut pose: impl FnMut(&mut Rng, &mut Vec<(Point3<f64>, f64)>) -> f64,
+    ) -> Acm {
         let mut rng = Rng::new(ACM_SEED);
         let mut pair_hits = [[0usize; NBODIES]; NBODIES];
         let mut body_hits = vec![[0usize; NBODIES]; parts.len()];
         let mut buf = Vec::new();
-        let off = arm.spheres.offsets;
+        let off = offsets;
         let r = |b: usize| off[b]..off[b + 1];
         for _ in 0..n {
-            let q = arm.random_q(&mut rng);
-            let lift = arm.lift_limits.lower
-                + (arm.lift_limits.upper - arm.lift_limits.lower) * rng.uniform();
-            let finger = arm.finger_limits.upper * rng.uniform();
-            let _ = world_spheres(arm, lift, &q, finger, &mut buf);
+            let lift = pose(&mut rng, &mut buf);
             for a in 0..NBODIES {
                 for b in a + 1..NBODIES {
                     if bodies_touch(&buf, r(a), &buf, r(b), 0.0) {

@@ -2,7 +2,7 @@
 //! lift mast, carriage, camera) as obstacles of an arm. Read from the URDF so a change of
 //! the robot changes the planner; parts on the lift move with it.
 
-use crate::chain::to_iso;
+use crate::iso::to_iso;
 use crate::prim::Prim;
 use agrisim_robot::{Collider, Robot};
 use nalgebra::{Isometry3, Translation3, Vector3};

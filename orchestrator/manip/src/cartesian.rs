@@ -5,11 +5,11 @@
 //! (a branch switch or singularity) or a collision ends the motion with an error telling how
 //! far it got (like MoveIt's computeCartesianPath fraction).
 
-use crate::chain::DOF;
 use crate::checker::Checker;
 use crate::ik::{Ik, ATTEMPT_ITERS};
+use crate::layout::DOF;
 use crate::target::Target;
-use agrisim_fmu_util::Rng;
+use agrisim_math::Rng;
 use nalgebra::{Translation3, Vector3};
 
 #[derive(Debug, Clone, PartialEq)]

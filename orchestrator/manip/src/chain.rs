@@ -6,6 +6,8 @@
 
 use crate::acm::{Acm, ACM_SAMPLES};
 use crate::body::{body_parts, BodyPart};
+use crate::iso::{to_iso, to_pose};
+use crate::layout::{join, BODY_NAMES, DOF, HAND, NBODIES};
 use crate::spheres::SphereModel;
 use agrisim_robot::{Joint, JointKind, Limits, Pose, Robot};
 use nalgebra::{Isometry3, Matrix6xX, Point3, Translation3, Unit, UnitQuaternion, Vector3};
@@ -13,19 +15,6 @@ use std::sync::OnceLock;
 
 /// The robot description every planner object is built from (compiled in).
 pub const URDF: &str = include_str!("../../../models/robot/agrisim_robot.urdf");
-
-/// Number of arm joints.
-pub const DOF: usize = 7;
-
-/// Collision bodies of one arm, in this order everywhere in the crate.
-pub const BODY_NAMES: [&str; NBODIES] = [
-    "link0", "link1", "link2", "link3", "link4", "link5", "link6", "link7", "hand", "finger1",
-    "finger2",
-];
-/// Number of collision bodies of one arm.
-pub const NBODIES: usize = 11;
-/// Index of the hand in [`BODY_NAMES`]; the fingers follow it.
-pub const HAND: usize = 8;
 
 /// Which arm.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -102,31 +91,6 @@ pub struct Frames {
     pub tcp: Isometry3<f64>,
     /// World axis and origin of each variable `[lift, q1..q7]`.
     axes: [(Vector3<f64>, Point3<f64>); 8],
-}
-
-pub fn to_iso(p: &Pose) -> Isometry3<f64> {
-    let r = nalgebra::Matrix3::from_row_slice(&[
-        p.rot[0][0],
-        p.rot[0][1],
-        p.rot[0][2],
-        p.rot[1][0],
-        p.rot[1][1],
-        p.rot[1][2],
-        p.rot[2][0],
-        p.rot[2][1],
-        p.rot[2][2],
-    ]);
-    let rot = UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(r));
-    Isometry3::from_parts(Translation3::new(p.trans[0], p.trans[1], p.trans[2]), rot)
-}
-
-pub fn to_pose(i: &Isometry3<f64>) -> Pose {
-    let m = i.rotation.to_rotation_matrix().into_inner();
-    let t = i.translation.vector;
-    Pose {
-        rot: [0, 1, 2].map(|r| [m[(r, 0)], m[(r, 1)], m[(r, 2)]]),
-        trans: [t.x, t.y, t.z],
-    }
 }
 
 fn seg_of(j: &Joint, var: Option<usize>) -> Seg {
@@ -241,7 +205,14 @@ impl ArmModel {
             body: body_parts(robot)?,
             acm: Acm::default(),
         };
-        arm.acm = Acm::sample(&arm, &arm.body, ACM_SAMPLES);
+        arm.acm = Acm::sample(&arm.body, ACM_SAMPLES, arm.spheres.offsets, |rng, buf| {
+            let q = arm.random_q(rng);
+            let lift = arm.lift_limits.lower
+                + (arm.lift_limits.upper - arm.lift_limits.lower) * rng.uniform();
+            let finger = arm.finger_limits.upper * rng.uniform();
+            let _ = world_spheres(&arm, lift, &q, finger, buf);
+            lift
+        });
         Ok(arm)
     }
 
@@ -258,7 +229,7 @@ impl ArmModel {
     }
 
     /// Uniform random configuration within the joint limits.
-    pub fn random_q(&self, rng: &mut agrisim_fmu_util::Rng) -> [f64; DOF] {
+    pub fn random_q(&self, rng: &mut agrisim_math::Rng) -> [f64; DOF] {
         self.limits
             .map(|l| l.lower + (l.upper - l.lower) * rng.uniform())
     }
@@ -349,13 +320,26 @@ impl Frames {
     }
 }
 
-/// `[lift, q1..q7]`.
-pub(crate) fn join(lift: f64, q: &[f64; DOF]) -> [f64; 8] {
-    let mut x = [lift; 8];
-    x[1..].copy_from_slice(q);
-    x
-}
-
-pub(crate) fn split(x: &[f64; 8]) -> (f64, [f64; DOF]) {
-    (x[0], x[1..].try_into().unwrap())
+/// World positions of an arm's spheres: (centre, radius, body).
+pub(crate) fn world_spheres(
+    arm: &ArmModel,
+    lift: f64,
+    q: &[f64; DOF],
+    finger: f64,
+    out: &mut Vec<(Point3<f64>, f64)>,
+) -> ([(Point3<f64>, f64); NBODIES], Isometry3<f64>) {
+    let fr = arm.frames_x(&join(lift, q), finger);
+    out.clear();
+    for b in 0..NBODIES {
+        for s in arm.spheres.of(b) {
+            out.push((fr.bodies[b] * s.center, s.radius));
+        }
+    }
+    let bounds = std::array::from_fn(|b| {
+        (
+            fr.bodies[b] * arm.spheres.bounds[b].center,
+            arm.spheres.bounds[b].radius,
+        )
+    });
+    (bounds, fr.tcp)
 }

@@ -3,10 +3,12 @@
 //! environment (closed-form sphere-primitive tests behind the scene's grid). A check is a few
 //! microseconds, which is what the RRT's inner loop needs.
 
-use crate::chain::{join, ArmModel, BODY_NAMES, DOF, HAND, NBODIES};
+use crate::chain::{world_spheres, ArmModel};
+use crate::layout::{BODY_NAMES, DOF, HAND, NBODIES};
 use crate::prim::Prim;
 use crate::scene::{ObstacleKind, Scene};
-use nalgebra::{Isometry3, Point3, Vector3};
+use crate::spheres::{bodies_touch, spheres_touch};
+use nalgebra::{Point3, Vector3};
 use std::cell::Cell;
 
 /// A grasped fruit, modelled as a sphere fixed to the TCP. It must not touch the
@@ -131,48 +133,6 @@ impl Contact {
         };
         format!("{p}{} / {what}", name(self.body))
     }
-}
-
-/// World positions of an arm's spheres: (centre, radius, body).
-pub(crate) fn world_spheres(
-    arm: &ArmModel,
-    lift: f64,
-    q: &[f64; DOF],
-    finger: f64,
-    out: &mut Vec<(Point3<f64>, f64)>,
-) -> ([(Point3<f64>, f64); NBODIES], Isometry3<f64>) {
-    let fr = arm.frames_x(&join(lift, q), finger);
-    out.clear();
-    for b in 0..NBODIES {
-        for s in arm.spheres.of(b) {
-            out.push((fr.bodies[b] * s.center, s.radius));
-        }
-    }
-    let bounds = std::array::from_fn(|b| {
-        (
-            fr.bodies[b] * arm.spheres.bounds[b].center,
-            arm.spheres.bounds[b].radius,
-        )
-    });
-    (bounds, fr.tcp)
-}
-
-#[inline]
-fn spheres_touch(a: &(Point3<f64>, f64), b: &(Point3<f64>, f64), pad: f64) -> bool {
-    let r = a.1 + b.1 + pad;
-    (a.0 - b.0).norm_squared() <= r * r
-}
-
-/// Whether two bodies' sphere sets touch.
-pub(crate) fn bodies_touch(
-    s: &[(Point3<f64>, f64)],
-    a: std::ops::Range<usize>,
-    t: &[(Point3<f64>, f64)],
-    b: std::ops::Range<usize>,
-    pad: f64,
-) -> bool {
-    s[a].iter()
-        .any(|x| t[b.clone()].iter().any(|y| spheres_touch(x, y, pad)))
 }
 
 /// The fast checker of one [`Context`]: everything that does not depend on this arm's

@@ -4,8 +4,9 @@
 //! conservative, so a path that passes the sphere checker at its samples normally passes this
 //! one; what it can catch is motion between the coarser samples of the planner's edges.
 
-use crate::chain::{join, ArmModel, DOF, HAND, NBODIES};
+use crate::chain::ArmModel;
 use crate::checker::{lerp, object_contact, steps, Contact, Context, Hit, HELD};
+use crate::layout::{join, DOF, HAND, NBODIES};
 use crate::prim::Prim;
 use agrisim_robot::Shape;
 use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
@@ -89,7 +90,7 @@ fn arm_parts(arm: &ArmModel) -> Vec<Vec<Part>> {
         .iter()
         .map(|cs| {
             cs.iter()
-                .map(|c| parry_part(&c.shape, crate::chain::to_iso(&c.origin)))
+                .map(|c| parry_part(&c.shape, crate::iso::to_iso(&c.origin)))
                 .collect()
         })
         .collect()

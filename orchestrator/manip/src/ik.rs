@@ -13,9 +13,10 @@
 //!   configuration drawn from the caller's seeded [`Rng`];
 //! - the budget is a total count of iterations (never wall time), so results are repeatable.
 
-use crate::chain::{join, split, ArmModel, DOF};
+use crate::chain::ArmModel;
+use crate::layout::{join, split, DOF};
 use crate::target::Target;
-use agrisim_fmu_util::Rng;
+use agrisim_math::Rng;
 use nalgebra::{SMatrix, SVector, Vector6};
 
 type Vec8 = SVector<f64, 8>;

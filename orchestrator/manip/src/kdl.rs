@@ -5,7 +5,8 @@
 //! most 100 iterations, converged when every twist component is below eps = 1e-5, started
 //! from one seed. It exists to measure our solver against the figure TRAC-IK compares with.
 
-use crate::chain::{join, split, ArmModel, DOF};
+use crate::chain::ArmModel;
+use crate::layout::{join, split, DOF};
 use crate::target::Target;
 use nalgebra::{SMatrix, Vector6};
 

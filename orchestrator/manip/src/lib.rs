@@ -32,7 +32,7 @@
 //! Context::new(&arm, lift, &scene).with_other(&other_arm, other_q, other_finger)
 //!     .holding(fruit_radius).other_holding(fruit_radius)   // optional held fruits at the TCPs
 //!     // pub fields: finger (this arm's opening, default open), padding (default 0.01 m), held
-//! // Contact { body: index into chain::BODY_NAMES or checker::HELD, hit: Hit::{SelfBody, RobotBody, OtherArm, Object} }
+//! // Contact { body: index into layout::BODY_NAMES or checker::HELD, hit: Hit::{SelfBody, RobotBody, OtherArm, Object} }
 //! Checker::new(ctx): .is_valid(&q), .contact(&q) -> Option<Contact>, .edge_valid(&a, &b, res)
 //! exact::exact_check(&ctx, &path, exact::EXACT_RESOLUTION) -> Result<(), PathContact>
 //! exact::exact_contact(&ctx, &q) -> Option<Contact>
@@ -56,7 +56,9 @@ pub mod chain;
 pub mod checker;
 pub mod exact;
 pub mod ik;
+pub mod iso;
 pub mod kdl;
+pub mod layout;
 pub mod planner;
 pub mod prim;
 pub mod rrt_connect;
@@ -65,13 +67,14 @@ pub mod shortcut;
 pub mod spheres;
 pub mod target;
 
-pub use agrisim_fmu_util::Rng;
+pub use agrisim_math::Rng;
 pub use agrisim_robot::{Pose, Shape};
 pub use cartesian::{cartesian_path, CartesianError};
-pub use chain::{ArmModel, Side, DOF};
+pub use chain::{ArmModel, Side};
 pub use checker::{Checker, Contact, Context, Held, Hit};
 pub use exact::{exact_check, PathContact};
 pub use ik::Ik;
+pub use layout::DOF;
 pub use planner::{Plan, PlanError, PlanStats, Planner, PlannerConfig};
 pub use scene::{Obstacle, ObstacleKind, Scene};
 pub use target::Target;

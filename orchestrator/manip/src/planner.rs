@@ -2,12 +2,12 @@
 //! (parry) check of the final path. Budgets are iteration counts; wall time is measured for
 //! the statistics only and never changes the result.
 
-use crate::chain::DOF;
 use crate::checker::{Checker, Context};
 use crate::exact::{exact_check, PathContact, EXACT_RESOLUTION};
+use crate::layout::DOF;
 use crate::rrt_connect::{rrt_connect, RrtConfig};
 use crate::shortcut::{path_length, shortcut};
-use agrisim_fmu_util::Rng;
+use agrisim_math::Rng;
 use std::time::Instant;
 
 type Q = [f64; DOF];

@@ -3,9 +3,9 @@
 //! whichever IK solution is easiest instead of committing to one beforehand.
 //! Seeded and bounded by an iteration count; edges are checked at a fixed joint resolution.
 
-use crate::chain::DOF;
 use crate::checker::{lerp, Checker};
-use agrisim_fmu_util::Rng;
+use crate::layout::DOF;
+use agrisim_math::Rng;
 
 type Q = [f64; DOF];
 

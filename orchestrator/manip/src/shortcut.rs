@@ -5,9 +5,9 @@
 //! joint-space segment is never longer than the polyline it replaces, so the path never
 //! gets longer and never gains a collision the checker can see.
 
-use crate::chain::DOF;
 use crate::checker::{lerp, Checker};
-use agrisim_fmu_util::Rng;
+use crate::layout::DOF;
+use agrisim_math::Rng;
 
 type Q = [f64; DOF];
 

@@ -6,7 +6,7 @@
 //! the exact shape is also a sphere contact (conservative), which the tests check against
 //! parry. Slabs no longer than the cross-section radius keep the overshoot below ~12 %.
 
-use crate::chain::NBODIES;
+use crate::layout::NBODIES;
 use agrisim_robot::{Collider, Shape};
 use nalgebra::{Point3, Vector3};
 
@@ -120,4 +120,23 @@ fn enclose(s: &[Sphere]) -> Sphere {
         .map(|x| (x.center - center).norm() + x.radius)
         .fold(0.0, f64::max);
     Sphere { center, radius }
+}
+
+/// Whether two spheres in the world (centre, radius) touch, with `pad` between them.
+#[inline]
+pub(crate) fn spheres_touch(a: &(Point3<f64>, f64), b: &(Point3<f64>, f64), pad: f64) -> bool {
+    let r = a.1 + b.1 + pad;
+    (a.0 - b.0).norm_squared() <= r * r
+}
+
+/// Whether two bodies' sphere sets touch.
+pub(crate) fn bodies_touch(
+    s: &[(Point3<f64>, f64)],
+    a: std::ops::Range<usize>,
+    t: &[(Point3<f64>, f64)],
+    b: std::ops::Range<usize>,
+    pad: f64,
+) -> bool {
+    s[a].iter()
+        .any(|x| t[b.clone()].iter().any(|y| spheres_touch(x, y, pad)))
 }

@@ -36,7 +36,7 @@ impl Target {
     }
     /// From agrisim-robot's pose type.
     pub fn from_pose(p: &Pose, free_roll: bool) -> Target {
-        let t = Target::pose(crate::chain::to_iso(p));
+        let t = Target::pose(crate::iso::to_iso(p));
         Target { free_roll, ..t }
     }
 

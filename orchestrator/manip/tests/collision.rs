@@ -316,7 +316,7 @@ fn a_held_fruit_collides_where_the_empty_gripper_does_not() {
         if let Some(c) = Checker::new(ctx).contact(q) {
             // Whatever touches, it is not this hand/fingers against the held fruit.
             assert!(
-                !(c.body >= agrisim_manip::chain::HAND
+                !(c.body >= agrisim_manip::layout::HAND
                     && c.hit == Hit::OtherArm(agrisim_manip::checker::HELD)),
                 "{c:?}"
             );

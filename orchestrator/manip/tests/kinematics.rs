@@ -84,8 +84,8 @@ fn body_frames_agree_with_the_generic_urdf_fk() {
         m.insert("right_finger_joint2".into(), finger);
         let all = robot.fk(&m).unwrap();
         let fr = arm.frames(lift, &q, finger);
-        for (b, name) in agrisim_manip::chain::BODY_NAMES.iter().enumerate() {
-            let want = agrisim_manip::chain::to_iso(&all[&format!("right_{name}")]);
+        for (b, name) in agrisim_manip::layout::BODY_NAMES.iter().enumerate() {
+            let want = agrisim_manip::iso::to_iso(&all[&format!("right_{name}")]);
             let d = (fr.bodies[b].to_homogeneous() - want.to_homogeneous())
                 .abs()
                 .max();

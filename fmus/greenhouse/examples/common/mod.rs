@@ -1,8 +1,8 @@
 //! Shared by the examples: LiDAR-like ray sets, .npy output, peak memory.
 #![allow(dead_code)]
 
-use agrisim_greenhouse::rng::Rng;
 use agrisim_greenhouse::Layout;
+use agrisim_math::Rng;
 use std::io::Write;
 
 /// `n` rays from LiDAR-like origins 0.5 m above the floor on aisle centre lines (8 spots
@@ -19,7 +19,7 @@ pub fn lidar_rays(layout: &Layout, n: usize, seed: u64) -> Vec<[f32; 6]> {
             [x0 + (x1 - x0) * (k as f64 + 0.5) / 8.0, y, 0.5]
         })
         .collect();
-    let mut rng = Rng::new(seed);
+    let mut rng = Rng::scene(seed);
     let (s0, s1) = ((-7f64).to_radians().sin(), 52f64.to_radians().sin());
     (0..n)
         .map(|i| {

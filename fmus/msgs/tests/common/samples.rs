@@ -5,7 +5,7 @@
 #![allow(dead_code)]
 
 use agrisim_msgs::agrisim::{
-    CollisionObject, CollisionState, Contact, FmuStatus, GripperState, HarvestStatus,
+    CollisionObject, CollisionState, Contact, FmuStatus, GripperState, HarvestStatus, PlanResult,
     NavigationStatus, PlanningScene, Signals, TrajectoryStatus,
 };
 use agrisim_msgs::builtin_interfaces::{Duration, Time};
@@ -298,6 +298,18 @@ fn manipulation_samples() -> Vec<Sample> {
                 failure_category: "handover".into(),
                 detail: "right gripper stalled at 0 m".into(),
                 plans: 7,
+            },
+        ),
+        sample(
+            "plan_result",
+            PlanResult {
+                header: hdr(12, 500_000_000, "map"),
+                stage: "pre_grasp".into(),
+                arm: "left".into(),
+                kind: "pregrasp".into(),
+                ok: false,
+                optional: false,
+                detail: "no IK solution for any of 6 grasps".into(),
             },
         ),
     ]

@@ -1,0 +1,338 @@
+//! `agrisim bench harvest`: the paper's dual-arm harvesting experiment, many trials, every
+//! one recorded.
+//!
+//! Each trial starts the harvest system afresh with the robot in an aisle short of a seeded
+//! ripe target fruit (see [`super::harvest_targets`]); the harvest node positions the base
+//! and the lift, plans and executes grasp, handover and placement. Success is judged on
+//! ground truth from the world FMU: the target fruit was placed in the box, no collision
+//! (robot against structure, arm against arm, base against anything), within the time
+//! limit. Planning success means every motion the trial asked for was planned.
+
+use super::harvest_targets::{draw, eligible, HarvestTarget};
+use super::map::{building_plan, grid_message};
+use super::nav::trial_seed;
+use super::stats::{percentile, wilson, Z95};
+use agrisim_bus::Node;
+use agrisim_error::{err, Context, Result};
+use agrisim_greenhouse::occupancy::OccupancyMap;
+use agrisim_harvest::{topics, HarvestNode};
+use agrisim_math::Rng;
+use agrisim_msgs::agrisim::{CollisionState, HarvestStatus, PlanResult};
+use agrisim_nav::{Localizer, NavConfig};
+use agrisim_nodes::{FaultInjector, MapServer, OdomTf, RobotStatePublisher};
+use agrisim_session::{prepare, RunOptions, Scenario};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::Path;
+use std::time::Instant;
+
+/// Simulated-time limit of one harvest [s].
+pub const TRIAL_TIMEOUT: f64 = 120.0;
+
+#[derive(Debug, Clone, Serialize)]
+pub struct HarvestTrial {
+    pub trial: u64,
+    pub seed: u64,
+    pub fruit_index: usize,
+    pub fruit_id: u32,
+    pub fruit_name: String,
+    pub fruit: [f64; 3],
+    pub start: [f64; 3],
+    pub outcome: &'static str,
+    /// Failure category: planning, grasp, handover, placement, timeout, collision, error.
+    pub failure: Option<String>,
+    pub failed_stage: Option<String>,
+    pub detail: String,
+    pub planning_ok: bool,
+    pub plans: usize,
+    /// Wall time of each plan [s]: the harvest node's step that asked for it (IK + RRT-Connect
+    /// + shortcut + time parameterization), shared among the plans of that step.
+    pub planning_times: Vec<f64>,
+    pub time_to_harvest: Option<f64>,
+    pub placed_count: i64,
+    pub contacts: BTreeMap<String, i64>,
+    /// RMS joint tracking error of the last trajectory of each arm [rad].
+    pub tracking_rms: [f64; 2],
+    pub sim_time: f64,
+    pub wall_time: f64,
+    pub mcap: String,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct HarvestSummary {
+    pub scenario: String,
+    pub seed: u64,
+    pub trials: u64,
+    pub successes: u64,
+    pub success_rate: f64,
+    pub wilson95: [f64; 2],
+    pub planning_successes: u64,
+    pub planning_success_rate: f64,
+    pub planning_wilson95: [f64; 2],
+    /// Harvest successes among the trials whose planning succeeded.
+    pub conditional_success_rate: f64,
+    pub conditional_wilson95: [f64; 2],
+    pub failures: BTreeMap<String, u64>,
+    pub plans: u64,
+    pub planning_time_p50: Option<f64>,
+    pub planning_time_p95: Option<f64>,
+    pub planning_time_max: Option<f64>,
+    pub tracking_rms_mean: f64,
+    pub time_to_harvest_mean: Option<f64>,
+    pub rtf: f64,
+    pub sim_time: f64,
+    pub wall_time: f64,
+}
+
+/// Contact counters of the world FMU that end a trial as a collision.
+pub const COLLISION_COUNTERS: [&str; 2] = ["contact_robot_structure", "contact_arm_arm"];
+/// Counted but expected: leaves and trusses brush the arm.
+pub const SOFT_COUNTERS: [&str; 1] = ["contact_robot_plant"];
+
+/// Everything a trial needs that does not change between trials.
+pub struct HarvestSetup {
+    pub layout: agrisim_greenhouse::Layout,
+    pub map: OccupancyMap,
+    pub candidates: Vec<HarvestTarget>,
+}
+
+impl HarvestSetup {
+    pub fn new(s: &Scenario) -> Result<HarvestSetup> {
+        let g = agrisim_session::scene::generate_scene(s)?;
+        let map = building_plan(&g);
+        let candidates = eligible(&g.objects, &g.layout);
+        if candidates.is_empty() {
+            return Err(err!("scenario {}: no ripe fruit faces an aisle at a harvestable height", s.path.display()));
+        }
+        Ok(HarvestSetup { layout: g.layout, map, candidates })
+    }
+}
+
+/// The harvest node under test: `fruit_index` is the task (the target the paper hands over),
+/// `seed` the trial's seed. Any node that speaks the harvest topics can take its place.
+pub type HarvestNodeFactory<'a> = &'a dyn Fn(usize, u64) -> Box<dyn Node>;
+
+/// The built-in harvest node.
+pub fn builtin_node(fruit_index: usize, seed: u64) -> Box<dyn Node> {
+    Box::new(HarvestNode::new(fruit_index, seed))
+}
+
+/// The judge's view of the harvest node: only what it published.
+#[derive(Default)]
+struct Reports {
+    plans: Vec<PlanResult>,
+    /// Wall time of each plan [s]: the node's step that asked for it, shared among the plans
+    /// of that step.
+    planning_times: Vec<f64>,
+    /// The final status (outcome success or failure), once published.
+    outcome: Option<HarvestStatus>,
+}
+
+impl Reports {
+    /// Takes everything the node published since the last look.
+    fn read(&mut self, m: &mut agrisim_session::Session, node: &str) -> Result<()> {
+        let plans: Vec<PlanResult> = m.bus.take_queued(topics::PLANS)?;
+        if !plans.is_empty() {
+            let wall = m.node_wall(node).unwrap_or(0.0) / plans.len() as f64;
+            self.planning_times.extend(std::iter::repeat_n(wall, plans.len()));
+            self.plans.extend(plans);
+        }
+        for st in m.bus.take_queued::<HarvestStatus>(topics::STATUS)? {
+            if self.outcome.is_none() && (st.outcome == "success" || st.outcome == "failure") {
+                self.outcome = Some(st);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Runs one trial into `mcap` with the built-in harvest node.
+pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index: u64, seed: u64, mcap: &Path) -> Result<HarvestTrial> {
+    run_trial_with(s, o, setup, index, seed, mcap, &builtin_node, TRIAL_TIMEOUT)
+}
+
+/// Runs one trial into `mcap` with the harvest node `node` makes, within `timeout` [s] of
+/// simulated time. The judge reads the node's messages (/harvest/status, /harvest/plans),
+/// the bus and the world FMU's ground truth; nothing else of the node.
+#[allow(clippy::too_many_arguments)]
+pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index: u64, seed: u64, mcap: &Path, node: HarvestNodeFactory, timeout: f64) -> Result<HarvestTrial> {
+    let wall = Instant::now();
+    let mut rng = Rng::new(seed);
+    let target = draw(&setup.candidates, &setup.layout, &mut rng).expect("candidates checked non-empty");
+    let mut s = s.clone();
+    let chassis = s.parameters.entry("chassis".into()).or_default();
+    for (k, v) in ["x0", "y0", "yaw0"].iter().zip(target.start) {
+        chassis.insert(k.to_string(), toml::Value::Float(v));
+    }
+    let mut nav_cfg = NavConfig::for_start(target.start);
+    nav_cfg.embedded_localizer = false;
+    let harvest = node(target.fruit_index, seed);
+    let node_name = harvest.name().to_string();
+    let nodes: Vec<Box<dyn Node>> = vec![
+        Box::new(MapServer::new(grid_message(&setup.map, 0))),
+        Box::new(OdomTf::default()),
+        Box::new(Localizer::new(&nav_cfg)),
+        Box::new(RobotStatePublisher::agrisim()),
+        harvest,
+        Box::new(FaultInjector::new(&s.inject)),
+    ];
+    let opts = RunOptions { seed: Some(seed), ..o.clone() };
+    let mut m = prepare(&s, &opts, mcap, nodes)?;
+    m.bus.subscribe(topics::PLANS);
+    m.bus.subscribe(topics::STATUS);
+    let (world, arm_l, arm_r) = (m.component("world", "harvest benchmark")?, m.component("arm_left", "harvest benchmark")?, m.component("arm_right", "harvest benchmark")?);
+    let max_ticks = (timeout / s.timing.step).round() as u64;
+    let mut reports = Reports::default();
+    let mut judged: Option<(Option<String>, String)> = None;
+    let mut time_to_harvest = None;
+    let mut collision_seen = 0;
+    let result: Result<()> = (|| {
+        for k in 1..=max_ticks {
+            m.advance()?;
+            reports.read(&mut m, &node_name)?;
+            // The base must touch nothing; the arms may brush plants (counted, not failures).
+            if let Some(cs) = m.bus.take_new::<CollisionState>("/collision", &mut collision_seen)? {
+                if let Some(c) = cs.contacts.iter().find(|c| c.robot_link == "base_link") {
+                    judged = Some((Some("collision".into()), format!("the base touched {} ({})", c.object_name, c.object_kind)));
+                    return Ok(());
+                }
+            }
+            for c in COLLISION_COUNTERS {
+                if m.number(world, c)? > 0.0 {
+                    judged = Some((Some("collision".into()), c.to_string()));
+                    return Ok(());
+                }
+            }
+            if let Some(st) = &reports.outcome {
+                let success = st.outcome == "success";
+                if success {
+                    time_to_harvest = Some(k as f64 * s.timing.step);
+                }
+                judged = Some(((!success).then(|| st.failure_category.clone()), if success { String::new() } else { st.detail.clone() }));
+                return Ok(());
+            }
+        }
+        judged = Some((Some("timeout".into()), format!("no outcome within {timeout} s")));
+        Ok(())
+    })();
+    let sim_time = m.time();
+    let failed_stage = reports.outcome.as_ref().filter(|o| o.outcome != "success").map(|o| o.stage.clone());
+    let mut contacts = BTreeMap::new();
+    let mut placed = 0;
+    let mut tracking = [0.0; 2];
+    let mut probe = || -> Result<()> {
+        for c in COLLISION_COUNTERS.iter().chain(SOFT_COUNTERS.iter()) {
+            contacts.insert(c.to_string(), m.number(world, c)? as i64);
+        }
+        placed = m.number(world, "placed_count")? as i64;
+        let placed_id = m.number(world, "last_placed_id")? as i64;
+        if placed > 0 && placed_id != target.object_id as i64 {
+            placed = 0;
+        }
+        tracking = [m.number(arm_l, "tracking_error_rms")?, m.number(arm_r, "tracking_error_rms")?];
+        Ok(())
+    };
+    let probed = probe();
+    let (mut failure, mut detail) = match (result, probed) {
+        (Ok(()), Ok(())) => {
+            m.finish_point()?;
+            judged.expect("set on every exit")
+        }
+        (Err(e), _) | (Ok(()), Err(e)) => {
+            m.record_failure(&e);
+            (Some("error".to_string()), e.to_string())
+        }
+    };
+    m.recorder_finish()?;
+    // Ground truth has the last word: the node believing in success is not enough.
+    if failure.is_none() && placed == 0 {
+        failure = Some("placement".into());
+        detail = "the node reported success but the world has not placed the target fruit".into();
+    }
+    let planning_ok = reports.plans.iter().all(|p| p.ok || p.optional) && failure.as_deref() != Some("planning");
+    Ok(HarvestTrial {
+        trial: index,
+        seed,
+        fruit_index: target.fruit_index,
+        fruit_id: target.object_id,
+        fruit_name: target.name.clone(),
+        fruit: target.center,
+        start: target.start,
+        outcome: if failure.is_none() { "success" } else { "failure" },
+        failed_stage: failure.as_ref().and(failed_stage),
+        failure,
+        detail,
+        planning_ok,
+        plans: reports.plans.len(),
+        planning_times: reports.planning_times,
+        time_to_harvest,
+        placed_count: placed,
+        contacts,
+        tracking_rms: tracking,
+        sim_time,
+        wall_time: wall.elapsed().as_secs_f64(),
+        mcap: mcap.file_name().map(|f| format!("trials/{}", f.to_string_lossy())).unwrap_or_default(),
+    })
+}
+
+/// Runs `trials` trials and writes trials.jsonl, summary.json and trials/*.mcap.
+pub fn bench_harvest(s: &Scenario, o: &RunOptions, trials: u64, seed: u64, out: &Path, mut progress: impl FnMut(u64, u64)) -> Result<HarvestSummary> {
+    let dir = out.join("trials");
+    std::fs::create_dir_all(&dir).context(|| format!("cannot create {}", dir.display()))?;
+    let setup = HarvestSetup::new(s)?;
+    let jsonl_path = out.join("trials.jsonl");
+    let mut jsonl = std::fs::File::create(&jsonl_path).context(|| format!("cannot create {}", jsonl_path.display()))?;
+    let mut results = vec![];
+    for i in 0..trials {
+        let ts = trial_seed(seed, i);
+        let trial = run_trial(s, o, &setup, i, ts, &dir.join(format!("{i:04}.mcap")))?;
+        writeln!(jsonl, "{}", serde_json::to_string(&trial).expect("plain struct")).context(|| jsonl_path.display().to_string())?;
+        results.push(trial);
+        progress(i + 1, trials);
+    }
+    let summary = summarize(s, seed, &results);
+    let sp = out.join("summary.json");
+    std::fs::write(&sp, serde_json::to_string_pretty(&summary).expect("plain struct") + "\n").context(|| sp.display().to_string())?;
+    Ok(summary)
+}
+
+pub fn summarize(s: &Scenario, seed: u64, results: &[HarvestTrial]) -> HarvestSummary {
+    let n = results.len() as u64;
+    let ok = results.iter().filter(|t| t.outcome == "success").count() as u64;
+    let planned = results.iter().filter(|t| t.planning_ok).count() as u64;
+    let ok_given_planned = results.iter().filter(|t| t.planning_ok && t.outcome == "success").count() as u64;
+    let mut failures = BTreeMap::new();
+    for t in results.iter().filter_map(|t| t.failure.as_ref()) {
+        *failures.entry(t.clone()).or_insert(0) += 1;
+    }
+    let mut times: Vec<f64> = results.iter().flat_map(|t| t.planning_times.iter().copied()).collect();
+    times.sort_by(f64::total_cmp);
+    let sim: f64 = results.iter().map(|t| t.sim_time).sum();
+    let wall: f64 = results.iter().map(|t| t.wall_time).sum();
+    let tth: Vec<f64> = results.iter().filter_map(|t| t.time_to_harvest).collect();
+    let rate = |a: u64, b: u64| if b == 0 { 0.0 } else { a as f64 / b as f64 };
+    HarvestSummary {
+        scenario: s.name.clone(),
+        seed,
+        trials: n,
+        successes: ok,
+        success_rate: rate(ok, n),
+        wilson95: wilson(ok, n, Z95),
+        planning_successes: planned,
+        planning_success_rate: rate(planned, n),
+        planning_wilson95: wilson(planned, n, Z95),
+        conditional_success_rate: rate(ok_given_planned, planned),
+        conditional_wilson95: wilson(ok_given_planned, planned, Z95),
+        failures,
+        plans: times.len() as u64,
+        planning_time_p50: percentile(&times, 0.5),
+        planning_time_p95: percentile(&times, 0.95),
+        planning_time_max: times.last().copied(),
+        tracking_rms_mean: if n == 0 { 0.0 } else { results.iter().map(|t| 0.5 * (t.tracking_rms[0] + t.tracking_rms[1])).sum::<f64>() / n as f64 },
+        time_to_harvest_mean: if tth.is_empty() { None } else { Some(tth.iter().sum::<f64>() / tth.len() as f64) },
+        rtf: if wall > 0.0 { sim / wall } else { 0.0 },
+        sim_time: sim,
+        wall_time: wall,
+    }
+}

@@ -1,0 +1,274 @@
+//! `agrisim bench nav`: the paper's navigation experiment, many trials, every one recorded.
+//!
+//! Each trial starts the system afresh at the predefined initial state, sends one seeded
+//! target (an aisle or the headland, so row switches are included), and ends in success
+//! (ground-truth base centre within the goal tolerance, no collision, within the time limit)
+//! or in failure with a reason: collision, timeout, no_path, stuck, goal_missed, error.
+//! Ground truth is read here only to judge; the navigation stack never sees it.
+
+use super::report::{render, TrialTrace};
+use super::stats::{wilson, Z95};
+use super::targets::draw_target;
+use agrisim_error::{Context, Result};
+use crate::map::{building_plan, grid_message, MAP_BAND, MAP_RESOLUTION};
+use agrisim_bus::Node;
+use agrisim_math::Rng;
+use agrisim_nodes::{FaultInjector, GoalPublisher, MapServer, OdomTf};
+use agrisim_session::{prepare, RunOptions, Scenario};
+use agrisim_greenhouse::occupancy::OccupancyMap;
+use agrisim_msgs::agrisim::NavigationStatus;
+use agrisim_msgs::geometry_msgs::PoseStamped;
+use agrisim_msgs::Message;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::io::Write;
+use std::path::Path;
+use std::time::Instant;
+
+#[derive(Debug, Clone, Serialize)]
+pub struct NavTrial {
+    pub trial: u64,
+    pub seed: u64,
+    pub target: [f64; 3],
+    pub outcome: &'static str,
+    pub reason: Option<String>,
+    pub time_to_goal: Option<f64>,
+    pub path_length: f64,
+    pub min_clearance: f64,
+    pub final_localization_error: Option<f64>,
+    pub sim_time: f64,
+    pub wall_time: f64,
+    pub mcap: String,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct NavSummary {
+    pub scenario: String,
+    pub seed: u64,
+    pub trials: u64,
+    pub successes: u64,
+    pub success_rate: f64,
+    pub wilson95: [f64; 2],
+    pub failures: BTreeMap<String, u64>,
+    /// Simulated time / wall time over all trials.
+    pub rtf: f64,
+    pub sim_time: f64,
+    pub wall_time: f64,
+    pub time_to_goal_mean: Option<f64>,
+    pub path_length_mean: f64,
+    pub min_clearance_min: f64,
+}
+
+/// The seed of trial `i`: independent streams per trial from one master seed.
+pub fn trial_seed(master: u64, i: u64) -> u64 {
+    let mut r = Rng::new(master ^ i.wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    r.next_u64()
+}
+
+/// Everything a trial needs that does not change between trials.
+pub struct NavSetup {
+    pub layout: agrisim_greenhouse::Layout,
+    pub objects: Vec<agrisim_greenhouse::Object>,
+    /// The static map the robot is given: the building plan, without obstacles (those it
+    /// must find with its LiDAR and plan around).
+    pub map: OccupancyMap,
+    /// Everything, obstacles included: only to keep targets out of obstacles.
+    pub truth: OccupancyMap,
+}
+
+impl NavSetup {
+    pub fn new(s: &Scenario) -> Result<NavSetup> {
+        let g = agrisim_session::scene::generate_scene(s)?;
+        let map = building_plan(&g);
+        let truth = OccupancyMap::from_objects(&g.objects, MAP_RESOLUTION, MAP_BAND, g.layout.bounds);
+        Ok(NavSetup { layout: g.layout, objects: g.objects, map, truth })
+    }
+}
+
+/// Runs one trial into `mcap`.
+pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &NavSetup, index: u64, seed: u64, mcap: &Path) -> Result<(NavTrial, Vec<[f64; 2]>)> {
+    let wall = Instant::now();
+    let mut rng = Rng::new(seed);
+    let nav = &s.nav;
+    let target = draw_target(&setup.layout, &setup.truth, &mut rng, nav.targets_in_headland, nav.aisle_margin, 0.7)
+        .ok_or_else(|| agrisim_error::err!("scenario {}: no free navigation target could be drawn", s.path.display()))?;
+    let navigator = agrisim_nav::Navigator::new(agrisim_nav::NavConfig::for_start(setup.layout.start_pose));
+    let nodes: Vec<Box<dyn Node>> = vec![
+        Box::new(MapServer::new(grid_message(&setup.map, 0))),
+        Box::new(OdomTf::default()),
+        Box::new(GoalPublisher::new(0, target)),
+        Box::new(navigator),
+        Box::new(FaultInjector::new(&s.inject)),
+    ];
+    let opts = RunOptions { seed: Some(seed), ..o.clone() };
+    let mut m = prepare(s, &opts, mcap, nodes)?;
+    let chassis = m.component("chassis", "nav benchmark")?;
+    let world = m.component("world", "nav benchmark")?;
+    let step = s.timing.step;
+    let max_ticks = (nav.trial_timeout / step).round() as u64;
+    let mut path = vec![[m.number(chassis, "x")?, m.number(chassis, "y")?]];
+    let (mut length, mut clearance) = (0.0, f64::INFINITY);
+    let mut status_seen = 0;
+    let mut outcome: Option<(bool, Option<String>)> = None;
+    let mut time_to_goal = None;
+    let result: Result<()> = (|| {
+        for k in 1..=max_ticks {
+            m.advance()?;
+            let (x, y) = (m.number(chassis, "x")?, m.number(chassis, "y")?);
+            let last = *path.last().expect("non-empty");
+            length += (x - last[0]).hypot(y - last[1]);
+            path.push([x, y]);
+            clearance = clearance.min(m.number(world, "min_clearance")?);
+            if m.number(world, "collision")? != 0.0 {
+                outcome = Some((false, Some("collision".into())));
+                return Ok(());
+            }
+            if let Some(st) = m.bus.take_new::<NavigationStatus>("/navigate/status", &mut status_seen)? {
+                match st.state.as_str() {
+                    "succeeded" => {
+                        let d = (x - target[0]).hypot(y - target[1]);
+                        outcome = Some(if d <= nav.goal_tolerance { (true, None) } else { (false, Some("goal_missed".into())) });
+                        time_to_goal = Some(k as f64 * step);
+                        return Ok(());
+                    }
+                    "failed" => {
+                        outcome = Some((false, Some(if st.detail.is_empty() { "failed".into() } else { st.detail.clone() })));
+                        return Ok(());
+                    }
+                    _ => {}
+                }
+            }
+        }
+        outcome = Some((false, Some("timeout".into())));
+        Ok(())
+    })();
+    let sim_time = m.time();
+    let loc_err = match m.bus.latest("/localization/pose") {
+        Some(sample) => PoseStamped::from_cdr(&sample.cdr).ok().map(|p| {
+            let [x, y] = *path.last().expect("non-empty");
+            (p.pose.position.x - x).hypot(p.pose.position.y - y)
+        }),
+        None => None,
+    };
+    let (success, reason) = match result {
+        Ok(()) => {
+            m.finish_point()?;
+            outcome.expect("set on every exit")
+        }
+        Err(e) => {
+            m.record_failure(&e);
+            (false, Some(format!("error: {e}")))
+        }
+    };
+    m.recorder_finish()?;
+    let trial = NavTrial {
+        trial: index,
+        seed,
+        target,
+        outcome: if success { "success" } else { "failure" },
+        reason,
+        time_to_goal: if success { time_to_goal } else { None },
+        path_length: length,
+        min_clearance: clearance,
+        final_localization_error: loc_err,
+        sim_time,
+        wall_time: wall.elapsed().as_secs_f64(),
+        mcap: mcap.file_name().map(|f| format!("trials/{}", f.to_string_lossy())).unwrap_or_default(),
+    };
+    Ok((trial, path))
+}
+
+/// Runs `trials` trials and writes trials.jsonl, summary.json, report.html and trials/*.mcap.
+pub fn bench_nav(s: &Scenario, o: &RunOptions, trials: u64, seed: u64, out: &Path, mut progress: impl FnMut(u64, u64)) -> Result<NavSummary> {
+    let dir = out.join("trials");
+    std::fs::create_dir_all(&dir).context(|| format!("cannot create {}", dir.display()))?;
+    let setup = NavSetup::new(s)?;
+    let jsonl_path = out.join("trials.jsonl");
+    let mut jsonl = std::fs::File::create(&jsonl_path).context(|| format!("cannot create {}", jsonl_path.display()))?;
+    let mut results = vec![];
+    let mut traces = vec![];
+    for i in 0..trials {
+        let ts = trial_seed(seed, i);
+        let (trial, path) = run_trial(s, o, &setup, i, ts, &dir.join(format!("{i:04}.mcap")))?;
+        // One line per trial as soon as it ends: a long benchmark that is stopped keeps them.
+        writeln!(jsonl, "{}", serde_json::to_string(&trial).expect("plain struct")).context(|| jsonl_path.display().to_string())?;
+        traces.push(TrialTrace { index: i, success: trial.outcome == "success", reason: trial.reason.clone().unwrap_or_else(|| "success".into()), target: trial.target, path: decimate(&path, 10) });
+        results.push(trial);
+        progress(i + 1, trials);
+    }
+    let summary = summarize(s, seed, &results);
+    let sp = out.join("summary.json");
+    std::fs::write(&sp, serde_json::to_string_pretty(&summary).expect("plain struct") + "\n").context(|| sp.display().to_string())?;
+    let rows = vec![
+        ("scenario".to_string(), summary.scenario.clone()),
+        ("trials".to_string(), summary.trials.to_string()),
+        ("successes".to_string(), summary.successes.to_string()),
+        ("success rate".to_string(), format!("{:.3}", summary.success_rate)),
+        ("Wilson 95 %".to_string(), format!("[{:.3}, {:.3}]", summary.wilson95[0], summary.wilson95[1])),
+        ("failures".to_string(), format!("{:?}", summary.failures)),
+        ("real-time factor".to_string(), format!("{:.2}", summary.rtf)),
+        ("mean time to goal [s]".to_string(), summary.time_to_goal_mean.map_or("-".into(), |t| format!("{t:.1}"))),
+        ("min clearance [m]".to_string(), format!("{:.3}", summary.min_clearance_min)),
+    ];
+    let html = render(&format!("agrisim nav benchmark: {}", s.name), &rows, &setup.objects, view_bounds(&setup.layout, &traces), &traces);
+    let rp = out.join("report.html");
+    std::fs::write(&rp, html).context(|| rp.display().to_string())?;
+    Ok(summary)
+}
+
+/// What the report's map shows: the rows, the headland and every path, with a margin (the
+/// hall around them is mostly empty floor).
+fn view_bounds(layout: &agrisim_greenhouse::Layout, traces: &[TrialTrace]) -> [f64; 4] {
+    let [hx0, hy0, hx1, hy1] = layout.headland;
+    let mut b = [hx0, hy0, hx1, hy1];
+    let mut grow = |x: f64, y: f64| {
+        b = [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)];
+    };
+    for r in layout.rows.iter().filter(|r| r.active) {
+        grow(r.x_start, r.y);
+        grow(r.x_end, r.y);
+    }
+    for p in traces.iter().flat_map(|t| t.path.iter()) {
+        grow(p[0], p[1]);
+    }
+    let m = 1.5;
+    let [x0, y0, x1, y1] = layout.bounds;
+    [(b[0] - m).max(x0), (b[1] - m).max(y0), (b[2] + m).min(x1), (b[3] + m).min(y1)]
+}
+
+fn decimate(path: &[[f64; 2]], every: usize) -> Vec<[f64; 2]> {
+    let mut v: Vec<[f64; 2]> = path.iter().step_by(every).copied().collect();
+    if let Some(last) = path.last() {
+        v.push(*last);
+    }
+    v
+}
+
+pub fn summarize(s: &Scenario, seed: u64, results: &[NavTrial]) -> NavSummary {
+    let n = results.len() as u64;
+    let ok: Vec<&NavTrial> = results.iter().filter(|t| t.outcome == "success").collect();
+    let mut failures = BTreeMap::new();
+    for t in results.iter().filter(|t| t.outcome != "success") {
+        let reason = t.reason.clone().unwrap_or_default();
+        let key = reason.split(':').next().unwrap_or("").to_string();
+        *failures.entry(key).or_insert(0) += 1;
+    }
+    let sim: f64 = results.iter().map(|t| t.sim_time).sum();
+    let wall: f64 = results.iter().map(|t| t.wall_time).sum();
+    let ttg: Vec<f64> = ok.iter().filter_map(|t| t.time_to_goal).collect();
+    NavSummary {
+        scenario: s.name.clone(),
+        seed,
+        trials: n,
+        successes: ok.len() as u64,
+        success_rate: if n == 0 { 0.0 } else { ok.len() as f64 / n as f64 },
+        wilson95: wilson(ok.len() as u64, n, Z95),
+        failures,
+        rtf: if wall > 0.0 { sim / wall } else { 0.0 },
+        sim_time: sim,
+        wall_time: wall,
+        time_to_goal_mean: if ttg.is_empty() { None } else { Some(ttg.iter().sum::<f64>() / ttg.len() as f64) },
+        path_length_mean: if n == 0 { 0.0 } else { results.iter().map(|t| t.path_length).sum::<f64>() / n as f64 },
+        min_clearance_min: results.iter().map(|t| t.min_clearance).fold(f64::INFINITY, f64::min),
+    }
+}

@@ -1,0 +1,246 @@
+//! `agrisim`: the command-line front of the orchestrator: runs, benchmarks, FMU packing,
+//! snapshots and scene export, with progress on a terminal and quiet in pipes.
+
+mod pack;
+mod png;
+mod snapshot;
+
+use agrisim_error::Result;
+use agrisim_session::{RunOptions, Scenario};
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "agrisim", version, about = "Greenhouse-robotics co-simulation: FMUs, SSP systems, ROS 2 messages, MCAP logs")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a scenario's system and record DIR/run.mcap.
+    Run {
+        /// Scenario file (TOML).
+        #[arg(long, default_value = "models/scenarios/default.toml")]
+        scenario: PathBuf,
+        /// Simulated duration [s] (default: the scenario's).
+        #[arg(long)]
+        duration: Option<f64>,
+        /// Master seed (default: the scenario's).
+        #[arg(long)]
+        seed: Option<u64>,
+        /// Replace a component's FMU: COMPONENT=FILE.fmu (e.g. chassis=ChassisDynamic.fmu).
+        #[arg(long = "fmu", value_parser = parse_override)]
+        fmus: Vec<(String, String)>,
+        #[command(flatten)]
+        dirs: Dirs,
+        /// Output directory.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Benchmarks.
+    Bench {
+        #[command(subcommand)]
+        command: BenchCommand,
+    },
+    /// Pictures of the default view: DIR/rgb.png, DIR/depth.png, DIR/lidar_top.png.
+    Snapshot {
+        #[arg(long, default_value = "models/scenarios/default.toml")]
+        scenario: PathBuf,
+        #[command(flatten)]
+        dirs: Dirs,
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// The greenhouse scene.
+    Scene {
+        #[command(subcommand)]
+        command: SceneCommand,
+    },
+    /// FMU packaging.
+    Fmu {
+        #[command(subcommand)]
+        command: FmuCommand,
+    },
+}
+
+#[derive(Subcommand)]
+enum FmuCommand {
+    /// Write target/fmu/<Name>.fmu (FMI 3.0) and target/fmu/fmi2/<Name>.fmu (FMI 2.0).
+    Pack {
+        /// Directory with the built FMU libraries (default: this executable's directory).
+        #[arg(long)]
+        lib_dir: Option<PathBuf>,
+        /// Output directory (default: target/fmu next to the build directory).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+}
+
+#[derive(Subcommand)]
+enum BenchCommand {
+    /// The navigation experiment: N trials to seeded targets; DIR/summary.json, trials.jsonl,
+    /// trials/<NNNN>.mcap, report.html (default scenario: models/scenarios/default.toml).
+    Nav(TrialArgs),
+    /// The dual-arm harvesting experiment: N trials on seeded ripe fruit; DIR/summary.json,
+    /// trials.jsonl, trials/<NNNN>.mcap (default scenario: models/scenarios/harvest.toml).
+    Harvest(TrialArgs),
+    /// Orchestrator cost per FMU and step, beside the bare fmi3DoStep cost (JSON on stdout).
+    Overhead {
+        #[arg(long, default_value = "models/scenarios/default.toml")]
+        scenario: PathBuf,
+        #[arg(long, default_value_t = 5000)]
+        steps: u64,
+        #[command(flatten)]
+        dirs: Dirs,
+        #[arg(long)]
+        out: PathBuf,
+    },
+}
+
+/// What a many-trial benchmark takes.
+#[derive(clap::Args)]
+struct TrialArgs {
+    /// Scenario file (default: the benchmark's own).
+    #[arg(long)]
+    scenario: Option<PathBuf>,
+    #[arg(long, default_value_t = 50)]
+    trials: u64,
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    #[command(flatten)]
+    dirs: Dirs,
+    #[arg(long)]
+    out: PathBuf,
+}
+
+#[derive(Subcommand)]
+enum SceneCommand {
+    /// Write the scenario's greenhouse as binary glTF (.glb) for any 3D viewer.
+    Export {
+        #[arg(long, default_value = "models/scenarios/default.toml")]
+        scenario: PathBuf,
+        #[arg(long)]
+        out: PathBuf,
+    },
+}
+
+#[derive(clap::Args, Clone)]
+struct Dirs {
+    /// Directory of packed FMUs (default: target/fmu next to this executable's build directory).
+    #[arg(long)]
+    fmu_dir: Option<PathBuf>,
+    /// Where FMU archives are unpacked (default: target/fmu-cache).
+    #[arg(long)]
+    cache_dir: Option<PathBuf>,
+}
+
+fn parse_override(s: &str) -> std::result::Result<(String, String), String> {
+    s.split_once('=').map(|(a, b)| (a.to_string(), b.to_string())).ok_or_else(|| format!("expected COMPONENT=FILE.fmu, got '{s}'"))
+}
+
+/// target/<profile>/ of this executable, and target/.
+fn build_dirs() -> (PathBuf, PathBuf) {
+    let exe_dir = std::env::current_exe().ok().and_then(|p| p.parent().map(|d| d.to_path_buf())).unwrap_or_else(|| PathBuf::from("target/release"));
+    let target = exe_dir.parent().map(|p| p.to_path_buf()).unwrap_or_else(|| PathBuf::from("target"));
+    (exe_dir, target)
+}
+
+/// A progress bar on stderr (k done of n); indicatif hides it when stderr is not a terminal,
+/// so pipes and CI logs get nothing.
+fn progress_printer() -> impl FnMut(u64, u64) {
+    let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
+    bar.set_style(ProgressStyle::with_template("[{bar:40}] {percent:>3}% {pos}/{len} ({elapsed}, eta {eta})").expect("valid template").progress_chars("# "));
+    move |k, n| {
+        if bar.length() != Some(n) {
+            bar.set_length(n);
+        }
+        bar.set_position(k);
+        if k >= n && !bar.is_finished() {
+            bar.finish();
+        }
+    }
+}
+
+fn run_options(dirs: Dirs, target: &std::path::Path, seed: Option<u64>, duration: Option<f64>, fmu_overrides: BTreeMap<String, String>) -> RunOptions {
+    RunOptions {
+        fmu_dir: dirs.fmu_dir.unwrap_or_else(|| target.join("fmu")),
+        cache_dir: dirs.cache_dir.unwrap_or_else(|| target.join("fmu-cache")),
+        seed,
+        duration,
+        fmu_overrides,
+    }
+}
+
+fn main() -> ExitCode {
+    match real_main() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("agrisim: error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// The scenario (or the benchmark's default) and run options of a many-trial benchmark.
+fn trial_setup(a: &TrialArgs, default_scenario: &str, target: &Path) -> Result<(Scenario, RunOptions)> {
+    let s = Scenario::load(a.scenario.as_deref().unwrap_or(Path::new(default_scenario)))?;
+    Ok((s, run_options(a.dirs.clone(), target, None, None, BTreeMap::new())))
+}
+
+fn real_main() -> Result<()> {
+    let cli = Cli::parse();
+    let (exe_dir, target) = build_dirs();
+    match cli.command {
+        Command::Run { scenario, duration, seed, fmus, dirs, out } => {
+            let s = Scenario::load(&scenario)?;
+            let opts = run_options(dirs, &target, seed, duration, fmus.into_iter().collect());
+            let summary = agrisim_session::run::run(&s, &opts, &out, progress_printer())?;
+            println!("{} steps ({} s simulated) -> {}", summary.steps, summary.simulated, summary.mcap.display());
+        }
+        Command::Bench { command: BenchCommand::Nav(a) } => {
+            let (s, opts) = trial_setup(&a, "models/scenarios/default.toml", &target)?;
+            let summary = agrisim_bench::nav::bench_nav(&s, &opts, a.trials, a.seed, &a.out, progress_printer())?;
+            println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
+        }
+        Command::Bench { command: BenchCommand::Harvest(a) } => {
+            let (s, opts) = trial_setup(&a, "models/scenarios/harvest.toml", &target)?;
+            let summary = agrisim_bench::harvest::bench_harvest(&s, &opts, a.trials, a.seed, &a.out, progress_printer())?;
+            println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
+        }
+        Command::Bench { command: BenchCommand::Overhead { scenario, steps, dirs, out } } => {
+            let s = Scenario::load(&scenario)?;
+            let opts = run_options(dirs, &target, None, None, BTreeMap::new());
+            let report = agrisim_bench::overhead(&s, &opts, steps, &out)?;
+            println!("{}", serde_json::to_string_pretty(&report).expect("plain struct serializes"));
+        }
+        Command::Snapshot { scenario, dirs, out } => {
+            let s = Scenario::load(&scenario)?;
+            let opts = run_options(dirs, &target, None, None, BTreeMap::new());
+            for p in snapshot::snapshot(&s, &opts, &out)? {
+                println!("{}", p.display());
+            }
+        }
+        Command::Scene { command: SceneCommand::Export { scenario, out } } => {
+            let s = Scenario::load(&scenario)?;
+            let g = agrisim_session::scene::generate_scene(&s)?;
+            agrisim_greenhouse::gltf::write_glb(&g.objects, &out).map_err(|e| agrisim_error::err!("cannot write {}: {e}", out.display()))?;
+            println!("{} objects -> {}", g.objects.len(), out.display());
+        }
+        Command::Fmu { command: FmuCommand::Pack { lib_dir, out } } => {
+            let lib_dir = lib_dir.unwrap_or(exe_dir);
+            let out = out.unwrap_or_else(|| target.join("fmu"));
+            for p in pack::pack_all(&lib_dir, &out)? {
+                match &p.fmi2 {
+                    Some(f2) => println!("{}: {} {}", p.model_identifier, p.fmi3.display(), f2.display()),
+                    None => println!("{}: {}", p.model_identifier, p.fmi3.display()),
+                }
+            }
+        }
+    }
+    Ok(())
+}

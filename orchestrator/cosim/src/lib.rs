@@ -1,0 +1,45 @@
+//! agrisim-cosim: the co-simulation engine. It imports FMI 3.0 co-simulation FMUs, composes
+//! them from an SSP system structure, and steps them on integer ticks with per-connection
+//! exchange rates (physics every step, message connections at their own period).
+//!
+//! It knows no ROS, no greenhouse and no component names: values that cross the system's
+//! own connectors (messages and scalars for the algorithm layer) go through the [`Hooks`]
+//! the embedding program passes to [`Master::advance`]. Embedding in a few lines:
+//!
+//! ```no_run
+//! use agrisim_cosim::{LoadOptions, Master, NoHooks, System};
+//! # fn main() -> agrisim_error::Result<()> {
+//! let opts = LoadOptions::new("target/fmu", "target/fmu-cache", 0.02, 0.1);
+//! let mut system = System::load("models/systems/base.ssd".as_ref(), &opts)?;
+//! system.apply_parameters(&Default::default(), 1, &Default::default())?;
+//! let mut master = Master::new(system, 0.02, 0.1)?;
+//! master.initialize()?;
+//! for _ in 0..500 {
+//!     master.advance(&mut NoHooks)?;
+//! }
+//! let x = master.system.number(master.system.component_index("chassis").unwrap(), "x")?;
+//! # let _ = x; Ok(()) }
+//! ```
+
+pub mod archive;
+pub mod fmi3;
+pub mod master;
+pub mod model_description;
+pub mod seed;
+pub mod ssp;
+pub mod system;
+pub mod value;
+
+pub use agrisim_error::{err, Context, Error, Result};
+pub use master::{Hooks, Master, NoHooks};
+pub use system::{LoadOptions, Port, Route, System};
+
+/// `crate::error::...` paths inside this crate.
+pub(crate) mod error {
+    pub use agrisim_error::{Context, Error, Result};
+}
+
+macro_rules! from_display {
+    ($($t:ty),*) => { $( impl From<$t> for Error { fn from(e: $t) -> Self { Error(e.to_string()) } } )* };
+}
+from_display!(fmi3::FmiError, archive::ImportError, model_description::ModelDescriptionError, ssp::SspError);

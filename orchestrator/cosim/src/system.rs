@@ -1,0 +1,287 @@
+//! A composed system: the FMU instances of an SSP system structure and the routes that move
+//! values between them and the message bus.
+//!
+//! Message ports are FMI 3 Binary variables named `X` with an Int64 counter `X_seq`: a route
+//! moves a message only when the counter changed, and bumps the counter of the input it
+//! writes, so every consumer sees each message exactly once.
+
+use crate::archive::FmuArchive;
+use crate::error::{Context, Result};
+use crate::fmi3::Instance;
+use crate::model_description::{Causality, ModelVariable, VarType};
+use crate::seed::component_seed;
+use crate::ssp::{self, SystemStructure};
+use crate::value::{self, Value};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Where to find FMUs and how to time the exchange.
+#[derive(Clone, Debug)]
+pub struct LoadOptions {
+    /// Directory `agrisim fmu pack` wrote the .fmu files to.
+    pub fmu_dir: PathBuf,
+    /// Where .fmu archives are unpacked.
+    pub cache_dir: PathBuf,
+    /// Component -> FMU file, replacing the system file's `source`.
+    pub fmu_overrides: BTreeMap<String, String>,
+    pub step: f64,
+    /// Period of message connections without their own [s].
+    pub message_period: f64,
+}
+
+impl LoadOptions {
+    /// FMUs from `fmu_dir`, unpacked to `cache_dir`, no overrides.
+    pub fn new(fmu_dir: impl Into<PathBuf>, cache_dir: impl Into<PathBuf>, step: f64, message_period: f64) -> LoadOptions {
+        LoadOptions { fmu_dir: fmu_dir.into(), cache_dir: cache_dir.into(), fmu_overrides: BTreeMap::new(), step, message_period }
+    }
+}
+
+pub struct Component {
+    pub name: String,
+    pub archive: FmuArchive,
+    pub instance: Instance,
+    /// Scalar inputs and outputs, recorded every step.
+    pub signals: Vec<ModelVariable>,
+}
+
+impl Component {
+    /// Current values of all [`Component::signals`], in their order, read with one call per
+    /// type (the recorder does this every step, so FFI round trips matter).
+    pub fn read_signals(&mut self, out: &mut Vec<f64>) -> Result<()> {
+        out.clear();
+        out.resize(self.signals.len(), 0.0);
+        for ty in [VarType::Float64, VarType::Int32, VarType::Int64, VarType::Boolean] {
+            let idx: Vec<usize> = (0..self.signals.len()).filter(|&i| self.signals[i].ty == ty).collect();
+            if idx.is_empty() {
+                continue;
+            }
+            let vrs: Vec<u32> = idx.iter().map(|&i| self.signals[i].value_reference).collect();
+            match ty {
+                VarType::Float64 => {
+                    let mut v = vec![0.0; vrs.len()];
+                    self.instance.get_f64(&vrs, &mut v)?;
+                    idx.iter().zip(v).for_each(|(&i, x)| out[i] = x);
+                }
+                VarType::Int32 => {
+                    let mut v = vec![0; vrs.len()];
+                    self.instance.get_i32(&vrs, &mut v)?;
+                    idx.iter().zip(v).for_each(|(&i, x)| out[i] = x as f64);
+                }
+                VarType::Int64 => {
+                    let mut v = vec![0; vrs.len()];
+                    self.instance.get_i64(&vrs, &mut v)?;
+                    idx.iter().zip(v).for_each(|(&i, x)| out[i] = x as f64);
+                }
+                _ => {
+                    let mut v = vec![false; vrs.len()];
+                    self.instance.get_bool(&vrs, &mut v)?;
+                    idx.iter().zip(v).for_each(|(&i, x)| out[i] = x as u8 as f64);
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One end of a route.
+#[derive(Clone, Debug)]
+pub enum Port {
+    /// A variable of component `comp`; `seq` is the counter of a message port.
+    Fmu { comp: usize, var: ModelVariable, seq: Option<ModelVariable> },
+    /// A system connector: a topic (messages) or a named scalar on the bus.
+    Bus { topic: String },
+}
+
+#[derive(Clone, Debug)]
+pub struct Route {
+    /// `chassis.odom -> /odom`, for errors and the timing check.
+    pub label: String,
+    pub from: Port,
+    pub to: Port,
+    /// Exchange every this many master steps.
+    pub period_ticks: u64,
+    /// mimeType of a message route's Binary port (the message layer reads the message type
+    /// from it); None for scalar routes.
+    pub mime_type: Option<String>,
+    /// Topic a message route is recorded on.
+    pub topic: String,
+    /// Last source counter seen (FMU source) or bus sequence delivered (bus source).
+    pub seen: i64,
+    /// Counter written to a message input.
+    pub written: i64,
+}
+
+pub struct System {
+    pub structure: SystemStructure,
+    pub components: Vec<Component>,
+    pub routes: Vec<Route>,
+}
+
+/// `x` is a whole multiple of `step` (to 1 ns): the number of steps.
+pub fn ticks_of(x: f64, step: f64, what: &str) -> Result<u64> {
+    let n = (x / step).round();
+    if !(n >= 1.0) || ((n * step - x).abs() > 1e-9) {
+        return Err(crate::err!("{what}: period {x} s is not a whole multiple of the step {step} s"));
+    }
+    Ok(n as u64)
+}
+
+fn port_label(e: &ssp::Endpoint) -> String {
+    match &e.element {
+        Some(c) => format!("{c}.{}", e.connector),
+        None => e.connector.clone(),
+    }
+}
+
+impl System {
+    /// Reads the system file, opens every FMU, checks the wiring and instantiates.
+    pub fn load(ssd: &Path, opts: &LoadOptions) -> Result<System> {
+        let mut structure = SystemStructure::from_file(ssd)?;
+        for (comp, fmu) in &opts.fmu_overrides {
+            let c = structure.components.iter_mut().find(|c| &c.name == comp).ok_or_else(|| crate::err!("FMU override for '{comp}': no such component in {}", ssd.display()))?;
+            c.source = fmu.clone();
+        }
+        let mut archives = BTreeMap::new();
+        let mut mds = BTreeMap::new();
+        for c in &structure.components {
+            let path = ssp::resolve_source(ssd, &c.source, &opts.fmu_dir);
+            let a = FmuArchive::open(&path, &opts.cache_dir).context(|| format!("component '{}' of {}", c.name, ssd.display()))?;
+            mds.insert(c.name.clone(), a.md.clone());
+            archives.insert(c.name.clone(), a);
+        }
+        ssp::validate(&structure, &mds)?;
+        let mut components = vec![];
+        for c in &structure.components {
+            let archive = archives.remove(&c.name).expect("opened above");
+            let instance = Instance::instantiate(&archive, &c.name, true)?;
+            let signals = archive
+                .md
+                .variables
+                .iter()
+                .filter(|v| matches!(v.causality, Causality::Input | Causality::Output))
+                .filter(|v| matches!(v.ty, VarType::Float64 | VarType::Int32 | VarType::Int64 | VarType::Boolean))
+                .cloned()
+                .collect();
+            components.push(Component { name: c.name.clone(), archive, instance, signals });
+        }
+        let mut sys = System { structure, components, routes: vec![] };
+        sys.routes = sys.build_routes(opts)?;
+        Ok(sys)
+    }
+
+    pub fn component_index(&self, name: &str) -> Option<usize> {
+        self.components.iter().position(|c| c.name == name)
+    }
+
+    fn port(&self, e: &ssp::Endpoint) -> Result<Port> {
+        let Some(comp_name) = &e.element else { return Ok(Port::Bus { topic: e.connector.clone() }) };
+        let comp = self.component_index(comp_name).ok_or_else(|| crate::err!("no component '{comp_name}'"))?;
+        let md = &self.components[comp].archive.md;
+        let var = md.variable(&e.connector).ok_or_else(|| crate::err!("FMU '{comp_name}' ({}) has no variable '{}'", md.model_name, e.connector))?.clone();
+        if !value::supported(var.ty) {
+            return Err(crate::err!("FMU '{comp_name}': variable '{}' has type {}, which agrisim cannot exchange", var.name, var.ty.name()));
+        }
+        let seq = if var.ty == VarType::Binary {
+            let name = format!("{}_seq", var.name);
+            let s = md.variable(&name).filter(|s| s.ty == VarType::Int64).ok_or_else(|| {
+                crate::err!("FMU '{comp_name}': message port '{}' has no Int64 counter '{name}'", var.name)
+            })?;
+            Some(s.clone())
+        } else {
+            None
+        };
+        Ok(Port::Fmu { comp, var, seq })
+    }
+
+    fn build_routes(&self, opts: &LoadOptions) -> Result<Vec<Route>> {
+        let file = self.structure.path.display().to_string();
+        let mut routes = vec![];
+        for c in &self.structure.connections {
+            let label = format!("{} -> {}", port_label(&c.start), port_label(&c.end));
+            let ctx = |e: crate::error::Error| crate::err!("{file}: connection {label}: {e}");
+            let from = self.port(&c.start).map_err(ctx)?;
+            let to = self.port(&c.end).map_err(ctx)?;
+            let mime = [&from, &to].iter().find_map(|p| match p {
+                Port::Fmu { var, .. } if var.ty == VarType::Binary => Some(var.mime_type.clone().unwrap_or_default()),
+                _ => None,
+            });
+            let is_message = mime.is_some();
+            let period = c.period.unwrap_or(if is_message { opts.message_period } else { opts.step });
+            let period_ticks = ticks_of(period, opts.step, &format!("{file}: connection {label}"))?;
+            let topic = match (&c.start.element, &c.end.element) {
+                (None, _) => c.start.connector.clone(),
+                (_, None) => c.end.connector.clone(),
+                (Some(e), Some(_)) => format!("/{e}/{}", c.start.connector),
+            };
+            routes.push(Route { label, from, to, period_ticks, mime_type: mime, topic, seen: 0, written: 0 });
+        }
+        Ok(routes)
+    }
+
+    /// Applies parameters: the system file's bindings, then `overrides`, and a `seed`
+    /// derived from the master seed for every component that has one (an Int32 parameter
+    /// `seed`), and each of `shared` (name -> text) to every component with a settable
+    /// String parameter of that name (e.g. one scene description for all FMUs that build
+    /// the scene), unless overridden. Returns what was set, per component, for a run's
+    /// metadata.
+    pub fn apply_parameters(&mut self, overrides: &BTreeMap<String, BTreeMap<String, toml::Value>>, master_seed: u64, shared: &BTreeMap<String, String>) -> Result<BTreeMap<String, BTreeMap<String, String>>> {
+        for name in overrides.keys() {
+            if self.component_index(name).is_none() {
+                return Err(crate::err!("scenario parameters for '{name}': no such component in {}", self.structure.path.display()));
+            }
+        }
+        let mut applied = BTreeMap::new();
+        for i in 0..self.components.len() {
+            let mut set: BTreeMap<String, Value> = BTreeMap::new();
+            let comp = &self.structure.components[i];
+            let md = self.components[i].archive.md.clone();
+            let param = |name: &str| -> Result<ModelVariable> {
+                md.variable(name)
+                    .filter(|v| v.causality.is_settable_parameter())
+                    .cloned()
+                    .ok_or_else(|| crate::err!("FMU '{}' ({}) has no parameter '{name}'", comp.name, md.model_name))
+            };
+            if md.variable("seed").is_some_and(|v| v.ty == VarType::Int32 && v.causality.is_settable_parameter()) {
+                set.insert("seed".into(), Value::I32(component_seed(master_seed, &comp.name)));
+            }
+            for (name, text) in shared {
+                if md.variable(name).is_some_and(|v| v.ty == VarType::String && v.causality.is_settable_parameter()) {
+                    set.insert(name.clone(), Value::Str(text.clone()));
+                }
+            }
+            for (name, v) in &comp.parameters {
+                let var = param(name)?;
+                let val = value::from_ssp(&var, v).ok_or_else(|| crate::err!("{}: parameter {}.{name}: value {v:?} does not fit type {}", self.structure.path.display(), comp.name, var.ty.name()))?;
+                set.insert(name.clone(), val);
+            }
+            for (name, v) in overrides.get(&comp.name).into_iter().flatten() {
+                let var = param(name)?;
+                let val = value::from_toml(&var, v).ok_or_else(|| crate::err!("scenario parameter {}.{name}: value {v} does not fit type {}", comp.name, var.ty.name()))?;
+                set.insert(name.clone(), val);
+            }
+            let mut texts = BTreeMap::new();
+            let name_of_comp = comp.name.clone();
+            for (name, val) in &set {
+                let var = param(name)?;
+                value::set(&mut self.components[i].instance, &var, val)?;
+                texts.insert(name.clone(), val.to_text());
+            }
+            applied.insert(name_of_comp, texts);
+        }
+        Ok(applied)
+    }
+
+    /// A numeric variable of component `comp` by name, as f64 (Float64, Int32, Int64,
+    /// Boolean): how a benchmark reads ground-truth outputs.
+    pub fn number(&mut self, comp: usize, name: &str) -> Result<f64> {
+        let c = &mut self.components[comp];
+        let v = c.archive.md.variable(name).cloned().ok_or_else(|| crate::err!("FMU '{}' has no variable '{name}'", c.name))?;
+        match value::get(&mut c.instance, &v)? {
+            Value::F64(x) => Ok(x),
+            Value::Bool(b) => Ok(b as u8 as f64),
+            Value::I32(i) => Ok(i as f64),
+            Value::I64(i) => Ok(i as f64),
+            other => Err(crate::err!("FMU '{}': {name} is {other:?}, expected a number", c.name)),
+        }
+    }
+}

@@ -1,0 +1,19 @@
+//! The dual-arm tomato harvest in the algorithm layer: a state machine node
+//! ([`node::HarvestNode`]) over the manipulation stack (agrisim-manip: IK, collision
+//! checking, RRT-Connect, shortcutting; agrisim-trajectory: TOPP-RA, ruckig, limit checks),
+//! speaking only ROS 2 messages to the arm, gripper, lift and world FMUs.
+//!
+//! * [`geometry`]: where base, lift and grippers go (stand-off, grasp, handover, box);
+//! * [`motion`]: goal -> IK goal set -> path -> time-parameterized, limit-checked
+//!   trajectory_msgs/JointTrajectory;
+//! * [`base`]: fine positioning of the holonomic base;
+//! * [`stage`]: stages and failure categories; [`node`]: the state machine.
+
+pub mod base;
+pub mod geometry;
+pub mod motion;
+pub mod node;
+pub mod stage;
+
+pub use node::{topics, HarvestNode};
+pub use stage::{Failure, Stage};

@@ -1,0 +1,557 @@
+//! From a TCP goal to a trajectory_msgs/JointTrajectory the arm FMU accepts.
+//!
+//! Free motions: IK goal set (collision-free configurations, several IK branches) ->
+//! RRT-Connect from the current joints to that set -> shortcutting -> exact parry check
+//! (agrisim-manip) -> TOPP-RA on a blended path -> samples at the send period checked
+//! against velocity, acceleration and jerk limits (agrisim-trajectory). Short Cartesian moves
+//! (approach, retreat, handover): IK seeded at the current joints, jerk-limited ruckig motion,
+//! accepted only if the TCP stays within a few millimetres of the straight line and the path
+//! passes the collision checks. Every step is deterministic (seeded sampler, iteration
+//! budgets); wall time is measured by the caller for statistics only.
+
+use super::geometry::TcpGoal;
+use agrisim_math::Pose2;
+use agrisim_manip::cartesian::cartesian_path;
+use agrisim_manip::{exact_check, ArmModel, Checker, Context, Ik, Obstacle, ObstacleKind, Planner, Rng, Scene, Shape, Side, Target, DOF};
+use agrisim_msgs::agrisim::PlanningScene;
+use agrisim_msgs::builtin_interfaces::Duration;
+use agrisim_msgs::shape_msgs::SolidPrimitive;
+use agrisim_msgs::trajectory_msgs::{JointTrajectory, JointTrajectoryPoint};
+use agrisim_trajectory::{time_state_to_state, time_waypoints, JointState, PathParam, PathShape, Sampled, TimingConfig};
+use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
+
+/// Where both arms start and end (the harvest system's `q_init` of both Arm FMUs): Franka's
+/// "ready" pose with the upper arm 0.3 rad instead of 0.785 rad back, because on this robot
+/// the ready pose's elbow touches the lift rails at low lift heights.
+pub const HOME: [f64; DOF] = [0.0, -0.3, 0.0, -2.356, 0.0, 1.571, 0.785];
+/// Period of the JointTrajectory points sent to the arms [s].
+pub const SEND_DT: f64 = 0.04;
+/// A Cartesian move may leave the straight TCP line by this much [m].
+const LINE_TOLERANCE: f64 = 0.005;
+/// TCP step between the IK waypoints of a Cartesian move [m].
+const CARTESIAN_STEP: f64 = 0.01;
+/// Fruit closer than this to the picked one (surface to surface) may be brushed [m].
+const NEIGHBOUR_GAP: f64 = 0.02;
+/// Rolls about the approach axis tried for a grasp.
+const ROLLS: usize = 12;
+/// Distinct IK solutions asked for per free goal, and their minimum joint-space spread [rad].
+const GOAL_SET: (usize, f64) = (6, 0.3);
+/// IK iterations for a goal set / for one seeded Cartesian goal.
+const IK_BUDGET: (usize, usize) = (12_000, 3_000);
+
+/// Which arm (the FMU instance), with its ROS names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Arm {
+    Left,
+    Right,
+}
+
+impl Arm {
+    pub fn index(self) -> usize {
+        self as usize
+    }
+    pub fn other(self) -> Arm {
+        match self {
+            Arm::Left => Arm::Right,
+            Arm::Right => Arm::Left,
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            Arm::Left => "left",
+            Arm::Right => "right",
+        }
+    }
+    fn side(self) -> Side {
+        match self {
+            Arm::Left => Side::Left,
+            Arm::Right => Side::Right,
+        }
+    }
+    pub fn joint_names(self) -> [String; DOF] {
+        std::array::from_fn(|i| format!("{}_joint{}", self.name(), i + 1))
+    }
+    /// `/left_arm/<suffix>`.
+    pub fn topic(self, suffix: &str) -> String {
+        format!("/{}_arm/{suffix}", self.name())
+    }
+    /// `/left_gripper/<suffix>`.
+    pub fn gripper_topic(self, suffix: &str) -> String {
+        format!("/{}_gripper/{suffix}", self.name())
+    }
+}
+
+/// A motion ready to send.
+#[derive(Debug, Clone)]
+pub struct Planned {
+    pub msg: JointTrajectory,
+    pub duration: f64,
+    pub goal_q: [f64; DOF],
+}
+
+pub struct Motion {
+    arms: [ArmModel; 2],
+    rng: Rng,
+    planner: Planner,
+    timing: TimingConfig,
+    /// The planning scene in base_link; the target fruit's index into it.
+    obstacles: Vec<Obstacle>,
+    scene: Scene,
+    target: Option<usize>,
+    target_map: Option<[f64; 3]>,
+    ignore_target: bool,
+    /// Radius of the fruit each arm holds (it moves with the hand in collision checks).
+    held: [Option<f64>; 2],
+    /// Safety margin of the sphere checks [m] (the exact check has none).
+    padding: f64,
+    /// The straight approach (joint path, pre-grasp first) checked by the last pre-grasp plan.
+    approach: Option<(Arm, Vec<[f64; DOF]>)>,
+}
+
+impl Motion {
+    pub fn new(seed: u64) -> Motion {
+        Motion {
+            arms: [ArmModel::new(Arm::Left.side()), ArmModel::new(Arm::Right.side())],
+            rng: Rng::new(seed ^ 0x0048_4152_5645_5354), // "HARVEST"
+            planner: Planner::default(),
+            timing: TimingConfig::panda(SEND_DT),
+            obstacles: vec![],
+            scene: Scene::new(vec![]),
+            target: None,
+            target_map: None,
+            ignore_target: false,
+            held: [None, None],
+            padding: agrisim_manip::checker::DEFAULT_PADDING,
+            approach: None,
+        }
+    }
+
+    pub fn model(&self, arm: Arm) -> &ArmModel {
+        &self.arms[arm.index()]
+    }
+
+    /// The target fruit (map frame): its scene object is the one the hand may touch.
+    pub fn set_target(&mut self, center_map: [f64; 3]) {
+        self.target_map = Some(center_map);
+    }
+
+    /// Once the fruit is in the hand (or about to be), nothing of it is an obstacle.
+    pub fn ignore_target(&mut self, ignore: bool) {
+        self.ignore_target = ignore;
+        self.rebuild();
+    }
+
+    /// The world's planning scene (map frame) seen from the localized base pose. Leaves are
+    /// soft (pushed aside, never planned around); the floor is left to the fixed body.
+    pub fn set_scene(&mut self, scene: &PlanningScene, base: Pose2) {
+        let (s, c) = base.yaw.sin_cos();
+        let to_base = |p: [f64; 3]| -> [f64; 3] {
+            let (dx, dy) = (p[0] - base.x, p[1] - base.y);
+            [c * dx + s * dy, -s * dx + c * dy, p[2]]
+        };
+        let yaw_inv = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), -base.yaw);
+        self.obstacles.clear();
+        self.target = None;
+        let mut best = f64::INFINITY;
+        for o in &scene.objects {
+            let Some(shape) = shape_of(&o.primitive) else { continue };
+            let kind = match o.kind.as_str() {
+                // Leaves and trusses bend out of the way (the world counts the contacts).
+                "leaf" | "truss" => ObstacleKind::Soft,
+                "floor" => continue,
+                _ => ObstacleKind::Solid,
+            };
+            let p = &o.pose.position;
+            let q = &o.pose.orientation;
+            let rot = yaw_inv * UnitQuaternion::from_quaternion(Quaternion::new(q.w, q.x, q.y, q.z));
+            let t = to_base([p.x, p.y, p.z]);
+            let pose = Isometry3::from_parts(Translation3::new(t[0], t[1], t[2]), rot);
+            if let (Some(tm), Shape::Sphere { .. }) = (self.target_map, shape) {
+                let d = ((p.x - tm[0]).powi(2) + (p.y - tm[1]).powi(2) + (p.z - tm[2]).powi(2)).sqrt();
+                if d < 0.01 && d < best {
+                    best = d;
+                    self.target = Some(self.obstacles.len());
+                }
+            }
+            self.obstacles.push(Obstacle::new(o.id.clone(), shape, pose, kind));
+        }
+        self.rebuild();
+    }
+
+    fn rebuild(&mut self) {
+        let mut objs = self.obstacles.clone();
+        if let Some(i) = self.target {
+            objs[i].kind = if self.ignore_target { ObstacleKind::Soft } else { ObstacleKind::Target };
+            // Tomatoes touching the target are pushed aside by the fingers and brushed when
+            // it is pulled out (plant contacts in the world), so they are no obstacles.
+            let c = objs[i].pose.translation.vector;
+            let rt = match objs[i].shape {
+                Shape::Sphere { radius } => radius,
+                _ => 0.0,
+            };
+            for (j, o) in objs.iter_mut().enumerate() {
+                if let Shape::Sphere { radius } = o.shape {
+                    if j != i && (o.pose.translation.vector - c).norm() < rt + radius + NEIGHBOUR_GAP {
+                        o.kind = ObstacleKind::Soft;
+                    }
+                }
+            }
+        }
+        self.scene = Scene::new(objs);
+    }
+
+    /// The target fruit's radius from the planning scene (None before a scene showed it).
+    pub fn target_radius(&self) -> Option<f64> {
+        match self.obstacles.get(self.target?)?.shape {
+            Shape::Sphere { radius } => Some(radius),
+            _ => None,
+        }
+    }
+
+    /// Sphere-check margin: the default, or a small one for the handover, where the two
+    /// hands meet by design and the exact check decides.
+    pub fn set_padding(&mut self, padding: f64) {
+        self.padding = padding;
+    }
+
+    /// `arm` now holds a fruit of `radius` (None: empty hand).
+    pub fn set_held(&mut self, arm: Arm, radius: Option<f64>) {
+        self.held[arm.index()] = radius;
+    }
+
+    fn context<'a>(&'a self, arm: Arm, lift: f64, other_q: [f64; DOF]) -> Context<'a> {
+        let o = self.model(arm.other());
+        let mut ctx = Context::new(self.model(arm), lift, &self.scene).with_other(o, other_q, o.finger_limits.upper);
+        ctx.padding = self.padding;
+        if let Some(r) = self.held[arm.index()] {
+            ctx = ctx.holding(r);
+        }
+        if let Some(r) = self.held[arm.other().index()] {
+            ctx = ctx.other_holding(r);
+        }
+        ctx
+    }
+
+    /// Whether both arms, frozen at `q` (left, right), stay collision-free while the lift
+    /// moves from `from` to `to` (checked every centimetre).
+    pub fn lift_sweep_clear(&self, q: [[f64; DOF]; 2], from: f64, to: f64) -> bool {
+        let n = ((to - from).abs() / 0.01).ceil().max(1.0) as usize;
+        (0..=n).all(|i| {
+            let lift = from + (to - from) * i as f64 / n as f64;
+            [Arm::Left, Arm::Right].iter().all(|&a| Checker::new(self.context(a, lift, q[a.other().index()])).is_valid(&q[a.index()]))
+        })
+    }
+
+    /// Free-space motion to a TCP goal through the IK goal set.
+    pub fn plan_free(&mut self, arm: Arm, lift: f64, start: [f64; DOF], goal: &TcpGoal, other: [f64; DOF]) -> Result<Planned, String> {
+        let target = target_of(goal);
+        let goals = {
+            let ctx = self.context(arm, lift, other);
+            let checker = Checker::new(ctx);
+            let ik = Ik::new(self.model(arm), lift);
+            let mut rng = self.rng.clone();
+            let g = ik.goal_set(&target, &start, &mut rng, GOAL_SET.0, GOAL_SET.1, IK_BUDGET.0, |q| checker.is_valid(q));
+            self.rng = rng;
+            g
+        };
+        if goals.is_empty() {
+            return Err(format!("no collision-free IK solution for the TCP at ({:.3}, {:.3}, {:.3}) in base_link", goal.position[0], goal.position[1], goal.position[2]));
+        }
+        self.plan_to_configs(arm, lift, start, &goals, other)
+    }
+
+    /// Free-space motion to a stand-off `standoff` m before a grasp: the goal set holds
+    /// pre-grasp configurations whose grasp configuration (same orientation, reached by the
+    /// straight approach) is valid too, over rolls every 30 degrees when the roll is free
+    /// (so fingers that would hit a neighbour are never chosen), else the given roll and its
+    /// opposite.
+    pub fn plan_pregrasp(&mut self, arm: Arm, lift: f64, start: [f64; DOF], grasp: &TcpGoal, standoff: f64, other: [f64; DOF]) -> Result<Planned, String> {
+        let mut rng = std::mem::replace(&mut self.rng, Rng::new(0));
+        let goals = {
+            let model = &self.arms[arm.index()];
+            let ctx = self.context(arm, lift, other);
+            let checker = Checker::new(ctx);
+            let ik = Ik::new(model, lift);
+            let z = super::geometry::normalize(grasp.approach);
+            let up = if z[2].abs() < 0.9 { [0.0, 0.0, 1.0] } else { [1.0, 0.0, 0.0] };
+            let x0 = super::geometry::normalize(super::geometry::cross(super::geometry::cross(z, up), z));
+            let y0 = super::geometry::cross(z, x0);
+            // Rolls to try: every 30 degrees when free; a given roll and its opposite (the
+            // same finger line) otherwise.
+            let rolls: Vec<(u32, [f64; 3])> = match grasp.x_axis {
+                Some(x) => vec![(0, x), (180, [-x[0], -x[1], -x[2]])],
+                None => (0..ROLLS)
+                    .map(|k| {
+                        let (sa, ca) = (k as f64 * std::f64::consts::TAU / ROLLS as f64).sin_cos();
+                        ((k * 360 / ROLLS) as u32, [ca * x0[0] + sa * y0[0], ca * x0[1] + sa * y0[1], ca * x0[2] + sa * y0[2]])
+                    })
+                    .collect(),
+            };
+            let mut goals: Vec<[f64; DOF]> = vec![];
+            let mut backout: Vec<String> = vec![];
+            let mut approaches: Vec<Vec<[f64; DOF]>> = vec![];
+            for &(deg, x) in &rolls {
+                let g = TcpGoal { x_axis: Some(x), ..*grasp };
+                let at_grasp = ik.goal_set(&target_of(&g), &start, &mut rng, 2, GOAL_SET.1, 2 * IK_BUDGET.1, |q| checker.is_valid(q));
+                for qg in at_grasp {
+                    // Back out along the approach: the reverse of the approach move, so the
+                    // pre-grasp and grasp configurations are joined by a valid straight line.
+                    let back = Vector3::new(-standoff * z[0], -standoff * z[1], -standoff * z[2]);
+                    match cartesian_path(&checker, &qg, back, CARTESIAN_STEP, 0.3, 0.02) {
+                        Ok(mut path) => {
+                            let qp = *path.last().expect("start at least");
+                            if goals.iter().all(|o| agrisim_manip::ik::dist(o, &qp) > 1e-3) {
+                                goals.push(qp);
+                                path.reverse();
+                                approaches.push(path);
+                            }
+                        }
+                        Err(e) => backout.push(format!("roll {deg}: {e}")),
+                    }
+                }
+            }
+            // Say why when nothing worked: what the grasp configuration touches.
+            let why = if goals.is_empty() {
+                let mut why = Vec::new();
+                for &(deg, x) in &rolls {
+                    let g = TcpGoal { x_axis: Some(x), ..*grasp };
+                    match ik.solve(&target_of(&g), &start, &mut rng, IK_BUDGET.1) {
+                        None => why.push(format!("roll {deg}: no IK")),
+                        Some(q) => why.push(format!("roll {deg}: {}", checker.contact(&q).map(|c| c.describe(&ctx)).unwrap_or_else(|| "free?".into()))),
+                    }
+                }
+                why.extend(backout);
+                why.join("; ")
+            } else {
+                String::new()
+            };
+            (goals, why, approaches)
+        };
+        let (goals, why, approaches) = goals;
+        self.rng = rng;
+        if goals.is_empty() {
+            return Err(format!("no collision-free IK solution for a grasp at ({:.3}, {:.3}, {:.3}) in base_link with any roll ({why})", grasp.position[0], grasp.position[1], grasp.position[2]));
+        }
+        // Nearest goals first: the planner tries the direct edge to them in order. The
+        // approach from the goal reached is kept for plan_linear.
+        let mut order: Vec<usize> = (0..goals.len()).collect();
+        order.sort_by(|&a, &b| agrisim_manip::ik::dist(&goals[a], &start).total_cmp(&agrisim_manip::ik::dist(&goals[b], &start)));
+        let sorted: Vec<[f64; DOF]> = order.iter().map(|&i| goals[i]).collect();
+        let planned = self.plan_to_configs(arm, lift, start, &sorted, other)?;
+        let reached = order.iter().copied().find(|&i| goals[i] == planned.goal_q);
+        self.approach = reached.map(|i| (arm, approaches[i].clone()));
+        Ok(planned)
+    }
+
+    /// The first of `goals` [`Self::plan_free`] reaches, with its index.
+    pub fn plan_free_any(&mut self, arm: Arm, lift: f64, start: [f64; DOF], goals: &[TcpGoal], other: [f64; DOF]) -> Result<(usize, Planned), String> {
+        let mut errors = vec![];
+        for (i, g) in goals.iter().enumerate() {
+            match self.plan_free(arm, lift, start, g, other) {
+                Ok(p) => return Ok((i, p)),
+                Err(e) => errors.push(format!("goal {i}: {e}")),
+            }
+        }
+        Err(errors.join("; "))
+    }
+
+    /// The first of `grasps` [`Self::plan_pregrasp`] reaches, with its index.
+    pub fn plan_pregrasp_any(&mut self, arm: Arm, lift: f64, start: [f64; DOF], grasps: &[TcpGoal], standoff: f64, other: [f64; DOF]) -> Result<(usize, Planned), String> {
+        let mut errors = vec![];
+        for (i, g) in grasps.iter().enumerate() {
+            match self.plan_pregrasp(arm, lift, start, g, standoff, other) {
+                Ok(p) => return Ok((i, p)),
+                Err(e) => errors.push(format!("approach {i}: {e}")),
+            }
+        }
+        Err(errors.join("; "))
+    }
+
+    /// Free-space motion back to [`HOME`].
+    pub fn plan_home(&mut self, arm: Arm, lift: f64, start: [f64; DOF], other: [f64; DOF]) -> Result<Planned, String> {
+        self.plan_to_configs(arm, lift, start, &[HOME], other)
+    }
+
+    fn plan_to_configs(&mut self, arm: Arm, lift: f64, start: [f64; DOF], goals: &[[f64; DOF]], other: [f64; DOF]) -> Result<Planned, String> {
+        let plan = {
+            let ctx = self.context(arm, lift, other);
+            let mut rng = self.rng.clone();
+            let p = self.planner.plan(&ctx, &start, goals, &mut rng);
+            self.rng = rng;
+            p.map_err(|e| format!("motion planning: {e}"))?
+        };
+        let wps: Vec<Vec<f64>> = plan.waypoints.iter().map(|q| q.to_vec()).collect();
+        let samples = if wps.len() < 2 || plan.waypoints[0] == plan.waypoints[wps.len() - 1] {
+            hold(&start)
+        } else {
+            time_waypoints(&wps, &self.timing).map_err(|e| format!("time parameterization: {e}"))?
+        };
+        Ok(self.to_msg(arm, &samples, *plan.waypoints.last().expect("start at least")))
+    }
+
+    /// Straight-line TCP move (approach, retreat, handover), orientation kept: joint
+    /// waypoints along the line (IK every centimetre, agrisim-manip's Cartesian path), timed
+    /// by ruckig as one jerk-limited motion when that stays on the line, else by TOPP-RA on a
+    /// spline through the waypoints; then the line, collision and exact checks.
+    pub fn plan_linear(&mut self, arm: Arm, lift: f64, start: [f64; DOF], goal: &TcpGoal, other: [f64; DOF]) -> Result<Planned, String> {
+        // The approach the pre-grasp plan checked, if this is it: the same joint path.
+        if let Some((a, path)) = &self.approach {
+            let same_start = path.first().is_some_and(|p| agrisim_manip::ik::dist(p, &start) < 1e-6);
+            let end = path.last().map(|q| self.model(arm).fk(lift, q).trans);
+            let same_end = end.is_some_and(|e| (0..3).all(|i| (e[i] - goal.position[i]).abs() < 5e-3));
+            if *a == arm && same_start && same_end {
+                let wps = path.clone();
+                return self.time_line(arm, lift, start, wps, goal.position, other);
+            }
+        }
+        let model = &self.arms[arm.index()];
+        let from = model.fk(lift, &start).trans;
+        let to = goal.position;
+        let ctx = self.context(arm, lift, other);
+        let checker = Checker::new(ctx);
+        let offset = Vector3::new(to[0] - from[0], to[1] - from[1], to[2] - from[2]);
+        let wps = match cartesian_path(&checker, &start, offset, CARTESIAN_STEP, 0.3, 0.02) {
+            Ok(w) => w,
+            Err(e) => {
+                // Name what the blocked configuration touches.
+                let last = *e.partial.last().unwrap_or(&start);
+                let what = Ik::new(model, lift)
+                    .solve(&target_of(&TcpGoal { x_axis: Some(current_x(model, lift, &start)), ..*goal }), &last, &mut Rng::new(7), IK_BUDGET.1)
+                    .and_then(|q| checker.contact(&q))
+                    .map(|c| format!(" (at the goal: {})", c.describe(&ctx)))
+                    .unwrap_or_default();
+                return Err(format!("Cartesian move: {e}{what}"));
+            }
+        };
+        self.time_line(arm, lift, start, wps, to, other)
+    }
+
+    /// Times joint waypoints that move the TCP along a straight line to `to` (ruckig when
+    /// that stays on the line, else TOPP-RA), then the line, collision and exact checks.
+    fn time_line(&self, arm: Arm, lift: f64, start: [f64; DOF], wps: Vec<[f64; DOF]>, to: [f64; 3], other: [f64; DOF]) -> Result<Planned, String> {
+        let model = self.model(arm);
+        let from = model.fk(lift, &start).trans;
+        let ctx = self.context(arm, lift, other);
+        let checker = Checker::new(ctx);
+        let end = *wps.last().expect("start at least");
+        let on_line = |samples: &Sampled| -> Result<Vec<[f64; DOF]>, String> {
+            let path: Vec<[f64; DOF]> = samples.q.iter().map(|v| std::array::from_fn(|i| v[i])).collect();
+            let worst = path.iter().map(|q| distance_to_segment(model.fk(lift, q).trans, from, to)).fold(0.0, f64::max);
+            if worst > LINE_TOLERANCE {
+                return Err(format!("Cartesian move leaves the straight line by {:.1} mm", worst * 1e3));
+            }
+            Ok(path)
+        };
+        let jerk_limited = time_state_to_state(&JointState::at_rest(start.to_vec()), &JointState::at_rest(end.to_vec()), &self.timing).map_err(|e| format!("jerk-limited motion: {e}"))?;
+        let (samples, path) = match on_line(&jerk_limited) {
+            Ok(path) => (jerk_limited, path),
+            Err(_) => {
+                // A spline through the dense waypoints is smooth; where it overshoots a limit,
+                // the polyline with small corner blends follows the checked segments.
+                let wv: Vec<Vec<f64>> = wps.iter().map(|q| q.to_vec()).collect();
+                let spline = TimingConfig { shape: PathShape::Spline(PathParam::ChordLength), ..self.timing.clone() };
+                let blended = TimingConfig { shape: PathShape::Blended { radius: 0.01 }, ..self.timing.clone() };
+                let s = time_waypoints(&wv, &spline).or_else(|_| time_waypoints(&wv, &blended)).map_err(|e| format!("time parameterization of the Cartesian path: {e}"))?;
+                let path = on_line(&s)?;
+                (s, path)
+            }
+        };
+        if let Some(qs) = path.iter().find(|q| !checker.is_valid(q)) {
+            let what = checker.contact(qs).map(|c| c.describe(&ctx)).unwrap_or_default();
+            return Err(format!("Cartesian move in collision: {what}"));
+        }
+        exact_check(&ctx, &path, agrisim_manip::exact::EXACT_RESOLUTION).map_err(|c| format!("Cartesian move fails the exact check: {}", c.description))?;
+        Ok(self.to_msg(arm, &samples, end))
+    }
+
+    fn to_msg(&self, arm: Arm, s: &Sampled, goal_q: [f64; DOF]) -> Planned {
+        let model = self.model(arm);
+        let points = (0..s.t.len())
+            .map(|k| JointTrajectoryPoint {
+                // Samples on a joint limit can be a rounding error beyond it; the arm's
+                // validator is strict.
+                positions: s.q[k].iter().zip(&model.limits).map(|(q, l)| q.clamp(l.lower, l.upper)).collect(),
+                velocities: s.qd[k].clone(),
+                accelerations: s.qdd[k].clone(),
+                effort: vec![],
+                time_from_start: Duration::from_nanos((s.t[k] * 1e9).round() as i64),
+            })
+            .collect();
+        let msg = JointTrajectory { joint_names: arm.joint_names().to_vec(), points, ..Default::default() };
+        Planned { msg, duration: s.t.last().copied().unwrap_or(0.0), goal_q }
+    }
+}
+
+/// A one-point "stay here" trajectory.
+fn hold(q: &[f64; DOF]) -> Sampled {
+    Sampled { t: vec![0.0], q: vec![q.to_vec()], qd: vec![vec![0.0; DOF]], qdd: vec![vec![0.0; DOF]] }
+}
+
+/// The TCP's x axis (the roll) at `q`.
+fn current_x(model: &ArmModel, lift: f64, q: &[f64; DOF]) -> [f64; 3] {
+    let p = model.fk(lift, q);
+    [p.rot[0][0], p.rot[1][0], p.rot[2][0]]
+}
+
+fn target_of(goal: &TcpGoal) -> Target {
+    let hint = goal.x_axis.unwrap_or_else(|| {
+        // Any vector not parallel to the approach; the roll is free anyway.
+        if goal.approach[2].abs() < 0.9 { [0.0, 0.0, 1.0] } else { [1.0, 0.0, 0.0] }
+    });
+    let p = goal.pose_with_x(hint);
+    Target::from_pose(&p, goal.x_axis.is_none())
+}
+
+fn shape_of(p: &SolidPrimitive) -> Option<Shape> {
+    let d = &p.dimensions;
+    match p.r#type {
+        SolidPrimitive::BOX if d.len() >= 3 => Some(Shape::Box { size: [d[0], d[1], d[2]] }),
+        SolidPrimitive::SPHERE if !d.is_empty() => Some(Shape::Sphere { radius: d[0] }),
+        SolidPrimitive::CYLINDER if d.len() >= 2 => Some(Shape::Cylinder { radius: d[SolidPrimitive::CYLINDER_RADIUS], length: d[SolidPrimitive::CYLINDER_HEIGHT] }),
+        _ => None,
+    }
+}
+
+fn distance_to_segment(p: [f64; 3], a: [f64; 3], b: [f64; 3]) -> f64 {
+    let ab = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let ap = [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
+    let l2 = ab.iter().map(|x| x * x).sum::<f64>();
+    let t = if l2 > 0.0 { (ab.iter().zip(&ap).map(|(x, y)| x * y).sum::<f64>() / l2).clamp(0.0, 1.0) } else { 0.0 };
+    (0..3).map(|i| (ap[i] - t * ab[i]).powi(2)).sum::<f64>().sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn line_distance() {
+        assert!((distance_to_segment([0.5, 1.0, 0.0], [0.0; 3], [1.0, 0.0, 0.0]) - 1.0).abs() < 1e-12);
+        assert!((distance_to_segment([2.0, 0.0, 0.0], [0.0; 3], [1.0, 0.0, 0.0]) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn home_is_collision_free_over_the_lift_range() {
+        let m = Motion::new(1);
+        for lift in [0.0, 0.3, 0.8] {
+            for arm in [Arm::Left, Arm::Right] {
+                let ctx = m.context(arm, lift, HOME);
+                assert!(Checker::new(ctx).is_valid(&HOME), "{arm:?} at lift {lift}");
+            }
+        }
+    }
+
+    #[test]
+    fn free_goal_in_open_space_is_planned_and_timed() {
+        let mut m = Motion::new(1);
+        let goal = TcpGoal { position: [0.6, 0.5, 1.0], approach: [0.0, 1.0, 0.0], x_axis: None };
+        let p = m.plan_free(Arm::Left, 0.2, HOME, &goal, HOME).expect("reachable in open space");
+        assert!(p.duration > 0.1 && p.msg.points.len() > 2);
+        let tcp = m.model(Arm::Left).fk(0.2, &p.goal_q).trans;
+        assert!((0..3).all(|i| (tcp[i] - goal.position[i]).abs() < 2e-3), "{tcp:?}");
+        // Approach 0.1 m along the axis from there: a straight, jerk-limited move.
+        let l = m.plan_linear(Arm::Left, 0.2, p.goal_q, &goal.along(0.1), HOME).expect("short line");
+        let tcp = m.model(Arm::Left).fk(0.2, &l.goal_q).trans;
+        assert!((tcp[1] - 0.6).abs() < 2e-3);
+    }
+}

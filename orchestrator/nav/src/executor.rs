@@ -1,0 +1,439 @@
+//! The navigation executor: what a behaviour-tree navigator does for one goal, as an
+//! explicit state machine. Plan, follow with the local planner, replan when sensed obstacles
+//! close the path or the robot strays from it, latch the goal position and rotate to the
+//! goal yaw, recover when no progress is made, and report why it failed.
+//!
+//! ```text
+//! idle -> planning -> following -> rotating -> succeeded
+//!            ^  |        |  ^         |
+//!            |  +-> failed (no_path)  +-> following (pushed out of the xy tolerance)
+//!            +-- recovering <- (no progress; after max_recoveries: failed "stuck")
+//! ```
+
+use super::astar::{self, PlanError};
+use super::config::NavConfig;
+use super::costmap::{ClearanceGrid, GlobalCostmap};
+use super::dwa::{self, Velocity};
+use super::local_costmap::LocalCostmap;
+use agrisim_math::pose2::{wrap_angle, Pose2};
+use super::tracking::TrackedPath;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum State {
+    Idle,
+    Planning,
+    Following,
+    Rotating,
+    Recovering,
+    Succeeded,
+    Failed,
+}
+
+impl State {
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            State::Idle => "idle",
+            State::Planning => "planning",
+            State::Following => "following",
+            State::Rotating => "rotating",
+            State::Recovering => "recovering",
+            State::Succeeded => "succeeded",
+            State::Failed => "failed",
+        }
+    }
+
+    pub fn is_active(&self) -> bool {
+        matches!(self, State::Planning | State::Following | State::Rotating | State::Recovering)
+    }
+}
+
+/// A navigation goal in the map frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Goal {
+    pub pose: Pose2,
+    /// Whether the final heading matters.
+    pub use_yaw: bool,
+}
+
+/// The costmaps the executor plans and checks against.
+pub struct World<'a> {
+    pub global: &'a mut GlobalCostmap,
+    pub local: &'a mut LocalCostmap,
+}
+
+/// What one tick produced.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TickOutput {
+    /// The command to publish on /cmd_vel, if any.
+    pub cmd: Option<Velocity>,
+    /// A new plan to publish.
+    pub plan: Option<Vec<(f64, f64)>>,
+}
+
+/// Counters for tests and the benchmark's report.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ExecutorStats {
+    pub plans: u64,
+    pub replans_blocked: u64,
+    pub replans_deviation: u64,
+    pub recoveries: u64,
+    pub controller_failures: u64,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Backup {
+    until_ns: i64,
+    /// Base-frame unit direction of the back-off.
+    dir: (f64, f64),
+}
+
+pub struct Executor {
+    cfg: NavConfig,
+    outline: Vec<(f64, f64)>,
+    state: State,
+    detail: String,
+    goal: Option<Goal>,
+    goal_start_ns: i64,
+    path: TrackedPath,
+    last_cmd: Velocity,
+    last_plan_ns: Option<i64>,
+    anchor: (Pose2, i64),
+    rotate_start_ns: i64,
+    recoveries: usize,
+    backup: Option<Backup>,
+    stop_until_ns: i64,
+    pub stats: ExecutorStats,
+    /// Why the last failed plan failed (the status detail stays "no_path").
+    pub last_plan_error: Option<PlanError>,
+}
+
+impl Executor {
+    pub fn new(cfg: &NavConfig) -> Executor {
+        Executor {
+            cfg: *cfg,
+            outline: cfg.robot.footprint.outline(0.05),
+            state: State::Idle,
+            detail: String::new(),
+            goal: None,
+            goal_start_ns: 0,
+            path: TrackedPath::default(),
+            last_cmd: Velocity::ZERO,
+            last_plan_ns: None,
+            anchor: (Pose2::default(), 0),
+            rotate_start_ns: 0,
+            recoveries: 0,
+            backup: None,
+            stop_until_ns: i64::MIN,
+            stats: ExecutorStats::default(),
+            last_plan_error: None,
+        }
+    }
+
+    pub fn state(&self) -> State {
+        self.state
+    }
+
+    pub fn detail(&self) -> &str {
+        &self.detail
+    }
+
+    pub fn goal(&self) -> Option<Goal> {
+        self.goal
+    }
+
+    pub fn path(&self) -> &[(f64, f64)] {
+        &self.path.points
+    }
+
+    /// Starts (or preempts with) a new goal.
+    pub fn set_goal(&mut self, goal: Goal, t_ns: i64) {
+        self.goal = Some(goal);
+        self.goal_start_ns = t_ns;
+        self.recoveries = 0;
+        self.backup = None;
+        self.path = TrackedPath::default();
+        self.last_plan_ns = None;
+        self.set(State::Planning, "");
+    }
+
+    /// Plans again from scratch for the goal in hand (e.g. after a new map), keeping its
+    /// timer and recovery count.
+    pub fn restart_planning(&mut self) {
+        if self.state.is_active() {
+            self.backup = None;
+            self.path = TrackedPath::default();
+            self.last_plan_ns = None;
+            self.set(State::Planning, "");
+        }
+    }
+
+    /// Rejects a goal it cannot take (e.g. wrong frame).
+    pub fn reject(&mut self, goal: Goal, detail: &str, t_ns: i64) {
+        self.goal = Some(goal);
+        self.goal_start_ns = t_ns;
+        self.finish(State::Failed, detail, t_ns);
+    }
+
+    fn set(&mut self, s: State, detail: &str) {
+        self.state = s;
+        self.detail = detail.to_string();
+    }
+
+    fn finish(&mut self, s: State, detail: &str, t_ns: i64) {
+        self.set(s, detail);
+        self.last_cmd = Velocity::ZERO;
+        self.backup = None;
+        self.stop_until_ns = t_ns + (self.cfg.executor.stop_publish_time * 1e9) as i64;
+    }
+
+    /// One control period. `pose` is the localization estimate (map frame); `world` is
+    /// `None` until a map has arrived.
+    pub fn tick(&mut self, t_ns: i64, pose: Option<Pose2>, world: Option<World>) -> TickOutput {
+        let mut out = TickOutput::default();
+        if !self.state.is_active() {
+            if t_ns < self.stop_until_ns {
+                out.cmd = Some(Velocity::ZERO);
+            }
+            return out;
+        }
+        let ec = self.cfg.executor;
+        let goal = self.goal.expect("active without goal");
+        if ec.goal_timeout > 0.0 && (t_ns - self.goal_start_ns) as f64 * 1e-9 > ec.goal_timeout {
+            self.finish(State::Failed, "timeout", t_ns);
+            out.cmd = Some(Velocity::ZERO);
+            return out;
+        }
+        let (Some(pose), Some(world)) = (pose, world) else {
+            let why = if pose.is_none() { "waiting for localization" } else { "waiting for map" };
+            self.set(State::Planning, why);
+            self.last_cmd = Velocity::ZERO;
+            out.cmd = Some(Velocity::ZERO);
+            return out;
+        };
+        let d_goal = pose.dist(&goal.pose);
+        let use_yaw = goal.use_yaw && ec.yaw_goal_tolerance.is_some();
+
+        if self.state == State::Recovering {
+            match self.backup {
+                Some(b) if t_ns < b.until_ns => {
+                    let c = &self.cfg.controller;
+                    let target = Velocity { vx: b.dir.0 * ec.backup_speed, vy: b.dir.1 * ec.backup_speed, wz: 0.0 };
+                    let cmd = step_towards(c, self.last_cmd, target);
+                    // Stop backing into something.
+                    let next = dwa::integrate(&pose, &cmd, 0.5);
+                    let clear = footprint_clearance(&self.outline, &next, &world);
+                    let cmd = if clear < c.collision_margin { dwa::brake(c, self.last_cmd) } else { cmd };
+                    self.last_cmd = cmd;
+                    out.cmd = Some(cmd);
+                    return out;
+                }
+                _ => {
+                    self.backup = None;
+                    self.set(State::Planning, "");
+                }
+            }
+        }
+
+        if self.state == State::Planning && !self.replan(t_ns, &pose, &goal, world.global, world.local, &mut out) {
+            return out;
+        }
+
+        if self.state == State::Rotating {
+            if d_goal > ec.xy_goal_tolerance {
+                self.set(State::Following, "");
+                self.anchor = (pose, t_ns);
+            } else {
+                let stuck = (t_ns - self.rotate_start_ns) as f64 * 1e-9 > 2.0 * ec.progress_timeout;
+                out.cmd = Some(self.settle_yaw(&pose, &goal, &world, t_ns, stuck));
+                return out;
+            }
+        }
+
+        // Following.
+        let deviation = self.path.project(pose.x, pose.y, 2.0);
+        let stalled = (t_ns - self.anchor.1) as f64 * 1e-9 > ec.progress_timeout;
+        if pose.dist(&self.anchor.0) >= ec.progress_radius {
+            self.anchor = (pose, t_ns);
+        }
+        if d_goal <= ec.xy_latch_tolerance || (stalled && d_goal <= ec.xy_goal_tolerance) {
+            self.set(State::Rotating, "");
+            self.rotate_start_ns = t_ns;
+            out.cmd = Some(self.settle_yaw(&pose, &goal, &world, t_ns, false));
+            return out;
+        }
+        if stalled {
+            return self.start_recovery(t_ns, &pose, world, out);
+        }
+        let can_replan = self.last_plan_ns.is_none_or(|t| (t_ns - t) as f64 * 1e-9 >= ec.replan_interval);
+        if can_replan {
+            let blocked = self.path_blocked(world.local);
+            let periodic = ec.periodic_replan > 0.0 && self.last_plan_ns.is_some_and(|t| (t_ns - t) as f64 * 1e-9 >= ec.periodic_replan);
+            if blocked || deviation > ec.max_path_deviation || periodic {
+                if blocked {
+                    self.stats.replans_blocked += 1;
+                } else if deviation > ec.max_path_deviation {
+                    self.stats.replans_deviation += 1;
+                }
+                if !self.replan(t_ns, &pose, &goal, world.global, world.local, &mut out) {
+                    return out;
+                }
+                self.path.project(pose.x, pose.y, 2.0);
+            }
+        }
+
+        let c = &self.cfg.controller;
+        let ia = self.path.index_ahead(c.lookahead);
+        let carrot = self.path.points[ia];
+        let near_goal = self.path.remaining() <= ec.goal_heading_distance.max(1e-9) || d_goal <= ec.goal_heading_distance;
+        let desired_yaw = if near_goal {
+            if use_yaw { goal.pose.yaw } else { pose.yaw }
+        } else {
+            self.path.tangent(ia)
+        };
+        let req = dwa::Request { pose, current: self.last_cmd, path: self.path.ahead(c.lookahead + 0.5), carrot, desired_yaw };
+        let (global, local) = (&*world.global, &*world.local);
+        let grid = ClearanceGrid::from_costmaps(global, local);
+        let d = dwa::dwa(c, &req, &self.outline, |x, y| grid.get(x, y).unwrap_or_else(|| global.distance_at(x, y).min(local.distance_at(x, y))));
+        if !d.valid {
+            self.stats.controller_failures += 1;
+        }
+        self.last_cmd = d.cmd;
+        out.cmd = Some(d.cmd);
+        out
+    }
+
+    /// The rotate phase's command: turn in place if the footprint sweeps clear of obstacles
+    /// on the way to the goal yaw, else let the local planner turn and shift at once (goal as
+    /// carrot, goal yaw as heading) so a long base can still turn near a row.
+    /// At the goal position: succeeded when the yaw is right (or not asked for), failed when
+    /// `stuck`, else the command that turns toward the goal yaw.
+    fn settle_yaw(&mut self, pose: &Pose2, goal: &Goal, world: &World, t_ns: i64, stuck: bool) -> Velocity {
+        let ec = &self.cfg.executor;
+        let use_yaw = goal.use_yaw && ec.yaw_goal_tolerance.is_some();
+        let err = wrap_angle(goal.pose.yaw - pose.yaw);
+        if !use_yaw || err.abs() <= ec.yaw_goal_tolerance.unwrap_or(f64::INFINITY) {
+            self.finish(State::Succeeded, "", t_ns);
+            return Velocity::ZERO;
+        }
+        if stuck {
+            self.finish(State::Failed, "stuck", t_ns);
+            return Velocity::ZERO;
+        }
+        let cmd = self.rotate(pose, goal, err, world);
+        self.last_cmd = cmd;
+        cmd
+    }
+
+    fn rotate(&self, pose: &Pose2, goal: &Goal, err: f64, world: &World) -> Velocity {
+        let c = &self.cfg.controller;
+        let steps = ((err.abs() / 0.05).ceil() as usize).max(1);
+        let sweep_clear = (1..=steps).all(|k| {
+            let p = Pose2::new(pose.x, pose.y, pose.yaw + err * k as f64 / steps as f64);
+            footprint_clearance(&self.outline, &p, world) >= c.collision_margin
+        });
+        if sweep_clear {
+            return dwa::rotate_in_place(c, self.last_cmd, err);
+        }
+        let path = [(pose.x, pose.y), (goal.pose.x, goal.pose.y)];
+        let req = dwa::Request { pose: *pose, current: self.last_cmd, path: &path, carrot: (goal.pose.x, goal.pose.y), desired_yaw: goal.pose.yaw };
+        let grid = ClearanceGrid::from_costmaps(world.global, world.local);
+        let (global, local) = (&*world.global, &*world.local);
+        dwa::dwa(c, &req, &self.outline, |x, y| grid.get(x, y).unwrap_or_else(|| global.distance_at(x, y).min(local.distance_at(x, y)))).cmd
+    }
+
+    /// Plans from `pose` after taking the sensed obstacles into the global costmap. Returns
+    /// false (and fails the goal) when there is no path.
+    fn replan(&mut self, t_ns: i64, pose: &Pose2, goal: &Goal, global: &mut GlobalCostmap, local: &LocalCostmap, out: &mut TickOutput) -> bool {
+        sync_blocked(global, local);
+        self.last_plan_ns = Some(t_ns);
+        self.stats.plans += 1;
+        match astar::plan(global, pose, &goal.pose, &self.cfg.planner) {
+            Ok(pts) => {
+                self.path = TrackedPath::new(pts.clone());
+                out.plan = Some(pts);
+                if self.state != State::Following {
+                    self.anchor = (*pose, t_ns);
+                }
+                self.set(State::Following, "");
+                true
+            }
+            Err(e) => {
+                self.last_plan_error = Some(e);
+                self.finish(State::Failed, "no_path", t_ns);
+                out.cmd = Some(Velocity::ZERO);
+                out.plan = Some(Vec::new());
+                false
+            }
+        }
+    }
+
+    /// Is a sensed obstacle within the inscribed radius of the path ahead?
+    fn path_blocked(&self, local: &LocalCostmap) -> bool {
+        if local.occupied_count() == 0 {
+            return false;
+        }
+        let r = self.cfg.robot.footprint.inscribed_radius();
+        self.path.ahead(self.cfg.executor.blocked_lookahead).iter().any(|&(x, y)| local.center_distance_at(x, y) <= r)
+    }
+
+    /// Clear the local costmap, back off towards the most open side, then replan; fail
+    /// "stuck" when out of attempts.
+    fn start_recovery(&mut self, t_ns: i64, pose: &Pose2, world: World, mut out: TickOutput) -> TickOutput {
+        if self.recoveries >= self.cfg.executor.max_recoveries {
+            self.finish(State::Failed, "stuck", t_ns);
+            out.cmd = Some(Velocity::ZERO);
+            return out;
+        }
+        self.recoveries += 1;
+        self.stats.recoveries += 1;
+        world.local.clear();
+        let ec = self.cfg.executor;
+        let dist = ec.backup_speed * ec.backup_time;
+        let mut best: Option<(f64, (f64, f64))> = None;
+        for k in 0..16 {
+            let a = k as f64 * std::f64::consts::TAU / 16.0;
+            let dir = (a.cos(), a.sin());
+            let mut clear = f64::INFINITY;
+            for s in 1..=4 {
+                let p = pose.compose(&Pose2::new(dir.0 * dist * s as f64 / 4.0, dir.1 * dist * s as f64 / 4.0, 0.0));
+                clear = clear.min(footprint_clearance(&self.outline, &p, &world));
+            }
+            if best.is_none_or(|(b, _)| clear > b + 1e-9) {
+                best = Some((clear, dir));
+            }
+        }
+        let (_, dir) = best.unwrap();
+        self.backup = Some(Backup { until_ns: t_ns + (ec.backup_time * 1e9) as i64, dir });
+        self.anchor = (*pose, t_ns);
+        self.set(State::Recovering, "");
+        self.last_cmd = dwa::brake(&self.cfg.controller, self.last_cmd);
+        out.cmd = Some(self.last_cmd);
+        out
+    }
+}
+
+/// Carries the local costmap's knowledge into the global one: cells seen occupied become
+/// blocked, blocked cells seen free are released.
+pub fn sync_blocked(global: &mut GlobalCostmap, local: &LocalCostmap) {
+    let cells: Vec<(f64, f64, bool)> = local.observed_cells().collect();
+    for (x, y, occ) in cells {
+        if let Some(i) = global.geom.index_of(x, y) {
+            if occ {
+                global.add_blocked(i);
+            } else {
+                global.clear_blocked(i);
+            }
+        }
+    }
+    global.update();
+}
+
+fn footprint_clearance(outline: &[(f64, f64)], p: &Pose2, world: &World) -> f64 {
+    super::footprint::Footprint::clearance(outline, p, |x, y| world.global.distance_at(x, y).min(world.local.distance_at(x, y)))
+}
+
+/// One acceleration-limited step from `current` towards `target`.
+fn step_towards(c: &dwa::ControllerConfig, current: Velocity, target: Velocity) -> Velocity {
+    let lim = |cur: f64, tgt: f64, max: f64, acc: f64| tgt.clamp(-max, max).clamp(cur - acc * c.period, cur + acc * c.period);
+    Velocity { vx: lim(current.vx, target.vx, c.max_vx, c.acc_xy), vy: lim(current.vy, target.vy, c.max_vy, c.acc_xy), wz: lim(current.wz, target.wz, c.max_wz, c.acc_wz) }
+}

@@ -1,0 +1,18 @@
+//! The algorithm layer's nodes: small units that speak only ROS 2 messages (and the
+//! system's scalar inputs), like ROS 2 nodes, so real ROS 2 nodes can later take their place.
+
+mod command_script;
+mod fault_injector;
+mod goal_publisher;
+mod map_server;
+mod odom_tf;
+mod robot_state;
+
+pub use command_script::{BaseCommand, CommandScript, LiftCommand};
+pub use fault_injector::{FaultInjector, Injection};
+pub use goal_publisher::GoalPublisher;
+pub use map_server::MapServer;
+pub use odom_tf::OdomTf;
+pub use robot_state::RobotStatePublisher;
+
+pub use agrisim_bus::Node;

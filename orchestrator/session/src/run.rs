@@ -1,0 +1,123 @@
+//! Building a session from a scenario (`agrisim run`, and every benchmark trial): the system
+//! with the scenario's parameters, the recorder with the run's metadata, the nodes.
+
+use crate::scenario::Scenario;
+use crate::session::{message_types, Session};
+use agrisim_bus::{Node, Recorder};
+use agrisim_cosim::system::ticks_of;
+use agrisim_cosim::{LoadOptions, Master, System};
+use agrisim_error::{err, Context, Result};
+use agrisim_nodes::{CommandScript, FaultInjector, OdomTf};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Everything `agrisim run` needs besides the scenario.
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    pub fmu_dir: PathBuf,
+    pub cache_dir: PathBuf,
+    pub seed: Option<u64>,
+    pub duration: Option<f64>,
+    /// Component -> FMU file (CLI `--fmu chassis=ChassisDynamic.fmu`), on top of the scenario's.
+    pub fmu_overrides: BTreeMap<String, String>,
+}
+
+/// What a finished run reports.
+#[derive(Clone, Debug)]
+pub struct RunSummary {
+    pub mcap: PathBuf,
+    pub steps: u64,
+    pub simulated: f64,
+}
+
+fn load_options(s: &Scenario, o: &RunOptions) -> LoadOptions {
+    let mut fmu_overrides = s.system.fmus.clone();
+    fmu_overrides.extend(o.fmu_overrides.clone());
+    LoadOptions { fmu_dir: o.fmu_dir.clone(), cache_dir: o.cache_dir.clone(), fmu_overrides, step: s.timing.step, message_period: 1.0 / s.timing.message_rate }
+}
+
+/// Start-pose parameters of a mobile base (REP 103, map frame).
+const START_POSE: [&str; 3] = ["x0", "y0", "yaw0"];
+
+/// True when some component of `system` has a settable parameter `name`.
+fn takes_parameter(system: &System, name: &str) -> bool {
+    system.components.iter().any(|c| c.archive.md.variable(name).is_some_and(|v| v.causality.is_settable_parameter()))
+}
+
+/// The scenario's parameters, plus: when the system builds the greenhouse scene (some
+/// component takes the `scene` parameter), every component with start-pose parameters
+/// starts at the layout's predefined initial pose unless the scenario says otherwise.
+fn parameters(s: &Scenario, system: &System) -> Result<BTreeMap<String, BTreeMap<String, toml::Value>>> {
+    let mut params = s.parameters.clone();
+    if takes_parameter(system, "scene") {
+        let start_pose = crate::scene::layout(s)?.start_pose;
+        for c in &system.components {
+            if START_POSE.iter().all(|n| c.archive.md.variable(n).is_some_and(|v| v.causality.is_settable_parameter())) {
+                let start = params.entry(c.name.clone()).or_default();
+                for (name, v) in START_POSE.iter().zip(start_pose) {
+                    start.entry(name.to_string()).or_insert(toml::Value::Float(v));
+                }
+            }
+        }
+    }
+    Ok(params)
+}
+
+/// The nodes of a plain `agrisim run`: the scenario's command script, odom TF, fault injection.
+pub fn default_nodes(s: &Scenario) -> Vec<Box<dyn Node>> {
+    vec![Box::new(CommandScript::new(s.base_commands.clone(), s.lift_commands.clone())), Box::new(OdomTf::default()), Box::new(FaultInjector::new(&s.inject))]
+}
+
+/// Builds the session for a scenario with the algorithm layer's `nodes`, recording to `mcap`.
+/// Setup errors come back before any file is written; from here on the MCAP exists and is
+/// finished whatever happens.
+pub fn prepare(s: &Scenario, o: &RunOptions, mcap: &Path, nodes: Vec<Box<dyn Node>>) -> Result<Session> {
+    let seed = o.seed.unwrap_or(s.seed);
+    let lo = load_options(s, o);
+    let mut system = System::load(&s.system_path(), &lo)?;
+    message_types(&system)?;
+    let params = parameters(s, &system)?;
+    let mut shared = BTreeMap::from([("scene".to_string(), s.scene_toml())]);
+    // The scenario's [environment] (when it has one) for every component with a String
+    // parameter `environment` (the sensors): light and weather, never geometry.
+    let environment = s.environment_toml();
+    if !environment.is_empty() {
+        shared.insert("environment".to_string(), environment);
+    }
+    let applied = system.apply_parameters(&params, seed, &shared)?;
+    let mut recorder = Recorder::create(mcap)?;
+    let mut run_info = BTreeMap::from([
+        ("scenario".to_string(), s.name.clone()),
+        ("scenario_file".to_string(), s.path.display().to_string()),
+        ("system".to_string(), system.structure.name.clone()),
+        ("seed".to_string(), seed.to_string()),
+        ("step".to_string(), format!("{:?}", s.timing.step)),
+        ("message_rate".to_string(), format!("{:?}", s.timing.message_rate)),
+    ]);
+    for c in &system.components {
+        run_info.insert(format!("fmu.{}", c.name), c.archive.md.model_name.clone());
+    }
+    recorder.metadata("agrisim.run", run_info)?;
+    for (comp, params) in applied {
+        recorder.metadata(&format!("agrisim.parameters.{comp}"), params)?;
+    }
+    let master = Master::new(system, s.timing.step, lo.message_period)?;
+    let mut session = Session::new(master, nodes, recorder)?;
+    session.master.initialize()?;
+    Ok(session)
+}
+
+/// Runs a scenario into `out_dir/run.mcap`.
+pub fn run(s: &Scenario, o: &RunOptions, out_dir: &Path, progress: impl FnMut(u64, u64)) -> Result<RunSummary> {
+    std::fs::create_dir_all(out_dir).context(|| format!("cannot create {}", out_dir.display()))?;
+    let mcap = out_dir.join("run.mcap");
+    let duration = o.duration.unwrap_or(s.duration);
+    let steps = ticks_of(duration, s.timing.step, "duration").or_else(|_| -> Result<u64> { Err(err!("duration {duration} s is not a whole number of {} s steps", s.timing.step)) })?;
+    let mut session = prepare(s, o, &mcap, default_nodes(s))?;
+    let mut progress = progress;
+    let result = session.run(steps, |k| progress(k, steps));
+    let finish = session.recorder_finish();
+    result?;
+    finish?;
+    Ok(RunSummary { mcap, steps, simulated: steps as f64 * s.timing.step })
+}

@@ -1,0 +1,211 @@
+//! Scenario files (TOML, models/scenarios/): which system to run, timing, seed, parameter
+//! overrides per component, and the scripted inputs of a plain `agrisim run`.
+//!
+//! Unknown keys are errors (a typo must not silently fall back to a default).
+
+use agrisim_error::{Context, Result};
+use serde::Deserialize;
+pub use agrisim_nodes::{BaseCommand, Injection, LiftCommand};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    #[serde(default = "default_name")]
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    /// Master seed: every component's `seed` parameter is derived from it.
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// Simulated duration of `agrisim run` [s].
+    #[serde(default = "default_duration")]
+    pub duration: f64,
+    #[serde(default)]
+    pub timing: Timing,
+    pub system: SystemRef,
+    /// The greenhouse (agrisim_greenhouse::GreenhouseConfig keys). Passed verbatim, as TOML
+    /// text, to every component with a String parameter `scene`, so all of them build the
+    /// same scene. Its `seed` (the scene's layout seed) defaults to the scenario's seed.
+    #[serde(default)]
+    pub greenhouse: toml::Table,
+    /// Sun, weather and render quality (agrisim_greenhouse::environment keys). Passed as TOML
+    /// text to every component with a String parameter `environment` (the camera and the
+    /// LiDAR); changes images and ranges, never the scene's geometry. Absent = the sensors'
+    /// fixed defaults.
+    #[serde(default)]
+    pub environment: Option<toml::Table>,
+    /// Navigation benchmark settings.
+    #[serde(default)]
+    pub nav: NavSettings,
+    /// Parameter overrides: component name -> parameter name -> value.
+    #[serde(default)]
+    pub parameters: BTreeMap<String, BTreeMap<String, toml::Value>>,
+    /// Timed base velocity commands (base frame, REP 103), published on /cmd_vel.
+    #[serde(default)]
+    pub base_commands: Vec<BaseCommand>,
+    /// Timed lift position set-points.
+    #[serde(default)]
+    pub lift_commands: Vec<LiftCommand>,
+    /// Fault injection: raw bytes published on a topic at a time (robustness tests).
+    #[serde(default)]
+    pub inject: Vec<Injection>,
+    /// Where the file was read from (relative paths resolve against its directory).
+    #[serde(skip)]
+    pub path: PathBuf,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Timing {
+    /// Master communication step [s].
+    #[serde(default = "default_step")]
+    pub step: f64,
+    /// Rate of message connections [Hz] (those without their own period in the system file).
+    #[serde(default = "default_message_rate")]
+    pub message_rate: f64,
+}
+
+impl Default for Timing {
+    fn default() -> Self {
+        Timing { step: default_step(), message_rate: default_message_rate() }
+    }
+}
+
+/// `[nav]`: how navigation trials are set up and judged.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct NavSettings {
+    /// Simulated time limit of a trial [s].
+    pub trial_timeout: f64,
+    /// Success radius around the target for the ground-truth base centre [m] (Nav2's default).
+    pub goal_tolerance: f64,
+    /// Where targets are drawn: aisles and the headland.
+    pub targets_in_headland: bool,
+    /// Keep targets at least this far from the aisle ends [m].
+    pub aisle_margin: f64,
+}
+
+impl Default for NavSettings {
+    fn default() -> Self {
+        NavSettings { trial_timeout: 120.0, goal_tolerance: 0.25, targets_in_headland: true, aisle_margin: 1.0 }
+    }
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SystemRef {
+    /// SSP SystemStructure.ssd, relative to the scenario file.
+    pub file: PathBuf,
+    /// Component -> FMU file override (e.g. `chassis = "ChassisDynamic.fmu"`).
+    #[serde(default)]
+    pub fmus: BTreeMap<String, String>,
+}
+
+fn default_name() -> String {
+    "unnamed".into()
+}
+fn default_seed() -> u64 {
+    1
+}
+fn default_duration() -> f64 {
+    20.0
+}
+fn default_step() -> f64 {
+    0.02
+}
+fn default_message_rate() -> f64 {
+    10.0
+}
+
+impl Scenario {
+    pub fn load(path: &Path) -> Result<Scenario> {
+        let text = std::fs::read_to_string(path).context(|| format!("cannot read scenario {}", path.display()))?;
+        Self::parse(&text, path)
+    }
+
+    pub fn parse(text: &str, path: &Path) -> Result<Scenario> {
+        let mut s: Scenario = toml::from_str(text).context(|| format!("scenario {}", path.display()))?;
+        s.path = path.to_path_buf();
+        s.validate()?;
+        Ok(s)
+    }
+
+    fn validate(&self) -> Result<()> {
+        let file = self.path.display();
+        let positive = |v: f64| v.is_finite() && v > 0.0;
+        if !positive(self.duration) {
+            return Err(agrisim_error::err!("scenario {file}: duration must be positive, got {}", self.duration));
+        }
+        if !positive(self.timing.step) || !positive(self.timing.message_rate) {
+            return Err(agrisim_error::err!("scenario {file}: timing.step and timing.message_rate must be positive"));
+        }
+        for (i, c) in self.base_commands.iter().enumerate() {
+            if !(c.t.is_finite() && c.t >= 0.0 && c.vx.is_finite() && c.vy.is_finite() && c.wz.is_finite()) {
+                return Err(agrisim_error::err!("scenario {file}: base_commands[{i}] has a negative or non-finite value"));
+            }
+            if i > 0 && c.t < self.base_commands[i - 1].t {
+                return Err(agrisim_error::err!("scenario {file}: base_commands[{i}].t goes back in time"));
+            }
+        }
+        for (i, c) in self.lift_commands.iter().enumerate() {
+            if !(c.t.is_finite() && c.t >= 0.0 && c.position.is_finite()) || (i > 0 && c.t < self.lift_commands[i - 1].t) {
+                return Err(agrisim_error::err!("scenario {file}: lift_commands[{i}] is not finite, negative or out of order"));
+            }
+        }
+        if self.environment.is_some() {
+            agrisim_greenhouse::environment::Environment::from_toml_str(&self.environment_toml())
+                .map_err(|e| agrisim_error::err!("scenario {file}: [environment]: {e}"))?;
+        }
+        for inj in &self.inject {
+            inj.bytes().map_err(|e| agrisim_error::err!("scenario {file}: {e}"))?;
+        }
+        Ok(())
+    }
+
+    /// The `[greenhouse]` section as TOML text, with its layout `seed` filled in.
+    pub fn scene_toml(&self) -> String {
+        let mut t = self.greenhouse.clone();
+        t.entry("seed").or_insert(toml::Value::Integer(self.seed as i64));
+        toml::to_string(&t).expect("a TOML table serializes")
+    }
+
+    /// The `[environment]` section as TOML text; empty when the scenario has none.
+    pub fn environment_toml(&self) -> String {
+        self.environment.as_ref().map_or(String::new(), |t| toml::to_string(t).expect("a TOML table serializes"))
+    }
+
+    /// The system file, resolved against the scenario's directory.
+    pub fn system_path(&self) -> PathBuf {
+        self.path.parent().unwrap_or(Path::new(".")).join(&self.system.file)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unknown_keys_are_errors_naming_the_file() {
+        let e = Scenario::parse("[system]\nfile = \"a.ssd\"\nduraton = 3\n", Path::new("x.toml")).unwrap_err();
+        assert!(e.0.contains("x.toml") && e.0.contains("duraton"), "{e}");
+    }
+
+    #[test]
+    fn defaults_are_the_papers_timing() {
+        let s = Scenario::parse("[system]\nfile = \"a.ssd\"\n", Path::new("dir/x.toml")).unwrap();
+        assert_eq!((s.timing.step, s.timing.message_rate), (0.02, 10.0));
+        assert_eq!(s.system_path(), Path::new("dir/a.ssd"));
+    }
+
+    #[test]
+    fn environment_is_validated_naming_the_key() {
+        let e = Scenario::parse("[system]\nfile = \"a.ssd\"\n[environment]\nweather = \"fog\"\nhumidity = 140.0\n", Path::new("x.toml")).unwrap_err();
+        assert!(e.0.contains("x.toml") && e.0.contains("environment") && e.0.contains("humidity"), "{e}");
+        let s = Scenario::parse("[system]\nfile = \"a.ssd\"\n[environment]\nweather = \"fog\"\n", Path::new("x.toml")).unwrap();
+        assert_eq!(s.environment_toml().trim(), "weather = \"fog\"");
+        let s = Scenario::parse("[system]\nfile = \"a.ssd\"\n", Path::new("x.toml")).unwrap();
+        assert_eq!(s.environment_toml(), "");
+    }
+}

@@ -1,0 +1,185 @@
+//! A session: the engine's system coupled to the message bus, the algorithm nodes and the
+//! MCAP recorder. This is where the two lower layers meet; neither knows the other.
+//!
+//! At each communication point the engine hands every message it moves to the session,
+//! which checks it against the ROS 2 type its port declares and publishes it on the bus;
+//! nodes run at message instants; the point's messages, /clock, the scalar system inputs and
+//! every FMU's scalar signals are recorded at the point's time.
+
+use agrisim_bus::check::{check_message, message_type};
+use agrisim_bus::{Bus, Node, Recorder};
+use agrisim_cosim::{Hooks, Master, Port, System};
+use agrisim_error::{err, Error, Result};
+use agrisim_msgs::agrisim::{FmuStatus, Signals};
+use agrisim_msgs::builtin_interfaces::Time;
+use agrisim_msgs::rosgraph_msgs::Clock;
+use agrisim_msgs::std_msgs::Header;
+
+pub const STATUS_TOPIC: &str = "/agrisim/status";
+/// Scalar system connectors (set by nodes or FMU outputs) recorded every step.
+pub const SCALARS_TOPIC: &str = "/agrisim/scalars";
+
+pub struct Session {
+    pub master: Master,
+    pub bus: Bus,
+    pub nodes: Vec<Box<dyn Node>>,
+    pub recorder: Recorder,
+    /// The ROS 2 type of each route's messages (None: a scalar route).
+    types: Vec<Option<String>>,
+    /// Wall time of each node's last step [s]: a speed statistic for reports, never an input.
+    node_wall: Vec<f64>,
+}
+
+/// The ROS 2 message type of every route of `system`, from its ports' mimeTypes; an error
+/// names the system file and connection whose mimeType names no ROS 2 type.
+pub fn message_types(system: &System) -> Result<Vec<Option<String>>> {
+    let file = system.structure.path.display().to_string();
+    system.routes.iter().map(|r| r.mime_type.as_deref().map(|m| message_type(m, &file, &r.label)).transpose()).collect()
+}
+
+impl Session {
+    pub fn new(master: Master, nodes: Vec<Box<dyn Node>>, recorder: Recorder) -> Result<Session> {
+        let types = message_types(&master.system)?;
+        let node_wall = vec![0.0; nodes.len()];
+        Ok(Session { master, bus: Bus::default(), nodes, recorder, types, node_wall })
+    }
+
+    pub fn time(&self) -> f64 {
+        self.master.time()
+    }
+
+    pub fn system(&mut self) -> &mut System {
+        &mut self.master.system
+    }
+
+    /// The index of component `name`, or an error saying who needed it.
+    pub fn component(&self, name: &str, who: &str) -> Result<usize> {
+        self.master.system.component_index(name).ok_or_else(|| err!("{who}: the system has no component '{name}'"))
+    }
+
+    /// A numeric FMU variable (ground truth a judge reads; nodes never see it).
+    pub fn number(&mut self, comp: usize, name: &str) -> Result<f64> {
+        self.master.system.number(comp, name)
+    }
+
+    /// Wall time of the last step of node `name` [s] (for speed statistics only).
+    pub fn node_wall(&self, name: &str) -> Option<f64> {
+        self.nodes.iter().position(|n| n.name() == name).map(|i| self.node_wall[i])
+    }
+
+    fn split(&mut self) -> (&mut Master, Link<'_>) {
+        (&mut self.master, Link { bus: &mut self.bus, nodes: &mut self.nodes, recorder: &mut self.recorder, types: &self.types, node_wall: &mut self.node_wall })
+    }
+
+    /// One communication point and one step of every FMU. Callers that drive the session
+    /// step by step (benchmarks deciding when a trial ends) call [`Session::finish_point`]
+    /// at the end, and [`Session::record_failure`] on an error.
+    pub fn advance(&mut self) -> Result<()> {
+        let (master, mut link) = self.split();
+        master.advance(&mut link)
+    }
+
+    /// Final point: outputs of the last step reach the bus and the log.
+    pub fn finish_point(&mut self) -> Result<()> {
+        let (master, mut link) = self.split();
+        master.finish_point(&mut link)
+    }
+
+    /// Runs `ticks` communication steps. On an error, it is recorded on /agrisim/status
+    /// (the MCAP stays complete and readable) and returned.
+    pub fn run(&mut self, ticks: u64, mut progress: impl FnMut(u64)) -> Result<()> {
+        let result = (|| {
+            for _ in 0..ticks {
+                self.advance()?;
+                progress(self.master.tick());
+            }
+            self.finish_point()
+        })();
+        if let Err(e) = &result {
+            self.record_failure(e);
+        }
+        result
+    }
+
+    /// Finishes the MCAP (summary, footer). Dropping the session does it too, silently.
+    pub fn recorder_finish(&mut self) -> Result<()> {
+        self.recorder.finish_in_place()
+    }
+
+    /// Records an error on /agrisim/status (the MCAP stays complete and readable).
+    pub fn record_failure(&mut self, e: &Error) {
+        let t_ns = self.master.time_ns();
+        let msg = FmuStatus { header: Header { stamp: Time::from_nanos(t_ns), frame_id: String::new() }, instance: String::new(), status: "error".into(), message: e.to_string() };
+        let _ = self.recorder.publish(STATUS_TOPIC, t_ns, &msg);
+    }
+}
+
+/// The session's side of the engine's [`Hooks`].
+struct Link<'a> {
+    bus: &'a mut Bus,
+    nodes: &'a mut Vec<Box<dyn Node>>,
+    recorder: &'a mut Recorder,
+    types: &'a [Option<String>],
+    node_wall: &'a mut [f64],
+}
+
+impl Hooks for Link<'_> {
+    fn message(&mut self, system: &System, route: usize, t_ns: i64, bytes: &[u8]) -> Result<()> {
+        let r = &system.routes[route];
+        let ty = self.types[route].as_deref().expect("message routes have a type (checked in Session::new)");
+        if let Port::Fmu { comp, var, .. } = &r.from {
+            check_message(&system.components[*comp].name, &var.name, ty, bytes, t_ns)?;
+        }
+        self.bus.publish_raw(&r.topic, ty, t_ns, bytes.to_vec());
+        Ok(())
+    }
+
+    fn scalar(&mut self, connector: &str, value: f64) {
+        self.bus.set_scalar(connector, value);
+    }
+
+    fn exchange(&mut self, t_ns: i64, message_instant: bool) -> Result<()> {
+        if message_instant {
+            for (n, wall) in self.nodes.iter_mut().zip(self.node_wall.iter_mut()) {
+                let start = std::time::Instant::now();
+                n.step(t_ns, self.bus).map_err(|e| err!("node {} at t={}: {e}", n.name(), t_ns as f64 / 1e9))?;
+                *wall = start.elapsed().as_secs_f64();
+            }
+        }
+        Ok(())
+    }
+
+    fn message_input(&mut self, connector: &str, seen: &mut i64) -> Option<Vec<u8>> {
+        match self.bus.latest(connector) {
+            Some(sample) if sample.seq as i64 > *seen => {
+                *seen = sample.seq as i64;
+                Some(sample.cdr.clone())
+            }
+            _ => None,
+        }
+    }
+
+    fn scalar_input(&self, connector: &str) -> Option<f64> {
+        self.bus.scalar(connector)
+    }
+
+    fn point(&mut self, system: &mut System, t_ns: i64) -> Result<()> {
+        for m in self.bus.drain() {
+            let ch = self.recorder.channel(&m.topic, &m.type_name)?;
+            self.recorder.write(ch, m.time_ns, &m.cdr)?;
+        }
+        self.recorder.publish("/clock", t_ns, &Clock { clock: Time::from_nanos(t_ns) })?;
+        if !self.bus.scalars().is_empty() {
+            let (names, values) = self.bus.scalars().iter().map(|(k, v)| (k.clone(), *v)).unzip();
+            let msg = Signals { header: Header { stamp: Time::from_nanos(t_ns), frame_id: String::new() }, names, values };
+            self.recorder.publish(SCALARS_TOPIC, t_ns, &msg)?;
+        }
+        for c in &mut system.components {
+            let mut values = Vec::new();
+            c.read_signals(&mut values)?;
+            let msg = Signals { header: Header { stamp: Time::from_nanos(t_ns), frame_id: String::new() }, names: c.signals.iter().map(|v| v.name.clone()).collect(), values };
+            self.recorder.publish(&format!("/fmu/{}/signals", c.name), t_ns, &msg)?;
+        }
+        Ok(())
+    }
+}
