@@ -83,7 +83,12 @@ impl Bus {
     }
 
     pub fn set_scalar(&mut self, name: &str, value: f64) {
-        self.scalars.insert(name.to_string(), value);
+        match self.scalars.get_mut(name) {
+            Some(v) => *v = value,
+            None => {
+                self.scalars.insert(name.to_string(), value);
+            }
+        }
     }
 
     pub fn scalar(&self, name: &str) -> Option<f64> {

@@ -156,17 +156,22 @@ impl Master {
         let t_ns = k as i64 * self.step_ns;
         for r in 0..self.system.routes.len() {
             let route = &self.system.routes[r];
-            if k % route.period_ticks != 0 {
+            if k % route.period_ticks != 0 || !matches!(route.to, Port::Bus { .. }) {
                 continue;
             }
-            let (Port::Fmu { comp, var, seq }, Port::Bus { topic }) = (&route.from, &route.to) else { continue };
-            let (comp, var, is_message, topic) = (*comp, var.clone(), seq.is_some(), topic.clone());
-            if is_message {
-                if let Some(bytes) = self.take_message(r)? {
-                    hooks.message(&self.system, r, t_ns, &bytes)?;
+            match &route.from {
+                Port::Fmu { seq: Some(_), .. } => {
+                    if let Some(bytes) = self.take_message(r)? {
+                        hooks.message(&self.system, r, t_ns, &bytes)?;
+                    }
                 }
-            } else if let Some(x) = value::get(&mut self.system.components[comp].instance, &var)?.as_f64() {
-                hooks.scalar(&topic, x);
+                Port::Fmu { comp, var, seq: None } => {
+                    let Port::Bus { topic } = &route.to else { unreachable!("checked above") };
+                    if let Some(x) = value::get(&mut self.system.components[*comp].instance, var)?.as_f64() {
+                        hooks.scalar(topic, x);
+                    }
+                }
+                Port::Bus { .. } => {}
             }
         }
         Ok(())
@@ -178,38 +183,38 @@ impl Master {
         let t_ns = k as i64 * self.step_ns;
         for r in 0..self.system.routes.len() {
             let route = &self.system.routes[r];
-            if k % route.period_ticks != 0 {
+            if k % route.period_ticks != 0 || !matches!(route.to, Port::Fmu { .. }) {
                 continue;
             }
-            let Port::Fmu { comp: dst, var: dst_var, seq: dst_seq } = route.to.clone() else { continue };
-            let value = match route.from.clone() {
-                Port::Bus { topic } => match &dst_seq {
-                    Some(_) => {
+            let value = match &route.from {
+                Port::Bus { topic } => match &route.to {
+                    Port::Fmu { seq: Some(_), .. } => {
                         let mut seen = route.seen;
-                        let bytes = hooks.message_input(&topic, &mut seen);
+                        let bytes = hooks.message_input(topic, &mut seen);
                         self.system.routes[r].seen = seen;
                         bytes.map(Value::Bin)
                     }
-                    None => hooks.scalar_input(&topic).map(|x| scalar_for(&dst_var, x)).transpose()?,
+                    Port::Fmu { var, .. } => hooks.scalar_input(topic).map(|x| scalar_for(var, x)).transpose()?,
+                    Port::Bus { .. } => None,
                 },
-                Port::Fmu { comp: src, var, seq } => match seq {
-                    Some(_) => match self.take_message(r)? {
-                        Some(bytes) => {
-                            hooks.message(&self.system, r, t_ns, &bytes)?;
-                            Some(Value::Bin(bytes))
-                        }
-                        None => None,
-                    },
-                    None => Some(value::get(&mut self.system.components[src].instance, &var)?),
+                Port::Fmu { seq: Some(_), .. } => match self.take_message(r)? {
+                    Some(bytes) => {
+                        hooks.message(&self.system, r, t_ns, &bytes)?;
+                        Some(Value::Bin(bytes))
+                    }
+                    None => None,
                 },
+                Port::Fmu { comp, var, seq: None } => Some(value::get(&mut self.system.components[*comp].instance, var)?),
             };
             let Some(value) = value else { continue };
-            let inst = &mut self.system.components[dst].instance;
-            value::set(inst, &dst_var, &value)?;
+            let System { routes, components, .. } = &mut self.system;
+            let route = &mut routes[r];
+            let Port::Fmu { comp: dst, var: dst_var, seq: dst_seq } = &route.to else { unreachable!("checked above") };
+            let inst = &mut components[*dst].instance;
+            value::set(inst, dst_var, &value)?;
             if let Some(seq) = dst_seq {
-                let n = self.system.routes[r].written + 1;
-                self.system.routes[r].written = n;
-                value::set(inst, &seq, &Value::I64(n))?;
+                route.written += 1;
+                value::set(inst, seq, &Value::I64(route.written))?;
             }
         }
         Ok(())
@@ -218,16 +223,16 @@ impl Master {
     /// The new message of route `r`'s FMU source, if its counter moved since the route last
     /// looked.
     fn take_message(&mut self, r: usize) -> Result<Option<Vec<u8>>> {
-        let route = &self.system.routes[r];
+        let System { routes, components, .. } = &mut self.system;
+        let route = &mut routes[r];
         let Port::Fmu { comp, var, seq: Some(seq) } = &route.from else { return Ok(None) };
-        let (comp, var, seq) = (*comp, var.clone(), seq.clone());
-        let inst = &mut self.system.components[comp].instance;
-        let Value::I64(n) = value::get(inst, &seq)? else { unreachable!("counter is Int64") };
+        let inst = &mut components[*comp].instance;
+        let Value::I64(n) = value::get(inst, seq)? else { unreachable!("counter is Int64") };
         if n == route.seen {
             return Ok(None);
         }
-        let Value::Bin(bytes) = value::get(inst, &var)? else { unreachable!("message port is Binary") };
-        self.system.routes[r].seen = n;
+        let Value::Bin(bytes) = value::get(inst, var)? else { unreachable!("message port is Binary") };
+        route.seen = n;
         Ok(Some(bytes))
     }
 

@@ -42,39 +42,58 @@ pub struct Component {
     pub instance: Instance,
     /// Scalar inputs and outputs, recorded every step.
     pub signals: Vec<ModelVariable>,
+    /// [`Component::signals`] grouped by type: (type, their indices, their value references),
+    /// built once so reading them every step allocates nothing but the values.
+    signal_groups: Vec<(VarType, Vec<usize>, Vec<u32>)>,
 }
 
 impl Component {
+    pub fn new(name: String, archive: FmuArchive, instance: Instance) -> Component {
+        let signals: Vec<ModelVariable> = archive
+            .md
+            .variables
+            .iter()
+            .filter(|v| matches!(v.causality, Causality::Input | Causality::Output))
+            .filter(|v| matches!(v.ty, VarType::Float64 | VarType::Int32 | VarType::Int64 | VarType::Boolean))
+            .cloned()
+            .collect();
+        let signal_groups = [VarType::Float64, VarType::Int32, VarType::Int64, VarType::Boolean]
+            .into_iter()
+            .map(|ty| {
+                let idx: Vec<usize> = (0..signals.len()).filter(|&i| signals[i].ty == ty).collect();
+                let vrs = idx.iter().map(|&i| signals[i].value_reference).collect();
+                (ty, idx, vrs)
+            })
+            .filter(|(_, idx, _)| !idx.is_empty())
+            .collect();
+        Component { name, archive, instance, signals, signal_groups }
+    }
+
     /// Current values of all [`Component::signals`], in their order, read with one call per
     /// type (the recorder does this every step, so FFI round trips matter).
     pub fn read_signals(&mut self, out: &mut Vec<f64>) -> Result<()> {
         out.clear();
         out.resize(self.signals.len(), 0.0);
-        for ty in [VarType::Float64, VarType::Int32, VarType::Int64, VarType::Boolean] {
-            let idx: Vec<usize> = (0..self.signals.len()).filter(|&i| self.signals[i].ty == ty).collect();
-            if idx.is_empty() {
-                continue;
-            }
-            let vrs: Vec<u32> = idx.iter().map(|&i| self.signals[i].value_reference).collect();
+        for (ty, idx, vrs) in &self.signal_groups {
             match ty {
                 VarType::Float64 => {
                     let mut v = vec![0.0; vrs.len()];
-                    self.instance.get_f64(&vrs, &mut v)?;
+                    self.instance.get_f64(vrs, &mut v)?;
                     idx.iter().zip(v).for_each(|(&i, x)| out[i] = x);
                 }
                 VarType::Int32 => {
                     let mut v = vec![0; vrs.len()];
-                    self.instance.get_i32(&vrs, &mut v)?;
+                    self.instance.get_i32(vrs, &mut v)?;
                     idx.iter().zip(v).for_each(|(&i, x)| out[i] = x as f64);
                 }
                 VarType::Int64 => {
                     let mut v = vec![0; vrs.len()];
-                    self.instance.get_i64(&vrs, &mut v)?;
+                    self.instance.get_i64(vrs, &mut v)?;
                     idx.iter().zip(v).for_each(|(&i, x)| out[i] = x as f64);
                 }
                 _ => {
                     let mut v = vec![false; vrs.len()];
-                    self.instance.get_bool(&vrs, &mut v)?;
+                    self.instance.get_bool(vrs, &mut v)?;
                     idx.iter().zip(v).for_each(|(&i, x)| out[i] = x as u8 as f64);
                 }
             }
@@ -154,15 +173,7 @@ impl System {
         for c in &structure.components {
             let archive = archives.remove(&c.name).expect("opened above");
             let instance = Instance::instantiate(&archive, &c.name, true)?;
-            let signals = archive
-                .md
-                .variables
-                .iter()
-                .filter(|v| matches!(v.causality, Causality::Input | Causality::Output))
-                .filter(|v| matches!(v.ty, VarType::Float64 | VarType::Int32 | VarType::Int64 | VarType::Boolean))
-                .cloned()
-                .collect();
-            components.push(Component { name: c.name.clone(), archive, instance, signals });
+            components.push(Component::new(c.name.clone(), archive, instance));
         }
         let mut sys = System { structure, components, routes: vec![] };
         sys.routes = sys.build_routes(opts)?;

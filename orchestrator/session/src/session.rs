@@ -28,6 +28,10 @@ pub struct Session {
     types: Vec<Option<String>>,
     /// Wall time of each node's last step [s]: a speed statistic for reports, never an input.
     node_wall: Vec<f64>,
+    /// What is recorded every point, built once: per FMU its signals topic and message (the
+    /// values and stamp change), and the scalar system inputs' message.
+    signals: Vec<(String, Signals)>,
+    scalars: Signals,
 }
 
 /// The ROS 2 message type of every route of `system`, from its ports' mimeTypes; an error
@@ -41,7 +45,13 @@ impl Session {
     pub fn new(master: Master, nodes: Vec<Box<dyn Node>>, recorder: Recorder) -> Result<Session> {
         let types = message_types(&master.system)?;
         let node_wall = vec![0.0; nodes.len()];
-        Ok(Session { master, bus: Bus::default(), nodes, recorder, types, node_wall })
+        let signals = master
+            .system
+            .components
+            .iter()
+            .map(|c| (format!("/fmu/{}/signals", c.name), Signals { header: Header::default(), names: c.signals.iter().map(|v| v.name.clone()).collect(), values: Vec::new() }))
+            .collect();
+        Ok(Session { master, bus: Bus::default(), nodes, recorder, types, node_wall, signals, scalars: Signals::default() })
     }
 
     pub fn time(&self) -> f64 {
@@ -68,7 +78,7 @@ impl Session {
     }
 
     fn split(&mut self) -> (&mut Master, Link<'_>) {
-        (&mut self.master, Link { bus: &mut self.bus, nodes: &mut self.nodes, recorder: &mut self.recorder, types: &self.types, node_wall: &mut self.node_wall })
+        (&mut self.master, Link { bus: &mut self.bus, nodes: &mut self.nodes, recorder: &mut self.recorder, types: &self.types, node_wall: &mut self.node_wall, signals: &mut self.signals, scalars: &mut self.scalars })
     }
 
     /// One communication point and one step of every FMU. Callers that drive the session
@@ -121,6 +131,8 @@ struct Link<'a> {
     recorder: &'a mut Recorder,
     types: &'a [Option<String>],
     node_wall: &'a mut [f64],
+    signals: &'a mut [(String, Signals)],
+    scalars: &'a mut Signals,
 }
 
 impl Hooks for Link<'_> {
@@ -169,16 +181,22 @@ impl Hooks for Link<'_> {
             self.recorder.write(ch, m.time_ns, &m.cdr)?;
         }
         self.recorder.publish("/clock", t_ns, &Clock { clock: Time::from_nanos(t_ns) })?;
-        if !self.bus.scalars().is_empty() {
-            let (names, values) = self.bus.scalars().iter().map(|(k, v)| (k.clone(), *v)).unzip();
-            let msg = Signals { header: Header { stamp: Time::from_nanos(t_ns), frame_id: String::new() }, names, values };
-            self.recorder.publish(SCALARS_TOPIC, t_ns, &msg)?;
+        let stamp = Header { stamp: Time::from_nanos(t_ns), frame_id: String::new() };
+        let scalars = self.bus.scalars();
+        if !scalars.is_empty() {
+            // Scalar connectors are only ever added, so the same count means the same names.
+            if self.scalars.names.len() != scalars.len() {
+                self.scalars.names = scalars.keys().cloned().collect();
+            }
+            self.scalars.values.clear();
+            self.scalars.values.extend(scalars.values());
+            self.scalars.header = stamp.clone();
+            self.recorder.publish(SCALARS_TOPIC, t_ns, &*self.scalars)?;
         }
-        for c in &mut system.components {
-            let mut values = Vec::new();
-            c.read_signals(&mut values)?;
-            let msg = Signals { header: Header { stamp: Time::from_nanos(t_ns), frame_id: String::new() }, names: c.signals.iter().map(|v| v.name.clone()).collect(), values };
-            self.recorder.publish(&format!("/fmu/{}/signals", c.name), t_ns, &msg)?;
+        for (c, (topic, msg)) in system.components.iter_mut().zip(self.signals.iter_mut()) {
+            c.read_signals(&mut msg.values)?;
+            msg.header = stamp.clone();
+            self.recorder.publish(topic, t_ns, msg)?;
         }
         Ok(())
     }
