@@ -206,15 +206,25 @@ class SystemFile:
     connectors: dict[str, str]  # system connector name -> "Binary" / "Real" / ...
 
 
+TOPIC_ANNOTATION = "org.agrisim.topic"
+
+
 def parse_ssd(path: Path) -> SystemFile:
+    """The system file as the master needs it. System connectors are named by their topic
+    (the `org.agrisim.topic` annotation, as the orchestrator reads it; else their name)."""
     root = ET.parse(path).getroot()
     system = root.find("ssd:System", NS)
     assert system is not None, f"{path}: no ssd:System"
     comps = [(c.get("name"), c.get("source")) for c in system.findall("ssd:Elements/ssd:Component", NS)]
-    connectors = {}
+    connectors, topic_of = {}, {}
     for c in system.findall("ssd:Connectors/ssd:Connector", NS):
+        topic = c.get("name")
+        for ann in c.findall("ssd:Annotations/ssc:Annotation", NS):
+            if ann.get("type") == TOPIC_ANNOTATION:
+                topic = next(n.get("name") for n in ann.iter() if n is not ann and n.get("name"))
+        topic_of[c.get("name")] = topic
         kind = next(iter(c), None)
-        connectors[c.get("name")] = kind.tag.split("}")[1] if kind is not None else ""
+        connectors[topic] = kind.tag.split("}")[1] if kind is not None else ""
     conns = []
     for c in system.findall("ssd:Connections/ssd:Connection", NS):
         period = None
@@ -223,8 +233,12 @@ def parse_ssd(path: Path) -> SystemFile:
                 p = next((n.get("period") for n in ann.iter() if n.get("period") is not None), None)
                 assert p is not None, f"{path}: exchange annotation without period"
                 period = float(p)
-        conns.append(Connection(Endpoint(c.get("startElement") or None, c.get("startConnector")),
-                                Endpoint(c.get("endElement") or None, c.get("endConnector")), period))
+
+        def endpoint(el: str, conn: str) -> Endpoint:
+            element, name = c.get(el) or None, c.get(conn)
+            return Endpoint(element, name if element else topic_of.get(name, name))
+
+        conns.append(Connection(endpoint("startElement", "startConnector"), endpoint("endElement", "endConnector"), period))
     return SystemFile(comps, conns, connectors)
 
 

@@ -88,7 +88,7 @@ def test_fmpy_master_reproduces_decimated_exchange(tmp_path):
     out every 0.2 s, commands in every 0.3 s, the lift -> chassis physics coupling every 0.06 s
     (with the dynamic chassis, whose physics uses the payload)."""
     scenario, ssd = annotated_scenario(tmp_path, {
-        ("odom", "/odom"): 0.2, ("/cmd_vel", "cmd_vel"): 0.3,
+        ("odom", "odom"): 0.2, ("cmd_vel", "cmd_vel"): 0.3,
         ("payload_mass", "payload_mass"): 0.06, ("payload_height", "payload_height"): 0.06})
     rec, m = reproduce(tmp_path / "out", "--fmu", "chassis=ChassisDynamic.fmu", overrides={"chassis": "ChassisDynamic.fmu"},
                        scenario=scenario, ssd=ssd)

@@ -99,7 +99,7 @@ def test_default_run_timing(tmp_path):
 
 
 def test_annotated_exchange_periods_are_obeyed(tmp_path):
-    scenario, ssd = annotated_scenario(tmp_path, {("odom", "/odom"): 0.2, ("/cmd_vel", "cmd_vel"): 0.3})
+    scenario, ssd = annotated_scenario(tmp_path, {("odom", "odom"): 0.2, ("cmd_vel", "cmd_vel"): 0.3})
     assert parse_ssd(ssd).connections[0].period == 0.3
     counts = check_run_timing(agrisim_run(tmp_path / "out", scenario=scenario), ssd)
     assert counts["/odom"] == 101

@@ -56,7 +56,7 @@ def test_type_mismatched_connection(tmp_path, fmu_dir):
     text = SSD.read_text().replace(
         '<ssd:Connection startElement="lift" startConnector="payload_mass" endElement="chassis" endConnector="payload_mass"/>',
         '<ssd:Connection startElement="lift" startConnector="payload_mass" endElement="chassis" endConnector="cmd_vel"/>',
-    ).replace('<ssd:Connection startConnector="/cmd_vel" endElement="chassis" endConnector="cmd_vel"/>', "")
+    ).replace('<ssd:Connection startConnector="cmd_vel" endElement="chassis" endConnector="cmd_vel"/>', "")
     ssd.write_text(text)
     err = failing_run("--scenario", str(scenario_with(tmp_path, ssd)), "--out", str(tmp_path / "out"))
     assert "payload_mass" in err and "cmd_vel" in err and "lift" in err and "chassis" in err, err

@@ -33,6 +33,23 @@ pub const READY_POSE: [f64; N] = [
 /// the arm for the excess and simulates only its last part, so an absurd step stays cheap.
 pub const MAX_SUBSTEPS: i64 = 100_000;
 
+/// Longest rejection reason a TrajectoryStatus carries [bytes]; a longer one (it can quote an
+/// arbitrarily long joint name from the rejected message) is cut, so the message stays within
+/// the trajectory_status port's maxSize.
+pub const MAX_REASON: usize = 1024;
+
+/// `text` cut to at most `max` bytes at a character boundary, "..." marking a cut.
+fn clip(text: &str, max: usize) -> String {
+    if text.len() <= max {
+        return text.to_string();
+    }
+    let mut end = max - 3;
+    while !text.is_char_boundary(end) {
+        end -= 1;
+    }
+    format!("{}...", &text[..end])
+}
+
 /// Executor state as in TrajectoryStatus (REJECTED is a flag on top of it).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Exec {
@@ -148,7 +165,7 @@ impl Arm {
                 self.rejected_last = false;
                 self.exec = Exec::Executing;
                 self.errors = ErrorStats::default();
-                log.info(&format!(
+                log.info(format_args!(
                     "{} arm: trajectory {} accepted at t={} s ({} points, {} s)",
                     self.description().side,
                     self.accepted,
@@ -160,7 +177,7 @@ impl Arm {
             Err(reason) => {
                 self.rejected += 1;
                 self.rejected_last = true;
-                log.warning(&format!("{} arm: trajectory rejected at t={} s (seq {seq}): {reason}", self.description().side, t_ns as f64 * 1e-9));
+                log.warning(format_args!("{} arm: trajectory rejected at t={} s (seq {seq}): {reason}", self.description().side, t_ns as f64 * 1e-9));
                 self.reason = reason;
             }
         }
@@ -176,7 +193,7 @@ impl Arm {
             .map_err(|e| format!("not a valid control_msgs/msg/GripperCommand CDR message: {e}"))
             .and_then(|c| self.gripper.command(c.position, c.max_effort));
         if let Err(e) = res {
-            log.warning(&format!("{} gripper: command refused at t={} s (seq {seq}): {e}", self.description().side, t_ns as f64 * 1e-9));
+            log.warning(format_args!("{} gripper: command refused at t={} s (seq {seq}): {e}", self.description().side, t_ns as f64 * 1e-9));
         }
     }
 
@@ -247,7 +264,7 @@ impl Arm {
             state: self.state_code(),
             trajectory_count: self.accepted,
             rejected_count: self.rejected,
-            reason: if self.rejected_last { self.reason.clone() } else { String::new() },
+            reason: if self.rejected_last { clip(&self.reason, MAX_REASON) } else { String::new() },
             rms_tracking_error: self.errors.rms(),
             max_tracking_error: self.errors.max,
         }
@@ -307,7 +324,6 @@ fn finite_param(io: &Store, i: usize, lo: f64, hi: f64) -> Result<f64, String> {
 
 impl Model for Arm {
     const NAME: &'static str = "Arm";
-    const TOKEN: &'static str = "{8d3f2a61-7c5e-4b19-a0d4-agrisim-arm-1}";
     const DESCRIPTION: &'static str = "7-DoF Panda-like arm with parallel gripper: JointTrajectory validation and interpolation, PD + feedforward joint dynamics at 1 kHz, GripperCommand, JointState";
     const VARIABLES: &'static [Var] = VARIABLES;
 

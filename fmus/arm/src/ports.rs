@@ -34,37 +34,46 @@ agrisim_fmi::variables! { pub VARIABLES {
         .desc("Std. deviation of encoder noise added to joint_states positions (not to q1..q7)"),
     SEED = Var::param("seed", Start::Int32(0)).desc("Seed of the encoder noise"),
     // --- inputs ---
-    TRAJECTORY = Var::input_discrete("trajectory", Start::Binary(&[])).mime(JointTrajectory::MIME_TYPE)
+    TRAJECTORY = Var::input_discrete("trajectory", Start::Binary(&[])).mime(JointTrajectory::MIME_TYPE).max_size(16 << 20)
         .desc("trajectory_msgs/JointTrajectory (CDR); taken when trajectory_seq changes"),
     TRAJECTORY_SEQ = Var::input_discrete("trajectory_seq", Start::Int64(0)).desc("Sequence counter of trajectory"),
-    GRIPPER_COMMAND = Var::input_discrete("gripper_command", Start::Binary(&[])).mime(GripperCommand::MIME_TYPE)
+    GRIPPER_COMMAND = Var::input_discrete("gripper_command", Start::Binary(&[])).mime(GripperCommand::MIME_TYPE).max_size(1024)
         .desc("control_msgs/GripperCommand (CDR): position = finger gap in m, max_effort in N"),
     GRIPPER_COMMAND_SEQ = Var::input_discrete("gripper_command_seq", Start::Int64(0)).desc("Sequence counter of gripper_command"),
     GRASP_WIDTH = Var::input("grasp_width", 0.0).unit("m")
         .desc("Width of the object between the fingers (world FMU); 0 = none. Closing fingers stop there"),
     // --- outputs ---
-    Q1 = Var::output("q1").unit("rad").desc("Actual joint 1 position"),
-    Q2 = Var::output("q2").unit("rad"),
-    Q3 = Var::output("q3").unit("rad"),
-    Q4 = Var::output("q4").unit("rad"),
-    Q5 = Var::output("q5").unit("rad"),
-    Q6 = Var::output("q6").unit("rad"),
-    Q7 = Var::output("q7").unit("rad"),
-    FINGER_WIDTH = Var::output("finger_width").unit("m").desc("Finger gap (each finger joint is half of it)"),
-    TRACKING_ERROR_RMS = Var::output("tracking_error_rms").unit("rad")
+    // Initially the arm rests at q_init with the gap gripper_width0; a trajectory or gripper
+    // command present at initialization is accepted or rejected (status) but not executed yet.
+    Q1 = Var::output("q1").unit("rad").init_depends_on(&[Q_INIT]).desc("Actual joint 1 position"),
+    Q2 = Var::output("q2").unit("rad").init_depends_on(&[Q_INIT]),
+    Q3 = Var::output("q3").unit("rad").init_depends_on(&[Q_INIT]),
+    Q4 = Var::output("q4").unit("rad").init_depends_on(&[Q_INIT]),
+    Q5 = Var::output("q5").unit("rad").init_depends_on(&[Q_INIT]),
+    Q6 = Var::output("q6").unit("rad").init_depends_on(&[Q_INIT]),
+    Q7 = Var::output("q7").unit("rad").init_depends_on(&[Q_INIT]),
+    FINGER_WIDTH = Var::output("finger_width").unit("m").init_depends_on(&[GRIPPER_WIDTH0])
+        .desc("Finger gap (each finger joint is half of it)"),
+    TRACKING_ERROR_RMS = Var::output("tracking_error_rms").unit("rad").init_depends_on(&[])
         .desc("RMS joint tracking error over the current/last accepted trajectory (all joints)"),
-    STATUS = Var::output_discrete("status", Start::Int32(0))
+    STATUS = Var::output_discrete("status", Start::Int32(0)).init_depends_on(TRAJECTORY_CHECK)
         .desc("0 ok (idle or done), 1 executing, 2 last trajectory rejected"),
-    JOINT_STATES = Var::output_discrete("joint_states", Start::Binary(&[])).mime(JointState::MIME_TYPE)
+    JOINT_STATES = Var::output_discrete("joint_states", Start::Binary(&[])).mime(JointState::MIME_TYPE).max_size(4096)
+        .init_depends_on(&[SIDE, Q_INIT, GRIPPER_WIDTH0, POSITION_NOISE, SEED, Var::TIME])
         .desc("sensor_msgs/JointState: 7 arm joints + 2 finger joints, position/velocity/effort"),
-    JOINT_STATES_SEQ = Var::output_discrete("joint_states_seq", Start::Int64(0)),
+    JOINT_STATES_SEQ = Var::output_discrete("joint_states_seq", Start::Int64(0)).init_depends_on(&[]),
     TRAJECTORY_STATUS = Var::output_discrete("trajectory_status", Start::Binary(&[])).mime(TrajectoryStatus::MIME_TYPE)
+        .max_size(4096).init_depends_on(&[SIDE, Q_INIT, TRAJECTORY, TRAJECTORY_SEQ, Var::TIME])
         .desc("agrisim_msgs/TrajectoryStatus, on change and at status_rate"),
-    TRAJECTORY_STATUS_SEQ = Var::output_discrete("trajectory_status_seq", Start::Int64(0)),
-    GRIPPER_STATE = Var::output_discrete("gripper_state", Start::Binary(&[])).mime(GripperState::MIME_TYPE)
+    TRAJECTORY_STATUS_SEQ = Var::output_discrete("trajectory_status_seq", Start::Int64(0)).init_depends_on(&[]),
+    GRIPPER_STATE = Var::output_discrete("gripper_state", Start::Binary(&[])).mime(GripperState::MIME_TYPE).max_size(1024)
+        .init_depends_on(&[SIDE, GRIPPER_WIDTH0, GRIPPER_COMMAND, GRIPPER_COMMAND_SEQ, Var::TIME])
         .desc("agrisim_msgs/GripperState, with joint_states"),
-    GRIPPER_STATE_SEQ = Var::output_discrete("gripper_state_seq", Start::Int64(0)),
+    GRIPPER_STATE_SEQ = Var::output_discrete("gripper_state_seq", Start::Int64(0)).init_depends_on(&[]),
 }}
+
+/// What accepting or rejecting a trajectory present at initialization depends on.
+const TRAJECTORY_CHECK: &[usize] = &[SIDE, Q_INIT, TRAJECTORY, TRAJECTORY_SEQ];
 
 /// The joint position outputs in joint order.
 pub const Q: [usize; 7] = [Q1, Q2, Q3, Q4, Q5, Q6, Q7];

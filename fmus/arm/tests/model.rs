@@ -18,10 +18,10 @@ use agrisim_msgs::Message;
 #[derive(Default)]
 struct Record(Vec<String>);
 impl Log for Record {
-    fn info(&mut self, m: &str) {
+    fn info(&mut self, m: std::fmt::Arguments<'_>) {
         self.0.push(format!("info: {m}"));
     }
-    fn warning(&mut self, m: &str) {
+    fn warning(&mut self, m: std::fmt::Arguments<'_>) {
         self.0.push(format!("warning: {m}"));
     }
 }
@@ -392,4 +392,16 @@ fn bad_parameters_fail_initialization() {
         setup(&mut io);
         assert!(Arm::new().initialize(&mut io, 0.0, &mut Record::default()).is_err());
     }
+}
+
+#[test]
+fn a_rejection_quoting_a_huge_joint_name_fits_the_status_port() {
+    let mut a = Sim::new(|_| {});
+    let mut t = sample_trajectory();
+    t.joint_names[0] = "x".repeat(100_000);
+    a.send(&t.to_cdr());
+    a.step(1);
+    let reason = a.status().reason;
+    assert!(reason.starts_with("unknown joint name \"xxx") && reason.ends_with("...") && reason.len() <= 1024, "{}", reason.len());
+    assert!(a.io.binary(TRAJECTORY_STATUS).len() <= Arm::VARIABLES[TRAJECTORY_STATUS].max_size);
 }

@@ -5,17 +5,11 @@
 //! `cargo run --release -p agrisim-fmu-camera --example camera_fps [FRAMES] [ENVIRONMENT] [THREADS]`
 //! (with THREADS: 1280x720 on that many threads only, e.g. to compare CPU and wall time).
 
-use agrisim_fmi::{Log, Model, Store, Value};
+use agrisim_fmi::{Model, Quiet, Store, Value};
 use agrisim_fmu_camera::ports::*;
 use agrisim_fmu_camera::Camera;
 use agrisim_greenhouse::{generate, GreenhouseConfig};
 use std::time::Instant;
-
-struct Quiet;
-impl Log for Quiet {
-    fn info(&mut self, _: &str) {}
-    fn warning(&mut self, _: &str) {}
-}
 
 fn main() {
     let frames: usize = std::env::args()

@@ -20,7 +20,7 @@ use agrisim_math::Rng;
 use agrisim_msgs::Message;
 use std::sync::Arc;
 
-pub const MAX_SIDE: i32 = 4096;
+pub use crate::ports::MAX_SIDE;
 
 #[derive(Clone, Debug)]
 pub struct Config {
@@ -175,7 +175,6 @@ impl Camera {
 
 impl Model for Camera {
     const NAME: &'static str = "Camera";
-    const TOKEN: &'static str = "{7c1e4b2a-93d5-4f08-b6a2-agrisim-camera-1}";
     const DESCRIPTION: &'static str = "RGB-D camera modelled on the Intel RealSense D435i (1280x720, 87x58 deg, 10 Hz): rgb8 + 32FC1 depth with stereo noise + CameraInfo + instance labels, ray cast at the greenhouse scene";
     const VARIABLES: &'static [Var] = VARIABLES;
 

@@ -8,6 +8,19 @@ use agrisim_fmi::{Start, Var};
 pub const IMAGE_MIME: &str = "application/x-ros2-cdr; type=sensor_msgs/msg/Image";
 pub const CAMERA_INFO_MIME: &str = "application/x-ros2-cdr; type=sensor_msgs/msg/CameraInfo";
 
+/// Room for a message's header, metadata and frame_id [bytes]: all of CameraInfo, and what
+/// an Image adds to its pixels.
+pub const HEADER_ROOM: usize = 4096;
+
+/// Largest image side the camera accepts [px]: bounds the image ports' maxSize.
+pub const MAX_SIDE: i32 = 4096;
+
+/// maxSize of an image port with `bytes_per_pixel`: the largest image plus its header.
+pub const fn image_max_size(bytes_per_pixel: usize) -> usize {
+    let side = MAX_SIDE as usize;
+    side * side * bytes_per_pixel + HEADER_ROOM
+}
+
 // camera_link on base_link (x forward, y left, z up; the optical frame is z forward, x right,
 // y down relative to it).
 agrisim_sensor_ports::sensor_variables! { pub VARIABLES {
@@ -59,24 +72,29 @@ agrisim_sensor_ports::sensor_variables! { pub VARIABLES {
     LIFT_POSITION = Var::input("lift_position", 0.0).unit("m")
         .desc("Lift joint position, added to mount_z (connect it when the camera rides on the lift, as on the robot: camera_link at (0.32, 0, 0.60 + lift) on base_link)"),
     // --- outputs ---
-    IMAGE = Var::output_discrete("image", Start::Binary(&[])).mime(IMAGE_MIME)
+    // Frames come with the steps; initialization only sets the sun and visibility outputs.
+    IMAGE = Var::output_discrete("image", Start::Binary(&[])).mime(IMAGE_MIME).max_size(image_max_size(3)).init_depends_on(&[])
         .desc("Latest colour image, sensor_msgs/Image rgb8 (CDR)"),
-    IMAGE_SEQ = Var::output_discrete("image_seq", Start::Int64(0)).desc("Sequence counter of image"),
-    DEPTH = Var::output_discrete("depth", Start::Binary(&[])).mime(IMAGE_MIME)
+    IMAGE_SEQ = Var::output_discrete("image_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence counter of image"),
+    DEPTH = Var::output_discrete("depth", Start::Binary(&[])).mime(IMAGE_MIME).max_size(image_max_size(4)).init_depends_on(&[])
         .desc("Latest depth image aligned to the colour image, sensor_msgs/Image 32FC1, z in metres, 0 = no data (REP 118)"),
-    DEPTH_SEQ = Var::output_discrete("depth_seq", Start::Int64(0)).desc("Sequence counter of depth"),
-    CAMERA_INFO = Var::output_discrete("camera_info", Start::Binary(&[])).mime(CAMERA_INFO_MIME)
+    DEPTH_SEQ = Var::output_discrete("depth_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence counter of depth"),
+    CAMERA_INFO = Var::output_discrete("camera_info", Start::Binary(&[])).mime(CAMERA_INFO_MIME).max_size(HEADER_ROOM)
+        .init_depends_on(&[])
         .desc("Calibration of the latest frame: plumb_bob, zero distortion, K from the field of view"),
-    CAMERA_INFO_SEQ = Var::output_discrete("camera_info_seq", Start::Int64(0)).desc("Sequence counter of camera_info"),
-    LABELS_IMAGE = Var::output_discrete("labels", Start::Binary(&[])).mime(IMAGE_MIME)
+    CAMERA_INFO_SEQ = Var::output_discrete("camera_info_seq", Start::Int64(0)).init_depends_on(&[])
+        .desc("Sequence counter of camera_info"),
+    LABELS_IMAGE = Var::output_discrete("labels", Start::Binary(&[])).mime(IMAGE_MIME).max_size(image_max_size(4))
+        .init_depends_on(&[])
         .desc("Latest instance labels, sensor_msgs/Image 32SC1: scene object id + 1 per pixel, 0 = nothing (empty when publish_labels is false)"),
-    LABELS_SEQ = Var::output_discrete("labels_seq", Start::Int64(0)).desc("Sequence counter of labels"),
-    SOLAR_ZENITH = Var::output_discrete("solar_zenith", Start::Float64(0.0)).unit("deg")
+    LABELS_SEQ = Var::output_discrete("labels_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence counter of labels"),
+    SOLAR_ZENITH = Var::output_discrete("solar_zenith", Start::Float64(0.0)).unit("deg").init_depends_on(&[ENVIRONMENT, SUN_ELEVATION])
         .desc("With environment: the sun's topocentric zenith angle with refraction (NREL SPA); else 90 - sun_elevation"),
-    SOLAR_AZIMUTH = Var::output_discrete("solar_azimuth", Start::Float64(0.0)).unit("deg")
+    SOLAR_AZIMUTH = Var::output_discrete("solar_azimuth", Start::Float64(0.0)).unit("deg").init_depends_on(&[ENVIRONMENT, SUN_AZIMUTH])
         .desc("With environment: the sun's compass azimuth, clockwise from north (NREL SPA); else the map angle sun_azimuth"),
-    VISIBILITY = Var::output_discrete("visibility", Start::Float64(0.0)).unit("m")
+    VISIBILITY = Var::output_discrete("visibility", Start::Float64(0.0)).unit("m").init_depends_on(&[ENVIRONMENT])
         .desc("Meteorological visibility of the environment (Koschmieder, 3.912 / extinction); 0 = no environment (clear air)"),
-    VALID_DEPTH = Var::output_discrete("valid_depth_pixels", Start::Int32(0)).desc("Pixels with depth data in the latest frame"),
+    VALID_DEPTH = Var::output_discrete("valid_depth_pixels", Start::Int32(0)).init_depends_on(&[])
+        .desc("Pixels with depth data in the latest frame"),
   },
 }}

@@ -2,7 +2,7 @@
 //! azimuth, geometry (depth, labels) untouched by light and weather, fog removing far depth
 //! only, and frames independent of the number of render threads.
 
-use agrisim_fmi::{Log, Model, Store, Value};
+use agrisim_fmi::{Model, Quiet, Store, Value};
 use agrisim_fmu_camera::lighting::Lighting;
 use agrisim_fmu_camera::optics::{CameraPose, Intrinsics, Mount};
 use agrisim_fmu_camera::ports::*;
@@ -15,12 +15,6 @@ use agrisim_greenhouse::{generate, GreenhouseConfig, Kind, Object, Placement, Sh
 use agrisim_math::Rng;
 use agrisim_msgs::sensor_msgs::Image;
 use agrisim_msgs::Message;
-
-struct Quiet;
-impl Log for Quiet {
-    fn info(&mut self, _: &str) {}
-    fn warning(&mut self, _: &str) {}
-}
 
 const NOON: &str = "date = \"2025-06-21\"\ntime = \"13:40\"";
 const DUSK: &str = "date = \"2025-06-21\"\ntime = \"21:15\"";

@@ -1,7 +1,7 @@
 //! Camera behaviour: depth geometry against known surfaces, the noise and invalid-band
 //! formulas, colour and labels of fruit, determinism, and the FMI model's messages.
 
-use agrisim_fmi::{Log, Model, Store, Value};
+use agrisim_fmi::{Model, Quiet, Store, Value};
 use agrisim_fmu_camera::lighting::Lighting;
 use agrisim_fmu_camera::optics::{CameraPose, Intrinsics, Mount};
 use agrisim_fmu_camera::ports::*;
@@ -12,12 +12,6 @@ use agrisim_greenhouse::{generate, GreenhouseConfig, Kind, Object, Placement, Sh
 use agrisim_math::Rng;
 use agrisim_msgs::sensor_msgs::{CameraInfo, Image};
 use agrisim_msgs::Message;
-
-struct Quiet;
-impl Log for Quiet {
-    fn info(&mut self, _: &str) {}
-    fn warning(&mut self, _: &str) {}
-}
 
 const MOUNT: Mount = Mount {
     translation: [0.6, 0.0, 1.2],

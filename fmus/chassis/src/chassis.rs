@@ -37,7 +37,6 @@ pub struct StepInput<'a> {
 /// How wheels and base respond to the wheel set-points.
 pub trait Drive: Clone + Send + Default + 'static {
     const NAME: &'static str;
-    const TOKEN: &'static str;
     const DESCRIPTION: &'static str;
     /// Longest communication step the drive integrates [s] (a dynamic model substeps).
     const MAX_STEP: f64 = f64::INFINITY;
@@ -139,7 +138,6 @@ impl<D: Drive> Chassis<D> {
 
 impl<D: Drive> Model for Chassis<D> {
     const NAME: &'static str = D::NAME;
-    const TOKEN: &'static str = D::TOKEN;
     const DESCRIPTION: &'static str = D::DESCRIPTION;
     const VARIABLES: &'static [Var] = VARIABLES;
 

@@ -37,7 +37,6 @@ fn finite_positive(io: &Store, i: usize) -> Result<f64, String> {
 
 impl Drive for DynamicDrive {
     const NAME: &'static str = "ChassisDynamic";
-    const TOKEN: &'static str = "{0b7d9e21-58c3-4f6a-8e14-agrisim-chassis-dynamic-1}";
     const DESCRIPTION: &'static str = "4-wheel-steering omnidirectional base, dynamic model: mass/inertia, torque-limited wheel motors, tyre slip and friction, load transfer; wheel odometry";
 
     /// 10 s is 20,000 substeps: longer steps would stall the importer, so they are refused.

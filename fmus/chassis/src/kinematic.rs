@@ -15,7 +15,6 @@ pub struct KinematicDrive {
 
 impl Drive for KinematicDrive {
     const NAME: &'static str = "ChassisKinematic";
-    const TOKEN: &'static str = "{6f1c3a52-4b7e-4c59-9d0a-agrisim-chassis-kinematic-1}";
     const DESCRIPTION: &'static str = "4-wheel-steering omnidirectional base, kinematic model with steering-rate, wheel-speed and acceleration limits, slip and wheel odometry";
 
     fn initialize(&mut self, io: &Store) -> Result<(), String> {

@@ -60,38 +60,39 @@ agrisim_fmi::variables! { pub VARIABLES {
     CMD_WZ = Var::input("cmd_wz", 0.0).unit("rad/s").desc("Scalar command: yaw rate"),
     CMD_SEQ = Var::input_discrete("cmd_seq", Start::Int32(0))
         .desc("Scalar command counter: a change makes cmd_vx/vy/wz the active command"),
-    CMD_VEL = Var::input_discrete("cmd_vel", Start::Binary(&[])).mime(TWIST_MIME)
+    CMD_VEL = Var::input_discrete("cmd_vel", Start::Binary(&[])).mime(TWIST_MIME).max_size(1024)
         .desc("Message command (geometry_msgs/Twist, CDR); taken when cmd_vel_seq changes"),
     CMD_VEL_SEQ = Var::input_discrete("cmd_vel_seq", Start::Int64(0)).desc("Sequence counter of cmd_vel"),
     PAYLOAD_MASS = Var::input("payload_mass", 0.0).unit("kg").desc("Mass carried on the base (lift, arms)"),
     PAYLOAD_HEIGHT = Var::input("payload_height", 0.0).unit("m").desc("Centre-of-mass height of the payload"),
     // --- outputs: ground truth ---
-    X = Var::output("x").unit("m").desc("Ground-truth x of base_link in the world frame"),
-    Y = Var::output("y").unit("m"),
-    YAW = Var::output("yaw").unit("rad"),
-    VX = Var::output("vx").unit("m/s").desc("Ground-truth forward velocity (base frame)"),
-    VY = Var::output("vy").unit("m/s"),
-    WZ = Var::output("wz").unit("rad/s"),
-    STEER_FL = Var::output("steer_fl").unit("rad"),
-    STEER_FR = Var::output("steer_fr").unit("rad"),
-    STEER_RL = Var::output("steer_rl").unit("rad"),
-    STEER_RR = Var::output("steer_rr").unit("rad"),
-    SPIN_FL = Var::output("spin_fl").unit("rad/s"),
-    SPIN_FR = Var::output("spin_fr").unit("rad/s"),
-    SPIN_RL = Var::output("spin_rl").unit("rad/s"),
-    SPIN_RR = Var::output("spin_rr").unit("rad/s"),
+    X = Var::output("x").unit("m").init_depends_on(&[X0]).desc("Ground-truth x of base_link in the world frame"),
+    Y = Var::output("y").unit("m").init_depends_on(&[Y0]),
+    YAW = Var::output("yaw").unit("rad").init_depends_on(&[YAW0]),
+    VX = Var::output("vx").unit("m/s").init_depends_on(&[]).desc("Ground-truth forward velocity (base frame)"),
+    VY = Var::output("vy").unit("m/s").init_depends_on(&[]),
+    WZ = Var::output("wz").unit("rad/s").init_depends_on(&[]),
+    STEER_FL = Var::output("steer_fl").unit("rad").init_depends_on(&[]),
+    STEER_FR = Var::output("steer_fr").unit("rad").init_depends_on(&[]),
+    STEER_RL = Var::output("steer_rl").unit("rad").init_depends_on(&[]),
+    STEER_RR = Var::output("steer_rr").unit("rad").init_depends_on(&[]),
+    SPIN_FL = Var::output("spin_fl").unit("rad/s").init_depends_on(&[]),
+    SPIN_FR = Var::output("spin_fr").unit("rad/s").init_depends_on(&[]),
+    SPIN_RL = Var::output("spin_rl").unit("rad/s").init_depends_on(&[]),
+    SPIN_RR = Var::output("spin_rr").unit("rad/s").init_depends_on(&[]),
     // --- outputs: wheel odometry (drifts with noise and slip) ---
-    ODOM_X = Var::output("odom_x").unit("m").desc("Wheel-odometry x in the odom frame"),
-    ODOM_Y = Var::output("odom_y").unit("m"),
-    ODOM_YAW = Var::output("odom_yaw").unit("rad"),
-    ODOM_VX = Var::output("odom_vx").unit("m/s"),
-    ODOM_VY = Var::output("odom_vy").unit("m/s"),
-    ODOM_WZ = Var::output("odom_wz").unit("rad/s"),
-    CMD_ACTIVE = Var::output_discrete("cmd_active", Start::Boolean(false))
+    ODOM_X = Var::output("odom_x").unit("m").init_depends_on(&[X0]).desc("Wheel-odometry x in the odom frame"),
+    ODOM_Y = Var::output("odom_y").unit("m").init_depends_on(&[Y0]),
+    ODOM_YAW = Var::output("odom_yaw").unit("rad").init_depends_on(&[YAW0]),
+    ODOM_VX = Var::output("odom_vx").unit("m/s").init_depends_on(&[]),
+    ODOM_VY = Var::output("odom_vy").unit("m/s").init_depends_on(&[]),
+    ODOM_WZ = Var::output("odom_wz").unit("rad/s").init_depends_on(&[]),
+    CMD_ACTIVE = Var::output_discrete("cmd_active", Start::Boolean(false)).init_depends_on(&[CMD_TIMEOUT])
         .desc("A fresh command is being followed (false: watchdog stopped the base)"),
-    ODOM = Var::output_discrete("odom", Start::Binary(&[])).mime(ODOMETRY_MIME)
+    ODOM = Var::output_discrete("odom", Start::Binary(&[])).mime(ODOMETRY_MIME).max_size(1024)
+        .init_depends_on(&[X0, Y0, YAW0, ODOM_RATE, Var::TIME])
         .desc("Wheel odometry as nav_msgs/Odometry (odom -> base_link), at odom_rate"),
-    ODOM_SEQ = Var::output_discrete("odom_seq", Start::Int64(0)).desc("Sequence counter of odom"),
+    ODOM_SEQ = Var::output_discrete("odom_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence counter of odom"),
 }}
 
 /// Steering output indices in wheel order.

@@ -2,16 +2,10 @@
 
 use agrisim_chassis::ports::*;
 use agrisim_chassis::{ChassisDynamic, ChassisKinematic};
-use agrisim_fmi::{Log, Model, Store};
+use agrisim_fmi::{Model, Quiet, Store};
 use agrisim_msgs::geometry_msgs::{Twist, Vector3};
 use agrisim_msgs::nav_msgs::Odometry;
 use agrisim_msgs::Message;
-
-struct Quiet;
-impl Log for Quiet {
-    fn info(&mut self, _: &str) {}
-    fn warning(&mut self, _: &str) {}
-}
 
 const H: f64 = 0.02;
 

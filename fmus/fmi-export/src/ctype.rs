@@ -22,6 +22,11 @@ pub trait CType {
     /// # Safety
     /// Pointers in `x` must be valid as the FMI standard requires (checked for NULL here).
     unsafe fn decode(x: Self::C) -> Result<Value, String>;
+    /// Size in bytes `x` claims (Binary: its size argument; 0 for other types), checked
+    /// against the variable's maxSize before anything is read.
+    fn size(_x: Self::C) -> usize {
+        0
+    }
 }
 
 macro_rules! direct {
@@ -130,6 +135,9 @@ impl CType for Bin {
             return Err(format!("the data pointer is NULL but its size is {size}"));
         }
         Ok(Value::Binary(std::slice::from_raw_parts(ptr, size).to_vec()))
+    }
+    fn size((size, _): (usize, *const u8)) -> usize {
+        size
     }
 }
 

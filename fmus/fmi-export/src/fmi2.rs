@@ -79,11 +79,11 @@ pub unsafe fn instantiate<M: Model>(
         }
         let guid = if fmu_guid.is_null() { None } else { CStr::from_ptr(fmu_guid).to_str().ok() };
         match guid {
-            Some(g) if g == M::TOKEN => {}
+            Some(g) if g == M::GUID => {}
             Some(g) => {
                 return fail(&format!(
                     "fmuGUID '{g}' does not match this FMU's '{}' (modelDescription.xml and binary differ)",
-                    M::TOKEN
+                    M::GUID
                 ))
             }
             None => return fail("fmuGUID is NULL or not UTF-8"),

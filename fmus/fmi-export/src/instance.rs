@@ -149,6 +149,7 @@ impl<M: Model> Instance<M> {
             model
                 .initialize(&mut store, self.start_time, &mut self.logger)
                 .map_err(|e| format!("the model failed to initialize (while computing initial values): {e}"))?;
+            check_output_sizes::<M>(&store)?;
             self.preview = Some((model, store));
         }
         Ok(())
@@ -205,6 +206,14 @@ impl<M: Model> Instance<M> {
                 ));
             }
             settable(var, self.mode).map_err(|why| format!("cannot set variable {}: {why}", self.var_name(slot)))?;
+            if T::size(x) > var.max_size {
+                return Err(format!(
+                    "bad value for variable {}: {} bytes exceed its maxSize of {} bytes",
+                    self.var_name(slot),
+                    T::size(x),
+                    var.max_size
+                ));
+            }
             let value = T::decode(x).map_err(|e| format!("bad value for variable {}: {e}", self.var_name(slot)))?;
             check_value(var, &value).map_err(|e| format!("bad value for variable {}: {e}", self.var_name(slot)))?;
             decoded.push((i, value));
@@ -249,10 +258,12 @@ impl<M: Model> Instance<M> {
                 self.model = model;
                 self.store = store;
             }
-            None => self
-                .model
-                .initialize(&mut self.store, self.start_time, &mut self.logger)
-                .map_err(|e| format!("the model failed to initialize: {e}"))?,
+            None => {
+                self.model
+                    .initialize(&mut self.store, self.start_time, &mut self.logger)
+                    .map_err(|e| format!("the model failed to initialize: {e}"))?;
+                check_output_sizes::<M>(&self.store)?;
+            }
         }
         self.mode = Mode::StepMode;
         Ok(())
@@ -287,6 +298,7 @@ impl<M: Model> Instance<M> {
         self.model
             .do_step(&mut self.store, tc, h, &mut self.logger)
             .map_err(|e| format!("the model failed in the step from t={tc:?} with h={h:?}: {e}"))?;
+        check_output_sizes::<M>(&self.store)?;
         self.time = end;
         Ok(())
     }
@@ -360,6 +372,24 @@ impl<M: Model> Instance<M> {
     pub fn live_states(&self) -> usize {
         self.states.len()
     }
+}
+
+/// A model never hands out a Binary output above its declared maxSize: it fails instead.
+fn check_output_sizes<M: Model>(store: &Store) -> Result<(), String> {
+    for (i, v) in M::VARIABLES.iter().enumerate() {
+        if let Value::Binary(b) = store.value(i) {
+            if b.len() > v.max_size {
+                return Err(format!(
+                    "the model produced {} bytes for '{}' (vr {}), above its maxSize of {} bytes",
+                    b.len(),
+                    v.name,
+                    i + 1,
+                    v.max_size
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Value checks beyond the type: finite floats and the declared range.

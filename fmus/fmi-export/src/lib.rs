@@ -19,11 +19,12 @@ mod registry;
 pub mod state;
 mod store;
 pub mod testing;
+pub mod token;
 mod units;
 mod var;
 pub mod xml;
 
-pub use model::{Log, Model, ModelError};
+pub use model::{Log, Model, ModelError, Quiet};
 pub use state::{Mode, Status};
 pub use store::{checked_f64, Store, Value};
-pub use var::{Causality, Start, Var, Variability};
+pub use var::{concat, Causality, Start, Var, Variability, DEFAULT_MAX_SIZE};

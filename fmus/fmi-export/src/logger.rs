@@ -1,9 +1,13 @@
 //! Routes messages to the importer's logger callback (FMI 3 or FMI 2 flavour).
 //!
-//! Errors and warnings are always reported (they explain a returned status); informational
-//! messages only when debug logging is on for their category.
+//! Lazy: nothing is formatted or allocated unless a message is going to reach a callback.
+//! Errors and warnings are always reported (they explain a returned status; FMI allows it
+//! with logging off); debug messages (categories logModel, logCalls) only while debug logging
+//! is on (`loggingOn` at instantiation, or SetDebugLogging) for their category. Without a
+//! category list, logging on enables every category (FMI 3.0 section 2.3.5).
 
 use std::ffi::{c_char, c_void, CStr, CString};
+use std::fmt;
 
 use crate::model::Log;
 use crate::state::Status;
@@ -33,6 +37,12 @@ pub const LOG_CATEGORIES: &[(&str, &str)] = &[
 const CAT_MODEL: u8 = 1 << 2;
 const CAT_CALLS: u8 = 1 << 3;
 
+/// The category names as C strings, in [`LOG_CATEGORIES`] order.
+const WARNING: &CStr = c"logStatusWarning";
+const ERROR: &CStr = c"logStatusError";
+const MODEL: &CStr = c"logModel";
+const CALLS: &CStr = c"logCalls";
+
 #[derive(Clone, Copy)]
 enum Sink {
     Fmi3 { env: *mut c_void, cb: Option<Fmi3LogMessage> },
@@ -46,6 +56,19 @@ pub struct Logger {
     debug: bool,
     /// Bit i set = category `LOG_CATEGORIES[i]` enabled (only matters when `debug`).
     enabled: u8,
+}
+
+/// A C string of `message`; NUL (which C cannot carry) becomes U+FFFD, and for FMI 2 '%'
+/// is doubled (its loggers treat the message as a printf format).
+fn c_message(message: fmt::Arguments<'_>, printf: bool) -> CString {
+    let mut text = fmt::format(message);
+    if text.contains('\0') {
+        text = text.replace('\0', "\u{FFFD}");
+    }
+    if printf && text.contains('%') {
+        text = text.replace('%', "%%");
+    }
+    CString::new(text).unwrap_or_default()
 }
 
 fn c_string(s: &str) -> CString {
@@ -64,17 +87,16 @@ impl Logger {
         self.instance_name.to_str().unwrap_or("?")
     }
 
-    fn emit(&self, status: Status, category: &str, message: &str) {
-        let category = c_string(category);
+    /// Formats `message` and calls the callback; nothing happens without a callback.
+    fn emit(&self, status: Status, category: &CStr, message: fmt::Arguments<'_>) {
         match self.sink {
             Sink::Fmi3 { env, cb: Some(cb) } => {
-                let message = c_string(message);
+                let message = c_message(message, false);
                 // SAFETY: the importer gave us this callback and environment for this instance.
                 unsafe { cb(env, status, category.as_ptr(), message.as_ptr()) }
             }
             Sink::Fmi2 { env, cb: Some(cb) } => {
-                // FMI 2 loggers treat the message as a printf format: escape '%'.
-                let message = c_string(&message.replace('%', "%%"));
+                let message = c_message(message, true);
                 // SAFETY: as above; no variadic arguments are passed and none are referenced.
                 unsafe { cb(env, self.instance_name.as_ptr(), status, category.as_ptr(), message.as_ptr()) }
             }
@@ -82,19 +104,24 @@ impl Logger {
         }
     }
 
+    /// True when debug messages of the category bit `cat` are wanted.
+    fn debug_enabled(&self, cat: u8) -> bool {
+        self.debug && self.enabled & cat != 0
+    }
+
     pub fn error(&self, message: &str) {
-        self.emit(Status::Error, "logStatusError", message);
+        self.emit(Status::Error, ERROR, format_args!("{message}"));
     }
     pub fn fatal(&self, message: &str) {
-        self.emit(Status::Fatal, "logStatusError", message);
+        self.emit(Status::Fatal, ERROR, format_args!("{message}"));
     }
     pub fn warn(&self, message: &str) {
-        self.emit(Status::Warning, "logStatusWarning", message);
+        self.emit(Status::Warning, WARNING, format_args!("{message}"));
     }
     /// Trace of an API call, if enabled.
     pub fn call(&self, function: &str) {
-        if self.debug && self.enabled & CAT_CALLS != 0 {
-            self.emit(Status::Ok, "logCalls", function);
+        if self.debug_enabled(CAT_CALLS) {
+            self.emit(Status::Ok, CALLS, format_args!("{function}"));
         }
     }
 
@@ -118,14 +145,15 @@ impl Logger {
     }
 }
 
-/// What the model sees: `info` goes to category logModel, `warning` is always reported.
+/// What the model sees: `info` goes to category logModel (formatted only when that category
+/// is on), `warning` is always reported.
 impl Log for Logger {
-    fn info(&mut self, msg: &str) {
-        if self.debug && self.enabled & CAT_MODEL != 0 {
-            self.emit(Status::Ok, "logModel", msg);
+    fn info(&mut self, message: fmt::Arguments<'_>) {
+        if self.debug_enabled(CAT_MODEL) {
+            self.emit(Status::Ok, MODEL, message);
         }
     }
-    fn warning(&mut self, msg: &str) {
-        self.warn(msg);
+    fn warning(&mut self, message: fmt::Arguments<'_>) {
+        self.emit(Status::Warning, WARNING, message);
     }
 }

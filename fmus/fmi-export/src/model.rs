@@ -7,26 +7,44 @@
 //! never drift from the code.
 
 use crate::store::Store;
+use crate::token;
 use crate::var::Var;
 
 /// What a model returns when it cannot go on; the export layer logs it and returns an error status.
 pub type ModelError = String;
 
-/// Log sink handed to a model; messages reach the importer's logger callback.
+/// Log sink handed to a model; messages reach the importer's logger callback. Pass
+/// `format_args!(..)`: a message is formatted only if it is going to be delivered (debug
+/// messages only while the importer enabled category logModel).
 pub trait Log {
-    fn info(&mut self, msg: &str);
-    fn warning(&mut self, msg: &str);
+    fn info(&mut self, message: std::fmt::Arguments<'_>);
+    fn warning(&mut self, message: std::fmt::Arguments<'_>);
+}
+
+/// A [`Log`] that drops every message, for driving a model directly (tests, tools).
+pub struct Quiet;
+
+impl Log for Quiet {
+    fn info(&mut self, _: std::fmt::Arguments<'_>) {}
+    fn warning(&mut self, _: std::fmt::Arguments<'_>) {}
 }
 
 /// A co-simulation model. Implementors are plain Rust; see `export_fmu!` for the C API.
 pub trait Model: Clone + Send + 'static {
     /// modelIdentifier: the FMU's shared-library name and its model name.
     const NAME: &'static str;
-    /// instantiationToken (FMI 3) / guid (FMI 2): checked at instantiation.
-    const TOKEN: &'static str;
     const DESCRIPTION: &'static str;
     /// Variable table, in value-reference order (vr = index + 1).
     const VARIABLES: &'static [Var];
+    /// FMI 3 instantiationToken, checked at instantiation: a hash of the interface
+    /// ([`token`](crate::token)). Derived; do not override.
+    const TOKEN: &'static str = token::as_str(&Self::TOKEN_BYTES);
+    /// FMI 2 guid: the same hash over the FMI 2 interface. Derived; do not override.
+    const GUID: &'static str = token::as_str(&Self::GUID_BYTES);
+    #[doc(hidden)]
+    const TOKEN_BYTES: [u8; token::LEN] = token::guid(token::hash("3.0", Self::NAME, Self::VARIABLES));
+    #[doc(hidden)]
+    const GUID_BYTES: [u8; token::LEN] = token::guid(token::hash("2.0", Self::NAME, Self::VARIABLES));
     /// Default experiment step size [s].
     const STEP_SIZE: f64 = 0.02;
 

@@ -5,7 +5,12 @@
 //! - parameters and inputs: initial defaults to `exact`, start written;
 //! - outputs (continuous/discrete), locals and calculated parameters: `initial="calculated"`,
 //!   no start; they are listed as InitialUnknowns; constants: start written.
-//! - every output is listed under ModelStructure/Output(s).
+//! - every output is listed under ModelStructure/Output(s) with `dependencies=""`: model code
+//!   runs only in `initialize` and `do_step`, getters and setters only move values, so no
+//!   output changes when an input is set within a communication point (no direct feedthrough);
+//! - InitialUnknowns carry the dependencies the table declares ([`Var::init_depends_on`]:
+//!   parameters, inputs, the start time); undeclared ones omit the attribute (= all knowns);
+//! - Binary variables carry `maxSize` (FMI 3).
 //!
 //! Output is deterministic (no timestamps); floats are written in round-trip form.
 
@@ -87,6 +92,24 @@ pub fn is_calculated(v: &Var) -> bool {
         && matches!(v.causality, Causality::Output | Causality::Local | Causality::CalculatedParameter)
 }
 
+/// True for the variables listed as ModelStructure InitialUnknowns.
+pub fn is_initial_unknown(v: &Var) -> bool {
+    is_calculated(v) && matches!(v.causality, Causality::Output | Causality::CalculatedParameter)
+}
+
+/// Value references of `v`'s declared initial dependencies, sorted and unique (time = 0);
+/// `None` when undeclared.
+fn initial_dependency_vrs(v: &Var) -> Option<Vec<usize>> {
+    let mut vrs: Vec<usize> = v.initial_dependencies?.iter().map(|&d| if d == Var::TIME { 0 } else { d + 1 }).collect();
+    vrs.sort_unstable();
+    vrs.dedup();
+    Some(vrs)
+}
+
+fn join(xs: impl IntoIterator<Item = usize>) -> String {
+    xs.into_iter().map(|x| x.to_string()).collect::<Vec<_>>().join(" ")
+}
+
 fn type_name(s: &Start) -> &'static str {
     match s {
         Start::Float64(_) => "Float64",
@@ -146,6 +169,27 @@ pub fn check_table(vars: &[Var]) -> Vec<String> {
         }
         if !v.mime_type.is_empty() && !matches!(v.start, Start::Binary(_)) {
             bad("only Binary variables can have a mimeType".into());
+        }
+        match v.start {
+            Start::Binary(b) if v.max_size == 0 || b.len() > v.max_size => {
+                bad(format!("maxSize {} must be positive and hold the start value ({} bytes)", v.max_size, b.len()))
+            }
+            Start::Binary(_) => {}
+            _ if v.max_size != 0 => bad("only Binary variables can have a maxSize".into()),
+            _ => {}
+        }
+        if let Some(deps) = v.initial_dependencies {
+            if !is_initial_unknown(v) {
+                bad("only initial unknowns (calculated outputs and calculated parameters) have initial dependencies".into());
+            }
+            for &d in deps {
+                match vars.get(d) {
+                    _ if d == Var::TIME => {}
+                    Some(k) if matches!(k.causality, Causality::Parameter | Causality::Input) => {}
+                    Some(k) => bad(format!("initial dependency '{}' is neither a parameter nor an input", k.name)),
+                    None => bad(format!("initial dependency {d} is not in the table")),
+                }
+            }
         }
         if (v.min.is_some() || v.max.is_some()) && !numeric {
             bad("only numeric variables can have min/max".into());
@@ -319,6 +363,7 @@ pub fn fmi3<M: Model>() -> String {
                 if !v.mime_type.is_empty() {
                     let _ = write!(o, " mimeType=\"{}\"", escape(v.mime_type));
                 }
+                let _ = write!(o, " maxSize=\"{}\"", v.max_size);
                 if with_start {
                     let _ = write!(o, ">\n      <Start value=\"{}\"/>\n    </Binary>\n", hex(b));
                 } else {
@@ -330,12 +375,16 @@ pub fn fmi3<M: Model>() -> String {
     o.push_str("  </ModelVariables>\n  <ModelStructure>\n");
     for (i, v) in vars.iter().enumerate() {
         if v.causality == Causality::Output {
-            let _ = writeln!(o, "    <Output valueReference=\"{}\"/>", i + 1);
+            let _ = writeln!(o, "    <Output valueReference=\"{}\" dependencies=\"\"/>", i + 1);
         }
     }
     for (i, v) in vars.iter().enumerate() {
-        if is_calculated(v) && matches!(v.causality, Causality::Output | Causality::CalculatedParameter) {
-            let _ = writeln!(o, "    <InitialUnknown valueReference=\"{}\"/>", i + 1);
+        if is_initial_unknown(v) {
+            let _ = write!(o, "    <InitialUnknown valueReference=\"{}\"", i + 1);
+            if let Some(deps) = initial_dependency_vrs(v) {
+                let _ = write!(o, " dependencies=\"{}\"", join(deps));
+            }
+            o.push_str("/>\n");
         }
     }
     o.push_str("  </ModelStructure>\n</fmiModelDescription>\n");
@@ -356,7 +405,7 @@ pub fn fmi2<M: Model>() -> String {
         o,
         "<fmiModelDescription fmiVersion=\"2.0\" modelName=\"{}\" guid=\"{}\" description=\"{}\" generationTool=\"agrisim-fmi {}\" variableNamingConvention=\"flat\" numberOfEventIndicators=\"0\">",
         escape(M::NAME),
-        escape(M::TOKEN),
+        escape(M::GUID),
         escape(M::DESCRIPTION),
         env!("CARGO_PKG_VERSION")
     );
@@ -410,26 +459,28 @@ pub fn fmi2<M: Model>() -> String {
         o.push_str("/>\n    </ScalarVariable>\n");
     }
     o.push_str("  </ModelVariables>\n  <ModelStructure>\n");
-    let index = |k: usize| k + 2;
+    // Position of a visible variable by value reference (time = vr 0 is position 1); knowns
+    // FMI 2 cannot see are frozen at their start values there and drop out.
+    let position = |vr: usize| if vr == 0 { Some(1) } else { visible.iter().position(|&(r, _)| r == vr).map(|k| k + 2) };
     let outputs: Vec<usize> =
-        visible.iter().enumerate().filter(|(_, (_, v))| v.causality == Causality::Output).map(|(k, _)| index(k)).collect();
+        visible.iter().filter(|(_, v)| v.causality == Causality::Output).filter_map(|&(vr, _)| position(vr)).collect();
     if !outputs.is_empty() {
         o.push_str("    <Outputs>\n");
         for i in &outputs {
-            let _ = writeln!(o, "      <Unknown index=\"{i}\"/>");
+            let _ = writeln!(o, "      <Unknown index=\"{i}\" dependencies=\"\"/>");
         }
         o.push_str("    </Outputs>\n");
     }
-    let initial: Vec<usize> = visible
-        .iter()
-        .enumerate()
-        .filter(|(_, (_, v))| is_calculated(v) && matches!(v.causality, Causality::Output | Causality::CalculatedParameter))
-        .map(|(k, _)| index(k))
-        .collect();
+    let initial: Vec<(usize, &Var)> =
+        visible.iter().filter(|(_, v)| is_initial_unknown(v)).filter_map(|&(vr, v)| Some((position(vr)?, v))).collect();
     if !initial.is_empty() {
         o.push_str("    <InitialUnknowns>\n");
-        for i in &initial {
-            let _ = writeln!(o, "      <Unknown index=\"{i}\"/>");
+        for (i, v) in initial {
+            let _ = write!(o, "      <Unknown index=\"{i}\"");
+            if let Some(deps) = initial_dependency_vrs(v) {
+                let _ = write!(o, " dependencies=\"{}\"", join(deps.into_iter().filter_map(position)));
+            }
+            o.push_str("/>\n");
         }
         o.push_str("    </InitialUnknowns>\n");
     }

@@ -123,7 +123,6 @@ impl Imu {
 
 impl Model for Imu {
     const NAME: &'static str = "Imu";
-    const TOKEN: &'static str = "{5b0f6c2e-1d7a-4c43-9a51-agrisim-imu-1}";
     const DESCRIPTION: &'static str = "IMU on the mobile base (ICM-40609-D noise figures, gz-sensors noise model): sensor_msgs/Imu at a configurable rate";
     const VARIABLES: &'static [Var] = VARIABLES;
 

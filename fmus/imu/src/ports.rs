@@ -54,17 +54,29 @@ agrisim_fmi::variables! { pub VARIABLES {
     VX = Var::input("vx", 0.0).unit("m/s").desc("Ground-truth forward velocity (base frame)"),
     VY = Var::input("vy", 0.0).unit("m/s"),
     WZ = Var::input("wz", 0.0).unit("rad/s"),
-    // --- outputs: the latest sample ---
-    GYRO_X = Var::output("gyro_x").unit("rad/s").desc("Latest angular velocity sample, IMU frame"),
-    GYRO_Y = Var::output("gyro_y").unit("rad/s"),
-    GYRO_Z = Var::output("gyro_z").unit("rad/s"),
-    ACCEL_X = Var::output("accel_x").unit("m/s2").desc("Latest specific force sample, IMU frame"),
-    ACCEL_Y = Var::output("accel_y").unit("m/s2"),
-    ACCEL_Z = Var::output("accel_z").unit("m/s2"),
-    IMU = Var::output_discrete("imu", Start::Binary(&[])).mime(IMU_MIME)
+    // --- outputs: the latest sample (at initialization: the sample at the start time) ---
+    GYRO_X = Var::output("gyro_x").unit("rad/s").init_depends_on(SAMPLE).desc("Latest angular velocity sample, IMU frame"),
+    GYRO_Y = Var::output("gyro_y").unit("rad/s").init_depends_on(SAMPLE),
+    GYRO_Z = Var::output("gyro_z").unit("rad/s").init_depends_on(SAMPLE),
+    ACCEL_X = Var::output("accel_x").unit("m/s2").init_depends_on(SAMPLE).desc("Latest specific force sample, IMU frame"),
+    ACCEL_Y = Var::output("accel_y").unit("m/s2").init_depends_on(SAMPLE),
+    ACCEL_Z = Var::output("accel_z").unit("m/s2").init_depends_on(SAMPLE),
+    IMU = Var::output_discrete("imu", Start::Binary(&[])).mime(IMU_MIME).max_size(4096).init_depends_on(MESSAGE)
         .desc("Latest sample as sensor_msgs/Imu (CDR), stamped with its sample time"),
-    IMU_SEQ = Var::output_discrete("imu_seq", Start::Int64(0)).desc("Sequence counter of imu (one per published sample)"),
+    IMU_SEQ = Var::output_discrete("imu_seq", Start::Int64(0)).init_depends_on(&[])
+        .desc("Sequence counter of imu (one per published sample)"),
 }}
+
+/// What the sample at the start time depends on: the sampling and noise parameters, the
+/// mount and the base motion (not its position), and the start time.
+const SAMPLE: &[usize] = &[
+    RATE, SEED, MOUNT_X, MOUNT_Y, MOUNT_Z, MOUNT_ROLL, MOUNT_PITCH, MOUNT_YAW, GRAVITY,
+    GYRO_NOISE_DENSITY, GYRO_BIAS_MEAN, GYRO_BIAS_STDDEV, GYRO_DYNAMIC_BIAS_STDDEV, GYRO_DYNAMIC_BIAS_CORRELATION_TIME,
+    GYRO_BIAS_INSTABILITY, ACCEL_NOISE_DENSITY, ACCEL_BIAS_MEAN, ACCEL_BIAS_STDDEV, ACCEL_DYNAMIC_BIAS_STDDEV,
+    ACCEL_DYNAMIC_BIAS_CORRELATION_TIME, ACCEL_BIAS_INSTABILITY, BASE_YAW, VX, VY, WZ, Var::TIME,
+];
+/// The message adds its frame and the orientation switch to the sample.
+const MESSAGE: &[usize] = &agrisim_fmi::concat::<28>(&[SAMPLE, &[FRAME_ID, ENABLE_ORIENTATION]]);
 
 /// Gyro and accelerometer output indices in axis order.
 pub const GYRO: [usize; 3] = [GYRO_X, GYRO_Y, GYRO_Z];

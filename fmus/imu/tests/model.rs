@@ -2,18 +2,12 @@
 //! successive inputs, orientation), its sample clock, determinism, and a run through the
 //! generic FMI 3 layer.
 
-use agrisim_fmi::{fmi3, Log, Model, Status, Store};
+use agrisim_fmi::{fmi3, Model, Quiet, Status, Store};
 use agrisim_fmu_imu::ports::*;
 use agrisim_fmu_imu::Imu;
 use agrisim_msgs::sensor_msgs;
 use agrisim_msgs::Message;
 use std::f64::consts::FRAC_PI_2;
-
-struct Quiet;
-impl Log for Quiet {
-    fn info(&mut self, _: &str) {}
-    fn warning(&mut self, _: &str) {}
-}
 
 const H: f64 = 0.02;
 const G: f64 = 9.80665;

@@ -2,17 +2,11 @@
 //! pose and in the middle of aisle 0, default sensor. `cargo run --release -p
 //! agrisim-fmu-lidar --example frame_rate [SCENE.toml-keys-file]`.
 
-use agrisim_fmi::{Log, Model, Store, Value};
+use agrisim_fmi::{Model, Quiet, Store, Value};
 use agrisim_fmu_lidar::ports::*;
 use agrisim_fmu_lidar::Lidar;
 use agrisim_greenhouse::{generate, GreenhouseConfig};
 use std::time::Instant;
-
-struct Quiet;
-impl Log for Quiet {
-    fn info(&mut self, _: &str) {}
-    fn warning(&mut self, _: &str) {}
-}
 
 fn main() {
     let scene = std::env::args().nth(1).map(|p| std::fs::read_to_string(p).expect("scene file")).unwrap_or_default();

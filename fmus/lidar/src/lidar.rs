@@ -26,8 +26,8 @@ use agrisim_msgs::sensor_msgs::PointCloud2;
 use agrisim_msgs::Message;
 use std::sync::Arc;
 
-/// Most rays in one frame (memory and time guard).
-pub const MAX_POINTS_PER_FRAME: usize = 1_000_000;
+/// Most rays in one frame (memory and time guard; the port table bounds the cloud by it).
+pub use crate::ports::MAX_POINTS_PER_FRAME;
 
 /// Everything fixed at initialization.
 #[derive(Clone, Debug)]
@@ -181,7 +181,6 @@ impl Lidar {
 
 impl Model for Lidar {
     const NAME: &'static str = "Lidar";
-    const TOKEN: &'static str = "{2d5e7a10-8c4f-4b96-a3e1-agrisim-lidar-1}";
     const DESCRIPTION: &'static str = "LiDAR modelled on the Livox MID-360 (non-repetitive pattern, 200k points/s, 10 Hz frames) cast at the greenhouse scene: sensor_msgs/PointCloud2";
     const VARIABLES: &'static [Var] = VARIABLES;
 

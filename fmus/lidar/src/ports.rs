@@ -8,6 +8,12 @@ use agrisim_fmi::{Start, Var};
 /// MIME type of the message port (FMI 3 Binary carrying ROS 2 CDR).
 pub const POINTS_MIME: &str = "application/x-ros2-cdr; type=sensor_msgs/msg/PointCloud2";
 
+/// maxSize of `points`: the most points a frame holds, plus 4 KiB for the header, field
+/// descriptions and frame_id.
+/// Most points one frame may hold (point_rate / frame_rate is checked against it).
+pub const MAX_POINTS_PER_FRAME: usize = 1_000_000;
+pub const MAX_CLOUD: usize = MAX_POINTS_PER_FRAME * crate::cloud::POINT_STEP + 4096;
+
 // lidar_link on base_link (default: on top of the robot).
 agrisim_sensor_ports::sensor_variables! { pub VARIABLES {
   mount: "lidar_link" (0.0, 0.0, 1.0),
@@ -37,14 +43,15 @@ agrisim_sensor_ports::sensor_variables! { pub VARIABLES {
         .desc("Leave rays without a return out of the cloud (default: kept at (0,0,0), as the Livox driver does)"),
   },
   ports: {
-    // --- outputs ---
-    POINTS = Var::output_discrete("points", Start::Binary(&[])).mime(POINTS_MIME)
+    // --- outputs (no frame at initialization: it would cover time before the run) ---
+    POINTS = Var::output_discrete("points", Start::Binary(&[])).mime(POINTS_MIME).max_size(MAX_CLOUD).init_depends_on(&[])
         .desc("The latest frame as sensor_msgs/PointCloud2 (CDR) in lidar_link: float32 x, y, z, intensity, t"),
-    POINTS_SEQ = Var::output_discrete("points_seq", Start::Int64(0)).desc("Sequence counter of points"),
-    POINTS_IN_FRAME = Var::output_discrete("points_in_frame", Start::Int32(0)).desc("Points in the latest cloud"),
-    VISIBILITY = Var::output_discrete("visibility", Start::Float64(0.0)).unit("m")
+    POINTS_SEQ = Var::output_discrete("points_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence counter of points"),
+    POINTS_IN_FRAME = Var::output_discrete("points_in_frame", Start::Int32(0)).init_depends_on(&[])
+        .desc("Points in the latest cloud"),
+    VISIBILITY = Var::output_discrete("visibility", Start::Float64(0.0)).unit("m").init_depends_on(&[ENVIRONMENT])
         .desc("Meteorological visibility of the environment; 0 = no environment (clear air)"),
-    RETURNS_IN_FRAME = Var::output_discrete("returns_in_frame", Start::Int32(0))
+    RETURNS_IN_FRAME = Var::output_discrete("returns_in_frame", Start::Int32(0)).init_depends_on(&[])
         .desc("Points of the latest cloud that are returns (the others are no-return placeholders)"),
   },
 }}

@@ -2,19 +2,13 @@
 //! wall at a known distance, coverage growing with integration time, motion, the robot's own
 //! box, intensities, determinism, and the PointCloud2 layout.
 
-use agrisim_fmi::{fmi3, Log, Model, Status, Store, Value};
+use agrisim_fmi::{fmi3, Model, Quiet, Status, Store, Value};
 use agrisim_fmu_lidar::cloud::{self, Point};
 use agrisim_fmu_lidar::ports::*;
 use agrisim_fmu_lidar::Lidar;
 use agrisim_msgs::sensor_msgs::{PointCloud2, PointField};
 use agrisim_msgs::Message;
 use std::f64::consts::PI;
-
-struct Quiet;
-impl Log for Quiet {
-    fn info(&mut self, _: &str) {}
-    fn warning(&mut self, _: &str) {}
-}
 
 const H: f64 = 0.02;
 

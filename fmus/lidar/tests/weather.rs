@@ -1,19 +1,13 @@
 //! The LiDAR in fog and rain: returns fade with two-way extinction, so the farthest return
 //! comes nearer and fewer rays return; clear air is untouched; results stay seeded.
 
-use agrisim_fmi::{Log, Model, Store, Value};
+use agrisim_fmi::{Model, Quiet, Store, Value};
 use agrisim_fmu_lidar::cloud;
 use agrisim_fmu_lidar::lidar::detected;
 use agrisim_fmu_lidar::ports::*;
 use agrisim_fmu_lidar::Lidar;
 use agrisim_msgs::sensor_msgs::PointCloud2;
 use agrisim_msgs::Message;
-
-struct Quiet;
-impl Log for Quiet {
-    fn info(&mut self, _: &str) {}
-    fn warning(&mut self, _: &str) {}
-}
 
 /// (returns, farthest return [m], cloud bytes) of the second frame from the aisle start of
 /// the default greenhouse, looking down the aisle.

@@ -30,14 +30,21 @@ agrisim_fmi::variables! { pub VARIABLES {
     BASE_HEIGHT = Var::param("base_height", Start::Float64(0.45)).unit("m")
         .desc("Height of the carried mass's centre above the floor at position 0"),
     SETPOINT = Var::input("setpoint", 0.2).unit("m").desc("Position set-point"),
-    POSITION = Var::output("position").unit("m"),
-    VELOCITY = Var::output("velocity").unit("m/s"),
-    STATUS = Var::output_discrete("status", Start::Int32(0))
+    // Initially the lift rests at position0; a set-point present at initialization only
+    // selects the target (and so status), it has not moved the lift yet.
+    POSITION = Var::output("position").unit("m").init_depends_on(&[POS0]),
+    VELOCITY = Var::output("velocity").unit("m/s").init_depends_on(&[]),
+    STATUS = Var::output_discrete("status", Start::Int32(0)).init_depends_on(SETPOINT_CHOICE)
         .desc("0 at target, 1 moving, 2 last set-point refused (out of range or not finite)"),
-    TARGET = Var::output("target").unit("m").desc("Target being followed (last valid set-point)"),
-    PAYLOAD_MASS = Var::output("payload_mass").unit("kg").desc("Carried mass, for the chassis"),
-    PAYLOAD_HEIGHT = Var::output("payload_height").unit("m").desc("Carried mass's centre height, for the chassis"),
+    TARGET = Var::output("target").unit("m").init_depends_on(SETPOINT_CHOICE).desc("Target being followed (last valid set-point)"),
+    PAYLOAD_MASS = Var::output("payload_mass").unit("kg").init_depends_on(&[CARRIED_MASS]).desc("Carried mass, for the chassis"),
+    PAYLOAD_HEIGHT = Var::output("payload_height").unit("m").init_depends_on(&[BASE_HEIGHT, POS0])
+        .desc("Carried mass's centre height, for the chassis"),
 }}
+
+/// What the target chosen at initialization depends on: the set-point, its valid range and
+/// where the lift starts.
+const SETPOINT_CHOICE: &[usize] = &[POS_MIN, POS_MAX, POS0, SETPOINT];
 
 #[derive(Clone, Debug, Default)]
 pub struct Lift {
@@ -59,7 +66,7 @@ impl Lift {
         self.last_setpoint = sp;
         if !(sp.is_finite() && sp >= self.range.0 && sp <= self.range.1) {
             self.refused = true;
-            log.warning(&format!("setpoint {sp} m refused at t={t}: outside [{}, {}] m; keeping target {} m", self.range.0, self.range.1, self.target));
+            log.warning(format_args!("setpoint {sp} m refused at t={t}: outside [{}, {}] m; keeping target {} m", self.range.0, self.range.1, self.target));
             return;
         }
         self.refused = false;
@@ -84,7 +91,6 @@ impl Lift {
 
 impl Model for Lift {
     const NAME: &'static str = "Lift";
-    const TOKEN: &'static str = "{3c2e8f90-1d4b-4a77-b5e6-agrisim-lift-1}";
     const DESCRIPTION: &'static str = "Prismatic lift with position set-point, velocity/acceleration limits and range check";
     const VARIABLES: &'static [Var] = VARIABLES;
 

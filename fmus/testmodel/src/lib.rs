@@ -17,15 +17,21 @@ agrisim_fmi::variables! { pub VARIABLES {
     X0 = Var::param("x0", Start::Float64(1.0)).unit("m").desc("Initial state (fixed)"),
     U = Var::input("u", 0.0).unit("m/s").desc("Additive input: x' = -k x + u"),
     HOLD = Var::input_discrete("hold", Start::Boolean(false)).desc("Freeze the state while true"),
-    MSG_IN = Var::input_discrete("msg_in", Start::Binary(EMPTY_STRING_CDR)).mime(MIME).desc("Message to echo"),
+    MSG_IN = Var::input_discrete("msg_in", Start::Binary(EMPTY_STRING_CDR)).mime(MIME).max_size(MAX_MESSAGE)
+        .desc("Message to echo"),
     LABEL = Var::param("label", Start::String("agrisim \"test\" <model> & more")).desc("Free text, logged at initialization"),
     FAULT = Var::tunable("fault", Start::Int32(0)).range(0.0, 2.0).desc("0: none, 1: step fails, 2: step panics"),
-    X = Var::output("x").unit("m").desc("State x(t)"),
-    STEPS = Var::output_discrete("steps", Start::Int32(0)).desc("Number of steps taken"),
-    ABOVE_HALF = Var::output_discrete("above_half", Start::Boolean(false)).desc("x > x0 / 2"),
-    MSG_OUT = Var::output_discrete("msg_out", Start::Binary(EMPTY_STRING_CDR)).mime(MIME).desc("Echo of msg_in"),
-    MSG_SEQ = Var::output_discrete("msg_seq", Start::Int64(0)).desc("Increments whenever msg_out changes"),
+    X = Var::output("x").unit("m").init_depends_on(&[X0]).desc("State x(t)"),
+    STEPS = Var::output_discrete("steps", Start::Int32(0)).init_depends_on(&[]).desc("Number of steps taken"),
+    ABOVE_HALF = Var::output_discrete("above_half", Start::Boolean(false)).init_depends_on(&[X0]).desc("x > x0 / 2"),
+    MSG_OUT = Var::output_discrete("msg_out", Start::Binary(EMPTY_STRING_CDR)).mime(MIME).max_size(MAX_MESSAGE)
+        .init_depends_on(&[MSG_IN]).desc("Echo of msg_in"),
+    MSG_SEQ = Var::output_discrete("msg_seq", Start::Int64(0)).init_depends_on(&[MSG_IN])
+        .desc("Increments whenever msg_out changes"),
 }}
+
+/// maxSize of msg_in, and so of its echo msg_out.
+pub const MAX_MESSAGE: usize = 1 << 20;
 
 #[derive(Clone, Debug, Default)]
 pub struct TestModel {
@@ -53,7 +59,6 @@ impl TestModel {
 
 impl Model for TestModel {
     const NAME: &'static str = "TestModel";
-    const TOKEN: &'static str = "{8c4e810f-3df3-4a00-8276-176fa3c9f001}";
     const DESCRIPTION: &'static str = "Dahlquist test model with every variable type (agrisim export-layer test)";
     const VARIABLES: &'static [Var] = VARIABLES;
 
@@ -67,7 +72,7 @@ impl Model for TestModel {
         self.seq = 0;
         self.echo(io);
         self.publish(io);
-        log.info(&format!("initialized with label {:?}", io.string(LABEL)));
+        log.info(format_args!("initialized with label {:?}", io.string(LABEL)));
         Ok(())
     }
 

@@ -30,7 +30,7 @@ fn vr(i: usize) -> u32 {
 fn legal_run_with_setup_experiment() {
     let mut logs = Logs::new();
     let cb = callbacks(&mut logs);
-    let guid = CString::new(TestModel::TOKEN).unwrap();
+    let guid = CString::new(TestModel::GUID).unwrap();
     unsafe {
         let c = fmi2::instantiate::<TestModel>(c"a".as_ptr(), fmi2::FMI2_CO_SIMULATION, guid.as_ptr(), std::ptr::null(), &cb, 0, 0);
         assert!(!c.is_null());
@@ -56,7 +56,7 @@ fn legal_run_with_setup_experiment() {
 fn fmi3_only_variables_are_invisible_and_set_is_all_or_nothing() {
     let mut logs = Logs::new();
     let cb = callbacks(&mut logs);
-    let guid = CString::new(TestModel::TOKEN).unwrap();
+    let guid = CString::new(TestModel::GUID).unwrap();
     unsafe {
         let c = fmi2::instantiate::<TestModel>(c"a".as_ptr(), 1, guid.as_ptr(), std::ptr::null(), &cb, 0, 0);
         assert_eq!(fmi2::enter_initialization_mode::<TestModel>(c), Status::Ok);
@@ -78,7 +78,7 @@ fn fmi3_only_variables_are_invisible_and_set_is_all_or_nothing() {
 fn instantiate_checks_guid_and_type() {
     let mut logs = Logs::new();
     let cb = callbacks(&mut logs);
-    let guid = CString::new(TestModel::TOKEN).unwrap();
+    let guid = CString::new(TestModel::GUID).unwrap();
     unsafe {
         assert!(fmi2::instantiate::<TestModel>(c"a".as_ptr(), 0, guid.as_ptr(), std::ptr::null(), &cb, 0, 0).is_null());
         assert!(fmi2::instantiate::<TestModel>(c"a".as_ptr(), 1, c"{x}".as_ptr(), std::ptr::null(), &cb, 0, 0).is_null());

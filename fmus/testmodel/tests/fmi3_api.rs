@@ -179,7 +179,7 @@ fn invalid_handles_are_errors_not_crashes() {
         assert_eq!(fmi3::reset::<TestModel>(0xdead_bee8 as *mut _), Status::Error);
         fmi3::free_instance::<TestModel>(std::ptr::null_mut());
         // An FMI 2 handle is not an FMI 3 instance.
-        let guid = CString::new(TestModel::TOKEN).unwrap();
+        let guid = CString::new(TestModel::GUID).unwrap();
         let cb = agrisim_fmi::fmi2::CallbackFunctions {
             logger: None, allocate_memory: None, free_memory: None, step_finished: None,
             component_environment: std::ptr::null_mut(),
@@ -202,4 +202,19 @@ fn exported_symbols_serve_the_same_xml() {
     assert_eq!(unsafe { CStr::from_ptr(p) }.to_str().unwrap(), agrisim_fmi::xml::fmi3::<TestModel>());
     let p = agrisim_fmu_testmodel::__agrisim_fmi_exports::agrisim_model_description_fmi2();
     assert_eq!(unsafe { CStr::from_ptr(p) }.to_str().unwrap(), agrisim_fmi::xml::fmi2::<TestModel>());
+}
+
+#[test]
+fn binary_input_above_its_max_size_is_refused_before_it_is_read() {
+    let i = I3::stepping();
+    let set = |bytes: &[u8]| unsafe { fmi3::set_binary::<TestModel>(i.p, &vr(MSG_IN), 1, &bytes.len(), &bytes.as_ptr(), 1) };
+    let mut bytes = vec![0u8; MAX_MESSAGE];
+    bytes[..9].copy_from_slice(EMPTY_STRING_CDR);
+    assert_eq!(set(&bytes), Status::Ok, "maxSize bytes are fine");
+    bytes.push(0);
+    assert_eq!(set(&bytes), Status::Error);
+    let msg = i.last_error();
+    for needle in ["fmi3SetBinary", "'msg_in'", "1048577 bytes exceed its maxSize of 1048576 bytes"] {
+        assert!(msg.contains(needle), "{msg:?} lacks {needle:?}");
+    }
 }

@@ -27,3 +27,10 @@ fn fuzz_fmi2() {
         agrisim_fmi::testing::fuzz_fmi2::<TestModel>(seed, 300);
     }
 }
+
+#[test]
+fn model_structure_dependencies_hold() {
+    agrisim_fmi::testing::assert_valid_table::<TestModel>();
+    agrisim_fmi::testing::assert_initial_dependencies::<TestModel>(&[]);
+    agrisim_fmi::testing::assert_no_direct_feedthrough::<TestModel>();
+}

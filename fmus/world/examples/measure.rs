@@ -6,7 +6,7 @@
 //!
 //! `cargo run --release -p agrisim-fmu-world --example measure`
 
-use agrisim_fmi::{Log, Model, Store, Value};
+use agrisim_fmi::{Model, Quiet, Store, Value};
 use agrisim_fmu_world::ground_truth::fruit_poses;
 use agrisim_fmu_world::ports::*;
 use agrisim_fmu_world::GreenhouseWorld;
@@ -14,12 +14,6 @@ use agrisim_greenhouse::config::GreenhouseConfig;
 use agrisim_greenhouse::layout::Layout;
 use agrisim_msgs::Message;
 use std::time::Instant;
-
-struct Quiet;
-impl Log for Quiet {
-    fn info(&mut self, _: &str) {}
-    fn warning(&mut self, _: &str) {}
-}
 
 /// Resident set size [MiB] (Linux).
 fn rss_mib() -> f64 {

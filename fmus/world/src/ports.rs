@@ -40,32 +40,34 @@ agrisim_fmi::variables! { pub VARIABLES {
         .desc("Lift extension (URDF lift_joint, clamped to its limits): raises the lift carriage and both arms"),
     TARGET_FRUIT = Var::input_discrete("target_fruit", Start::Int32(-1))
         .desc("Index into the fruit list (order of fruit_poses) whose pose is the target; -1 = none"),
-    // --- outputs: contacts and clearance ---
-    COLLISION = Var::output_discrete("collision", Start::Boolean(false))
+    // --- outputs: contacts and clearance (at initialization: of the robot as the inputs
+    // place it; every message is published once, so the *_seq counters start at 1 except
+    // target's, which needs a valid target_fruit; nothing is held, picked or placed yet) ---
+    COLLISION = Var::output_discrete("collision", Start::Boolean(false)).init_depends_on(&CONTACTS)
         .desc("Any robot contact now: a scene object (floor excluded for the base box; carried, falling and placed fruit excluded) or arm vs arm"),
-    COLLISION_COUNT = Var::output_discrete("collision_count", Start::Int32(0))
+    COLLISION_COUNT = Var::output_discrete("collision_count", Start::Int32(0)).init_depends_on(&CONTACTS)
         .desc("Cumulative contact onsets, all categories (sum of contact_robot_plant, contact_robot_structure, contact_arm_arm)"),
-    MIN_CLEARANCE = Var::output("min_clearance").unit("m")
+    MIN_CLEARANCE = Var::output("min_clearance").unit("m").init_depends_on(&[SCENE, SEED, BASE_LENGTH, BASE_WIDTH, BASE_HEIGHT, BASE_CLEARANCE, BASE_X, BASE_Y, BASE_YAW, CLEARANCE_CAP])
         .desc("Distance from the base box to the nearest scene object within the base's height band, capped at clearance_cap"),
-    COLLISION_STATE = Var::output_discrete("collision_state", Start::Binary(&[])).mime(COLLISION_STATE_MIME)
+    COLLISION_STATE = Var::output_discrete("collision_state", Start::Binary(&[])).mime(COLLISION_STATE_MIME).init_depends_on(&COLLISION_REPORT)
         .desc("agrisim_msgs/CollisionState in the map frame, at collision_rate and whenever the contact set changes"),
-    COLLISION_STATE_SEQ = Var::output_discrete("collision_state_seq", Start::Int64(0))
+    COLLISION_STATE_SEQ = Var::output_discrete("collision_state_seq", Start::Int64(0)).init_depends_on(&[])
         .desc("Sequence counter of collision_state"),
     // --- outputs: ground truth ---
-    FRUIT_COUNT = Var::output_discrete("fruit_count", Start::Int32(0)).desc("Number of fruit in the scene"),
-    FRUIT_POSES = Var::output_discrete("fruit_poses", Start::Binary(&[])).mime(POSE_ARRAY_MIME)
+    FRUIT_COUNT = Var::output_discrete("fruit_count", Start::Int32(0)).init_depends_on(&[SCENE, SEED]).desc("Number of fruit in the scene"),
+    FRUIT_POSES = Var::output_discrete("fruit_poses", Start::Binary(&[])).mime(POSE_ARRAY_MIME).init_depends_on(&[SCENE, SEED, FRUIT_RATE, Var::TIME])
         .desc("geometry_msgs/PoseArray of every fruit centre (frame map), at fruit_rate"),
-    FRUIT_POSES_SEQ = Var::output_discrete("fruit_poses_seq", Start::Int64(0)).desc("Sequence counter of fruit_poses"),
-    TARGET_VALID = Var::output_discrete("target_valid", Start::Boolean(false))
+    FRUIT_POSES_SEQ = Var::output_discrete("fruit_poses_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence counter of fruit_poses"),
+    TARGET_VALID = Var::output_discrete("target_valid", Start::Boolean(false)).init_depends_on(TARGET_CHOICE)
         .desc("target_fruit names an existing fruit"),
-    TARGET_ID = Var::output_discrete("target_id", Start::Int32(-1))
+    TARGET_ID = Var::output_discrete("target_id", Start::Int32(-1)).init_depends_on(TARGET_CHOICE)
         .desc("Scene object id of the target fruit (as in collision_state), -1 when none"),
-    TARGET_X = Var::output("target_x").unit("m").desc("Target fruit centre in the map frame (0 when none)"),
-    TARGET_Y = Var::output("target_y").unit("m"),
-    TARGET_Z = Var::output("target_z").unit("m"),
-    TARGET = Var::output_discrete("target", Start::Binary(&[])).mime(POSE_STAMPED_MIME)
+    TARGET_X = Var::output("target_x").unit("m").init_depends_on(TARGET_CHOICE).desc("Target fruit centre in the map frame (0 when none)"),
+    TARGET_Y = Var::output("target_y").unit("m").init_depends_on(TARGET_CHOICE),
+    TARGET_Z = Var::output("target_z").unit("m").init_depends_on(TARGET_CHOICE),
+    TARGET = Var::output_discrete("target", Start::Binary(&[])).mime(POSE_STAMPED_MIME).max_size(1024).init_depends_on(&[SCENE, SEED, TARGET_FRUIT, Var::TIME])
         .desc("geometry_msgs/PoseStamped of the target fruit (frame map), at fruit_rate and when target_fruit changes"),
-    TARGET_SEQ = Var::output_discrete("target_seq", Start::Int64(0)).desc("Sequence counter of target"),
+    TARGET_SEQ = Var::output_discrete("target_seq", Start::Int64(0)).init_depends_on(TARGET_CHOICE).desc("Sequence counter of target"),
     // --- harvest physics (appended: earlier value references stay as they were) ---
     LEFT_Q1 = Var::input("left_q1", READY_POSE[0]).unit("rad").desc("left_joint1 angle (default: Franka ready pose; clamped to the URDF limits)"),
     LEFT_Q2 = Var::input("left_q2", READY_POSE[1]).unit("rad").desc("left_joint2 angle"),
@@ -91,33 +93,45 @@ agrisim_fmi::variables! { pub VARIABLES {
         .desc("Release: gap > fruit diameter + this"),
     PHYSICS_DT = Var::param("physics_dt", Start::Float64(0.005)).unit("s").range(1e-4, 0.1)
         .desc("Largest rapier substep while a released fruit falls"),
-    LEFT_GRASP_WIDTH = Var::output("left_grasp_width").unit("m")
+    LEFT_GRASP_WIDTH = Var::output("left_grasp_width").unit("m").init_depends_on(&[])
         .desc("Diameter of the fruit between the left fingers (where the gripper stalls), 0 when empty"),
-    RIGHT_GRASP_WIDTH = Var::output("right_grasp_width").unit("m")
+    RIGHT_GRASP_WIDTH = Var::output("right_grasp_width").unit("m").init_depends_on(&[])
         .desc("Diameter of the fruit between the right fingers, 0 when empty"),
-    LEFT_HELD_ID = Var::output_discrete("left_held_id", Start::Int32(-1))
+    LEFT_HELD_ID = Var::output_discrete("left_held_id", Start::Int32(-1)).init_depends_on(&[])
         .desc("Scene object id of the fruit the left gripper holds (as target_id), -1 when none"),
-    RIGHT_HELD_ID = Var::output_discrete("right_held_id", Start::Int32(-1))
+    RIGHT_HELD_ID = Var::output_discrete("right_held_id", Start::Int32(-1)).init_depends_on(&[])
         .desc("Scene object id of the fruit the right gripper holds, -1 when none"),
-    PICKED_COUNT = Var::output_discrete("picked_count", Start::Int32(0))
+    PICKED_COUNT = Var::output_discrete("picked_count", Start::Int32(0)).init_depends_on(&[])
         .desc("Fruit detached from their plants by a grasp (cumulative)"),
-    PLACED_COUNT = Var::output_discrete("placed_count", Start::Int32(0))
+    PLACED_COUNT = Var::output_discrete("placed_count", Start::Int32(0)).init_depends_on(&[])
         .desc("Released fruit that came to rest inside the harvest box (cumulative)"),
-    DROPPED_COUNT = Var::output_discrete("dropped_count", Start::Int32(0))
+    DROPPED_COUNT = Var::output_discrete("dropped_count", Start::Int32(0)).init_depends_on(&[])
         .desc("Releases that ended on the floor or at rest outside the box (cumulative)"),
-    LAST_PLACED_ID = Var::output_discrete("last_placed_id", Start::Int32(-1))
+    LAST_PLACED_ID = Var::output_discrete("last_placed_id", Start::Int32(-1)).init_depends_on(&[])
         .desc("Scene object id of the fruit placed last, -1 before the first"),
-    CONTACT_ROBOT_PLANT = Var::output_discrete("contact_robot_plant", Start::Int32(0))
+    CONTACT_ROBOT_PLANT = Var::output_discrete("contact_robot_plant", Start::Int32(0)).init_depends_on(&CONTACTS)
         .desc("Cumulative onsets of robot contact with stems, leaves, trusses, fruit on the crop (expected; not a failure)"),
-    CONTACT_ROBOT_STRUCTURE = Var::output_discrete("contact_robot_structure", Start::Int32(0))
+    CONTACT_ROBOT_STRUCTURE = Var::output_discrete("contact_robot_structure", Start::Int32(0)).init_depends_on(&CONTACTS)
         .desc("Cumulative onsets of robot contact with posts, pipes, gutters, walls, obstacles, floor (a collision failure)"),
-    CONTACT_ARM_ARM = Var::output_discrete("contact_arm_arm", Start::Int32(0))
+    CONTACT_ARM_ARM = Var::output_discrete("contact_arm_arm", Start::Int32(0)).init_depends_on(&CONTACTS)
         .desc("Cumulative onsets of left-arm vs right-arm link contact (a collision failure)"),
     PLANNING_SCENE_RADIUS = Var::param("planning_scene_radius", Start::Float64(2.5)).unit("m").range(0.0, 1000.0)
         .desc("planning_scene lists the objects whose bounding box comes this close (horizontally) to base_link"),
     PLANNING_SCENE_RATE = Var::param("planning_scene_rate", Start::Float64(1.0)).unit("Hz").range(0.001, 1e6)
         .desc("Publication rate of planning_scene"),
-    PLANNING_SCENE = Var::output_discrete("planning_scene", Start::Binary(&[])).mime(PLANNING_SCENE_MIME)
+    PLANNING_SCENE = Var::output_discrete("planning_scene", Start::Binary(&[])).mime(PLANNING_SCENE_MIME).init_depends_on(&[SCENE, SEED, BASE_X, BASE_Y, PLANNING_SCENE_RADIUS, PLANNING_SCENE_RATE, Var::TIME])
         .desc("agrisim_msgs/PlanningScene: scene objects near the robot as primitives (frame map; ids = scene object ids), at planning_scene_rate"),
-    PLANNING_SCENE_SEQ = Var::output_discrete("planning_scene_seq", Start::Int64(0)).desc("Sequence counter of planning_scene"),
+    PLANNING_SCENE_SEQ = Var::output_discrete("planning_scene_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence counter of planning_scene"),
 }}
+
+/// The robot's configuration inputs: base pose, lift, arm joints, finger gaps.
+const ROBOT: &[usize] = &[
+    BASE_X, BASE_Y, BASE_YAW, LIFT_POSITION, LEFT_Q1, LEFT_Q2, LEFT_Q3, LEFT_Q4, LEFT_Q5, LEFT_Q6, LEFT_Q7, RIGHT_Q1, RIGHT_Q2,
+    RIGHT_Q3, RIGHT_Q4, RIGHT_Q5, RIGHT_Q6, RIGHT_Q7, LEFT_FINGER_WIDTH, RIGHT_FINGER_WIDTH,
+];
+/// What the contacts at the start depend on: the scene, the base box and the robot's configuration.
+const CONTACTS: [usize; 26] = agrisim_fmi::concat(&[&[SCENE, SEED, BASE_LENGTH, BASE_WIDTH, BASE_HEIGHT, BASE_CLEARANCE], ROBOT]);
+/// The first collision_state: the contacts, stamped on the collision_rate grid.
+const COLLISION_REPORT: [usize; 28] = agrisim_fmi::concat(&[&CONTACTS, &[COLLISION_RATE, Var::TIME]]);
+/// Which fruit is the target (and where it is).
+const TARGET_CHOICE: &[usize] = &[SCENE, SEED, TARGET_FRUIT];

@@ -263,7 +263,6 @@ impl Running {
 
 impl Model for GreenhouseWorld {
     const NAME: &'static str = "Greenhouse";
-    const TOKEN: &'static str = "{9b7d2e41-5c3a-4f18-a6e2-agrisim-greenhouse-world-1}";
     const DESCRIPTION: &'static str =
         "Tomato greenhouse world: the scene in a rapier world, robot-scene contacts and clearance, ground-truth fruit poses";
     const VARIABLES: &'static [Var] = VARIABLES;
@@ -315,7 +314,7 @@ impl Model for GreenhouseWorld {
             physics_dt,
         };
         let harvest = Harvest::new(params, coords.widths, robot.hands(&base_link));
-        log.info(&format!(
+        log.info(format_args!(
             "greenhouse: {} rows, {} objects, {} fruit (seed {seed})",
             cfg.rows,
             world.objects.len(),

@@ -5,7 +5,7 @@
 
 #![allow(clippy::needless_range_loop)] // small dense linear algebra reads best with indices
 
-use agrisim_fmi::{Log, Model, Store, Value};
+use agrisim_fmi::{Model, Quiet, Store, Value};
 use agrisim_fmu_world::ports::*;
 use agrisim_fmu_world::robot_links::from_rapier;
 use agrisim_fmu_world::robot_model::{Coords, RobotModel, Side, READY_POSE};
@@ -13,12 +13,6 @@ use agrisim_fmu_world::GreenhouseWorld;
 use agrisim_msgs::agrisim::CollisionState;
 use agrisim_msgs::Message;
 use agrisim_robot::Pose as RPose;
-
-struct Quiet;
-impl Log for Quiet {
-    fn info(&mut self, _: &str) {}
-    fn warning(&mut self, _: &str) {}
-}
 
 const H: f64 = 0.02;
 const G: f64 = 9.81;

@@ -1,6 +1,6 @@
 //! The Greenhouse model against analytic answers and its own contracts, through the Model trait.
 
-use agrisim_fmi::{Log, Model, Store, Value};
+use agrisim_fmi::{Model, Quiet, Store, Value};
 use agrisim_fmu_world::ports::*;
 use agrisim_fmu_world::GreenhouseWorld;
 use agrisim_greenhouse::config::GreenhouseConfig;
@@ -9,12 +9,6 @@ use agrisim_greenhouse::Shape;
 use agrisim_msgs::agrisim::CollisionState;
 use agrisim_msgs::geometry_msgs::{PoseArray, PoseStamped};
 use agrisim_msgs::Message;
-
-struct Quiet;
-impl Log for Quiet {
-    fn info(&mut self, _: &str) {}
-    fn warning(&mut self, _: &str) {}
-}
 
 const H: f64 = 0.02;
 

@@ -38,6 +38,8 @@ enum Command {
         fmus: Vec<(String, String)>,
         #[command(flatten)]
         dirs: Dirs,
+        #[command(flatten)]
+        log: FmuLog,
         /// Output directory.
         #[arg(long)]
         out: PathBuf,
@@ -70,7 +72,8 @@ enum Command {
 
 #[derive(Subcommand)]
 enum FmuCommand {
-    /// Write target/fmu/<Name>.fmu (FMI 3.0) and target/fmu/fmi2/<Name>.fmu (FMI 2.0).
+    /// Write target/fmu/<Name>.fmu (FMI 3.0), target/fmu/fmi2/<Name>.fmu (FMI 2.0) and a
+    /// self-contained target/ssp/<system>.ssp for every system file.
     Pack {
         /// Directory with the built FMU libraries (default: this executable's directory).
         #[arg(long)]
@@ -78,6 +81,12 @@ enum FmuCommand {
         /// Output directory (default: target/fmu next to the build directory).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// System files to pack as .ssp archives (default: models/systems of the checkout).
+        #[arg(long)]
+        systems: Option<PathBuf>,
+        /// Where the .ssp archives go (default: target/ssp).
+        #[arg(long)]
+        ssp_out: Option<PathBuf>,
     },
 }
 
@@ -97,6 +106,8 @@ enum BenchCommand {
         steps: u64,
         #[command(flatten)]
         dirs: Dirs,
+        #[command(flatten)]
+        log: FmuLog,
         #[arg(long)]
         out: PathBuf,
     },
@@ -114,6 +125,8 @@ struct TrialArgs {
     seed: u64,
     #[command(flatten)]
     dirs: Dirs,
+    #[command(flatten)]
+    log: FmuLog,
     #[arg(long)]
     out: PathBuf,
 }
@@ -137,6 +150,22 @@ struct Dirs {
     /// Where FMU archives are unpacked (default: target/fmu-cache).
     #[arg(long)]
     cache_dir: Option<PathBuf>,
+}
+
+#[derive(clap::Args, Clone)]
+struct FmuLog {
+    /// FMU debug logging to stderr (off by default; warnings and errors are always shown):
+    /// bare = every category, or comma-separated categories (e.g. logModel,logCalls).
+    /// Replaces the scenario's [logging] fmu.
+    #[arg(long = "fmu-log", value_name = "CATEGORIES", num_args = 0..=1, default_missing_value = "")]
+    fmu_log: Option<String>,
+}
+
+impl FmuLog {
+    /// As `RunOptions::fmu_log`: `Some(empty)` = every category.
+    fn categories(&self) -> Option<Vec<String>> {
+        self.fmu_log.as_ref().map(|s| s.split(',').map(str::trim).filter(|c| !c.is_empty()).map(String::from).collect())
+    }
 }
 
 fn parse_override(s: &str) -> std::result::Result<(String, String), String> {
@@ -166,13 +195,14 @@ fn progress_printer() -> impl FnMut(u64, u64) {
     }
 }
 
-fn run_options(dirs: Dirs, target: &std::path::Path, seed: Option<u64>, duration: Option<f64>, fmu_overrides: BTreeMap<String, String>) -> RunOptions {
+fn run_options(dirs: Dirs, target: &std::path::Path, seed: Option<u64>, duration: Option<f64>, fmu_overrides: BTreeMap<String, String>, fmu_log: Option<Vec<String>>) -> RunOptions {
     RunOptions {
         fmu_dir: dirs.fmu_dir.unwrap_or_else(|| target.join("fmu")),
         cache_dir: dirs.cache_dir.unwrap_or_else(|| target.join("fmu-cache")),
         seed,
         duration,
         fmu_overrides,
+        fmu_log,
     }
 }
 
@@ -189,16 +219,16 @@ fn main() -> ExitCode {
 /// The scenario (or the benchmark's default) and run options of a many-trial benchmark.
 fn trial_setup(a: &TrialArgs, default_scenario: &str, target: &Path) -> Result<(Scenario, RunOptions)> {
     let s = Scenario::load(a.scenario.as_deref().unwrap_or(Path::new(default_scenario)))?;
-    Ok((s, run_options(a.dirs.clone(), target, None, None, BTreeMap::new())))
+    Ok((s, run_options(a.dirs.clone(), target, None, None, BTreeMap::new(), a.log.categories())))
 }
 
 fn real_main() -> Result<()> {
     let cli = Cli::parse();
     let (exe_dir, target) = build_dirs();
     match cli.command {
-        Command::Run { scenario, duration, seed, fmus, dirs, out } => {
+        Command::Run { scenario, duration, seed, fmus, dirs, log, out } => {
             let s = Scenario::load(&scenario)?;
-            let opts = run_options(dirs, &target, seed, duration, fmus.into_iter().collect());
+            let opts = run_options(dirs, &target, seed, duration, fmus.into_iter().collect(), log.categories());
             let summary = agrisim_session::run::run(&s, &opts, &out, progress_printer())?;
             println!("{} steps ({} s simulated) -> {}", summary.steps, summary.simulated, summary.mcap.display());
         }
@@ -212,15 +242,15 @@ fn real_main() -> Result<()> {
             let summary = agrisim_bench::harvest::bench_harvest(&s, &opts, a.trials, a.seed, &a.out, progress_printer())?;
             println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
         }
-        Command::Bench { command: BenchCommand::Overhead { scenario, steps, dirs, out } } => {
+        Command::Bench { command: BenchCommand::Overhead { scenario, steps, dirs, log, out } } => {
             let s = Scenario::load(&scenario)?;
-            let opts = run_options(dirs, &target, None, None, BTreeMap::new());
+            let opts = run_options(dirs, &target, None, None, BTreeMap::new(), log.categories());
             let report = agrisim_bench::overhead(&s, &opts, steps, &out)?;
             println!("{}", serde_json::to_string_pretty(&report).expect("plain struct serializes"));
         }
         Command::Snapshot { scenario, dirs, out } => {
             let s = Scenario::load(&scenario)?;
-            let opts = run_options(dirs, &target, None, None, BTreeMap::new());
+            let opts = run_options(dirs, &target, None, None, BTreeMap::new(), None);
             for p in snapshot::snapshot(&s, &opts, &out)? {
                 println!("{}", p.display());
             }
@@ -231,7 +261,7 @@ fn real_main() -> Result<()> {
             agrisim_greenhouse::gltf::write_glb(&g.objects, &out).map_err(|e| agrisim_error::err!("cannot write {}: {e}", out.display()))?;
             println!("{} objects -> {}", g.objects.len(), out.display());
         }
-        Command::Fmu { command: FmuCommand::Pack { lib_dir, out } } => {
+        Command::Fmu { command: FmuCommand::Pack { lib_dir, out, systems, ssp_out } } => {
             let lib_dir = lib_dir.unwrap_or(exe_dir);
             let out = out.unwrap_or_else(|| target.join("fmu"));
             for p in pack::pack_all(&lib_dir, &out)? {
@@ -239,6 +269,10 @@ fn real_main() -> Result<()> {
                     Some(f2) => println!("{}: {} {}", p.model_identifier, p.fmi3.display(), f2.display()),
                     None => println!("{}: {}", p.model_identifier, p.fmi3.display()),
                 }
+            }
+            let systems = systems.unwrap_or_else(|| target.parent().unwrap_or(Path::new(".")).join("models/systems"));
+            for p in pack::pack_ssps(&systems, &out, &ssp_out.unwrap_or_else(|| target.join("ssp")))? {
+                println!("{}", p.display());
             }
         }
     }

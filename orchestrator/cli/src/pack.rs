@@ -49,6 +49,12 @@ pub fn find_fmu_libraries(dir: &Path) -> Result<Vec<PathBuf>> {
 }
 
 fn zip_fmu(out: &Path, xml: &str, binary_dir: &str, identifier: &str, library: &[u8]) -> Result<()> {
+    write_zip(out, &[(format!("binaries/{binary_dir}/{identifier}.so"), library), ("modelDescription.xml".to_string(), xml.as_bytes())])
+}
+
+/// A deterministic zip (entries in the given order, fixed timestamps), so the same inputs give
+/// byte-identical archives.
+fn write_zip(out: &Path, entries: &[(String, &[u8])]) -> Result<()> {
     use zip::write::SimpleFileOptions;
     let file = std::fs::File::create(out).context(|| format!("cannot create {}", out.display()))?;
     let mut zip = zip::ZipWriter::new(file);
@@ -56,8 +62,6 @@ fn zip_fmu(out: &Path, xml: &str, binary_dir: &str, identifier: &str, library: &
         .compression_method(zip::CompressionMethod::Deflated)
         .last_modified_time(zip::DateTime::default())
         .unix_permissions(0o644);
-    let entries: [(String, &[u8]); 2] =
-        [(format!("binaries/{binary_dir}/{identifier}.so"), library), ("modelDescription.xml".to_string(), xml.as_bytes())];
     for (name, bytes) in entries {
         zip.start_file(name.as_str(), opts).context(|| format!("{}: {name}", out.display()))?;
         zip.write_all(bytes).context(|| format!("{}: {name}", out.display()))?;
@@ -99,4 +103,43 @@ pub fn pack_all(lib_dir: &Path, out_dir: &Path) -> Result<Vec<Packed>> {
         return Err(agrisim_error::err!("no FMU libraries (libagrisim_fmu_*.so) in {}: run `cargo build --release` first", lib_dir.display()));
     }
     libs.iter().map(|l| pack_library(l, out_dir)).collect()
+}
+
+/// Writes `out_dir/<system>.ssp` for every `.ssd` in `systems_dir`: a self-contained SSP
+/// archive (SystemStructure.ssd at the root, every component's FMU under resources/, sources
+/// rewritten to point there) that other SSP tools and `agrisim run` load as they are.
+pub fn pack_ssps(systems_dir: &Path, fmu_dir: &Path, out_dir: &Path) -> Result<Vec<PathBuf>> {
+    use agrisim_cosim::ssp::{resolve_source, SystemStructure};
+    let mut ssds: Vec<PathBuf> = std::fs::read_dir(systems_dir)
+        .context(|| format!("cannot list {}", systems_dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "ssd"))
+        .collect();
+    ssds.sort();
+    std::fs::create_dir_all(out_dir).context(|| format!("cannot create {}", out_dir.display()))?;
+    let mut written = vec![];
+    for ssd in ssds {
+        let mut text = std::fs::read_to_string(&ssd).context(|| format!("cannot read {}", ssd.display()))?;
+        let structure = SystemStructure::parse(&text, &ssd)?;
+        let mut resources = std::collections::BTreeMap::new();
+        for c in &structure.components {
+            let path = resolve_source(&ssd, &c.source, fmu_dir);
+            let file = path.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default();
+            let bytes = std::fs::read(&path).context(|| format!("{}: component '{}': cannot read {} (run `agrisim fmu pack` after `cargo build --release`)", ssd.display(), c.name, path.display()))?;
+            resources.insert(format!("resources/{file}"), bytes);
+            let (old, new) = (format!("source=\"{}\"", c.source), format!("source=\"resources/{file}\""));
+            // Components sharing one FMU (the two arms) were rewritten with the first.
+            if !text.contains(&old) && !text.contains(&new) {
+                return Err(agrisim_error::err!("{}: component '{}': cannot find {old} to rewrite", ssd.display(), c.name));
+            }
+            text = text.replace(&old, &new);
+        }
+        let stem = ssd.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let out = out_dir.join(format!("{stem}.ssp"));
+        let mut entries: Vec<(String, &[u8])> = vec![("SystemStructure.ssd".to_string(), text.as_bytes())];
+        entries.extend(resources.iter().map(|(k, v)| (k.clone(), v.as_slice())));
+        write_zip(&out, &entries)?;
+        written.push(out);
+    }
+    Ok(written)
 }

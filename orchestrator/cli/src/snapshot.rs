@@ -30,7 +30,7 @@ fn open(s: &Scenario, o: &RunOptions, file: &str, name: &str, pose: [f64; 3]) ->
     }
     for (n, v) in s.parameters.get(name).into_iter().flatten() {
         let var = var(n)?;
-        let val = value::from_toml(&var, v).ok_or_else(|| agrisim_error::err!("scenario parameter {name}.{n}: value {v} does not fit type {}", var.ty.name()))?;
+        let val = value::from_toml(&var, v).map_err(|e| agrisim_error::err!("scenario parameter {name}.{n}: {e}"))?;
         value::set(&mut inst, &var, &val)?;
     }
     for (n, v) in ["base_x", "base_y", "base_yaw"].iter().zip(pose) {

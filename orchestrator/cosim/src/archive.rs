@@ -134,6 +134,20 @@ impl FmuArchive {
     }
 }
 
+/// Unpacks any archive of the FMI/SSP family (an `.ssp`) under `cache_root` with the same
+/// checks as an FMU (no entry outside its directory), reusing a complete earlier unpacking of
+/// the same bytes; returns the directory.
+pub fn unpack(path: &Path, cache_root: &Path) -> Result<PathBuf, ImportError> {
+    let bytes = std::fs::read(path).map_err(|e| ImportError::new(path, format!("cannot read: {e}")))?;
+    let mut zip = zip::ZipArchive::new(Cursor::new(&bytes[..])).map_err(|e| ImportError::new(path, format!("not a valid zip archive: {e}")))?;
+    let stem = sanitize(&path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
+    let dir = cache_root.join(format!("{stem}-{:016x}", fnv1a64(&bytes)));
+    if !dir.join(MARKER).is_file() {
+        extract(&mut zip, path, cache_root, &dir)?;
+    }
+    Ok(dir)
+}
+
 /// Extracts every entry into a temporary directory, then renames it to `dir`.
 fn extract(
     zip: &mut zip::ZipArchive<Cursor<&[u8]>>,

@@ -14,50 +14,43 @@
 //! inputs and of what the hooks answer.
 
 use crate::error::Result;
-use crate::model_description::{ModelVariable, VarType};
 use crate::system::{Port, System};
 use crate::value::{self, Value};
 
 /// What the engine exchanges with the program around it at each communication point: the
 /// system's own connectors (no component), and every message it moves.
 pub trait Hooks {
-    /// A message left an FMU on route `route` (an index into `system.routes`) at `t_ns` (bound for a system connector, or for
-    /// another FMU: then it is shown here too, on the route's topic). An error stops the run.
-    fn message(&mut self, system: &System, route: usize, t_ns: i64, bytes: &[u8]) -> Result<()>;
+    /// A message left an FMU on route `route` (an index into `system.routes`) at `t_ns`
+    /// (bound for a system connector, or for another FMU: then it is shown here too, on the
+    /// route's topic). An error stops the run.
+    fn message(&mut self, _system: &System, _route: usize, _t_ns: i64, _bytes: &[u8]) -> Result<()> {
+        Ok(())
+    }
     /// A scalar FMU output reached system connector `connector`.
-    fn scalar(&mut self, connector: &str, value: f64);
+    fn scalar(&mut self, _connector: &str, _value: f64) {}
     /// Between outputs and inputs of point `t_ns`; `message_instant` at the message rate.
-    fn exchange(&mut self, t_ns: i64, message_instant: bool) -> Result<()>;
+    fn exchange(&mut self, _t_ns: i64, _message_instant: bool) -> Result<()> {
+        Ok(())
+    }
     /// The newest message on system connector `connector` if its sequence number is above
     /// `*seen` (then `*seen` is updated).
-    fn message_input(&mut self, connector: &str, seen: &mut i64) -> Option<Vec<u8>>;
+    fn message_input(&mut self, _connector: &str, _seen: &mut i64) -> Option<Vec<u8>> {
+        None
+    }
     /// The current value of scalar system connector `connector`, if it has one.
-    fn scalar_input(&self, connector: &str) -> Option<f64>;
+    fn scalar_input(&self, _connector: &str) -> Option<f64> {
+        None
+    }
     /// The point `t_ns` is complete (inputs written, FMUs not yet stepped).
-    fn point(&mut self, system: &mut System, t_ns: i64) -> Result<()>;
+    fn point(&mut self, _system: &mut System, _t_ns: i64) -> Result<()> {
+        Ok(())
+    }
 }
 
 /// Hooks for a system run on its own: system connectors stay unconnected.
 pub struct NoHooks;
 
-impl Hooks for NoHooks {
-    fn message(&mut self, _: &System, _: usize, _: i64, _: &[u8]) -> Result<()> {
-        Ok(())
-    }
-    fn scalar(&mut self, _: &str, _: f64) {}
-    fn exchange(&mut self, _: i64, _: bool) -> Result<()> {
-        Ok(())
-    }
-    fn message_input(&mut self, _: &str, _: &mut i64) -> Option<Vec<u8>> {
-        None
-    }
-    fn scalar_input(&self, _: &str) -> Option<f64> {
-        None
-    }
-    fn point(&mut self, _: &mut System, _: i64) -> Result<()> {
-        Ok(())
-    }
-}
+impl Hooks for NoHooks {}
 
 pub struct Master {
     pub system: System,
@@ -194,7 +187,7 @@ impl Master {
                         self.system.routes[r].seen = seen;
                         bytes.map(Value::Bin)
                     }
-                    Port::Fmu { var, .. } => hooks.scalar_input(topic).map(|x| scalar_for(var, x)).transpose()?,
+                    Port::Fmu { var, .. } => hooks.scalar_input(topic).map(|x| value::scalar_from_f64(var, x).map_err(|e| crate::err!("{}: {e}", route.label))).transpose()?,
                     Port::Bus { .. } => None,
                 },
                 Port::Fmu { seq: Some(_), .. } => match self.take_message(r)? {
@@ -247,14 +240,4 @@ impl Master {
         self.tick += 1;
         Ok(())
     }
-}
-
-fn scalar_for(var: &ModelVariable, x: f64) -> Result<Value> {
-    Ok(match var.ty {
-        VarType::Float64 => Value::F64(x),
-        VarType::Int32 => Value::I32(x as i32),
-        VarType::Int64 => Value::I64(x as i64),
-        VarType::Boolean => Value::Bool(x != 0.0),
-        other => return Err(crate::err!("variable {} of type {} cannot take a scalar", var.name, other.name())),
-    })
 }

@@ -220,6 +220,8 @@ pub struct ModelDescription {
     /// `CoSimulation/@modelIdentifier`: the shared library's file stem.
     pub model_identifier: String,
     pub can_get_and_set_fmu_state: bool,
+    /// Names of `<LogCategories>` (empty when the FMU declares none).
+    pub log_categories: Vec<String>,
     pub default_step_size: Option<f64>,
     pub variables: Vec<ModelVariable>,
 }
@@ -283,6 +285,15 @@ impl ModelDescription {
                     "<CoSimulation> canGetAndSetFMUState=\"{v}\" is not a boolean"
                 ))
             })?,
+        };
+
+        let log_categories = match child(root, "LogCategories") {
+            None => Vec::new(),
+            Some(lc) => lc
+                .children()
+                .filter(|n| n.is_element() && n.tag_name().name() == "Category")
+                .map(|n| attr(n, "name", "a <LogCategories> <Category>"))
+                .collect::<Result<Vec<_>, _>>()?,
         };
 
         let default_step_size =
@@ -371,6 +382,7 @@ impl ModelDescription {
             instantiation_token,
             model_identifier,
             can_get_and_set_fmu_state,
+            log_categories,
             default_step_size,
             variables,
         })
@@ -434,6 +446,7 @@ mod tests {
         assert_eq!(b.start.as_deref(), Some("0aff"));
         assert_eq!(b.mime_type.as_deref(), Some("application/octet-stream"));
         assert!(!md.can_get_and_set_fmu_state);
+        assert!(md.log_categories.is_empty());
         assert_eq!(md.variable_by_vr(2).unwrap().name, "n");
     }
 }

@@ -22,6 +22,9 @@ pub const NS_SSC: &str = "http://ssp-standard.org/SSP1/SystemStructureCommon";
 pub const NS_SSV: &str = "http://ssp-standard.org/SSP1/SystemStructureParameterValues";
 /// `ssc:Annotation/@type` carrying agrisim's per-connection exchange period.
 pub const EXCHANGE_ANNOTATION: &str = "org.agrisim.exchange";
+/// Annotation type on a system connector: the name of the message-layer topic (or scalar)
+/// it stands for (e.g. `/cmd_vel`), which SSP tools would refuse as a connector name.
+pub const TOPIC_ANNOTATION: &str = "org.agrisim.topic";
 /// The only component type supported.
 pub const FMU_COMPONENT_TYPE: &str = "application/x-fmu-sharedlibrary";
 
@@ -107,6 +110,16 @@ pub struct Connector {
     pub kind: ConnectorKind,
     /// `None` when the connector declares no type (it is then taken from the FMU).
     pub ty: Option<ConnectorType>,
+    /// The topic from an `org.agrisim.topic` annotation (system connectors).
+    pub topic: Option<String>,
+}
+
+impl Connector {
+    /// What the program around the engine calls this connector: its topic if annotated,
+    /// else its name.
+    pub fn external_name(&self) -> &str {
+        self.topic.as_deref().unwrap_or(&self.name)
+    }
 }
 
 /// A parameter value from an inline `ssv:ParameterSet`.
@@ -333,10 +346,17 @@ fn parse_connectors(node: Node, owner: &str) -> Result<Vec<Connector>, String> {
                 other => return Err(format!("{what}: unknown type element ssc:{other}")),
             }),
         };
+        let mut topic = None;
+        if let Some(anns) = child(c, NS_SSD, "Annotations") {
+            for ann in elements(anns, NS_SSC, "Annotation").filter(|a| a.attribute("type") == Some(TOPIC_ANNOTATION)) {
+                let t = ann.descendants().filter(|n| n.is_element()).find_map(|n| n.attribute("name")).filter(|t| !t.is_empty());
+                topic = Some(t.ok_or_else(|| format!("{what}: the {TOPIC_ANNOTATION} annotation names no topic (expected an element with a name attribute)"))?.to_string());
+            }
+        }
         if out.iter().any(|o| o.name == name) {
             return Err(format!("{owner} declares connector '{name}' twice"));
         }
-        out.push(Connector { name, kind, ty });
+        out.push(Connector { name, kind, ty, topic });
     }
     Ok(out)
 }

@@ -8,7 +8,7 @@
 use crate::archive::FmuArchive;
 use crate::error::{Context, Result};
 use crate::fmi3::Instance;
-use crate::model_description::{Causality, ModelVariable, VarType};
+use crate::model_description::{Causality, ModelDescription, ModelVariable, VarType};
 use crate::seed::component_seed;
 use crate::ssp::{self, SystemStructure};
 use crate::value::{self, Value};
@@ -27,12 +27,17 @@ pub struct LoadOptions {
     pub step: f64,
     /// Period of message connections without their own [s].
     pub message_period: f64,
+    /// FMU debug logging (FMI `loggingOn`, then `fmi3SetDebugLogging`): `None` off, the
+    /// default (the FMUs report only warnings and errors, which always reach the user: in a
+    /// call's error, else on stderr); `Some(vec![])` every category; `Some(list)` those
+    /// categories, each FMU getting the ones it declares. Debug messages go to stderr.
+    pub fmu_log: Option<Vec<String>>,
 }
 
 impl LoadOptions {
     /// FMUs from `fmu_dir`, unpacked to `cache_dir`, no overrides.
     pub fn new(fmu_dir: impl Into<PathBuf>, cache_dir: impl Into<PathBuf>, step: f64, message_period: f64) -> LoadOptions {
-        LoadOptions { fmu_dir: fmu_dir.into(), cache_dir: cache_dir.into(), fmu_overrides: BTreeMap::new(), step, message_period }
+        LoadOptions { fmu_dir: fmu_dir.into(), cache_dir: cache_dir.into(), fmu_overrides: BTreeMap::new(), step, message_period, fmu_log: None }
     }
 }
 
@@ -152,9 +157,55 @@ fn port_label(e: &ssp::Endpoint) -> String {
     }
 }
 
+/// Every category of a `fmu_log` list must be declared by some FMU of the system (a typo
+/// must not silently log nothing), unless some FMU declares no categories at all.
+fn check_log_categories(categories: &[String], mds: &BTreeMap<String, ModelDescription>, ssd: &Path) -> Result<()> {
+    if mds.values().any(|md| md.log_categories.is_empty()) {
+        return Ok(());
+    }
+    for c in categories {
+        if !mds.values().any(|md| md.log_categories.contains(c)) {
+            let mut known: Vec<&str> = mds.values().flat_map(|md| md.log_categories.iter().map(String::as_str)).collect();
+            known.sort_unstable();
+            known.dedup();
+            return Err(crate::err!("FMU log category '{c}': no FMU of {} declares it (they declare: {})", ssd.display(), known.join(", ")));
+        }
+    }
+    Ok(())
+}
+
+/// Instantiates component `name` with debug logging as `fmu_log` asks (see
+/// [`LoadOptions::fmu_log`]): of a category list, the FMU gets those it declares (all of them
+/// when it declares none); with none of them, debug logging stays off.
+fn instantiate(archive: &FmuArchive, name: &str, fmu_log: Option<&[String]>) -> Result<Instance> {
+    let Some(categories) = fmu_log else { return Ok(Instance::instantiate(archive, name, false)?) };
+    if categories.is_empty() {
+        return Ok(Instance::instantiate(archive, name, true)?);
+    }
+    let declared = &archive.md.log_categories;
+    let mine: Vec<&str> = categories.iter().map(String::as_str).filter(|c| declared.is_empty() || declared.iter().any(|d| d == c)).collect();
+    let mut instance = Instance::instantiate(archive, name, false)?;
+    if !mine.is_empty() {
+        instance.set_debug_logging(true, &mine)?;
+    }
+    Ok(instance)
+}
+
 impl System {
     /// Reads the system file, opens every FMU, checks the wiring and instantiates.
+    /// `ssd` is a SystemStructure.ssd or a self-contained `.ssp` archive (unpacked to the
+    /// cache; its components' sources are inside it, under resources/).
     pub fn load(ssd: &Path, opts: &LoadOptions) -> Result<System> {
+        let unpacked;
+        let ssd = if ssd.extension().is_some_and(|e| e.eq_ignore_ascii_case("ssp")) {
+            unpacked = crate::archive::unpack(ssd, &opts.cache_dir)?.join("SystemStructure.ssd");
+            if !unpacked.is_file() {
+                return Err(crate::err!("{}: no SystemStructure.ssd at the archive root", ssd.display()));
+            }
+            unpacked.as_path()
+        } else {
+            ssd
+        };
         let mut structure = SystemStructure::from_file(ssd)?;
         for (comp, fmu) in &opts.fmu_overrides {
             let c = structure.components.iter_mut().find(|c| &c.name == comp).ok_or_else(|| crate::err!("FMU override for '{comp}': no such component in {}", ssd.display()))?;
@@ -169,10 +220,13 @@ impl System {
             archives.insert(c.name.clone(), a);
         }
         ssp::validate(&structure, &mds)?;
+        if let Some(categories) = &opts.fmu_log {
+            check_log_categories(categories, &mds, ssd)?;
+        }
         let mut components = vec![];
         for c in &structure.components {
             let archive = archives.remove(&c.name).expect("opened above");
-            let instance = Instance::instantiate(&archive, &c.name, true)?;
+            let instance = instantiate(&archive, &c.name, opts.fmu_log.as_deref())?;
             components.push(Component::new(c.name.clone(), archive, instance));
         }
         let mut sys = System { structure, components, routes: vec![] };
@@ -180,12 +234,17 @@ impl System {
         Ok(sys)
     }
 
+    /// A system connector's name outside the engine (its topic annotation, else its name).
+    fn external_name(&self, connector: &str) -> String {
+        self.structure.system_connector(connector).map_or(connector, |c| c.external_name()).to_string()
+    }
+
     pub fn component_index(&self, name: &str) -> Option<usize> {
         self.components.iter().position(|c| c.name == name)
     }
 
     fn port(&self, e: &ssp::Endpoint) -> Result<Port> {
-        let Some(comp_name) = &e.element else { return Ok(Port::Bus { topic: e.connector.clone() }) };
+        let Some(comp_name) = &e.element else { return Ok(Port::Bus { topic: self.external_name(&e.connector) }) };
         let comp = self.component_index(comp_name).ok_or_else(|| crate::err!("no component '{comp_name}'"))?;
         let md = &self.components[comp].archive.md;
         let var = md.variable(&e.connector).ok_or_else(|| crate::err!("FMU '{comp_name}' ({}) has no variable '{}'", md.model_name, e.connector))?.clone();
@@ -220,8 +279,8 @@ impl System {
             let period = c.period.unwrap_or(if is_message { opts.message_period } else { opts.step });
             let period_ticks = ticks_of(period, opts.step, &format!("{file}: connection {label}"))?;
             let topic = match (&c.start.element, &c.end.element) {
-                (None, _) => c.start.connector.clone(),
-                (_, None) => c.end.connector.clone(),
+                (None, _) => self.external_name(&c.start.connector),
+                (_, None) => self.external_name(&c.end.connector),
                 (Some(e), Some(_)) => format!("/{e}/{}", c.start.connector),
             };
             routes.push(Route { label, from, to, period_ticks, mime_type: mime, topic, seen: 0, written: 0 });
@@ -267,7 +326,7 @@ impl System {
             }
             for (name, v) in overrides.get(&comp.name).into_iter().flatten() {
                 let var = param(name)?;
-                let val = value::from_toml(&var, v).ok_or_else(|| crate::err!("scenario parameter {}.{name}: value {v} does not fit type {}", comp.name, var.ty.name()))?;
+                let val = value::from_toml(&var, v).map_err(|e| crate::err!("scenario parameter {}.{name}: {e}", comp.name))?;
                 set.insert(name.clone(), val);
             }
             let mut texts = BTreeMap::new();

@@ -24,14 +24,10 @@ impl Hooks for Program {
         self.odom.push((t_ns, bytes.len()));
         Ok(())
     }
-    fn scalar(&mut self, _: &str, _: f64) {}
     fn exchange(&mut self, _: i64, message_instant: bool) -> Result<()> {
         self.exchanges += 1;
         self.message_instants += message_instant as u64;
         Ok(())
-    }
-    fn message_input(&mut self, _: &str, _: &mut i64) -> Option<Vec<u8>> {
-        None
     }
     fn scalar_input(&self, connector: &str) -> Option<f64> {
         (connector == "/lift/setpoint").then_some(0.5)

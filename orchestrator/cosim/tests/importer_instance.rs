@@ -1,7 +1,8 @@
 //! Live tests of the FMI 3.0 wrapper against a small C FMU compiled at test time with the
 //! system C compiler (skipped, with the reason printed, when there is none). The C model
-//! exists only to exercise the importer: every data type, log statuses, Error/Fatal paths,
-//! FMU state, and counters that reveal leaked or double-freed instances.
+//! exists only to exercise the importer: every data type, log statuses, Error/Discard/Fatal
+//! paths, debug logging, FMU state, and counters that reveal leaked or double-freed instances
+//! and calls FMI does not allow (fmi3Terminate outside Step Mode).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -22,7 +23,7 @@ typedef void (*logcb)(void*, int, const char*, const char*);
 enum { OK, WARNING, DISCARD, ERROR, FATAL };
 
 typedef struct {
-    int freed; void* env; logcb log;
+    int freed; void* env; logcb log; bool logging, log_calls;
     double time, x, u; int32_t n, fail; int64_t k; bool flag;
     char s[256]; char res[1024];
     uint8_t bin[256]; size_t bin_len; uint8_t bout[256]; size_t bout_len;
@@ -30,12 +31,15 @@ typedef struct {
 } Inst;
 typedef struct { double x; int64_t k; } State;
 
-static int live = 0, double_frees = 0, live_states = 0;
+static int live = 0, double_frees = 0, live_states = 0, bad_terminates = 0;
 int test_live_instances(void) { return live; }
 int test_double_frees(void) { return double_frees; }
 int test_live_states(void) { return live_states; }
+int test_bad_terminates(void) { return bad_terminates; }
 
 static void lg(Inst* c, int st, const char* m) { if (c->log) c->log(c->env, st, "test", m); }
+/* A debug message: only while debug logging is on for category logCalls. */
+static void trace(Inst* c, const char* m) { if (c->log && c->logging && c->log_calls) c->log(c->env, OK, "logCalls", m); }
 static int bad_vr(Inst* c, uint32_t vr) { char m[64]; snprintf(m, 64, "unknown value reference %u", vr); lg(c, ERROR, m); return ERROR; }
 
 const char* fmi3GetVersion(void) { return "3.0"; }
@@ -47,7 +51,7 @@ void* fmi3InstantiateCoSimulation(const char* name, const char* token, const cha
         return NULL;
     }
     Inst* c = calloc(1, sizeof(Inst));
-    c->env = env; c->log = log;
+    c->env = env; c->log = log; c->logging = loggingOn; c->log_calls = true;
     snprintf(c->res, sizeof c->res, "%s", res ? res : "");
     strcpy(c->s, "hello");
     live++;
@@ -60,7 +64,16 @@ int fmi3EnterInitializationMode(void* p, bool td, double tol, double start, bool
     Inst* c = p; c->mode = 1; c->time = start; return OK; }
 int fmi3ExitInitializationMode(void* p) { Inst* c = p;
     if (c->mode != 1) { lg(c, ERROR, "exit without enter"); return ERROR; } c->mode = 2; return OK; }
-int fmi3Terminate(void* p) { Inst* c = p; c->mode = 3; return OK; }
+#ifndef OMIT_SET_DEBUG_LOGGING
+int fmi3SetDebugLogging(void* p, bool on, size_t n, const char* const* cats) { Inst* c = p;
+    c->logging = on; c->log_calls = n == 0;
+    for (size_t i = 0; i < n; i++) if (strcmp(cats[i], "logCalls") == 0) c->log_calls = true;
+    return OK; }
+#endif
+/* FMI 3.0 allows fmi3Terminate only in Step Mode (among the modes used here). */
+int fmi3Terminate(void* p) { Inst* c = p;
+    if (c->mode != 2) { bad_terminates++; lg(c, ERROR, "fmi3Terminate outside step mode"); return ERROR; }
+    c->mode = 3; return OK; }
 int fmi3Reset(void* p) { Inst* c = p; c->mode = 0; c->x = 0; c->k = 0; c->fail = 0; return OK; }
 #ifndef OMIT_DOSTEP
 int fmi3DoStep(void* p, double t, double h, bool nos, bool* ehn, bool* term, bool* er, double* lst) {
@@ -68,6 +81,9 @@ int fmi3DoStep(void* p, double t, double h, bool nos, bool* ehn, bool* term, boo
     if (c->mode != 2) { lg(c, ERROR, "fmi3DoStep called outside step mode"); return ERROR; }
     if (c->fail == 1) { char m[128]; snprintf(m, 128, "commanded failure at t=%g", t); lg(c, ERROR, m); return ERROR; }
     if (c->fail == 2) { lg(c, FATAL, "commanded fatal"); return FATAL; }
+    if (c->fail == 4) { lg(c, WARNING, "commanded discard: stopped half way");
+        c->time = t + h / 2; *ehn = false; *term = false; *er = false; *lst = t + h / 2; return DISCARD; }
+    trace(c, "fmi3DoStep");
     c->x += c->u * h; c->k += 1; c->time = t + h;
     c->bout_len = c->bin_len;
     for (size_t i = 0; i < c->bin_len; i++) c->bout[i] = c->bin[c->bin_len - 1 - i];
@@ -122,17 +138,23 @@ int fmi3SetBinary(void* p, const uint32_t* vr, size_t n, const size_t* sz, const
                 memcpy(c->bin, v[i], sz[i]); c->bin_len = sz[i]; break;
         default: return bad_vr(c, vr[i]); }
     return OK; }
+#ifndef OMIT_STATE
 int fmi3GetFMUState(void* p, void** s) { Inst* c = p; State* st = malloc(sizeof(State));
     st->x = c->x; st->k = c->k; *s = st; live_states++; return OK; }
 int fmi3SetFMUState(void* p, void* s) { Inst* c = p; State* st = s; c->x = st->x; c->k = st->k; return OK; }
 int fmi3FreeFMUState(void* p, void** s) { if (*s) { free(*s); *s = NULL; live_states--; } return OK; }
+#endif
 "#;
 
-fn model_description(token: &str) -> String {
+fn model_description(token: &str, can_get_and_set_state: bool) -> String {
     format!(
         r#"<?xml version="1.0" encoding="UTF-8"?>
 <fmiModelDescription fmiVersion="3.0" modelName="TestModel" instantiationToken="{token}">
-  <CoSimulation modelIdentifier="testmodel" canGetAndSetFMUState="true"/>
+  <CoSimulation modelIdentifier="testmodel" canGetAndSetFMUState="{can_get_and_set_state}"/>
+  <LogCategories>
+    <Category name="logStatusWarning"/>
+    <Category name="logCalls"/>
+  </LogCategories>
   <DefaultExperiment stepSize="0.1"/>
   <ModelVariables>
     <Float64 name="time" valueReference="0" causality="independent" variability="continuous"/>
@@ -201,10 +223,14 @@ struct Fixture {
 }
 
 fn fixture(token: &str, extra_cflags: &[&str]) -> Option<Fixture> {
+    fixture_with(token, extra_cflags, true)
+}
+
+fn fixture_with(token: &str, extra_cflags: &[&str], can_get_and_set_state: bool) -> Option<Fixture> {
     let tmp = tempfile::tempdir().unwrap();
     let so = compile(tmp.path(), extra_cflags)?;
     let fmu = tmp.path().join("TestModel.fmu");
-    pack(&fmu, &model_description(token), &so);
+    pack(&fmu, &model_description(token, can_get_and_set_state), &so);
     let archive = FmuArchive::open(&fmu, &tmp.path().join("cache")).unwrap();
     let lib = unsafe { libloading::Library::new(&archive.library_path) }.unwrap();
     Some(Fixture {
@@ -234,10 +260,21 @@ const BOUT: u32 = 8;
 const FAIL: u32 = 9;
 const RES: u32 = 10;
 
-fn ready(fx: &Fixture, name: &str) -> Instance {
-    let mut i = Instance::instantiate(&fx.archive, name, true).unwrap();
+/// Through Initialization Mode into Step Mode.
+fn start(i: &mut Instance) {
     i.enter_initialization_mode(0.0, Some(10.0)).unwrap();
     i.exit_initialization_mode().unwrap();
+}
+
+/// Commands the model's failure mode `code` (see `fail` in the C source) and steps: the error.
+fn failing_step(i: &mut Instance, code: i32, t: f64, h: f64) -> agrisim_cosim::fmi3::FmiError {
+    i.set_i32(&[FAIL], &[code]).unwrap();
+    i.do_step(t, h).unwrap_err()
+}
+
+fn ready(fx: &Fixture, name: &str) -> Instance {
+    let mut i = Instance::instantiate(&fx.archive, name, true).unwrap();
+    start(&mut i);
     i
 }
 
@@ -496,4 +533,172 @@ fn instances_can_move_to_another_thread() {
     let mut i = h.join().unwrap();
     i.terminate().unwrap();
     assert_eq!(i.state(), InstanceState::Terminated);
+}
+
+#[test]
+fn debug_logging_is_off_unless_asked_and_chosen_by_category() {
+    let Some(fx) = fixture("{agrisim-test-token}", &[]) else {
+        return;
+    };
+    let steps = |i: &mut Instance| {
+        i.take_log();
+        for k in 0..5 {
+            i.do_step(k as f64 * 0.1, 0.1).unwrap();
+        }
+        i.take_log()
+            .iter()
+            .filter(|m| m.category == "logCalls")
+            .count()
+    };
+    // Off by default: not a single callback while stepping.
+    let mut off = Instance::instantiate(&fx.archive, "off", false).unwrap();
+    start(&mut off);
+    let before = off.log_count();
+    assert_eq!(steps(&mut off), 0);
+    assert_eq!(off.log_count(), before);
+    // loggingOn: every step traced.
+    let mut on = ready(&fx, "on");
+    assert_eq!(steps(&mut on), 5);
+    // fmi3SetDebugLogging by category: another category silences the trace, logCalls brings
+    // it back, and logging off stops it.
+    on.set_debug_logging(true, &["logStatusWarning"]).unwrap();
+    assert_eq!(steps(&mut on), 0);
+    off.set_debug_logging(true, &["logCalls"]).unwrap();
+    assert_eq!(steps(&mut off), 5);
+    off.set_debug_logging(false, &[]).unwrap();
+    assert_eq!(steps(&mut off), 0);
+    // A category the modelDescription does not declare is refused without calling the FMU.
+    let e = on.set_debug_logging(true, &["logCall"]).unwrap_err();
+    assert!(e.is_refused());
+    assert_eq!(
+        e.to_string(),
+        "FMU 'on' (TestModel): fmi3SetDebugLogging failed: refused: unknown log category logCall (the FMU declares: logStatusWarning, logCalls)"
+    );
+    assert_eq!(on.state(), InstanceState::StepMode);
+}
+
+#[test]
+fn errors_reach_the_user_with_debug_logging_off() {
+    let Some(fx) = fixture("{agrisim-test-token}", &[]) else {
+        return;
+    };
+    let mut i = Instance::instantiate(&fx.archive, "chassis", false).unwrap();
+    start(&mut i);
+    let e = failing_step(&mut i, 1, 0.5, 0.1);
+    assert_eq!(
+        e.to_string(),
+        "FMU 'chassis' (TestModel): fmi3DoStep at t=0.5 (h=0.1) returned fmi3Error: commanded failure at t=0.5"
+    );
+    assert_eq!(e.messages.len(), 1);
+}
+
+#[test]
+fn discard_is_its_own_outcome_and_keeps_the_instance_usable() {
+    let Some(fx) = fixture("{agrisim-test-token}", &[]) else {
+        return;
+    };
+    let mut i = ready(&fx, "lift");
+    let e = failing_step(&mut i, 4, 1.0, 0.1);
+    assert!(e.is_discard() && !e.is_fatal() && !e.is_refused());
+    assert_eq!(e.status, Some(Status::Discard));
+    let r = e.step.expect("the step's flags come with a discard");
+    assert!((r.last_successful_time - 1.05).abs() < 1e-12, "{r:?}");
+    assert_eq!(
+        e.to_string(),
+        "FMU 'lift' (TestModel): fmi3DoStep at t=1 (h=0.1) returned fmi3Discard: commanded discard: stopped half way (the step ended early, at t=1.05)"
+    );
+    // Not the Error state: the instance goes on (outputs, the rest of the step, terminate).
+    assert_eq!(i.state(), InstanceState::StepMode);
+    let mut t = [0.0];
+    i.get_f64(&[0], &mut t).unwrap();
+    assert!((t[0] - 1.05).abs() < 1e-12);
+    i.set_i32(&[FAIL], &[0]).unwrap();
+    i.do_step(1.05, 0.05).unwrap();
+    i.terminate().unwrap();
+    assert_eq!(counter(&fx, "test_bad_terminates"), 0);
+}
+
+#[test]
+fn drop_and_terminate_call_fmi3_terminate_only_in_step_mode() {
+    let Some(fx) = fixture("{agrisim-test-token}", &[]) else {
+        return;
+    };
+    // Dropped in Initialization Mode, Instantiated, Step Mode, Terminated and Error: freed
+    // every time, terminated only from Step Mode.
+    let mut init = Instance::instantiate(&fx.archive, "init", false).unwrap();
+    init.enter_initialization_mode(0.0, None).unwrap();
+    // terminate() in Initialization Mode is refused up front, the state unchanged.
+    let e = init.terminate().unwrap_err();
+    assert!(e.is_refused(), "{e}");
+    assert!(e.to_string().starts_with("FMU 'init' (TestModel): fmi3Terminate failed: refused: not allowed in state InitializationMode"), "{e}");
+    assert_eq!(init.state(), InstanceState::InitializationMode);
+    init.exit_initialization_mode().unwrap();
+    init.reset().unwrap();
+    init.enter_initialization_mode(0.0, None).unwrap();
+    let fresh = Instance::instantiate(&fx.archive, "fresh", false).unwrap();
+    let stepping = ready(&fx, "stepping");
+    let mut done = ready(&fx, "done");
+    done.terminate().unwrap();
+    assert!(done.terminate().unwrap_err().is_refused());
+    let mut failed = ready(&fx, "failed");
+    failing_step(&mut failed, 1, 0.0, 0.1);
+    assert_eq!(failed.state(), InstanceState::Error);
+    assert!(failed.terminate().unwrap_err().is_refused());
+    assert_eq!(counter(&fx, "test_live_instances"), 5);
+    drop((init, fresh, stepping, done, failed));
+    assert_eq!(counter(&fx, "test_live_instances"), 0);
+    assert_eq!(counter(&fx, "test_bad_terminates"), 0);
+    assert_eq!(counter(&fx, "test_double_frees"), 0);
+}
+
+#[test]
+fn unsupported_fmu_state_is_refused_up_front_leaving_the_instance_usable() {
+    // canGetAndSetFMUState="false" (the functions exist, but the FMU says it cannot).
+    let Some(fx) = fixture_with("{agrisim-test-token}", &[], false) else {
+        return;
+    };
+    let mut i = ready(&fx, "world");
+    let e = i.get_state().unwrap_err();
+    assert!(e.is_refused());
+    assert_eq!(
+        e.to_string(),
+        "FMU 'world' (TestModel): fmi3GetFMUState failed: refused: not supported, the FMU declares canGetAndSetFMUState=\"false\" (not called; instance state unchanged)"
+    );
+    assert_eq!(counter(&fx, "test_live_states"), 0, "the FMU was not called");
+    assert_eq!(i.state(), InstanceState::StepMode);
+    i.do_step(0.0, 0.1).unwrap();
+
+    // Declared, but the library does not export the functions (nor fmi3SetDebugLogging).
+    let Some(fx) = fixture("{agrisim-test-token}", &["-DOMIT_STATE", "-DOMIT_SET_DEBUG_LOGGING"]) else {
+        return;
+    };
+    let mut i = ready(&fx, "arm");
+    let e = i.get_state().unwrap_err();
+    assert!(
+        e.is_refused() && e.to_string().contains("fmi3GetFMUState failed: refused: the shared library does not export this function"),
+        "{e}"
+    );
+    let e = i.set_debug_logging(true, &[]).unwrap_err();
+    assert!(
+        e.is_refused() && e.to_string().starts_with("FMU 'arm' (TestModel): fmi3SetDebugLogging failed: refused: the shared library does not export"),
+        "{e}"
+    );
+    assert_eq!(i.state(), InstanceState::StepMode);
+    i.do_step(0.0, 0.1).unwrap();
+    i.terminate().unwrap();
+}
+
+#[test]
+fn restoring_a_state_restores_the_wrappers_state_too() {
+    let Some(fx) = fixture("{agrisim-test-token}", &[]) else {
+        return;
+    };
+    let mut i = ready(&fx, "s");
+    let saved = i.get_state().unwrap();
+    failing_step(&mut i, 1, 0.0, 0.1);
+    assert_eq!(i.state(), InstanceState::Error);
+    i.set_state(&saved).unwrap();
+    assert_eq!(i.state(), InstanceState::StepMode);
+    i.set_i32(&[FAIL], &[0]).unwrap();
+    i.do_step(0.0, 0.1).unwrap();
 }

@@ -302,3 +302,17 @@ fn minimal_description_has_defaults() {
     assert!(!md.can_get_and_set_fmu_state);
     assert_eq!(md.default_step_size, None);
 }
+
+#[test]
+fn log_categories_are_read() {
+    let xml = GOOD.replace(
+        "<UnitDefinitions>",
+        r#"<LogCategories><Category name="logCalls" description="calls"/><Category name="logModel"/></LogCategories><UnitDefinitions>"#,
+    );
+    let md = ModelDescription::parse(&xml, "good.xml").unwrap();
+    assert_eq!(md.log_categories, vec!["logCalls", "logModel"]);
+    assert!(ModelDescription::parse(GOOD, "good.xml").unwrap().log_categories.is_empty());
+    let bad = GOOD.replace("<UnitDefinitions>", "<LogCategories><Category/></LogCategories><UnitDefinitions>");
+    let e = ModelDescription::parse(&bad, "bad.xml").unwrap_err();
+    assert!(e.to_string().contains("bad.xml") && e.to_string().contains("<Category> has no attribute 'name'"), "{e}");
+}

@@ -501,3 +501,19 @@ fn sources_resolve_next_to_the_ssd_then_in_the_fmu_dir() {
         sys_dir.join("fmus/Chassis.fmu")
     );
 }
+
+#[test]
+fn topic_annotation_names_a_system_connector_outside_the_engine() {
+    let annotated = SSD.replace(
+        r#"<ssd:Connector name="/odom" kind="output"><ssc:Binary/></ssd:Connector>"#,
+        r#"<ssd:Connector name="odom" kind="output"><ssc:Binary/><ssd:Annotations><ssc:Annotation type="org.agrisim.topic"><ag:Topic name="/odom"/></ssc:Annotation></ssd:Annotations></ssd:Connector>"#,
+    );
+    assert_ne!(annotated, SSD);
+    let s = parse(&annotated);
+    let odom = s.system_connector("odom").unwrap();
+    assert_eq!((odom.topic.as_deref(), odom.external_name()), (Some("/odom"), "/odom"));
+    assert_eq!(s.system_connector("/cmd_vel").unwrap().external_name(), "/cmd_vel");
+    let nameless = annotated.replace(r#"<ag:Topic name="/odom"/>"#, "<ag:Topic/>");
+    let e = SystemStructure::parse(&nameless, Path::new("x.ssd")).unwrap_err().to_string();
+    assert!(e.contains("x.ssd") && e.contains("connector 'odom'") && e.contains("org.agrisim.topic"), "{e}");
+}

@@ -10,7 +10,7 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use agrisim_cosim::archive::{FmuArchive, PLATFORM};
-use agrisim_cosim::fmi3::Instance;
+use agrisim_cosim::fmi3::{Instance, LogMessage, Status};
 use agrisim_cosim::model_description::{Causality, ModelDescription, VarType};
 
 const LIB: &str = "libagrisim_fmu_testmodel.so";
@@ -42,14 +42,15 @@ fn description_of(lib_path: &std::path::Path) -> String {
     }
 }
 
-#[test]
-fn test_model_imports_steps_and_exchanges_every_type() {
+/// The TestModel packed into an .fmu (in the returned temporary directory) and opened; `None`
+/// (with the reason printed) until its library has been built.
+fn test_model() -> Option<(ModelDescription, FmuArchive, tempfile::TempDir)> {
     let Some(lib_path) = find_library() else {
         eprintln!(
             "SKIPPED: {LIB} not found in target/debug or target/release; build it with \
              `cargo build -p agrisim-fmu-testmodel` to run this end-to-end test"
         );
-        return;
+        return None;
     };
     let xml = description_of(&lib_path);
     let md = ModelDescription::parse(&xml, "agrisim_model_description_fmi3()").unwrap();
@@ -68,6 +69,14 @@ fn test_model_imports_steps_and_exchanges_every_type() {
         z.finish().unwrap();
     }
     let archive = FmuArchive::open(&fmu, &tmp.path().join("cache")).unwrap();
+    Some((md, archive, tmp))
+}
+
+#[test]
+fn test_model_imports_steps_and_exchanges_every_type() {
+    let Some((md, archive, _tmp)) = test_model() else {
+        return;
+    };
     let h = md.default_step_size.unwrap_or(0.02);
 
     // Two instances of the same library at once (as for the two arms).
@@ -206,4 +215,63 @@ fn check_test_model_semantics(md: &ModelDescription, a: &mut Instance, b: &mut I
     let e = b.do_step(10.0 * h, h).unwrap_err();
     assert!(e.status.is_some(), "{e}");
     eprintln!("panic in model reported as: {e}");
+}
+
+/// Initializes, steps 10 times and reads an output; returns the log messages of all that.
+fn run_briefly(i: &mut Instance, md: &ModelDescription) -> Vec<LogMessage> {
+    let h = md.default_step_size.unwrap_or(0.02);
+    i.enter_initialization_mode(0.0, None).unwrap();
+    i.exit_initialization_mode().unwrap();
+    let x = md.variable("x").map_or(0, |v| v.value_reference);
+    for k in 0..10 {
+        i.do_step(k as f64 * h, h).unwrap();
+        i.get_f64(&[x], &mut [0.0]).unwrap();
+    }
+    i.take_log()
+}
+
+#[test]
+fn test_model_logs_nothing_by_default_and_what_is_asked_otherwise() {
+    let Some((md, archive, _tmp)) = test_model() else {
+        return;
+    };
+    // Debug logging off (the default of a run): not one logger callback.
+    let mut quiet = Instance::instantiate(&archive, "quiet", false).unwrap();
+    assert!(run_briefly(&mut quiet, &md).is_empty());
+    assert_eq!(quiet.log_count(), 0);
+
+    // loggingOn: the FMU traces its calls (and whatever else it enables by default).
+    let mut all = Instance::instantiate(&archive, "all", true).unwrap();
+    let log = run_briefly(&mut all, &md);
+    assert!(log.len() >= 20, "{log:?}");
+    assert!(log.iter().all(|m| m.status == Status::Ok));
+
+    // One category, as the modelDescription declares it: only that one.
+    assert!(md.log_categories.iter().any(|c| c == "logModel"), "{:?}", md.log_categories);
+    let mut model_only = Instance::instantiate(&archive, "model_only", false).unwrap();
+    model_only.set_debug_logging(true, &["logModel"]).unwrap();
+    let log = run_briefly(&mut model_only, &md);
+    assert!(!log.is_empty() && log.iter().all(|m| m.category == "logModel"), "{log:?}");
+    let e = model_only.set_debug_logging(true, &["logEverything"]).unwrap_err();
+    assert!(e.is_refused() && e.to_string().contains("unknown log category logEverything"), "{e}");
+}
+
+#[test]
+fn test_model_errors_name_instance_and_reason_with_logging_off() {
+    let Some((md, archive, _tmp)) = test_model() else {
+        return;
+    };
+    let Some(fault) = md.variable("fault").map(|v| v.value_reference) else {
+        eprintln!("NOTE: TestModel has no 'fault' variable; skipped");
+        return;
+    };
+    let mut i = Instance::instantiate(&archive, "faulty", false).unwrap();
+    run_briefly(&mut i, &md);
+    i.set_i32(&[fault], &[1]).unwrap();
+    let h = md.default_step_size.unwrap_or(0.02);
+    let e = i.do_step(10.0 * h, h).unwrap_err();
+    let line = e.to_string();
+    assert!(line.starts_with("FMU 'faulty' (TestModel): fmi3DoStep at t="), "{line}");
+    assert!(line.contains("returned fmi3Error") && line.contains("injected failure at t="), "{line}");
+    assert_eq!(i.log_count(), e.messages.len() as u64, "only the error was logged");
 }

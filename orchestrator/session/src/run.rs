@@ -20,6 +20,10 @@ pub struct RunOptions {
     pub duration: Option<f64>,
     /// Component -> FMU file (CLI `--fmu chassis=ChassisDynamic.fmu`), on top of the scenario's.
     pub fmu_overrides: BTreeMap<String, String>,
+    /// FMU debug logging (CLI `--fmu-log [CATEGORIES]`), replacing the scenario's
+    /// `[logging] fmu`: see [`agrisim_cosim::LoadOptions::fmu_log`]. `None` leaves it to the
+    /// scenario (off unless it says otherwise).
+    pub fmu_log: Option<Vec<String>>,
 }
 
 /// What a finished run reports.
@@ -33,7 +37,8 @@ pub struct RunSummary {
 fn load_options(s: &Scenario, o: &RunOptions) -> LoadOptions {
     let mut fmu_overrides = s.system.fmus.clone();
     fmu_overrides.extend(o.fmu_overrides.clone());
-    LoadOptions { fmu_dir: o.fmu_dir.clone(), cache_dir: o.cache_dir.clone(), fmu_overrides, step: s.timing.step, message_period: 1.0 / s.timing.message_rate }
+    let fmu_log = o.fmu_log.clone().or_else(|| s.logging.fmu.categories());
+    LoadOptions { fmu_dir: o.fmu_dir.clone(), cache_dir: o.cache_dir.clone(), fmu_overrides, step: s.timing.step, message_period: 1.0 / s.timing.message_rate, fmu_log }
 }
 
 /// Start-pose parameters of a mobile base (REP 103, map frame).

@@ -51,6 +51,9 @@ pub struct Scenario {
     /// Fault injection: raw bytes published on a topic at a time (robustness tests).
     #[serde(default)]
     pub inject: Vec<Injection>,
+    /// What is logged beyond warnings and errors (which always reach the user).
+    #[serde(default)]
+    pub logging: Logging,
     /// Where the file was read from (relative paths resolve against its directory).
     #[serde(skip)]
     pub path: PathBuf,
@@ -101,6 +104,62 @@ pub struct SystemRef {
     /// Component -> FMU file override (e.g. `chassis = "ChassisDynamic.fmu"`).
     #[serde(default)]
     pub fmus: BTreeMap<String, String>,
+}
+
+/// `[logging]`.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Logging {
+    /// FMU debug logging, printed to stderr: `false` (the default) off, `true` every category,
+    /// or a list of categories as the FMUs' modelDescription declares them (e.g.
+    /// `["logModel"]`; the project's FMUs have logStatusWarning, logStatusError, logModel,
+    /// logCalls). The CLI's `--fmu-log` replaces it.
+    #[serde(default)]
+    pub fmu: FmuLog,
+}
+
+/// The value of `[logging] fmu`: a boolean or a non-empty list of category names.
+#[derive(Clone, Debug, PartialEq, Eq, Deserialize)]
+#[serde(try_from = "toml::Value")]
+pub enum FmuLog {
+    All(bool),
+    Categories(Vec<String>),
+}
+
+impl Default for FmuLog {
+    fn default() -> Self {
+        FmuLog::All(false)
+    }
+}
+
+impl TryFrom<toml::Value> for FmuLog {
+    type Error = String;
+    fn try_from(v: toml::Value) -> std::result::Result<FmuLog, String> {
+        let expected = "expected true, false or a non-empty list of log category names";
+        match v {
+            toml::Value::Boolean(b) => Ok(FmuLog::All(b)),
+            toml::Value::Array(a) if !a.is_empty() => a
+                .into_iter()
+                .map(|c| match c {
+                    toml::Value::String(s) => Ok(s),
+                    other => Err(format!("{expected}, got {other} in the list")),
+                })
+                .collect::<std::result::Result<_, _>>()
+                .map(FmuLog::Categories),
+            other => Err(format!("{expected}, got {other}")),
+        }
+    }
+}
+
+impl FmuLog {
+    /// As [`agrisim_cosim::LoadOptions::fmu_log`]: `None` off, `Some(empty)` all categories.
+    pub fn categories(&self) -> Option<Vec<String>> {
+        match self {
+            FmuLog::All(false) => None,
+            FmuLog::All(true) => Some(Vec::new()),
+            FmuLog::Categories(c) => Some(c.clone()),
+        }
+    }
 }
 
 fn default_name() -> String {
@@ -197,6 +256,22 @@ mod tests {
         let s = Scenario::parse("[system]\nfile = \"a.ssd\"\n", Path::new("dir/x.toml")).unwrap();
         assert_eq!((s.timing.step, s.timing.message_rate), (0.02, 10.0));
         assert_eq!(s.system_path(), Path::new("dir/a.ssd"));
+    }
+
+    #[test]
+    fn fmu_logging_is_off_by_default_and_chosen_by_category() {
+        let parse = |extra: &str| Scenario::parse(&format!("[system]\nfile = \"a.ssd\"\n{extra}"), Path::new("x.toml"));
+        assert_eq!(parse("").unwrap().logging.fmu.categories(), None);
+        assert_eq!(parse("[logging]\nfmu = false\n").unwrap().logging.fmu.categories(), None);
+        assert_eq!(parse("[logging]\nfmu = true\n").unwrap().logging.fmu.categories(), Some(vec![]));
+        let s = parse("[logging]\nfmu = [\"logModel\", \"logCalls\"]\n").unwrap();
+        assert_eq!(s.logging.fmu.categories(), Some(vec!["logModel".to_string(), "logCalls".to_string()]));
+        for bad in ["[logging]\nfmu = []\n", "[logging]\nfmu = 3\n", "[logging]\nfmu = [1]\n"] {
+            let e = parse(bad).unwrap_err();
+            assert!(e.0.contains("x.toml") && e.0.contains("expected true, false or a non-empty list"), "{e}");
+        }
+        let e = parse("[logging]\nfmus = true\n").unwrap_err();
+        assert!(e.0.contains("x.toml") && e.0.contains("fmus"), "{e}");
     }
 
     #[test]

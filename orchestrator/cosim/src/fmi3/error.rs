@@ -3,7 +3,7 @@
 use std::fmt;
 
 use super::log::LogMessage;
-use super::status::Status;
+use super::status::{Status, StepResult};
 
 /// A failed call on an FMU instance (or a call the wrapper refused / could not make).
 /// Boxed so `Result<(), FmiError>` stays one word on the per-step get/set path; the fields
@@ -30,6 +30,8 @@ pub struct FmiErrorInfo {
     pub detail: Option<String>,
     /// What the FMU logged during this call.
     pub messages: Vec<LogMessage>,
+    /// For `fmi3DoStep`: the flags it returned (with fmi3Discard, how far the step got).
+    pub step: Option<StepResult>,
 }
 
 impl From<FmiErrorInfo> for FmiError {
@@ -55,6 +57,20 @@ impl FmiErrorInfo {
     /// True when the FMU reported fmi3Fatal (the instance is unusable).
     pub fn is_fatal(&self) -> bool {
         self.status == Some(Status::Fatal)
+    }
+
+    /// True when the FMU reported fmi3Discard: the call did not do its job (a step ended
+    /// early, see [`FmiErrorInfo::step`]), but the instance is not in the Error state and
+    /// stays usable (e.g. a shorter step, reading outputs, terminating).
+    pub fn is_discard(&self) -> bool {
+        self.status == Some(Status::Discard)
+    }
+
+    /// True when the wrapper refused the call without calling the FMU (an unsupported
+    /// optional function, a call not allowed in the instance's state, bad arguments): the
+    /// instance's state is unchanged.
+    pub fn is_refused(&self) -> bool {
+        self.status.is_none()
     }
 
     /// The FMU's reason: its warning-or-worse messages of the call, else all of them.
@@ -92,22 +108,47 @@ impl fmt::Display for FmiError {
     }
 }
 
+/// `FMU 'chassis' (Chassis): fmi3SetFloat64(v, w) at t=1`: which call of which instance, the
+/// head of every error and printed warning.
+pub(crate) fn write_call(
+    f: &mut impl fmt::Write,
+    instance: &str,
+    model: &str,
+    function: &str,
+    variables: &[String],
+    context: Option<&str>,
+) -> fmt::Result {
+    write!(f, "FMU '{instance}' ({model}): {function}")?;
+    if !variables.is_empty() {
+        write!(f, "({})", variables.join(", "))?;
+    }
+    if let Some(c) = context {
+        write!(f, " {c}")?;
+    }
+    Ok(())
+}
+
 impl fmt::Display for FmiErrorInfo {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
+        write_call(
             f,
-            "FMU '{}' ({}): {}",
-            self.instance, self.model, self.function
+            &self.instance,
+            &self.model,
+            &self.function,
+            &self.variables,
+            self.context.as_deref(),
         )?;
-        if !self.variables.is_empty() {
-            write!(f, "({})", self.variables.join(", "))?;
-        }
-        if let Some(c) = &self.context {
-            write!(f, " {c}")?;
-        }
         match self.status {
-            Some(s) => write!(f, " returned {s}: {}", self.reason()),
-            None => write!(f, " failed: {}", self.reason()),
+            Some(s) => write!(f, " returned {s}: {}", self.reason())?,
+            None => write!(f, " failed: {}", self.reason())?,
+        }
+        match self.step {
+            Some(r) if self.is_discard() => write!(
+                f,
+                " (the step ended early, at t={})",
+                r.last_successful_time
+            ),
+            _ => Ok(()),
         }
     }
 }

@@ -48,6 +48,13 @@ pub type InstantiateCoSimulation = unsafe extern "C" fn(
 
 pub type FreeInstance = unsafe extern "C" fn(instance: Fmi3Instance);
 
+pub type SetDebugLogging = unsafe extern "C" fn(
+    instance: Fmi3Instance,
+    logging_on: bool,
+    n_categories: usize,
+    categories: *const *const c_char,
+) -> Fmi3Status;
+
 pub type EnterInitializationMode = unsafe extern "C" fn(
     instance: Fmi3Instance,
     tolerance_defined: bool,

@@ -1,10 +1,18 @@
 //! [`Instance`]: one FMU co-simulation instance behind a safe API.
 //!
-//! The wrapper tracks the FMI state machine only as far as safety needs: which states need
-//! `fmi3Terminate` before `fmi3FreeInstance` on drop, and that nothing is called after
-//! `fmi3Fatal` (the standard forbids any further call, even freeing). Everything else (call
-//! order, allowed variables per state) the FMU checks itself and reports through its status
-//! and log, which end up in the [`FmiError`].
+//! The wrapper tracks the FMI state machine only as far as safety needs: drop terminates only
+//! from Step Mode (the one state of ours where `fmi3Terminate` is allowed) before
+//! `fmi3FreeInstance`, nothing is called after `fmi3Fatal` (the standard forbids any further
+//! call, even freeing), and calls that would put a healthy FMU into its Error state for good
+//! (an optional function it does not support, `fmi3Terminate` outside Step Mode) are refused
+//! up front without calling it. Everything else (call order, allowed variables per state) the
+//! FMU checks itself and reports through its status and log, which end up in the [`FmiError`].
+//!
+//! Logging: an FMU logs warnings and errors even with debug logging off. Messages of a failed
+//! call go into its [`FmiError`]; those of a call that succeeded are printed to stderr when
+//! they are warnings or worse (naming instance, function and variables), and debug messages
+//! too when debug logging is on. All of them also stay available, bounded, to
+//! [`Instance::take_log`].
 
 use std::collections::BTreeMap;
 use std::ffi::{c_char, c_void, CStr, CString};
@@ -13,11 +21,11 @@ use std::ptr;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
-use super::error::{FmiError, FmiErrorInfo};
+use super::error::{write_call, FmiError, FmiErrorInfo};
 use super::ffi::{self, Fmi3FmuState, Fmi3Instance, Vr};
 use super::library::{Fmi3Library, Functions};
 use super::log::{log_callback, LogMessage, LogSink};
-use super::status::Status;
+use super::status::{Status, StepResult};
 use crate::archive::FmuArchive;
 
 /// Where the instance is in the FMI co-simulation state machine, as far as the wrapper knows.
@@ -27,19 +35,11 @@ pub enum InstanceState {
     InitializationMode,
     StepMode,
     Terminated,
-    /// The last call returned fmi3Error: only `reset` (or dropping) makes sense now.
+    /// The last call returned fmi3Error: only `reset`, restoring an FMU state (or dropping)
+    /// makes sense now. (fmi3Discard does not lead here.)
     Error,
     /// The FMU returned fmi3Fatal: every further call is refused, and it is never freed.
     Fatal,
-}
-
-/// Flags returned by `fmi3DoStep`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct StepResult {
-    pub event_handling_needed: bool,
-    pub terminate_simulation: bool,
-    pub early_return: bool,
-    pub last_successful_time: f64,
 }
 
 /// A saved FMU state (`fmi3FMUState`). Owned by the instance that made it, which frees any
@@ -48,6 +48,25 @@ pub struct StepResult {
 pub struct FmuState {
     slot: usize,
     owner: u64,
+}
+
+/// Call context for messages, formatted only when a message needs it (never on the
+/// per-step success path).
+#[derive(Clone, Copy)]
+enum Ctx {
+    None,
+    At(f64),
+    Step(f64, f64),
+}
+
+impl Ctx {
+    fn text(self) -> Option<String> {
+        match self {
+            Ctx::None => None,
+            Ctx::At(t) => Some(format!("at t={t}")),
+            Ctx::Step(t, h) => Some(format!("at t={t} (h={h})")),
+        }
+    }
 }
 
 static NEXT_INSTANCE_ID: AtomicU64 = AtomicU64::new(1);
@@ -59,10 +78,15 @@ pub struct Instance {
     name: String,
     model: String,
     can_get_and_set_state: bool,
+    /// `<LogCategories>` of the modelDescription (empty: none declared).
+    log_categories: Vec<String>,
+    /// Debug logging is on: the FMU's debug messages are printed to stderr.
+    debug_logging: bool,
     /// vr -> variable name, for error messages.
     names: Arc<BTreeMap<Vr, String>>,
-    /// FMU states by slot; `None` once freed.
-    fmu_states: Vec<Option<Fmi3FmuState>>,
+    /// FMU states by slot, with the wrapper's state when saved (restored with it); `None`
+    /// once freed.
+    fmu_states: Vec<Option<(Fmi3FmuState, InstanceState)>>,
     id: u64,
     /// Read by the logger callback via `instanceEnvironment`; boxed so its address is stable.
     sink: Box<LogSink>,
@@ -76,6 +100,10 @@ unsafe impl Send for Instance {}
 
 impl Instance {
     /// Loads the archive's binary and instantiates it for co-simulation.
+    ///
+    /// `logging_on` is FMI's `loggingOn`: debug logging (all categories the FMU enables by
+    /// default); off, the FMU reports only warnings and errors. [`Instance::set_debug_logging`]
+    /// picks categories later.
     ///
     /// `resourcePath` is passed as the FMI 3.0 standard defines it: the absolute native path
     /// of `resources/` with a trailing separator (not the FMI 2.0 `file://` URI).
@@ -95,6 +123,7 @@ impl Instance {
                 status: None,
                 detail: Some(detail),
                 messages,
+                step: None,
             }
             .into()
         };
@@ -163,18 +192,71 @@ impl Instance {
                 sink.take(),
             ));
         }
-        Ok(Instance {
+        let inst = Instance {
             handle,
             state: InstanceState::Instantiated,
             name: instance_name.to_string(),
             model: md.model_name.clone(),
             can_get_and_set_state: md.can_get_and_set_fmu_state,
+            log_categories: md.log_categories.clone(),
+            debug_logging: logging_on,
             names: Arc::new(names),
             fmu_states: Vec::new(),
             id: NEXT_INSTANCE_ID.fetch_add(1, Ordering::Relaxed),
             sink,
             lib,
-        })
+        };
+        inst.report("fmi3InstantiateCoSimulation", &[], Ctx::None, 0, Status::Ok);
+        Ok(inst)
+    }
+
+    /// `fmi3SetDebugLogging`: debug logging on or off; `categories` empty = all categories,
+    /// else those (each must be one of the modelDescription's `<LogCategories>` when it
+    /// declares any). Refused up front, without calling the FMU, for an unknown category or
+    /// when the FMU does not export the function.
+    pub fn set_debug_logging(&mut self, on: bool, categories: &[&str]) -> Result<(), FmiError> {
+        const F: &str = "fmi3SetDebugLogging";
+        let Some(set) = self.lib.f.set_debug_logging else {
+            return Err(self.refuse(F, &[], "refused: the shared library does not export this function (not called; instance state unchanged)"));
+        };
+        if !self.log_categories.is_empty() {
+            let unknown: Vec<&str> = categories
+                .iter()
+                .copied()
+                .filter(|c| !self.log_categories.iter().any(|k| k == c))
+                .collect();
+            if !unknown.is_empty() {
+                let detail = format!(
+                    "refused: unknown log categor{} {} (the FMU declares: {})",
+                    if unknown.len() == 1 { "y" } else { "ies" },
+                    unknown.join(", "),
+                    self.log_categories.join(", ")
+                );
+                return Err(self.refuse(F, &[], &detail));
+            }
+        }
+        let c: Vec<CString> = categories
+            .iter()
+            .map(|c| CString::new(*c))
+            .collect::<Result<_, _>>()
+            .map_err(|_| self.refuse(F, &[], "a category name contains a NUL byte"))?;
+        let ptrs: Vec<*const c_char> = c.iter().map(|c| c.as_ptr()).collect();
+        let p = if ptrs.is_empty() {
+            ptr::null()
+        } else {
+            ptrs.as_ptr()
+        };
+        self.call(F, &[], Ctx::None, |_, h| unsafe {
+            set(h, on, ptrs.len(), p)
+        })?;
+        self.debug_logging = on;
+        Ok(())
+    }
+
+    /// Number of messages the FMU has sent through the logger callback since instantiation
+    /// (with debug logging off: its warnings and errors only).
+    pub fn log_count(&self) -> u64 {
+        self.sink.mark()
     }
 
     pub fn name(&self) -> &str {
@@ -189,7 +271,8 @@ impl Instance {
         self.state
     }
 
-    /// All messages logged since the last call (warnings included), oldest first.
+    /// The messages logged since the last `take_log` (warnings included), oldest first; at
+    /// most the latest 4096.
     pub fn take_log(&mut self) -> Vec<LogMessage> {
         self.sink.take()
     }
@@ -199,11 +282,10 @@ impl Instance {
         start_time: f64,
         stop_time: Option<f64>,
     ) -> Result<(), FmiError> {
-        let ctx = format!("at t={start_time}");
         self.call(
             "fmi3EnterInitializationMode",
             &[],
-            Some(ctx),
+            Ctx::At(start_time),
             |f, h| unsafe {
                 (f.enter_initialization_mode)(
                     h,
@@ -220,14 +302,21 @@ impl Instance {
     }
 
     pub fn exit_initialization_mode(&mut self) -> Result<(), FmiError> {
-        self.call("fmi3ExitInitializationMode", &[], None, |f, h| unsafe {
-            (f.exit_initialization_mode)(h)
-        })?;
+        self.call(
+            "fmi3ExitInitializationMode",
+            &[],
+            Ctx::None,
+            |f, h| unsafe { (f.exit_initialization_mode)(h) },
+        )?;
         self.state = InstanceState::StepMode;
         Ok(())
     }
 
-    /// Advances from `t` to `t + h`. Discard (step not completed) is an error like Error.
+    /// Advances from `t` to `t + h`.
+    ///
+    /// fmi3Discard (the FMU could not complete the step) is an error of its own kind:
+    /// [`FmiErrorInfo::is_discard`], with the step's flags (how far it got) in
+    /// [`FmiErrorInfo::step`]. Unlike fmi3Error it leaves the instance in Step Mode, usable.
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<StepResult, FmiError> {
         let mut r = StepResult {
             event_handling_needed: false,
@@ -235,8 +324,7 @@ impl Instance {
             early_return: false,
             last_successful_time: t,
         };
-        let ctx = format!("at t={t} (h={h})");
-        self.call("fmi3DoStep", &[], Some(ctx), |f, inst| unsafe {
+        let res = self.call("fmi3DoStep", &[], Ctx::Step(t, h), |f, inst| unsafe {
             (f.do_step)(
                 inst,
                 t,
@@ -247,12 +335,28 @@ impl Instance {
                 &mut r.early_return,
                 &mut r.last_successful_time,
             )
-        })?;
-        Ok(r)
+        });
+        match res {
+            Ok(_) => Ok(r),
+            Err(mut e) => {
+                e.step = Some(r);
+                Err(e)
+            }
+        }
     }
 
+    /// `fmi3Terminate`. FMI 3.0 allows it only in Step Mode among the states used here; from
+    /// Instantiated, Initialization Mode, Terminated or Error it is refused up front, leaving
+    /// the instance as it was (drop it, or `reset` it, instead).
     pub fn terminate(&mut self) -> Result<(), FmiError> {
-        self.call("fmi3Terminate", &[], None, |f, h| unsafe {
+        if self.state != InstanceState::StepMode {
+            let detail = format!(
+                "refused: not allowed in state {:?} (FMI 3.0 terminates from Step Mode only; not called; instance state unchanged)",
+                self.state
+            );
+            return Err(self.refuse("fmi3Terminate", &[], &detail));
+        }
+        self.call("fmi3Terminate", &[], Ctx::None, |f, h| unsafe {
             (f.terminate)(h)
         })?;
         self.state = InstanceState::Terminated;
@@ -261,14 +365,14 @@ impl Instance {
 
     /// Back to the just-instantiated state (also the way out of an Error).
     pub fn reset(&mut self) -> Result<(), FmiError> {
-        self.call("fmi3Reset", &[], None, |f, h| unsafe { (f.reset)(h) })?;
+        self.call("fmi3Reset", &[], Ctx::None, |f, h| unsafe { (f.reset)(h) })?;
         self.state = InstanceState::Instantiated;
         Ok(())
     }
 
     pub fn set_f64(&mut self, vrs: &[Vr], values: &[f64]) -> Result<(), FmiError> {
         self.check_len("fmi3SetFloat64", vrs, values.len())?;
-        self.call("fmi3SetFloat64", vrs, None, |f, h| unsafe {
+        self.call("fmi3SetFloat64", vrs, Ctx::None, |f, h| unsafe {
             (f.set_float64)(h, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len())
         })
         .map(drop)
@@ -276,7 +380,7 @@ impl Instance {
 
     pub fn get_f64(&mut self, vrs: &[Vr], values: &mut [f64]) -> Result<(), FmiError> {
         self.check_len("fmi3GetFloat64", vrs, values.len())?;
-        self.call("fmi3GetFloat64", vrs, None, |f, h| unsafe {
+        self.call("fmi3GetFloat64", vrs, Ctx::None, |f, h| unsafe {
             (f.get_float64)(
                 h,
                 vrs.as_ptr(),
@@ -290,7 +394,7 @@ impl Instance {
 
     pub fn set_i32(&mut self, vrs: &[Vr], values: &[i32]) -> Result<(), FmiError> {
         self.check_len("fmi3SetInt32", vrs, values.len())?;
-        self.call("fmi3SetInt32", vrs, None, |f, h| unsafe {
+        self.call("fmi3SetInt32", vrs, Ctx::None, |f, h| unsafe {
             (f.set_int32)(h, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len())
         })
         .map(drop)
@@ -298,7 +402,7 @@ impl Instance {
 
     pub fn get_i32(&mut self, vrs: &[Vr], values: &mut [i32]) -> Result<(), FmiError> {
         self.check_len("fmi3GetInt32", vrs, values.len())?;
-        self.call("fmi3GetInt32", vrs, None, |f, h| unsafe {
+        self.call("fmi3GetInt32", vrs, Ctx::None, |f, h| unsafe {
             (f.get_int32)(
                 h,
                 vrs.as_ptr(),
@@ -312,7 +416,7 @@ impl Instance {
 
     pub fn set_i64(&mut self, vrs: &[Vr], values: &[i64]) -> Result<(), FmiError> {
         self.check_len("fmi3SetInt64", vrs, values.len())?;
-        self.call("fmi3SetInt64", vrs, None, |f, h| unsafe {
+        self.call("fmi3SetInt64", vrs, Ctx::None, |f, h| unsafe {
             (f.set_int64)(h, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len())
         })
         .map(drop)
@@ -320,7 +424,7 @@ impl Instance {
 
     pub fn get_i64(&mut self, vrs: &[Vr], values: &mut [i64]) -> Result<(), FmiError> {
         self.check_len("fmi3GetInt64", vrs, values.len())?;
-        self.call("fmi3GetInt64", vrs, None, |f, h| unsafe {
+        self.call("fmi3GetInt64", vrs, Ctx::None, |f, h| unsafe {
             (f.get_int64)(
                 h,
                 vrs.as_ptr(),
@@ -334,7 +438,7 @@ impl Instance {
 
     pub fn set_bool(&mut self, vrs: &[Vr], values: &[bool]) -> Result<(), FmiError> {
         self.check_len("fmi3SetBoolean", vrs, values.len())?;
-        self.call("fmi3SetBoolean", vrs, None, |f, h| unsafe {
+        self.call("fmi3SetBoolean", vrs, Ctx::None, |f, h| unsafe {
             (f.set_boolean)(h, vrs.as_ptr(), vrs.len(), values.as_ptr(), values.len())
         })
         .map(drop)
@@ -342,7 +446,7 @@ impl Instance {
 
     pub fn get_bool(&mut self, vrs: &[Vr], values: &mut [bool]) -> Result<(), FmiError> {
         self.check_len("fmi3GetBoolean", vrs, values.len())?;
-        self.call("fmi3GetBoolean", vrs, None, |f, h| unsafe {
+        self.call("fmi3GetBoolean", vrs, Ctx::None, |f, h| unsafe {
             (f.get_boolean)(
                 h,
                 vrs.as_ptr(),
@@ -358,7 +462,7 @@ impl Instance {
         let c = CString::new(value)
             .map_err(|_| self.refuse("fmi3SetString", &[vr], "the string contains a NUL byte"))?;
         let p = c.as_ptr();
-        self.call("fmi3SetString", &[vr], None, |f, h| unsafe {
+        self.call("fmi3SetString", &[vr], Ctx::None, |f, h| unsafe {
             (f.set_string)(h, &vr, 1, &p, 1)
         })
         .map(drop)
@@ -367,7 +471,7 @@ impl Instance {
     /// Copies the string out of FMU-owned memory.
     pub fn get_string(&mut self, vr: Vr) -> Result<String, FmiError> {
         let mut p: *const c_char = ptr::null();
-        self.call("fmi3GetString", &[vr], None, |f, h| unsafe {
+        self.call("fmi3GetString", &[vr], Ctx::None, |f, h| unsafe {
             (f.get_string)(h, &vr, 1, &mut p, 1)
         })?;
         if p.is_null() {
@@ -380,7 +484,7 @@ impl Instance {
     pub fn set_binary(&mut self, vr: Vr, value: &[u8]) -> Result<(), FmiError> {
         let size = value.len();
         let p = value.as_ptr();
-        self.call("fmi3SetBinary", &[vr], None, |f, h| unsafe {
+        self.call("fmi3SetBinary", &[vr], Ctx::None, |f, h| unsafe {
             (f.set_binary)(h, &vr, 1, &size, &p, 1)
         })
         .map(drop)
@@ -390,7 +494,7 @@ impl Instance {
     pub fn get_binary(&mut self, vr: Vr) -> Result<Vec<u8>, FmiError> {
         let mut size: usize = 0;
         let mut p: *const u8 = ptr::null();
-        self.call("fmi3GetBinary", &[vr], None, |f, h| unsafe {
+        self.call("fmi3GetBinary", &[vr], Ctx::None, |f, h| unsafe {
             (f.get_binary)(h, &vr, 1, &mut size, &mut p, 1)
         })?;
         if size == 0 {
@@ -411,33 +515,37 @@ impl Instance {
     pub fn get_state(&mut self) -> Result<FmuState, FmiError> {
         let get = self.state_fn("fmi3GetFMUState", |f| f.get_fmu_state)?;
         let mut s: Fmi3FmuState = ptr::null_mut();
-        self.call("fmi3GetFMUState", &[], None, |_, h| unsafe {
+        self.call("fmi3GetFMUState", &[], Ctx::None, |_, h| unsafe {
             get(h, &mut s)
         })?;
         if s.is_null() {
             return Err(self.refuse("fmi3GetFMUState", &[], "the FMU returned a NULL state"));
         }
-        self.fmu_states.push(Some(s));
+        self.fmu_states.push(Some((s, self.state)));
         Ok(FmuState {
             slot: self.fmu_states.len() - 1,
             owner: self.id,
         })
     }
 
-    /// Restores a state saved by this instance.
+    /// Restores a state saved by this instance (and with it the state-machine state it was
+    /// saved in: the way out of an Error).
     pub fn set_state(&mut self, state: &FmuState) -> Result<(), FmiError> {
         let set = self.state_fn("fmi3SetFMUState", |f| f.set_fmu_state)?;
-        let s = self.own_state("fmi3SetFMUState", state)?;
-        self.call("fmi3SetFMUState", &[], None, |_, h| unsafe { set(h, s) })
-            .map(drop)
+        let (s, saved_in) = self.own_state("fmi3SetFMUState", state)?;
+        self.call("fmi3SetFMUState", &[], Ctx::None, |_, h| unsafe {
+            set(h, s)
+        })?;
+        self.state = saved_in;
+        Ok(())
     }
 
     /// Frees a saved state now (otherwise it is freed with the instance).
     pub fn free_state(&mut self, state: FmuState) -> Result<(), FmiError> {
         let free = self.state_fn("fmi3FreeFMUState", |f| f.free_fmu_state)?;
-        let mut s = self.own_state("fmi3FreeFMUState", &state)?;
+        let (mut s, _) = self.own_state("fmi3FreeFMUState", &state)?;
         self.fmu_states[state.slot] = None;
-        self.call("fmi3FreeFMUState", &[], None, |_, h| unsafe {
+        self.call("fmi3FreeFMUState", &[], Ctx::None, |_, h| unsafe {
             free(h, &mut s)
         })
         .map(drop)
@@ -445,12 +553,14 @@ impl Instance {
 
     // ---- internals ----
 
-    /// Runs one FFI call: refuses after Fatal, maps the status, attaches the call's log.
+    /// Runs one FFI call: refuses after Fatal, maps the status, attaches the call's log to
+    /// its error or reports it (see [`Instance::report`]). Error and Fatal move the wrapper's
+    /// state; Discard does not.
     fn call(
         &mut self,
-        function: &str,
+        function: &'static str,
         vrs: &[Vr],
-        context: Option<String>,
+        context: Ctx,
         f: impl FnOnce(&Functions, Fmi3Instance) -> ffi::Fmi3Status,
     ) -> Result<Status, FmiError> {
         if self.state == InstanceState::Fatal {
@@ -460,12 +570,15 @@ impl Instance {
                 "refused: this instance returned fmi3Fatal earlier and is unusable",
             );
             e.status = Some(Status::Fatal);
-            e.context = context;
+            e.context = context.text();
             return Err(e);
         }
         let mark = self.sink.mark();
         let status = Status::from_raw(f(&self.lib.f, self.handle));
         if status <= Status::Warning {
+            if status == Status::Warning || self.sink.mark() != mark {
+                self.report(function, vrs, context, mark, status);
+            }
             return Ok(status);
         }
         match status {
@@ -477,13 +590,53 @@ impl Instance {
             instance: self.name.clone(),
             model: self.model.clone(),
             function: function.to_string(),
-            context,
+            context: context.text(),
             variables: self.var_names(vrs),
             status: Some(status),
             detail: None,
             messages: self.sink.since(mark),
+            step: None,
         }
         .into())
+    }
+
+    /// What a call that nobody gets an error from (it succeeded, or it ran in `drop`) logged
+    /// since `mark`, to stderr: every message of status Warning or worse, as one line naming
+    /// instance, model, function, variables and context; debug messages when debug logging
+    /// is on; and a line for a non-OK `status` that came without any message.
+    fn report(&self, function: &str, vrs: &[Vr], context: Ctx, mark: u64, status: Status) {
+        let messages = self.sink.since(mark);
+        let serious = messages.iter().any(|m| m.status >= Status::Warning);
+        let debug = self.debug_logging && !messages.is_empty();
+        if !serious && !debug && status == Status::Ok {
+            return;
+        }
+        let mut call = String::new();
+        let context = context.text();
+        let _ = write_call(
+            &mut call,
+            &self.name,
+            &self.model,
+            function,
+            &self.var_names(vrs),
+            context.as_deref(),
+        );
+        // eprintln! (not a locked handle) so test harnesses capture it.
+        for m in &messages {
+            if m.status >= Status::Warning {
+                eprintln!(
+                    "warning: {call} logged {} [{}]: {}",
+                    m.status,
+                    m.category,
+                    m.message.trim()
+                );
+            } else if self.debug_logging {
+                eprintln!("FMU '{}' [{}]: {}", self.name, m.category, m.message.trim());
+            }
+        }
+        if status > Status::Ok && !serious {
+            eprintln!("warning: {call} returned {status} (the FMU logged no reason)");
+        }
     }
 
     /// An error the wrapper raises itself (no FMU status).
@@ -497,6 +650,7 @@ impl Instance {
             status: None,
             detail: Some(detail.to_string()),
             messages: Vec::new(),
+            step: None,
         }
         .into()
     }
@@ -533,19 +687,23 @@ impl Instance {
             return Err(self.refuse(
                 function,
                 &[],
-                "not supported: the FMU declares canGetAndSetFMUState=\"false\"",
+                "refused: not supported, the FMU declares canGetAndSetFMUState=\"false\" (not called; instance state unchanged)",
             ));
         }
         pick(&self.lib.f).ok_or_else(|| {
             self.refuse(
                 function,
                 &[],
-                "the shared library does not export this function",
+                "refused: the shared library does not export this function (not called; instance state unchanged)",
             )
         })
     }
 
-    fn own_state(&self, function: &str, state: &FmuState) -> Result<Fmi3FmuState, FmiError> {
+    fn own_state(
+        &self,
+        function: &str,
+        state: &FmuState,
+    ) -> Result<(Fmi3FmuState, InstanceState), FmiError> {
         match self.fmu_states.get(state.slot) {
             Some(Some(s)) if state.owner == self.id => Ok(*s),
             _ => Err(self.refuse(
@@ -558,6 +716,10 @@ impl Instance {
 }
 
 impl Drop for Instance {
+    /// Terminates only from Step Mode (FMI 3.0 allows fmi3Terminate nowhere else among our
+    /// states: not in Instantiated, Initialization Mode, Terminated or Error), frees the
+    /// saved FMU states (not after an Error), then frees the instance. Nobody receives an
+    /// error from a drop, so whatever the FMU reports here is printed (see `report`).
     fn drop(&mut self) {
         if self.handle.is_null() || self.state == InstanceState::Fatal {
             // After fmi3Fatal the standard allows no call at all, not even freeing: leak it.
@@ -566,21 +728,25 @@ impl Drop for Instance {
         let f = &self.lib.f;
         // SAFETY: the handle is live (never freed before; nulled right after freeing).
         unsafe {
-            if matches!(
-                self.state,
-                InstanceState::InitializationMode | InstanceState::StepMode
-            ) {
-                let _ = (f.terminate)(self.handle);
+            if self.state == InstanceState::StepMode {
+                let mark = self.sink.mark();
+                let status = Status::from_raw((f.terminate)(self.handle));
+                self.report("fmi3Terminate (on drop)", &[], Ctx::None, mark, status);
+                if status == Status::Fatal {
+                    return;
+                }
             }
             if self.state != InstanceState::Error {
                 if let Some(free) = f.free_fmu_state {
-                    for s in self.fmu_states.iter_mut().filter_map(Option::take) {
+                    for (s, _) in self.fmu_states.iter_mut().filter_map(Option::take) {
                         let mut s = s;
                         let _ = free(self.handle, &mut s);
                     }
                 }
             }
+            let mark = self.sink.mark();
             (f.free_instance)(self.handle);
+            self.report("fmi3FreeInstance", &[], Ctx::None, mark, Status::Ok);
         }
         self.handle = ptr::null_mut();
         // `sink` and then `lib` are dropped after this, i.e. after the FMU can no longer log.

@@ -32,6 +32,9 @@ pub(crate) struct Functions {
     pub set_string: ffi::Setter<*const std::ffi::c_char>,
     pub get_binary: ffi::GetBinary,
     pub set_binary: ffi::SetBinary,
+    /// Required by FMI 3.0, but resolved as optional: an FMU without it still runs with
+    /// debug logging as chosen at instantiation, and asking for more is refused up front.
+    pub set_debug_logging: Option<ffi::SetDebugLogging>,
     /// Optional: only needed when the FMU declares canGetAndSetFMUState.
     pub get_fmu_state: Option<ffi::GetFmuState>,
     pub set_fmu_state: Option<ffi::SetFmuState>,
@@ -109,6 +112,7 @@ impl Fmi3Library {
             set_string: sym!("fmi3SetString"),
             get_binary: sym!("fmi3GetBinary"),
             set_binary: sym!("fmi3SetBinary"),
+            set_debug_logging: opt_sym!("fmi3SetDebugLogging"),
             get_fmu_state: opt_sym!("fmi3GetFMUState"),
             set_fmu_state: opt_sym!("fmi3SetFMUState"),
             free_fmu_state: opt_sym!("fmi3FreeFMUState"),

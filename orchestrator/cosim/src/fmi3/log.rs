@@ -3,10 +3,13 @@
 //! Each instance gets its own [`LogSink`] as `instanceEnvironment`, so messages are attributed
 //! to the right instance even when several instances share one loaded library. Messages carry
 //! a sequence number so the wrapper can pick out exactly the messages logged during one call
-//! (for its error) while the whole stream stays available to `take_log`.
+//! (for its error, or to print its warnings) while the whole stream stays available to
+//! `take_log`. With debug logging off an FMU calls back only for warnings and errors, and the
+//! wrapper's per-call cost is one atomic load (no lock, no allocation).
 
 use std::collections::VecDeque;
 use std::ffi::{c_char, c_void, CStr};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 
 use super::ffi::Fmi3Status;
@@ -26,39 +29,36 @@ const CAPACITY: usize = 4096;
 
 #[derive(Default)]
 pub(crate) struct LogSink {
-    inner: Mutex<SinkInner>,
-}
-
-#[derive(Default)]
-struct SinkInner {
-    messages: VecDeque<(u64, LogMessage)>,
-    next_seq: u64,
+    inner: Mutex<VecDeque<(u64, LogMessage)>>,
+    /// Messages received so far (the next one's sequence number); written under the lock,
+    /// read without it.
+    received: AtomicU64,
 }
 
 impl LogSink {
     pub(crate) fn push(&self, msg: LogMessage) {
         let mut g = self.inner.lock().unwrap_or_else(|p| p.into_inner());
-        let seq = g.next_seq;
-        g.next_seq += 1;
-        if g.messages.len() == CAPACITY {
-            g.messages.pop_front();
+        let seq = self.received.load(Ordering::Relaxed);
+        if g.len() == CAPACITY {
+            g.pop_front();
         }
-        g.messages.push_back((seq, msg));
+        g.push_back((seq, msg));
+        self.received.store(seq + 1, Ordering::Release);
     }
 
-    /// Sequence number the next message will get: a mark before a call.
+    /// Sequence number the next message will get: a mark before a call. Also the number of
+    /// messages received since the instance was created.
     pub(crate) fn mark(&self) -> u64 {
-        self.inner
-            .lock()
-            .unwrap_or_else(|p| p.into_inner())
-            .next_seq
+        self.received.load(Ordering::Acquire)
     }
 
-    /// Copies of the messages logged since `mark`.
+    /// Copies of the messages logged since `mark` (none, without locking, when there are none).
     pub(crate) fn since(&self, mark: u64) -> Vec<LogMessage> {
+        if self.mark() == mark {
+            return Vec::new();
+        }
         let g = self.inner.lock().unwrap_or_else(|p| p.into_inner());
-        g.messages
-            .iter()
+        g.iter()
             .filter(|(s, _)| *s >= mark)
             .map(|(_, m)| m.clone())
             .collect()
@@ -66,7 +66,7 @@ impl LogSink {
 
     pub(crate) fn take(&self) -> Vec<LogMessage> {
         let mut g = self.inner.lock().unwrap_or_else(|p| p.into_inner());
-        g.messages.drain(..).map(|(_, m)| m).collect()
+        g.drain(..).map(|(_, m)| m).collect()
     }
 }
 

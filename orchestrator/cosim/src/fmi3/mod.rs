@@ -12,7 +12,7 @@ mod log;
 mod status;
 
 pub use error::{FmiError, FmiErrorInfo};
-pub use instance::{FmuState, Instance, InstanceState, StepResult};
+pub use instance::{FmuState, Instance, InstanceState};
 pub use library::Fmi3Library;
 pub use log::LogMessage;
-pub use status::Status;
+pub use status::{Status, StepResult};

@@ -1,4 +1,4 @@
-//! `fmi3Status`.
+//! `fmi3Status`, and what `fmi3DoStep` returns besides it.
 
 use std::fmt;
 
@@ -39,4 +39,13 @@ impl fmt::Display for Status {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
     }
+}
+
+/// Flags returned by `fmi3DoStep` (also carried by the error of a discarded step).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepResult {
+    pub event_handling_needed: bool,
+    pub terminate_simulation: bool,
+    pub early_return: bool,
+    pub last_successful_time: f64,
 }
