@@ -44,3 +44,14 @@ def test_scenario_key_and_unknown_category(tmp_path, fmu_dir):
     sc.write_text(text + "\n[logging]\nfmu = 3\n")
     bad = run(tmp_path, "bad2", scenario=sc, check=False)
     assert bad.returncode != 0 and "fmu = 3" in bad.stderr and "expected true, false" in bad.stderr, bad.stderr
+
+
+def test_world_builds_its_scene_at_most_twice_while_initializing(tmp_path, fmu_dir):
+    """Propagating unchanged values in Initialization Mode keeps the FMU's initialization
+    preview: the world (scene + physics) was built 14 times for harvest.ssd before, once per
+    read after a write; now only when an input really changed (2: the lift -> chassis ->
+    world chain settles in the master's second pass)."""
+    harvest = REPO / "models" / "scenarios" / "harvest.toml"
+    p = run_agrisim("run", "--scenario", str(harvest), "--duration", "0.02", "--fmu-log", "logModel", "--out", str(tmp_path / "h"))
+    builds = [line for line in fmu_lines(p.stderr) if line.startswith("FMU 'world' [logModel]: greenhouse:")]
+    assert 1 <= len(builds) <= 2, p.stderr[:3000]

@@ -46,7 +46,8 @@ pub struct Instance<M: Model> {
     pub start_time: f64,
     pub stop_time: Option<f64>,
     /// In Initialization Mode: model and values after `initialize` on a clone, so getters
-    /// return outputs consistent with the parameters set so far. Cleared by every set.
+    /// return outputs consistent with the parameters set so far. Cleared by every set that
+    /// changes a value.
     preview: Option<(M, Store)>,
     /// Strings returned by GetString, alive until the next GetString.
     strings: Vec<CString>,
@@ -218,11 +219,14 @@ impl<M: Model> Instance<M> {
             check_value(var, &value).map_err(|e| format!("bad value for variable {}: {e}", self.var_name(slot)))?;
             decoded.push((i, value));
         }
+        // The initialization preview stays valid while nothing changes: an importer that
+        // propagates the same values again (iterating to a consistent start) must not make a
+        // heavy model (the world: scene + physics) initialize again.
         for (i, value) in decoded {
-            *self.store.value_mut(i) = value;
-        }
-        if !vrs.is_empty() {
-            self.preview = None;
+            if !self.store.value(i).identical(&value) {
+                *self.store.value_mut(i) = value;
+                self.preview = None;
+            }
         }
         Ok(())
     }

@@ -14,6 +14,15 @@ pub enum Value {
 }
 
 impl Value {
+    /// The very same value: floats bit for bit (so -0.0 differs from 0.0 and a NaN equals
+    /// itself). Setting an identical value changes nothing a model could compute from it.
+    pub fn identical(&self, other: &Value) -> bool {
+        match (self, other) {
+            (Value::Float64(a), Value::Float64(b)) => a.to_bits() == b.to_bits(),
+            _ => self == other,
+        }
+    }
+
     pub fn from_start(start: &Start) -> Value {
         match *start {
             Start::Float64(v) => Value::Float64(v),
