@@ -89,10 +89,6 @@ impl Master {
         self.tick as i64 * self.step_ns
     }
 
-    pub fn step(&self) -> f64 {
-        self.step_ns as f64 / 1e9
-    }
-
     /// Initializes every FMU at t = 0.
     pub fn initialize(&mut self) -> Result<()> {
         for c in &mut self.system.components {

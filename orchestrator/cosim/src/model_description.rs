@@ -393,6 +393,11 @@ impl ModelDescription {
         self.variables.iter().find(|v| v.name == name)
     }
 
+    /// A parameter an importer may set (before or during initialization) by name.
+    pub fn settable_parameter(&self, name: &str) -> Option<&ModelVariable> {
+        self.variable(name).filter(|v| v.causality.is_settable_parameter())
+    }
+
     /// Variable by value reference.
     pub fn variable_by_vr(&self, vr: u32) -> Option<&ModelVariable> {
         self.variables.iter().find(|v| v.value_reference == vr)

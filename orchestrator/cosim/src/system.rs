@@ -306,16 +306,15 @@ impl System {
             let comp = &self.structure.components[i];
             let md = self.components[i].archive.md.clone();
             let param = |name: &str| -> Result<ModelVariable> {
-                md.variable(name)
-                    .filter(|v| v.causality.is_settable_parameter())
+                md.settable_parameter(name)
                     .cloned()
                     .ok_or_else(|| crate::err!("FMU '{}' ({}) has no parameter '{name}'", comp.name, md.model_name))
             };
-            if md.variable("seed").is_some_and(|v| v.ty == VarType::Int32 && v.causality.is_settable_parameter()) {
+            if md.settable_parameter("seed").is_some_and(|v| v.ty == VarType::Int32) {
                 set.insert("seed".into(), Value::I32(component_seed(master_seed, &comp.name)));
             }
             for (name, text) in shared {
-                if md.variable(name).is_some_and(|v| v.ty == VarType::String && v.causality.is_settable_parameter()) {
+                if md.settable_parameter(name).is_some_and(|v| v.ty == VarType::String) {
                     set.insert(name.clone(), Value::Str(text.clone()));
                 }
             }

@@ -44,20 +44,15 @@ fn load_options(s: &Scenario, o: &RunOptions) -> LoadOptions {
 /// Start-pose parameters of a mobile base (REP 103, map frame).
 const START_POSE: [&str; 3] = ["x0", "y0", "yaw0"];
 
-/// True when some component of `system` has a settable parameter `name`.
-fn takes_parameter(system: &System, name: &str) -> bool {
-    system.components.iter().any(|c| c.archive.md.variable(name).is_some_and(|v| v.causality.is_settable_parameter()))
-}
-
 /// The scenario's parameters, plus: when the system builds the greenhouse scene (some
 /// component takes the `scene` parameter), every component with start-pose parameters
 /// starts at the layout's predefined initial pose unless the scenario says otherwise.
 fn parameters(s: &Scenario, system: &System) -> Result<BTreeMap<String, BTreeMap<String, toml::Value>>> {
     let mut params = s.parameters.clone();
-    if takes_parameter(system, "scene") {
+    if system.components.iter().any(|c| c.archive.md.settable_parameter("scene").is_some()) {
         let start_pose = crate::scene::layout(s)?.start_pose;
         for c in &system.components {
-            if START_POSE.iter().all(|n| c.archive.md.variable(n).is_some_and(|v| v.causality.is_settable_parameter())) {
+            if START_POSE.iter().all(|n| c.archive.md.settable_parameter(n).is_some()) {
                 let start = params.entry(c.name.clone()).or_default();
                 for (name, v) in START_POSE.iter().zip(start_pose) {
                     start.entry(name.to_string()).or_insert(toml::Value::Float(v));
@@ -80,7 +75,8 @@ pub fn prepare(s: &Scenario, o: &RunOptions, mcap: &Path, nodes: Vec<Box<dyn Nod
     let seed = o.seed.unwrap_or(s.seed);
     let lo = load_options(s, o);
     let mut system = System::load(&s.system_path(), &lo)?;
-    message_types(&system)?;
+    // Checked before the MCAP file exists: a bad mimeType leaves nothing behind.
+    let types = message_types(&system)?;
     let params = parameters(s, &system)?;
     let mut shared = BTreeMap::from([("scene".to_string(), s.scene_toml())]);
     // The scenario's [environment] (when it has one) for every component with a String
@@ -107,7 +103,7 @@ pub fn prepare(s: &Scenario, o: &RunOptions, mcap: &Path, nodes: Vec<Box<dyn Nod
         recorder.metadata(&format!("agrisim.parameters.{comp}"), params)?;
     }
     let master = Master::new(system, s.timing.step, lo.message_period)?;
-    let mut session = Session::new(master, nodes, recorder)?;
+    let mut session = Session::new(master, nodes, recorder, types);
     session.master.initialize()?;
     Ok(session)
 }

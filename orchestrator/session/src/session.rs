@@ -42,8 +42,8 @@ pub fn message_types(system: &System) -> Result<Vec<Option<String>>> {
 }
 
 impl Session {
-    pub fn new(master: Master, nodes: Vec<Box<dyn Node>>, recorder: Recorder) -> Result<Session> {
-        let types = message_types(&master.system)?;
+    /// `types`: [`message_types`] of `master.system`.
+    pub fn new(master: Master, nodes: Vec<Box<dyn Node>>, recorder: Recorder, types: Vec<Option<String>>) -> Session {
         let node_wall = vec![0.0; nodes.len()];
         let signals = master
             .system
@@ -51,7 +51,7 @@ impl Session {
             .iter()
             .map(|c| (format!("/fmu/{}/signals", c.name), Signals { header: Header::default(), names: c.signals.iter().map(|v| v.name.clone()).collect(), values: Vec::new() }))
             .collect();
-        Ok(Session { master, bus: Bus::default(), nodes, recorder, types, node_wall, signals, scalars: Signals::default() })
+        Session { master, bus: Bus::default(), nodes, recorder, types, node_wall, signals, scalars: Signals::default() }
     }
 
     pub fn time(&self) -> f64 {
@@ -138,7 +138,7 @@ struct Link<'a> {
 impl Hooks for Link<'_> {
     fn message(&mut self, system: &System, route: usize, t_ns: i64, bytes: &[u8]) -> Result<()> {
         let r = &system.routes[route];
-        let ty = self.types[route].as_deref().expect("message routes have a type (checked in Session::new)");
+        let ty = self.types[route].as_deref().expect("message routes have a type (message_types)");
         if let Port::Fmu { comp, var, .. } = &r.from {
             check_message(&system.components[*comp].name, &var.name, ty, bytes, t_ns)?;
         }
