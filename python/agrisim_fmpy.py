@@ -9,6 +9,7 @@ tautology. Imports are plain: a missing package fails the test run instead of sk
 
 from __future__ import annotations
 
+import itertools
 import os
 import shutil
 import subprocess
@@ -20,6 +21,8 @@ from pathlib import Path
 import fmpy
 from fmpy import read_model_description
 from fmpy.fmi3 import FMU3Slave
+
+import agrisim_frames
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 
@@ -84,6 +87,9 @@ class Slave:
         unzip = tempfile.mkdtemp(prefix=f"agrisim-{instance_name}-", dir=unzip_root)
         self._unzip = fmpy.extract(str(fmu), unzip)
         self.vars = {v.name: v for v in self.md.modelVariables}
+        # FMPy does not expose mimeType: read it from the XML (framed ports, agrisim_frames).
+        root = ET.parse(Path(self._unzip) / "modelDescription.xml").getroot()
+        self.mimes = {b.get("name"): b.get("mimeType") for b in root.iter("Binary")}
         self.slave = FMU3Slave(guid=self.md.guid, unzipDirectory=self._unzip,
                                modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=instance_name)
         self.slave.instantiate()
@@ -103,6 +109,16 @@ class Slave:
     def get(self, name: str):
         v = self.var(name)
         return self._getters[v.type]([v.valueReference])[0]
+
+    def messages(self, name: str) -> list[bytes]:
+        """The messages (CDR) in framed message port `name`, oldest first."""
+        return [f.payload for f in agrisim_frames.decode(self.get(name))]
+
+    def latest(self, name: str) -> bytes:
+        """The newest message in framed message port `name`."""
+        msgs = self.messages(name)
+        assert msgs, f"{self.md.modelName}.{name}: no message in the port"
+        return msgs[-1]
 
     def get_many(self, names: list[str]) -> list:
         return [self.get(n) for n in names]
@@ -257,6 +273,7 @@ class Port:
     comp: int | None  # None: a bus connector
     name: str  # variable name or topic
     seq: str | None = None  # counter of a message port
+    framed: bool = False  # a frame-list port (agrisim_frames)
 
 
 @dataclass
@@ -266,7 +283,8 @@ class Route:
     period_ticks: int
     is_message: bool
     topic: str
-    seen: int = 0
+    cursor: agrisim_frames.Cursor = field(default_factory=agrisim_frames.Cursor)
+    bus_seen: int = 0  # bus source: the last bus sequence number delivered
     written: int = 0
 
 
@@ -280,13 +298,15 @@ class BusReplay:
             if r.topic in input_topics:
                 self.incoming.setdefault(r.log_time, []).append((r.topic, r.data))
         self.scalar_log = {r.log_time: dict(zip(r.msg.names, r.msg.values)) for r in rec.topic("/agrisim/scalars")}
-        self.latest: dict[str, tuple[int, bytes]] = {}  # topic -> (seq, cdr)
+        self.history: dict[str, list[tuple[int, int, bytes]]] = {}  # topic -> [(seq, t_ns, cdr)]
         self.scalars: dict[str, float] = {}
-        self.published: list[tuple[str, int, bytes]] = []  # FMU outputs reaching the bus
 
     def publish(self, topic: str, t_ns: int, cdr: bytes) -> None:
-        seq = self.latest.get(topic, (0, b""))[0] + 1
-        self.latest[topic] = (seq, cdr)
+        h = self.history.setdefault(topic, [])
+        h.append((len(h) + 1, t_ns, cdr))
+
+    def since(self, topic: str, seq: int) -> list[tuple[int, int, bytes]]:
+        return [m for m in self.history.get(topic, []) if m[0] > seq]
 
     def nodes_at(self, t_ns: int) -> None:
         """What the algorithm layer published at t_ns, taken from the recording."""
@@ -297,9 +317,26 @@ class BusReplay:
         self.scalars.update(self.scalar_log.get(t_ns, {}))
 
 
+def step_order(n: int, links: list[tuple[int, int]]) -> list[int]:
+    """Gauss-Seidel order: the permutation of components 0..n-1 with the fewest FMU-to-FMU
+    connections from a later to an earlier component (those are read one step late), the
+    lexicographically smallest among equals. Brute force: systems here have a handful of
+    components (the orchestrator solves the same problem by dynamic programming)."""
+    assert n <= 9, "brute force: at most 9 components"
+    best = None
+    for perm in itertools.permutations(range(n)):  # lexicographic order
+        pos = {c: i for i, c in enumerate(perm)}
+        cost = sum(1 for a, b in links if a != b and pos[a] > pos[b])
+        if best is None or cost < best[0]:
+            best = (cost, list(perm))
+    return best[1]
+
+
 class MasterReplay:
-    """Drives FMU3Slaves exactly like orchestrator/cosim/src/master.rs, with the system inputs taken
-    from a recorded run, and collects what the orchestrator records about the FMUs."""
+    """Drives FMU3Slaves like orchestrator/cosim/src/master.rs (integer ticks, Gauss-Seidel in
+    the order of `step_order`, delayed connections only in loops, every message of a framed
+    port once), with the system inputs taken from a recorded run, and collects what the
+    orchestrator records about the FMUs."""
 
     def __init__(self, ssd: Path, rec: Recording, fmu_overrides: dict[str, str] | None = None):
         run = rec.metadata["agrisim.run"]
@@ -320,6 +357,10 @@ class MasterReplay:
             for pname, text in rec.metadata.get(f"agrisim.parameters.{name}", {}).items():
                 slave.set_text(pname, text)
         self.routes = [self._route(c, message_period) for c in sysf.connections]
+        links = [(r.src.comp, r.dst.comp) for r in self.routes if r.src.comp is not None and r.dst.comp is not None]
+        self.order = step_order(len(self.slaves), links)
+        pos = {c: i for i, c in enumerate(self.order)}
+        self.delayed = [r.src.comp is not None and r.dst.comp is not None and pos[r.src.comp] >= pos[r.dst.comp] for r in self.routes]
         input_topics = {r.src.name for r in self.routes if r.src.comp is None and r.is_message}
         self.bus = BusReplay(rec, input_topics)
         self.signals: dict[str, list[tuple[int, list[str], list[float]]]] = {n: [] for n in self.names}
@@ -330,12 +371,13 @@ class MasterReplay:
         if e.element is None:
             return Port(None, e.connector)
         comp = self.names.index(e.element)
-        v = self.slaves[comp].var(e.connector)
+        slave = self.slaves[comp]
+        v = slave.var(e.connector)
         seq = None
         if v.type == "Binary":
             seq = f"{v.name}_seq"
-            assert self.slaves[comp].var(seq).type == "Int64", f"{e.element}.{seq} must be Int64"
-        return Port(comp, e.connector, seq)
+            assert slave.var(seq).type == "Int64", f"{e.element}.{seq} must be Int64"
+        return Port(comp, e.connector, seq, agrisim_frames.is_framed_mime(slave.mimes.get(v.name)))
 
     def _route(self, c: Connection, message_period: float) -> Route:
         src, dst = self._port(c.start), self._port(c.end)
@@ -355,16 +397,36 @@ class MasterReplay:
     def time(self, k: int) -> float:
         return (k * self.step_ns) / 1e9
 
+    def inputs_of(self, comp: int) -> list[Route]:
+        return [r for r in self.routes if r.dst.comp == comp and r.src.comp is not None]
+
     def initialize(self) -> None:
+        """One pass in the step order (a component's inputs set before its outputs are read),
+        then passes over every scalar FMU-to-FMU connection until nothing changes."""
         for s in self.slaves:
             s.slave.enterInitializationMode(startTime=0.0)
-        # As master.rs: scalar FMU-to-FMU connections propagate in initialization mode, one
-        # pass per component so chains settle.
-        for _ in self.slaves:
-            for r in self.routes:
-                if r.src.comp is None or r.dst.comp is None or r.is_message:
-                    continue
-                self.slaves[r.dst.comp].set(r.dst.name, self.slaves[r.src.comp].get(r.src.name))
+        last: dict[int, object] = {}
+
+        def propagate(i: int, r: Route) -> bool:
+            if r.is_message:
+                return False
+            v = self.slaves[r.src.comp].get(r.src.name)
+            if i in last and last[i] == v:
+                return False
+            self.slaves[r.dst.comp].set(r.dst.name, v)
+            last[i] = v
+            return True
+
+        index = {id(r): i for i, r in enumerate(self.routes)}
+        for c in self.order:
+            for r in self.inputs_of(c):
+                if not self.delayed[index[id(r)]]:
+                    propagate(index[id(r)], r)
+        for _ in range(50):
+            if not any([propagate(index[id(r)], r) for c in self.order for r in self.inputs_of(c)]):
+                break
+        else:
+            raise AssertionError("initialization did not converge")
         for s in self.slaves:
             s.slave.exitInitializationMode()
 
@@ -375,15 +437,45 @@ class MasterReplay:
             if k % self.message_ticks == 0:
                 self.bus.nodes_at(self.t_ns(k))
             self.bus.scalars_at(self.t_ns(k))
-            self.deliver_inputs(k)
+            self.deliver_bus_inputs(k)
             self.record_point()
             t, h = self.time(k), self.step_ns / 1e9
-            for s in self.slaves:
-                s.do_step(t, h)
+            for c in self.order:
+                for r in self.inputs_of(c):
+                    at = k if self.delayed[self.routes.index(r)] else k + 1
+                    if at % r.period_ticks == 0:
+                        self.propagate(r, at)
+                self.slaves[c].do_step(t, h)
             self.tick += 1
         self.collect_outputs(self.tick)
         self.bus.scalars_at(self.t_ns(self.tick))
         self.record_point()
+
+    def take_messages(self, r: Route, t_ns: int) -> list[agrisim_frames.Frame]:
+        """The source port's messages the route has not taken, each once (GapError if lost)."""
+        s = self.slaves[r.src.comp]
+        n = s.get(r.src.seq)
+        if n == r.cursor.last:
+            return []
+        data = s.get(r.src.name)
+        if r.src.framed:
+            return r.cursor.take(data, n)
+        if n > r.cursor.last + 1:
+            raise agrisim_frames.GapError(r.cursor.last + 1, n - 1)
+        r.cursor.last = n
+        return [agrisim_frames.Frame(n, t_ns, data)]
+
+    def write_messages(self, r: Route, messages: list[tuple[int, bytes]]) -> None:
+        if not messages:
+            return
+        d = self.slaves[r.dst.comp]
+        if r.dst.framed:
+            first = r.written + 1
+            d.set(r.dst.name, agrisim_frames.encode(agrisim_frames.Frame(first + i, t, b) for i, (t, b) in enumerate(messages)))
+        else:
+            d.set(r.dst.name, messages[-1][1])
+        r.written += len(messages)
+        d.set(r.dst.seq, r.written)
 
     def collect_outputs(self, k: int) -> None:
         t_ns = self.t_ns(k)
@@ -392,48 +484,36 @@ class MasterReplay:
                 continue
             s = self.slaves[r.src.comp]
             if r.src.seq is not None:
-                n = s.get(r.src.seq)
-                if n == r.seen:
-                    continue
-                r.seen = n
-                cdr = s.get(r.src.name)
-                self.bus.publish(r.topic, t_ns, cdr)
-                self.bus_messages.append((r.topic, t_ns, cdr))
+                for f in self.take_messages(r, t_ns):
+                    self.bus.publish(r.topic, f.stamp_ns, f.payload)
+                    self.bus_messages.append((r.topic, f.stamp_ns, f.payload))
             else:
                 self.bus.scalars[r.topic] = as_float(s.get(r.src.name))
 
-    def deliver_inputs(self, k: int) -> None:
-        t_ns = self.t_ns(k)
+    def deliver_bus_inputs(self, k: int) -> None:
         for r in self.routes:
-            if k % r.period_ticks or r.dst.comp is None:
-                continue
-            value = None
-            if r.src.comp is None:
-                if r.dst.seq is not None:
-                    latest = self.bus.latest.get(r.src.name)
-                    if latest is not None and latest[0] > r.seen:
-                        r.seen = latest[0]
-                        value = latest[1]
-                elif r.src.name in self.bus.scalars:
-                    value = self._scalar_for(self.slaves[r.dst.comp].var(r.dst.name), self.bus.scalars[r.src.name])
-            else:
-                s = self.slaves[r.src.comp]
-                if r.src.seq is not None:
-                    n = s.get(r.src.seq)
-                    if n != r.seen:
-                        r.seen = n
-                        value = s.get(r.src.name)
-                        self.bus.publish(r.topic, t_ns, value)
-                        self.bus_messages.append((r.topic, t_ns, value))
-                else:
-                    value = s.get(r.src.name)
-            if value is None:
+            if k % r.period_ticks or r.dst.comp is None or r.src.comp is not None:
                 continue
             d = self.slaves[r.dst.comp]
-            d.set(r.dst.name, value)
             if r.dst.seq is not None:
-                r.written += 1
-                d.set(r.dst.seq, r.written)
+                new = self.bus.since(r.src.name, r.bus_seen)
+                if new:
+                    r.bus_seen = new[-1][0]
+                self.write_messages(r, [(t, b) for _, t, b in new])
+            elif r.src.name in self.bus.scalars:
+                d.set(r.dst.name, self._scalar_for(d.var(r.dst.name), self.bus.scalars[r.src.name]))
+
+    def propagate(self, r: Route, at: int) -> None:
+        """An FMU-to-FMU route: its source's value now (at tick `at`) to its destination."""
+        s = self.slaves[r.src.comp]
+        if r.src.seq is not None:
+            frames = self.take_messages(r, self.t_ns(at))
+            for f in frames:
+                self.bus.publish(r.topic, f.stamp_ns, f.payload)
+                self.bus_messages.append((r.topic, f.stamp_ns, f.payload))
+            self.write_messages(r, [(f.stamp_ns, f.payload) for f in frames])
+        else:
+            self.slaves[r.dst.comp].set(r.dst.name, s.get(r.src.name))
 
     @staticmethod
     def _scalar_for(var, x: float):
@@ -456,10 +536,10 @@ class MasterReplay:
             s.close()
 
 
-def annotated_scenario(tmp: Path, periods: dict[tuple[str, str], float]) -> tuple[Path, Path]:
+def annotated_scenario(tmp: Path, periods: dict[tuple[str, str], float], chassis: dict[str, float] | None = None) -> tuple[Path, Path]:
     """A copy of the default scenario and system where the connections named by
-    (start connector, end connector) carry an `org.agrisim.exchange` period annotation.
-    Returns (scenario, system file)."""
+    (start connector, end connector) carry an `org.agrisim.exchange` period annotation, and
+    the chassis takes the extra parameters `chassis`. Returns (scenario, system file)."""
     ET.register_namespace("ssd", NS["ssd"])
     ET.register_namespace("ssc", NS["ssc"])
     ET.register_namespace("ssv", NS["ssv"])
@@ -478,6 +558,9 @@ def annotated_scenario(tmp: Path, periods: dict[tuple[str, str], float]) -> tupl
     lines = DEFAULT_SCENARIO.read_text().splitlines()
     i = next(i for i, l in enumerate(lines) if l.strip().startswith("file ="))
     lines[i] = f"file = {str(ssd)!r}".replace("'", '"')
+    if chassis:
+        j = lines.index("[parameters.chassis]")
+        lines[j + 1:j + 1] = [f"{k} = {v!r}" for k, v in chassis.items()]
     scenario = tmp / "annotated.toml"
     scenario.write_text("\n".join(lines) + "\n")
     return scenario, ssd

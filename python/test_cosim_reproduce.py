@@ -2,8 +2,9 @@
 
 `agrisim run` records a run; here the same FMUs are driven through FMPy's low-level FMU3Slave
 by an independent implementation of the master algorithm (python/agrisim_fmpy.py, written
-from orchestrator/cosim/src/master.rs: integer ticks, Jacobi exchange, message routes only when a
-counter moved, 10 Hz message instants), fed with the recorded system inputs (/cmd_vel raw CDR
+from orchestrator/cosim/src/master.rs: integer ticks, Gauss-Seidel in the order with the fewest
+delayed connections (found here by brute force), one-pass initialization in that order, every
+message of a framed port once (python/agrisim_frames.py), 10 Hz message instants), fed with the recorded system inputs (/cmd_vel raw CDR
 at its log times, /agrisim/scalars) and the recorded parameters (MCAP metadata). Every FMU's
 scalar inputs and outputs must match /fmu/<component>/signals to 1e-9 at every tick, and the
 chassis' /odom bytes must be identical.
@@ -15,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from agrisim_fmpy import DEFAULT_SCENARIO, DEFAULT_SSD, MasterReplay, agrisim_run, annotated_scenario, read_mcap
+from agrisim_fmpy import DEFAULT_SCENARIO, DEFAULT_SSD, MasterReplay, agrisim_run, annotated_scenario, read_mcap, run_agrisim
 
 TOL = 1e-9
 
@@ -86,15 +87,21 @@ def test_fmpy_master_reproduces_recorded_run(tmp_path, chassis):
 def test_fmpy_master_reproduces_decimated_exchange(tmp_path):
     """Connections with their own exchange periods (org.agrisim.exchange annotations): odometry
     out every 0.2 s, commands in every 0.3 s, the lift -> chassis physics coupling every 0.06 s
-    (with the dynamic chassis, whose physics uses the payload)."""
-    scenario, ssd = annotated_scenario(tmp_path, {
-        ("odom", "odom"): 0.2, ("cmd_vel", "cmd_vel"): 0.3,
-        ("payload_mass", "payload_mass"): 0.06, ("payload_height", "payload_height"): 0.06})
+    (with the dynamic chassis, whose physics uses the payload). The chassis keeps 0.2 s of
+    odometry in its port (port_window) so the slower route loses nothing; with the default
+    0.1 s the run stops with a sequence-gap error naming the port."""
+    periods = {("odom", "odom"): 0.2, ("cmd_vel", "cmd_vel"): 0.3,
+               ("payload_mass", "payload_mass"): 0.06, ("payload_height", "payload_height"): 0.06}
+    (tmp_path / "short").mkdir()
+    scenario, _ = annotated_scenario(tmp_path / "short", periods)
+    p = run_agrisim("run", "--scenario", str(scenario), "--out", str(tmp_path / "short" / "out"), check=False)
+    assert p.returncode != 0 and "FMU 'chassis': message port 'odom'" in p.stderr and "sequence gap" in p.stderr, p.stderr
+    scenario, ssd = annotated_scenario(tmp_path, periods, chassis={"port_window": 0.2})
     rec, m = reproduce(tmp_path / "out", "--fmu", "chassis=ChassisDynamic.fmu", overrides={"chassis": "ChassisDynamic.fmu"},
                        scenario=scenario, ssd=ssd)
     worst = compare_signals(rec, m)
     n = compare_messages(rec, m)
-    assert n == 101
+    assert n == 201, "every 10 Hz odometry message, two per exchange"
     assert [r.period_ticks for r in m.routes] == [15, 10, 1, 3, 3]
     print(f"decimated: max abs error per component {worst}, {n} /odom messages byte-identical")
 

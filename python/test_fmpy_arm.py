@@ -79,18 +79,18 @@ def test_two_instances_track_reject_and_grip():
         # Left: accepted, tracked, done.
         ql = q_of(left)
         assert max(abs(a - b) for a, b in zip(ql, goal)) < 6e-3
-        ts = st.deserialize_cdr(left.get("trajectory_status"), "agrisim_msgs/msg/TrajectoryStatus")
+        ts = st.deserialize_cdr(left.latest("trajectory_status"), "agrisim_msgs/msg/TrajectoryStatus")
         assert (ts.state, ts.trajectory_count, ts.rejected_count) == (2, 1, 0)
         assert 0.0 < ts.rms_tracking_error < 5e-3 and left.get("status") == 0
-        js = st.deserialize_cdr(left.get("joint_states"), "sensor_msgs/msg/JointState")
+        js = st.deserialize_cdr(left.latest("joint_states"), "sensor_msgs/msg/JointState")
         assert js.name[:7] == [f"left_joint{i}" for i in range(1, 8)] and len(js.effort) == 9
         assert js.position[:7].tolist() == ql  # published at t = 2 s, the current step end
         # Right: rejected, did not move at all, reason names the joint; gripper stalled.
         assert q_of(right) == READY
-        ts = st.deserialize_cdr(right.get("trajectory_status"), "agrisim_msgs/msg/TrajectoryStatus")
+        ts = st.deserialize_cdr(right.latest("trajectory_status"), "agrisim_msgs/msg/TrajectoryStatus")
         assert ts.state == 3 and ts.rejected_count == 1 and "right_joint4" in ts.reason and "NaN" in ts.reason
         assert right.get("status") == 2
-        gs = st.deserialize_cdr(right.get("gripper_state"), "agrisim_msgs/msg/GripperState")
+        gs = st.deserialize_cdr(right.latest("gripper_state"), "agrisim_msgs/msg/GripperState")
         assert (gs.position, gs.effort, gs.stalled, gs.reached_goal) == (0.06, 20.0, True, False)
         assert right.get("finger_width") == 0.06
     finally:

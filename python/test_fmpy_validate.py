@@ -77,7 +77,7 @@ def test_fmi3_message_ports_have_ros2_mime_and_counter(name: str):
         if v.type == "Binary":
             seq = names.get(f"{v.name}_seq")
             assert seq is not None and seq.type == "Int64" and seq.causality == v.causality, f"{name}.{v.name}: no Int64 counter"
-            assert (mimes.get(v.name) or "").startswith("application/x-ros2-cdr; type="), f"{name}.{v.name}: mimeType {mimes.get(v.name)!r}"
+            assert (mimes.get(v.name) or "").startswith("application/x-ros2-cdr-frames; version=1; type="), f"{name}.{v.name}: mimeType {mimes.get(v.name)!r}"
 
 
 @pytest.mark.parametrize("fmu", FMI2, ids=ids(FMI2))

@@ -34,8 +34,9 @@ def test_image_and_camera_info_decode(sensors_run):
     depth = messages(sensors_run, "/camera/aligned_depth_to_color/image_raw")
     info = messages(sensors_run, "/camera/color/camera_info")
     labels = messages(sensors_run, "/camera/labels")
-    # 10 Hz over 0.5 s: frames at 0.0 .. 0.4 s.
-    assert len(rgb) == len(depth) == len(info) == len(labels) == 5
+    # 10 Hz over 0.5 s: frames stamped 0.0 .. 0.5 s, each one recorded (the port keeps them all).
+    assert len(rgb) == len(depth) == len(info) == len(labels) == 6
+    assert [im.header.stamp.sec * 10**9 + im.header.stamp.nanosec for _, im in rgb] == list(range(0, 500_000_001, 100_000_000))
     assert {s for s, _ in rgb + depth + labels} == {"sensor_msgs/msg/Image"}
     assert {s for s, _ in info} == {"sensor_msgs/msg/CameraInfo"}
     for (_, im), (_, d), (_, ci), (_, lb) in zip(rgb, depth, info, labels):

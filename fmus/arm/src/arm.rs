@@ -8,7 +8,7 @@ use crate::inertia::joint_inertia;
 use crate::ports::*;
 use crate::reference::{Reference, Setpoint};
 use crate::validate::validate;
-use agrisim_fmi::{Log, Model, Store, Var};
+use agrisim_fmi::{InPort, Log, Model, OutPort, Store, Var};
 use agrisim_fmu_util::{to_ns, Schedule};
 use agrisim_math::Rng;
 use agrisim_msgs::agrisim::{GripperState, TrajectoryStatus};
@@ -99,18 +99,37 @@ pub struct Arm {
     pub rejected: u64,
     pub reason: String,
     pub errors: ErrorStats,
-    traj_seq: i64,
-    grip_seq: i64,
+    ports: Option<Ports>,
+    window_ns: i64,
     now_ns: i64,
     js_schedule: Schedule,
     status_schedule: Schedule,
     snapshot: Option<Snapshot>,
-    js_seq: i64,
-    status_seq: i64,
-    gripper_seq: i64,
     last_status: Option<(u8, u64, u64)>,
     noise: f64,
     rng: Rng,
+}
+
+/// The arm's message ports.
+#[derive(Clone, Debug)]
+struct Ports {
+    trajectory: InPort,
+    gripper_command: InPort,
+    joint_states: OutPort,
+    trajectory_status: OutPort,
+    gripper_state: OutPort,
+}
+
+impl Ports {
+    fn new() -> Ports {
+        Ports {
+            trajectory: InPort::new(TRAJECTORY, TRAJECTORY_SEQ),
+            gripper_command: InPort::new(GRIPPER_COMMAND, GRIPPER_COMMAND_SEQ),
+            joint_states: OutPort::new(JOINT_STATES, JOINT_STATES_SEQ),
+            trajectory_status: OutPort::new(TRAJECTORY_STATUS, TRAJECTORY_STATUS_SEQ),
+            gripper_state: OutPort::new(GRIPPER_STATE, GRIPPER_STATE_SEQ),
+        }
+    }
 }
 
 /// Parses "a,b,..." into exactly 7 finite numbers; empty -> `default`.
@@ -150,15 +169,21 @@ impl Arm {
         }
     }
 
-    /// Takes a new trajectory at `t_ns` if its sequence counter changed.
-    fn poll_trajectory(&mut self, io: &Store, t_ns: i64, log: &mut dyn Log) {
-        let seq = io.i64(TRAJECTORY_SEQ);
-        if seq == self.traj_seq {
-            return;
+    fn ports(&mut self) -> &mut Ports {
+        self.ports.get_or_insert_with(Ports::new)
+    }
+
+    /// Takes the new trajectories at `t_ns`, in order (each replaces the one before).
+    fn poll_trajectory(&mut self, io: &Store, t_ns: i64, log: &mut dyn Log) -> Result<(), String> {
+        for bytes in self.ports().trajectory.take(io, "trajectory")? {
+            self.take_trajectory(&bytes, t_ns, log);
         }
-        self.traj_seq = seq;
+        Ok(())
+    }
+
+    fn take_trajectory(&mut self, bytes: &[u8], t_ns: i64, log: &mut dyn Log) {
         let from: Setpoint = self.reference.sample(t_ns);
-        match validate(io.binary(TRAJECTORY), self.description(), &from.q) {
+        match validate(bytes, self.description(), &from.q) {
             Ok(points) => {
                 self.reference = Reference::new(t_ns, &from, &points);
                 self.accepted += 1;
@@ -177,24 +202,23 @@ impl Arm {
             Err(reason) => {
                 self.rejected += 1;
                 self.rejected_last = true;
-                log.warning(format_args!("{} arm: trajectory rejected at t={} s (seq {seq}): {reason}", self.description().side, t_ns as f64 * 1e-9));
+                log.warning(format_args!("{} arm: trajectory {} rejected at t={} s: {reason}", self.description().side, self.accepted + self.rejected, t_ns as f64 * 1e-9));
                 self.reason = reason;
             }
         }
     }
 
-    fn poll_gripper(&mut self, io: &Store, t_ns: i64, log: &mut dyn Log) {
-        let seq = io.i64(GRIPPER_COMMAND_SEQ);
-        if seq == self.grip_seq {
-            return;
+    /// Takes the new gripper commands at `t_ns`, in order.
+    fn poll_gripper(&mut self, io: &Store, t_ns: i64, log: &mut dyn Log) -> Result<(), String> {
+        for bytes in self.ports().gripper_command.take(io, "gripper_command")? {
+            let res = GripperCommand::from_cdr(&bytes)
+                .map_err(|e| format!("not a valid control_msgs/msg/GripperCommand CDR message: {e}"))
+                .and_then(|c| self.gripper.command(c.position, c.max_effort));
+            if let Err(e) = res {
+                log.warning(format_args!("{} gripper: command refused at t={} s: {e}", self.description().side, t_ns as f64 * 1e-9));
+            }
         }
-        self.grip_seq = seq;
-        let res = GripperCommand::from_cdr(io.binary(GRIPPER_COMMAND))
-            .map_err(|e| format!("not a valid control_msgs/msg/GripperCommand CDR message: {e}"))
-            .and_then(|c| self.gripper.command(c.position, c.max_effort));
-        if let Err(e) = res {
-            log.warning(format_args!("{} gripper: command refused at t={} s (seq {seq}): {e}", self.description().side, t_ns as f64 * 1e-9));
-        }
+        Ok(())
     }
 
     /// Runs the control loop from `from_ns` to `to_ns`.
@@ -279,10 +303,8 @@ impl Arm {
         let status = if self.rejected_last { 2 } else if self.exec == Exec::Executing { 1 } else { 0 };
         io.set_i32(STATUS, status);
         if let Some(s) = self.snapshot.take() {
-            let js = self.joint_state_message(&s);
-            self.js_seq += 1;
-            io.set_binary(JOINT_STATES, &js.to_cdr());
-            io.set_i64(JOINT_STATES_SEQ, self.js_seq);
+            let js = self.joint_state_message(&s).to_cdr();
+            self.ports().joint_states.publish(s.stamp_ns, js);
             let g = &s.gripper;
             let gs = GripperState {
                 header: Header::new(Time::from_nanos(s.stamp_ns), format!("{}_hand", self.description().side)),
@@ -291,17 +313,19 @@ impl Arm {
                 stalled: g.stalled,
                 reached_goal: g.reached_goal(),
             };
-            self.gripper_seq += 1;
-            io.set_binary(GRIPPER_STATE, &gs.to_cdr());
-            io.set_i64(GRIPPER_STATE_SEQ, self.gripper_seq);
+            self.ports().gripper_state.publish(s.stamp_ns, gs.to_cdr());
         }
         let key = (self.state_code(), self.accepted, self.rejected);
         let due = self.status_schedule.due(t_ns as f64 * 1e-9).is_some();
         if due || self.last_status != Some(key) {
             self.last_status = Some(key);
-            self.status_seq += 1;
-            io.set_binary(TRAJECTORY_STATUS, &self.status_message(t_ns).to_cdr());
-            io.set_i64(TRAJECTORY_STATUS_SEQ, self.status_seq);
+            let status = self.status_message(t_ns).to_cdr();
+            self.ports().trajectory_status.publish(t_ns, status);
+        }
+        let w = self.window_ns;
+        let p = self.ports();
+        for port in [&mut p.joint_states, &mut p.trajectory_status, &mut p.gripper_state] {
+            port.sync(io, t_ns, w);
         }
     }
 }
@@ -371,11 +395,12 @@ impl Model for Arm {
             noise,
             rng: Rng::new(io.i32(SEED) as u32 as u64),
             now_ns: start_ns,
+            window_ns: agrisim_fmi::port::window_ns(io, PORT_WINDOW)?,
             arm: Some(d),
             ..Default::default()
         };
-        self.poll_trajectory(io, start_ns, log);
-        self.poll_gripper(io, start_ns, log);
+        self.poll_trajectory(io, start_ns, log)?;
+        self.poll_gripper(io, start_ns, log)?;
         if self.js_schedule.due(start_time).is_some() {
             self.snapshot = Some(Snapshot { stamp_ns: start_ns, joints: self.state, gripper: self.gripper });
         }
@@ -386,8 +411,8 @@ impl Model for Arm {
     fn do_step(&mut self, io: &mut Store, t: f64, h: f64, log: &mut dyn Log) -> Result<(), String> {
         let t_ns = to_ns(t);
         let end_ns = to_ns(t + h);
-        self.poll_trajectory(io, t_ns, log);
-        self.poll_gripper(io, t_ns, log);
+        self.poll_trajectory(io, t_ns, log)?;
+        self.poll_gripper(io, t_ns, log)?;
         let gw = io.f64(GRASP_WIDTH);
         self.advance(t_ns, end_ns, if gw.is_finite() { gw } else { 0.0 });
         self.now_ns = end_ns;

@@ -33,13 +33,14 @@ agrisim_fmi::variables! { pub VARIABLES {
     POSITION_NOISE = Var::param("position_noise", Start::Float64(0.0)).unit("rad").range(0.0, 1.0)
         .desc("Std. deviation of encoder noise added to joint_states positions (not to q1..q7)"),
     SEED = Var::param("seed", Start::Int32(0)).desc("Seed of the encoder noise"),
+    PORT_WINDOW = agrisim_fmi::port_window(),
     // --- inputs ---
     TRAJECTORY = Var::input_discrete("trajectory", Start::Binary(&[])).mime(JointTrajectory::MIME_TYPE).max_size(16 << 20)
-        .desc("trajectory_msgs/JointTrajectory (CDR); taken when trajectory_seq changes"),
-    TRAJECTORY_SEQ = Var::input_discrete("trajectory_seq", Start::Int64(0)).desc("Sequence counter of trajectory"),
-    GRIPPER_COMMAND = Var::input_discrete("gripper_command", Start::Binary(&[])).mime(GripperCommand::MIME_TYPE).max_size(1024)
-        .desc("control_msgs/GripperCommand (CDR): position = finger gap in m, max_effort in N"),
-    GRIPPER_COMMAND_SEQ = Var::input_discrete("gripper_command_seq", Start::Int64(0)).desc("Sequence counter of gripper_command"),
+        .desc("trajectory_msgs/JointTrajectory (CDR frames, or one bare CDR message); those after the last taken are taken in order, each replacing the one before"),
+    TRAJECTORY_SEQ = Var::input_discrete("trajectory_seq", Start::Int64(0)).desc("Sequence number of the newest message in trajectory"),
+    GRIPPER_COMMAND = Var::input_discrete("gripper_command", Start::Binary(&[])).mime(GripperCommand::MIME_TYPE).max_size(agrisim_fmi::port::frames_max_size(1024, 64))
+        .desc("control_msgs/GripperCommand (CDR frames, or one bare CDR message): position = finger gap in m, max_effort in N"),
+    GRIPPER_COMMAND_SEQ = Var::input_discrete("gripper_command_seq", Start::Int64(0)).desc("Sequence number of the newest message in gripper_command"),
     GRASP_WIDTH = Var::input("grasp_width", 0.0).unit("m")
         .desc("Width of the object between the fingers (world FMU); 0 = none. Closing fingers stop there"),
     // --- outputs ---
@@ -58,15 +59,15 @@ agrisim_fmi::variables! { pub VARIABLES {
         .desc("RMS joint tracking error over the current/last accepted trajectory (all joints)"),
     STATUS = Var::output_discrete("status", Start::Int32(0)).init_depends_on(TRAJECTORY_CHECK)
         .desc("0 ok (idle or done), 1 executing, 2 last trajectory rejected"),
-    JOINT_STATES = Var::output_discrete("joint_states", Start::Binary(&[])).mime(JointState::MIME_TYPE).max_size(4096)
+    JOINT_STATES = Var::output_discrete("joint_states", Start::Binary(&[])).mime(JointState::MIME_TYPE).max_size(agrisim_fmi::port::frames_max_size(4096, 1024))
         .init_depends_on(&[SIDE, Q_INIT, GRIPPER_WIDTH0, POSITION_NOISE, SEED, Var::TIME])
-        .desc("sensor_msgs/JointState: 7 arm joints + 2 finger joints, position/velocity/effort"),
+        .desc("sensor_msgs/JointState: 7 arm joints + 2 finger joints, position/velocity/effort (CDR frames of the last port_window)"),
     JOINT_STATES_SEQ = Var::output_discrete("joint_states_seq", Start::Int64(0)).init_depends_on(&[]),
     TRAJECTORY_STATUS = Var::output_discrete("trajectory_status", Start::Binary(&[])).mime(TrajectoryStatus::MIME_TYPE)
-        .max_size(4096).init_depends_on(&[SIDE, Q_INIT, TRAJECTORY, TRAJECTORY_SEQ, Var::TIME])
+        .max_size(agrisim_fmi::port::frames_max_size(4096, 1024)).init_depends_on(&[SIDE, Q_INIT, TRAJECTORY, TRAJECTORY_SEQ, Var::TIME])
         .desc("agrisim_msgs/TrajectoryStatus, on change and at status_rate"),
     TRAJECTORY_STATUS_SEQ = Var::output_discrete("trajectory_status_seq", Start::Int64(0)).init_depends_on(&[]),
-    GRIPPER_STATE = Var::output_discrete("gripper_state", Start::Binary(&[])).mime(GripperState::MIME_TYPE).max_size(1024)
+    GRIPPER_STATE = Var::output_discrete("gripper_state", Start::Binary(&[])).mime(GripperState::MIME_TYPE).max_size(agrisim_fmi::port::frames_max_size(1024, 1024))
         .init_depends_on(&[SIDE, GRIPPER_WIDTH0, GRIPPER_COMMAND, GRIPPER_COMMAND_SEQ, Var::TIME])
         .desc("agrisim_msgs/GripperState, with joint_states"),
     GRIPPER_STATE_SEQ = Var::output_discrete("gripper_state_seq", Start::Int64(0)).init_depends_on(&[]),

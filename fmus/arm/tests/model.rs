@@ -75,7 +75,7 @@ impl Sim {
     }
 
     fn status(&self) -> TrajectoryStatus {
-        TrajectoryStatus::from_cdr(self.io.binary(TRAJECTORY_STATUS)).unwrap()
+        TrajectoryStatus::from_cdr(agrisim_fmi::port::latest(&self.io, TRAJECTORY_STATUS)).unwrap()
     }
 }
 
@@ -295,17 +295,17 @@ fn gripper_closes_on_object_and_stalls() {
     assert!((sim.io.f64(FINGER_WIDTH) - 0.06).abs() < 1e-9, "{}", sim.io.f64(FINGER_WIDTH));
     sim.step(40);
     assert_eq!(sim.io.f64(FINGER_WIDTH), 0.05);
-    let gs = GripperState::from_cdr(sim.io.binary(GRIPPER_STATE)).unwrap();
+    let gs = GripperState::from_cdr(agrisim_fmi::port::latest(&sim.io, GRIPPER_STATE)).unwrap();
     assert!(gs.stalled && !gs.reached_goal);
     assert_eq!((gs.position, gs.effort), (0.05, 30.0));
-    let js = JointState::from_cdr(sim.io.binary(JOINT_STATES)).unwrap();
+    let js = JointState::from_cdr(agrisim_fmi::port::latest(&sim.io, JOINT_STATES)).unwrap();
     assert_eq!(&js.name[7..], ["left_finger_joint1", "left_finger_joint2"]);
     assert_eq!(&js.position[7..], [0.025, 0.025]);
     assert_eq!(&js.effort[7..], [30.0, 30.0]);
     // Open again: reaches the goal, no force.
     sim.grip(0.08, 30.0);
     sim.step(30);
-    let gs = GripperState::from_cdr(sim.io.binary(GRIPPER_STATE)).unwrap();
+    let gs = GripperState::from_cdr(agrisim_fmi::port::latest(&sim.io, GRIPPER_STATE)).unwrap();
     assert!(!gs.stalled && gs.reached_goal && gs.effort == 0.0);
     // A command out of range is refused and logged; the target stays.
     sim.grip(0.2, 10.0);
@@ -327,7 +327,7 @@ fn joint_states_at_rate_with_stamps_and_right_side_names() {
         sim.step(1);
         if sim.io.i64(JOINT_STATES_SEQ) != last {
             last = sim.io.i64(JOINT_STATES_SEQ);
-            let js = JointState::from_cdr(sim.io.binary(JOINT_STATES)).unwrap();
+            let js = JointState::from_cdr(agrisim_fmi::port::latest(&sim.io, JOINT_STATES)).unwrap();
             assert_eq!(js.name[0], "right_joint1");
             assert_eq!(js.position.len(), 9);
             assert_eq!(js.velocity.len(), 9);

@@ -12,8 +12,8 @@ use crate::optics::{CameraPose, Intrinsics, Mount};
 use crate::ports::*;
 use crate::render::{self, DepthModel, DepthNoise, Frame};
 use crate::scene::{self, Scene};
-use agrisim_fmi::{Log, Model, Store, Var};
-use agrisim_fmu_util::Schedule;
+use agrisim_fmi::{Log, Model, OutPort, Store, Var};
+use agrisim_fmu_util::{to_ns, Schedule};
 use agrisim_greenhouse::environment::Environment;
 use agrisim_greenhouse::weather::Conditions;
 use agrisim_math::Rng;
@@ -44,7 +44,13 @@ pub struct Camera {
     config: Option<Config>,
     schedule: Schedule,
     rng: Rng,
-    seq: i64,
+    /// image, depth, camera_info, labels.
+    ports: Option<[OutPort; 4]>,
+    window_ns: i64,
+}
+
+fn new_ports() -> [OutPort; 4] {
+    [OutPort::new(IMAGE, IMAGE_SEQ), OutPort::new(DEPTH, DEPTH_SEQ), OutPort::new(CAMERA_INFO, CAMERA_INFO_SEQ), OutPort::new(LABELS_IMAGE, LABELS_SEQ)]
 }
 
 fn param(io: &Store, i: usize, ok: impl Fn(f64) -> bool, what: &str) -> Result<f64, String> {
@@ -192,7 +198,9 @@ impl Model for Camera {
         SENSOR_PORTS.base_pose(io)?;
         self.schedule = Schedule::new(1.0 / config.period, start_time)?;
         self.rng = Rng::new(io.i32(NOISE_SEED) as u32 as u64);
-        self.seq = 0;
+        self.window_ns = agrisim_fmi::port::window_ns(io, PORT_WINDOW)?;
+        self.ports = Some(new_ports());
+        self.sync(io, to_ns(start_time));
         let (zenith, azimuth, visibility) = match &config.conditions {
             Some(c) => (c.sun.zenith, c.sun.azimuth, c.visibility),
             None => (90.0 - io.f64(SUN_ELEVATION), io.f64(SUN_AZIMUTH), 0.0),
@@ -216,9 +224,23 @@ impl Model for Camera {
         if !(lift.is_finite() && lift.abs() < 100.0) {
             return Err(format!("input lift_position = {lift} is not finite or beyond 100 m"));
         }
-        let Some(stamp) = self.schedule.due(t + h) else {
-            return Ok(());
-        };
+        if let Some(stamp) = self.schedule.due(t + h) {
+            self.capture_and_publish(io, stamp, x, y, yaw, lift);
+        }
+        self.sync(io, to_ns(t + h));
+        Ok(())
+    }
+}
+
+impl Camera {
+    fn sync(&mut self, io: &mut Store, now_ns: i64) {
+        let w = self.window_ns;
+        for p in self.ports.get_or_insert_with(new_ports) {
+            p.sync(io, now_ns, w);
+        }
+    }
+
+    fn capture_and_publish(&mut self, io: &mut Store, stamp: i64, x: f64, y: f64, yaw: f64, lift: f64) {
         let frame = self.capture_on_lift(x, y, yaw, lift);
         let c = self.config.as_ref().expect("initialized");
         let (w, hh, id) = (c.intrinsics.width, c.intrinsics.height, c.frame_id.as_str());
@@ -228,18 +250,13 @@ impl Model for Camera {
         let labels = c
             .labels
             .then(|| image::labels_32sc1(stamp, id, w, hh, &frame.labels).to_cdr());
-        self.seq += 1;
-        io.set_binary(IMAGE, &rgb);
-        io.set_i64(IMAGE_SEQ, self.seq);
-        io.set_binary(DEPTH, &depth);
-        io.set_i64(DEPTH_SEQ, self.seq);
-        io.set_binary(CAMERA_INFO, &info);
-        io.set_i64(CAMERA_INFO_SEQ, self.seq);
+        let ports = self.ports.get_or_insert_with(new_ports);
+        ports[0].publish(stamp, rgb);
+        ports[1].publish(stamp, depth);
+        ports[2].publish(stamp, info);
         if let Some(l) = labels {
-            io.set_binary(LABELS_IMAGE, &l);
-            io.set_i64(LABELS_SEQ, self.seq);
+            ports[3].publish(stamp, l);
         }
         io.set_i32(VALID_DEPTH, frame.valid as i32);
-        Ok(())
     }
 }

@@ -5,8 +5,8 @@
 use crate::datasheet as ds;
 use agrisim_fmi::{Start, Var};
 
-pub const IMAGE_MIME: &str = "application/x-ros2-cdr; type=sensor_msgs/msg/Image";
-pub const CAMERA_INFO_MIME: &str = "application/x-ros2-cdr; type=sensor_msgs/msg/CameraInfo";
+pub const IMAGE_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=sensor_msgs/msg/Image";
+pub const CAMERA_INFO_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=sensor_msgs/msg/CameraInfo";
 
 /// Room for a message's header, metadata and frame_id [bytes]: all of CameraInfo, and what
 /// an Image adds to its pixels.
@@ -66,6 +66,7 @@ agrisim_sensor_ports::sensor_variables! { pub VARIABLES {
         .desc("Publish the instance-label image (32SC1: scene object id + 1, 0 = nothing)"),
     FRAME_ID = Var::param("frame_id", Start::String("camera_color_optical_frame"))
         .desc("header.frame_id of images and CameraInfo (optical convention: z forward, x right, y down)"),
+    PORT_WINDOW = agrisim_fmi::port_window(),
   },
   ports: {
     // --- inputs (and base_x, base_y, base_yaw) ---
@@ -73,20 +74,20 @@ agrisim_sensor_ports::sensor_variables! { pub VARIABLES {
         .desc("Lift joint position, added to mount_z (connect it when the camera rides on the lift, as on the robot: camera_link at (0.32, 0, 0.60 + lift) on base_link)"),
     // --- outputs ---
     // Frames come with the steps; initialization only sets the sun and visibility outputs.
-    IMAGE = Var::output_discrete("image", Start::Binary(&[])).mime(IMAGE_MIME).max_size(image_max_size(3)).init_depends_on(&[])
-        .desc("Latest colour image, sensor_msgs/Image rgb8 (CDR)"),
+    IMAGE = Var::output_discrete("image", Start::Binary(&[])).mime(IMAGE_MIME).max_size(agrisim_fmi::port::frames_max_size(image_max_size(3), 2)).init_depends_on(&[])
+        .desc("Colour images of the last port_window, sensor_msgs/Image rgb8 (CDR frames)"),
     IMAGE_SEQ = Var::output_discrete("image_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence counter of image"),
-    DEPTH = Var::output_discrete("depth", Start::Binary(&[])).mime(IMAGE_MIME).max_size(image_max_size(4)).init_depends_on(&[])
-        .desc("Latest depth image aligned to the colour image, sensor_msgs/Image 32FC1, z in metres, 0 = no data (REP 118)"),
+    DEPTH = Var::output_discrete("depth", Start::Binary(&[])).mime(IMAGE_MIME).max_size(agrisim_fmi::port::frames_max_size(image_max_size(4), 2)).init_depends_on(&[])
+        .desc("Depth images of the last port_window (CDR frames) aligned to the colour image, sensor_msgs/Image 32FC1, z in metres, 0 = no data (REP 118)"),
     DEPTH_SEQ = Var::output_discrete("depth_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence counter of depth"),
-    CAMERA_INFO = Var::output_discrete("camera_info", Start::Binary(&[])).mime(CAMERA_INFO_MIME).max_size(HEADER_ROOM)
+    CAMERA_INFO = Var::output_discrete("camera_info", Start::Binary(&[])).mime(CAMERA_INFO_MIME).max_size(agrisim_fmi::port::frames_max_size(HEADER_ROOM, 1024))
         .init_depends_on(&[])
-        .desc("Calibration of the latest frame: plumb_bob, zero distortion, K from the field of view"),
+        .desc("Calibration of each frame (CDR frames): plumb_bob, zero distortion, K from the field of view"),
     CAMERA_INFO_SEQ = Var::output_discrete("camera_info_seq", Start::Int64(0)).init_depends_on(&[])
         .desc("Sequence counter of camera_info"),
-    LABELS_IMAGE = Var::output_discrete("labels", Start::Binary(&[])).mime(IMAGE_MIME).max_size(image_max_size(4))
+    LABELS_IMAGE = Var::output_discrete("labels", Start::Binary(&[])).mime(IMAGE_MIME).max_size(agrisim_fmi::port::frames_max_size(image_max_size(4), 2))
         .init_depends_on(&[])
-        .desc("Latest instance labels, sensor_msgs/Image 32SC1: scene object id + 1 per pixel, 0 = nothing (empty when publish_labels is false)"),
+        .desc("Instance labels of each frame (CDR frames), sensor_msgs/Image 32SC1: scene object id + 1 per pixel, 0 = nothing (empty when publish_labels is false)"),
     LABELS_SEQ = Var::output_discrete("labels_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence counter of labels"),
     SOLAR_ZENITH = Var::output_discrete("solar_zenith", Start::Float64(0.0)).unit("deg").init_depends_on(&[ENVIRONMENT, SUN_ELEVATION])
         .desc("With environment: the sun's topocentric zenith angle with refraction (NREL SPA); else 90 - sun_elevation"),

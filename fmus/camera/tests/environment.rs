@@ -42,7 +42,7 @@ fn shot(environment: &str, threads: i32) -> Shot {
     let mut m = Camera::new();
     m.initialize(&mut io, 0.0, &mut Quiet).unwrap();
     m.do_step(&mut io, 0.0, 0.02, &mut Quiet).unwrap();
-    let img = |i| Image::from_cdr(io.binary(i)).unwrap().data;
+    let img = |i| Image::from_cdr(agrisim_fmi::port::latest(&io, i)).unwrap().data;
     Shot { rgb: img(IMAGE), depth: img(DEPTH), labels: img(LABELS_IMAGE) }
 }
 

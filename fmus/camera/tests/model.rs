@@ -371,7 +371,7 @@ fn fmu_publishes_decodable_messages_at_10_hz() {
     }
     // Frames at 0, 0.1, 0.2 s, each published by the step that reaches its instant.
     assert_eq!(seqs, [1, 1, 1, 1, 2, 2, 2, 2, 2, 3, 3]);
-    let info = CameraInfo::from_cdr(io.binary(CAMERA_INFO)).unwrap();
+    let info = CameraInfo::from_cdr(agrisim_fmi::port::latest(&io, CAMERA_INFO)).unwrap();
     let k = Intrinsics::from_fov(160, 120, 87.0, 58.0);
     assert_eq!(info.k, k.k());
     assert_eq!(
@@ -388,7 +388,7 @@ fn fmu_publishes_decodable_messages_at_10_hz() {
         200_000_000
     );
     assert_eq!(info.header.frame_id, "camera_color_optical_frame");
-    let rgb = Image::from_cdr(io.binary(IMAGE)).unwrap();
+    let rgb = Image::from_cdr(agrisim_fmi::port::latest(&io, IMAGE)).unwrap();
     assert_eq!(
         (
             rgb.encoding.as_str(),
@@ -399,7 +399,7 @@ fn fmu_publishes_decodable_messages_at_10_hz() {
         ),
         ("rgb8", 160, 120, 480, 160 * 120 * 3)
     );
-    let depth = image::read_32fc1(&Image::from_cdr(io.binary(DEPTH)).unwrap()).unwrap();
+    let depth = image::read_32fc1(&Image::from_cdr(agrisim_fmi::port::latest(&io, DEPTH)).unwrap()).unwrap();
     assert_eq!(depth.len(), 160 * 120);
     assert_eq!(
         depth.iter().filter(|&&d| d > 0.0).count(),
@@ -416,7 +416,7 @@ fn fmu_publishes_decodable_messages_at_10_hz() {
     assert!(depth
         .iter()
         .all(|&d| d == 0.0 || (d > 0.0 && (d as f64) < 10.0 + 6.0 * sigma_max)));
-    let labels = image::read_32sc1(&Image::from_cdr(io.binary(LABELS_IMAGE)).unwrap()).unwrap();
+    let labels = image::read_32sc1(&Image::from_cdr(agrisim_fmi::port::latest(&io, LABELS_IMAGE)).unwrap()).unwrap();
     assert_eq!(labels.len(), 160 * 120);
     assert_eq!(io.i64(LABELS_SEQ), 3);
     assert!(labels.iter().any(|&l| l > 0));
@@ -435,7 +435,7 @@ fn square_pixels_when_fov_horizontal_is_zero() {
         (k.fx - k.fy).abs() < 1e-9 && (k.fy - 240.0 / 29f64.to_radians().tan()).abs() < 1e-9,
         "{k:?}"
     );
-    let info = CameraInfo::from_cdr(io.binary(CAMERA_INFO)).unwrap();
+    let info = CameraInfo::from_cdr(agrisim_fmi::port::latest(&io, CAMERA_INFO)).unwrap();
     assert_eq!(info.k, k.k());
 }
 
@@ -445,7 +445,7 @@ fn labels_off_leaves_the_port_empty() {
     *io.value_mut(LABELS) = Value::Boolean(false);
     run(&mut io, 3);
     assert_eq!(io.i64(IMAGE_SEQ), 1);
-    assert!(io.binary(LABELS_IMAGE).is_empty() && io.i64(LABELS_SEQ) == 0);
+    assert!(agrisim_fmi::port::messages(&io, LABELS_IMAGE).is_empty() && io.i64(LABELS_SEQ) == 0);
 }
 
 #[test]

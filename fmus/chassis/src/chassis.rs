@@ -6,9 +6,10 @@ use crate::command::CommandIntake;
 use crate::odometry::WheelOdometry;
 use crate::ports::*;
 use crate::schedule::Schedule;
+use agrisim_fmu_util::to_ns;
 use crate::se2::{integrate, Twist2};
 use crate::wheels::{approach, WheelLayout, WheelState};
-use agrisim_fmi::{Log, Model, Store, Var};
+use agrisim_fmi::{Log, Model, OutPort, Store, Var};
 use agrisim_math::{Pose2, Rng};
 use agrisim_msgs::Message;
 
@@ -82,7 +83,8 @@ pub struct Chassis<D: Drive> {
     odom: WheelOdometry,
     odom_schedule: Schedule,
     rng: Rng,
-    odom_seq: i64,
+    odom_port: Option<OutPort>,
+    window_ns: i64,
 }
 
 fn positive(io: &Store, i: usize) -> Result<f64, String> {
@@ -128,11 +130,11 @@ impl<D: Drive> Chassis<D> {
     }
 
     fn publish_odom(&mut self, io: &mut Store, t: f64) {
+        let port = self.odom_port.get_or_insert_with(|| OutPort::new(ODOM, ODOM_SEQ));
         if let Some(stamp) = self.odom_schedule.due(t) {
-            self.odom_seq += 1;
-            io.set_binary(ODOM, &self.odom.message(stamp).to_cdr());
-            io.set_i64(ODOM_SEQ, self.odom_seq);
+            port.publish(stamp, self.odom.message(stamp).to_cdr());
         }
+        port.sync(io, to_ns(t), self.window_ns);
     }
 }
 
@@ -162,6 +164,8 @@ impl<D: Drive> Model for Chassis<D> {
         self.odom = WheelOdometry { pose: self.pose, twist: Twist2::default() };
         self.odom_schedule = Schedule::new(io.f64(ODOM_RATE), start_time)?;
         self.rng = Rng::new(io.i32(SEED) as u32 as u64);
+        self.window_ns = agrisim_fmi::port::window_ns(io, PORT_WINDOW)?;
+        self.odom_port = None;
         self.write_outputs(io);
         io.set_bool(CMD_ACTIVE, self.commands.active(start_time, io.f64(CMD_TIMEOUT)).is_some());
         self.publish_odom(io, start_time);

@@ -4,27 +4,31 @@
 
 use crate::ports::*;
 use crate::se2::Twist2;
-use agrisim_fmi::Store;
+use agrisim_fmi::{InPort, Store};
 use agrisim_msgs::geometry_msgs::Twist;
 use agrisim_msgs::Message;
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct CommandIntake {
     cmd_seq: i32,
-    vel_seq: i64,
+    cmd_vel: InPort,
     latest: Twist2,
     received_at: f64,
+}
+
+impl Default for CommandIntake {
+    fn default() -> Self {
+        CommandIntake { cmd_seq: 0, cmd_vel: InPort::new(CMD_VEL, CMD_VEL_SEQ), latest: Twist2::default(), received_at: 0.0 }
+    }
 }
 
 impl CommandIntake {
     /// Takes the command present at initialization (scalar ports, or the message if one is set).
     pub fn initialize(&mut self, io: &Store, t: f64) -> Result<(), String> {
         self.cmd_seq = io.i32(CMD_SEQ);
-        self.vel_seq = io.i64(CMD_VEL_SEQ);
+        self.cmd_vel.clear();
         self.latest = scalar_command(io)?;
-        if !io.binary(CMD_VEL).is_empty() {
-            self.latest = decode_twist(io.binary(CMD_VEL))?;
-        }
+        self.take_messages(io)?;
         self.received_at = t;
         Ok(())
     }
@@ -37,12 +41,19 @@ impl CommandIntake {
             self.latest = scalar_command(io)?;
             self.received_at = t;
         }
-        if io.i64(CMD_VEL_SEQ) != self.vel_seq {
-            self.vel_seq = io.i64(CMD_VEL_SEQ);
-            self.latest = decode_twist(io.binary(CMD_VEL))?;
+        if self.take_messages(io)? {
             self.received_at = t;
         }
         Ok(())
+    }
+
+    /// Every new Twist on cmd_vel, in order (each must be valid; the last one wins).
+    fn take_messages(&mut self, io: &Store) -> Result<bool, String> {
+        let msgs = self.cmd_vel.take(io, "cmd_vel")?;
+        for m in &msgs {
+            self.latest = decode_twist(m)?;
+        }
+        Ok(!msgs.is_empty())
     }
 
     /// The command to follow at `t`, or `None` when the watchdog has expired.

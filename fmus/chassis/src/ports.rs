@@ -4,8 +4,8 @@
 use agrisim_fmi::{Start, Var};
 
 /// MIME types of the message ports (FMI 3 Binary variables carrying ROS 2 CDR).
-pub const TWIST_MIME: &str = "application/x-ros2-cdr; type=geometry_msgs/msg/Twist";
-pub const ODOMETRY_MIME: &str = "application/x-ros2-cdr; type=nav_msgs/msg/Odometry";
+pub const TWIST_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=geometry_msgs/msg/Twist";
+pub const ODOMETRY_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=nav_msgs/msg/Odometry";
 
 agrisim_fmi::variables! { pub VARIABLES {
     // --- geometry and limits (fixed parameters) ---
@@ -28,6 +28,7 @@ agrisim_fmi::variables! { pub VARIABLES {
     YAW0 = Var::param("yaw0", Start::Float64(0.0)).unit("rad"),
     ODOM_RATE = Var::param("odom_rate", Start::Float64(10.0)).unit("Hz").range(0.001, 1e6)
         .desc("Publication rate of the odom message port, scheduled on simulation time"),
+    PORT_WINDOW = agrisim_fmi::port_window(),
     SEED = Var::param("seed", Start::Int32(0)).desc("Seed of odometry noise and slip"),
     ENC_NOISE = Var::param("enc_noise", Start::Float64(0.0)).unit("rad/s")
         .desc("Wheel encoder spin-rate noise, 1 sigma per step"),
@@ -60,9 +61,9 @@ agrisim_fmi::variables! { pub VARIABLES {
     CMD_WZ = Var::input("cmd_wz", 0.0).unit("rad/s").desc("Scalar command: yaw rate"),
     CMD_SEQ = Var::input_discrete("cmd_seq", Start::Int32(0))
         .desc("Scalar command counter: a change makes cmd_vx/vy/wz the active command"),
-    CMD_VEL = Var::input_discrete("cmd_vel", Start::Binary(&[])).mime(TWIST_MIME).max_size(1024)
-        .desc("Message command (geometry_msgs/Twist, CDR); taken when cmd_vel_seq changes"),
-    CMD_VEL_SEQ = Var::input_discrete("cmd_vel_seq", Start::Int64(0)).desc("Sequence counter of cmd_vel"),
+    CMD_VEL = Var::input_discrete("cmd_vel", Start::Binary(&[])).mime(TWIST_MIME).max_size(agrisim_fmi::port::frames_max_size(1024, 64))
+        .desc("Message commands (geometry_msgs/Twist, CDR frames, or one bare CDR message); those after the last taken are applied in order"),
+    CMD_VEL_SEQ = Var::input_discrete("cmd_vel_seq", Start::Int64(0)).desc("Sequence number of the newest command in cmd_vel"),
     PAYLOAD_MASS = Var::input("payload_mass", 0.0).unit("kg").desc("Mass carried on the base (lift, arms)"),
     PAYLOAD_HEIGHT = Var::input("payload_height", 0.0).unit("m").desc("Centre-of-mass height of the payload"),
     // --- outputs: ground truth ---
@@ -89,10 +90,10 @@ agrisim_fmi::variables! { pub VARIABLES {
     ODOM_WZ = Var::output("odom_wz").unit("rad/s").init_depends_on(&[]),
     CMD_ACTIVE = Var::output_discrete("cmd_active", Start::Boolean(false)).init_depends_on(&[CMD_TIMEOUT])
         .desc("A fresh command is being followed (false: watchdog stopped the base)"),
-    ODOM = Var::output_discrete("odom", Start::Binary(&[])).mime(ODOMETRY_MIME).max_size(1024)
-        .init_depends_on(&[X0, Y0, YAW0, ODOM_RATE, Var::TIME])
-        .desc("Wheel odometry as nav_msgs/Odometry (odom -> base_link), at odom_rate"),
-    ODOM_SEQ = Var::output_discrete("odom_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence counter of odom"),
+    ODOM = Var::output_discrete("odom", Start::Binary(&[])).mime(ODOMETRY_MIME).max_size(agrisim_fmi::port::frames_max_size(1024, 1024))
+        .init_depends_on(&[X0, Y0, YAW0, ODOM_RATE, PORT_WINDOW, Var::TIME])
+        .desc("Wheel odometry as nav_msgs/Odometry (odom -> base_link), at odom_rate: the messages of the last port_window (CDR frames)"),
+    ODOM_SEQ = Var::output_discrete("odom_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence number of the newest message in odom"),
 }}
 
 /// Steering output indices in wheel order.

@@ -140,7 +140,7 @@ fn odom_message_published_at_ten_hertz_with_sim_time_stamps() {
         m.do_step(&mut io, k as f64 * H, H, &mut Quiet).unwrap();
         if io.i64(ODOM_SEQ) != seq {
             seq = io.i64(ODOM_SEQ);
-            let o = Odometry::from_cdr(io.binary(ODOM)).unwrap();
+            let o = Odometry::from_cdr(agrisim_fmi::port::latest(&io, ODOM)).unwrap();
             assert_eq!(o.header.frame_id, "odom");
             assert_eq!(o.child_frame_id, "base_link");
             stamps.push(o.header.stamp.sec as i64 * 1_000_000_000 + o.header.stamp.nanosec as i64);

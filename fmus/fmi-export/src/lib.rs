@@ -15,6 +15,7 @@ mod guard;
 mod instance;
 pub mod logger;
 mod model;
+pub mod port;
 mod registry;
 pub mod state;
 mod store;
@@ -24,6 +25,7 @@ mod units;
 mod var;
 pub mod xml;
 
+pub use port::{port_window, InPort, OutPort};
 pub use model::{Log, Model, ModelError, Quiet};
 pub use state::{Mode, Status};
 pub use store::{checked_f64, Store, Value};

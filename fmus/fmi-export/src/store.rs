@@ -122,6 +122,13 @@ impl Store {
             other => panic!("variable {i} is {other:?}, not Binary"),
         }
     }
+    /// A Binary value to write in place.
+    pub fn binary_mut(&mut self, i: usize) -> &mut Vec<u8> {
+        match &mut self.values[i] {
+            Value::Binary(x) => x,
+            other => panic!("variable {i} is {other:?}, not Binary"),
+        }
+    }
     /// Replace a Binary value (reuses the allocation).
     pub fn set_binary(&mut self, i: usize, bytes: &[u8]) {
         match &mut self.values[i] {

@@ -310,11 +310,19 @@ pub fn fmi3<M: Model>() -> String {
         "  <CoSimulation modelIdentifier=\"{}\" needsExecutionTool=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" canGetAndSetFMUState=\"true\" canSerializeFMUState=\"false\" providesDirectionalDerivatives=\"false\" providesAdjointDerivatives=\"false\" providesPerElementDependencies=\"false\" canHandleVariableCommunicationStepSize=\"true\" maxOutputDerivativeOrder=\"0\" providesIntermediateUpdate=\"false\" mightReturnEarlyFromDoStep=\"false\" canReturnEarlyAfterIntermediateUpdate=\"false\" hasEventMode=\"false\" providesEvaluateDiscreteStates=\"false\"/>",
         escape(M::NAME)
     );
-    unit_definitions(&mut o, &used_units(&vars));
+    let units = used_units(&vars);
+    unit_definitions(&mut o, &units);
+    // Units through one Float64Type per unit (declaredType) rather than a unit attribute on
+    // each variable: both are FMI 3, and some importers (fmi-sim 0.7) read only the former.
+    o.push_str("  <TypeDefinitions>\n");
+    for u in &units {
+        let _ = writeln!(o, "    <Float64Type name=\"{}\" unit=\"{}\"/>", escape(u), escape(u));
+    }
+    o.push_str("  </TypeDefinitions>\n");
     log_categories(&mut o);
     let _ = writeln!(o, "  <DefaultExperiment startTime=\"0.0\" stepSize=\"{}\"/>", fmt_f64(M::STEP_SIZE));
     o.push_str("  <ModelVariables>\n");
-    o.push_str("    <Float64 name=\"time\" valueReference=\"0\" description=\"Simulation time\" causality=\"independent\" variability=\"continuous\" unit=\"s\"/>\n");
+    o.push_str("    <Float64 name=\"time\" valueReference=\"0\" description=\"Simulation time\" causality=\"independent\" variability=\"continuous\" declaredType=\"s\"/>\n");
     for (i, v) in vars.iter().enumerate() {
         let vr = i + 1;
         let with_start = !is_calculated(v);
@@ -324,7 +332,7 @@ pub fn fmi3<M: Model>() -> String {
         match v.start {
             Start::Float64(x) => {
                 if !v.unit.is_empty() {
-                    let _ = write!(o, " unit=\"{}\"", escape(v.unit));
+                    let _ = write!(o, " declaredType=\"{}\"", escape(v.unit));
                 }
                 min_max(&mut o, v, false);
                 if with_start {

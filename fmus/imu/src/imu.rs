@@ -1,12 +1,12 @@
 //! The `Imu` model: chassis ground truth in, samples at the configured rate on simulation
-//! time out; the message port carries the latest sample of each communication step.
+//! time out; the message port carries every sample (the scalar outputs the latest one).
 
 use crate::frame::Quat;
 use crate::motion::{BaseState, HeldMotion, Mount};
 use crate::noise::NoiseParams;
 use crate::ports::*;
 use crate::sensor::{ImuSensor, Sample};
-use agrisim_fmi::{Log, Model, Store, Var};
+use agrisim_fmi::{Log, Model, OutPort, Store, Var};
 use agrisim_fmu_util::to_ns;
 use agrisim_msgs::builtin_interfaces::Time;
 use agrisim_msgs::geometry_msgs::{Quaternion, Vector3};
@@ -20,7 +20,8 @@ pub struct Imu {
     motion: HeldMotion,
     frame_id: String,
     orientation_enabled: bool,
-    seq: i64,
+    port: Option<OutPort>,
+    window_ns: i64,
     /// End of the last step [ns]: samples of the next step come after it.
     now_ns: i64,
 }
@@ -115,9 +116,12 @@ impl Imu {
             io.set_f64(GYRO[i], s.angular_velocity[i]);
             io.set_f64(ACCEL[i], s.linear_acceleration[i]);
         }
-        self.seq += 1;
-        io.set_binary(IMU, &self.message(s).to_cdr());
-        io.set_i64(IMU_SEQ, self.seq);
+        let cdr = self.message(s).to_cdr();
+        self.port.get_or_insert_with(|| OutPort::new(IMU, IMU_SEQ)).publish(s.stamp_ns, cdr);
+    }
+
+    fn sync(&mut self, io: &mut Store) {
+        self.port.get_or_insert_with(|| OutPort::new(IMU, IMU_SEQ)).sync(io, self.now_ns, self.window_ns);
     }
 }
 
@@ -136,26 +140,26 @@ impl Model for Imu {
         self.frame_id = io.string(FRAME_ID).to_string();
         self.orientation_enabled = io.bool(ENABLE_ORIENTATION);
         self.motion = HeldMotion::start(start_time, base_state(io));
-        self.seq = 0;
+        self.port = None;
+        self.window_ns = agrisim_fmi::port::window_ns(io, PORT_WINDOW)?;
         self.now_ns = start_ns;
         let truth = self.motion.truth_at(start_time, &self.sensor.mount, self.sensor.gravity);
         let s = self.sensor.sample(start_ns, &truth);
         self.publish(io, &s);
+        self.sync(io);
         Ok(())
     }
 
     fn do_step(&mut self, io: &mut Store, t: f64, h: f64, _log: &mut dyn Log) -> Result<(), String> {
         self.motion.update(t, base_state(io));
         let end_ns = to_ns(t + h);
-        let mut latest = None;
         for stamp in self.sensor.instants(self.now_ns, end_ns) {
             let truth = self.motion.truth_at(stamp as f64 * 1e-9, &self.sensor.mount, self.sensor.gravity);
-            latest = Some(self.sensor.sample(stamp, &truth));
-        }
-        self.now_ns = end_ns;
-        if let Some(s) = latest {
+            let s = self.sensor.sample(stamp, &truth);
             self.publish(io, &s);
         }
+        self.now_ns = end_ns;
+        self.sync(io);
         Ok(())
     }
 }

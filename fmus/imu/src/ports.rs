@@ -6,12 +6,13 @@ use crate::datasheet as ds;
 use agrisim_fmi::{Start, Var};
 
 /// MIME type of the message port (FMI 3 Binary carrying ROS 2 CDR).
-pub const IMU_MIME: &str = "application/x-ros2-cdr; type=sensor_msgs/msg/Imu";
+pub const IMU_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=sensor_msgs/msg/Imu";
 
 agrisim_fmi::variables! { pub VARIABLES {
     // --- sampling, frame, mount ---
     RATE = Var::param("rate", Start::Float64(200.0)).unit("Hz").range(0.001, 100_000.0)
-        .desc("Sample rate on simulation time; the port carries the latest sample of each step"),
+        .desc("Sample rate on simulation time; the port carries every sample"),
+    PORT_WINDOW = agrisim_fmi::port_window(),
     SEED = Var::param("seed", Start::Int32(0)).desc("Seed of every noise process"),
     FRAME_ID = Var::param("frame_id", Start::String("imu_link")).desc("header.frame_id of the messages"),
     MOUNT_X = Var::param("mount_x", Start::Float64(0.0)).unit("m")
@@ -61,10 +62,10 @@ agrisim_fmi::variables! { pub VARIABLES {
     ACCEL_X = Var::output("accel_x").unit("m/s2").init_depends_on(SAMPLE).desc("Latest specific force sample, IMU frame"),
     ACCEL_Y = Var::output("accel_y").unit("m/s2").init_depends_on(SAMPLE),
     ACCEL_Z = Var::output("accel_z").unit("m/s2").init_depends_on(SAMPLE),
-    IMU = Var::output_discrete("imu", Start::Binary(&[])).mime(IMU_MIME).max_size(4096).init_depends_on(MESSAGE)
-        .desc("Latest sample as sensor_msgs/Imu (CDR), stamped with its sample time"),
+    IMU = Var::output_discrete("imu", Start::Binary(&[])).mime(IMU_MIME).max_size(agrisim_fmi::port::frames_max_size(4096, 1024)).init_depends_on(MESSAGE)
+        .desc("Every sample of the last port_window as sensor_msgs/Imu (CDR frames), each stamped with its sample time"),
     IMU_SEQ = Var::output_discrete("imu_seq", Start::Int64(0)).init_depends_on(&[])
-        .desc("Sequence counter of imu (one per published sample)"),
+        .desc("Sequence number of the newest sample in imu (one per sample)"),
 }}
 
 /// What the sample at the start time depends on: the sampling and noise parameters, the

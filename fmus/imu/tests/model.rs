@@ -2,6 +2,7 @@
 //! successive inputs, orientation), its sample clock, determinism, and a run through the
 //! generic FMI 3 layer.
 
+use agrisim_fmi::port::{latest, messages};
 use agrisim_fmi::{fmi3, Model, Quiet, Status, Store};
 use agrisim_fmu_imu::ports::*;
 use agrisim_fmu_imu::Imu;
@@ -31,7 +32,7 @@ fn start(setup: impl FnOnce(&mut Store)) -> (Imu, Store) {
 }
 
 fn msg(io: &Store) -> sensor_msgs::Imu {
-    sensor_msgs::Imu::from_cdr(io.binary(IMU)).unwrap()
+    sensor_msgs::Imu::from_cdr(latest(io, IMU)).unwrap()
 }
 
 fn accel(io: &Store) -> [f64; 3] {
@@ -135,13 +136,17 @@ fn orientation_is_base_yaw_advanced_by_the_rate_then_the_mount() {
 
 #[test]
 fn samples_follow_the_rate_on_simulation_time() {
-    // 200 Hz on a 0.02 s step: every step publishes its last sample, stamped t + h.
+    // 200 Hz on a 0.02 s step: every step publishes its 4 samples, 5 ms apart, and the port
+    // holds those of the last 0.1 s (port_window).
     let (mut m, mut io) = start(|_| {});
     assert_eq!(io.i64(IMU_SEQ), 1, "a sample at the start");
     for k in 0..10 {
         m.do_step(&mut io, k as f64 * H, H, &mut Quiet).unwrap();
-        assert_eq!(io.i64(IMU_SEQ), k + 2);
+        assert_eq!(io.i64(IMU_SEQ), 4 * k + 5);
         assert_eq!(msg(&io).header.stamp.to_nanos(), (k + 1) * 20_000_000);
+        let stamps: Vec<i64> = messages(&io, IMU).iter().map(|b| sensor_msgs::Imu::from_cdr(b).unwrap().header.stamp.to_nanos()).collect();
+        let first = if k < 4 { 0 } else { (k - 4) * 20_000_000 + 5_000_000 };
+        assert_eq!(stamps, (first..=(k + 1) * 20_000_000).step_by(5_000_000).collect::<Vec<_>>(), "step {k}");
     }
     // 30 Hz: samples at multiples of 33.333 ms; steps without one publish nothing.
     let (mut m, mut io) = start(|io| io.set_f64(RATE, 30.0));
@@ -149,9 +154,9 @@ fn samples_follow_the_rate_on_simulation_time() {
     for k in 0..50 {
         let before = io.i64(IMU_SEQ);
         m.do_step(&mut io, k as f64 * H, H, &mut Quiet).unwrap();
-        if io.i64(IMU_SEQ) != before {
-            stamps.push(msg(&io).header.stamp.to_nanos());
-        }
+        let new = (io.i64(IMU_SEQ) - before) as usize;
+        let all = messages(&io, IMU);
+        stamps.extend(all[all.len() - new..].iter().map(|b| sensor_msgs::Imu::from_cdr(b).unwrap().header.stamp.to_nanos()));
     }
     let want: Vec<i64> = (1..=30).map(|k| k * 33_333_333).collect();
     assert_eq!(stamps, want);
@@ -217,10 +222,12 @@ fn through_the_fmi3_layer() {
         }
         let mut seq = 0i64;
         assert_eq!(fmi3::get_int64::<Imu>(p, &vr(IMU_SEQ), 1, &mut seq, 1), Status::Ok);
-        assert_eq!(seq, 6);
+        assert_eq!(seq, 11, "100 Hz: two samples per step");
         let (mut size, mut data) = (0usize, std::ptr::null::<u8>());
         assert_eq!(fmi3::get_binary::<Imu>(p, &vr(IMU), 1, &mut size, &mut data, 1), Status::Ok);
-        let m = sensor_msgs::Imu::from_cdr(std::slice::from_raw_parts(data, size)).unwrap();
+        let frames = agrisim_frames::decode(std::slice::from_raw_parts(data, size)).unwrap();
+        assert_eq!(frames.iter().map(|f| f.seq).collect::<Vec<_>>(), (2..=11).collect::<Vec<_>>(), "the samples of the last 0.1 s");
+        let m = sensor_msgs::Imu::from_cdr(frames.last().unwrap().payload).unwrap();
         assert_eq!(m.header.stamp.to_nanos(), 100_000_000);
         assert_eq!(m.orientation_covariance[0], -1.0);
         assert!((m.angular_velocity.z - 0.3).abs() < 0.05, "{}", m.angular_velocity.z);

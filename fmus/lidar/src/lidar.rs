@@ -17,8 +17,8 @@ use crate::ports::*;
 use crate::reflectivity;
 use crate::scene::{BaseBox, Scene};
 use crate::trajectory::Trajectory;
-use agrisim_fmi::{Log, Model, Store, Var};
-use agrisim_fmu_util::Schedule;
+use agrisim_fmi::{Log, Model, OutPort, Store, Var};
+use agrisim_fmu_util::{to_ns, Schedule};
 use agrisim_greenhouse::environment::Environment;
 use agrisim_greenhouse::weather::Conditions;
 use agrisim_math::{Pose2, Rng};
@@ -60,7 +60,8 @@ pub struct Lidar {
     trajectory: Trajectory,
     schedule: Schedule,
     rng: Rng,
-    seq: i64,
+    port: Option<OutPort>,
+    window_ns: i64,
 }
 
 fn param(io: &Store, i: usize, ok: impl Fn(f64) -> bool, what: &str) -> Result<f64, String> {
@@ -198,7 +199,9 @@ impl Model for Lidar {
         // No frame at the start instant: it would cover time before the run.
         self.schedule.due(start_time);
         self.rng = Rng::new(io.i32(NOISE_SEED) as u32 as u64);
-        self.seq = 0;
+        self.window_ns = agrisim_fmi::port::window_ns(io, PORT_WINDOW)?;
+        self.port = Some(OutPort::new(POINTS, POINTS_SEQ));
+        self.port.as_mut().expect("set above").sync(io, to_ns(start_time), self.window_ns);
         io.set_f64(VISIBILITY, config.visibility);
         self.config = Some(config);
         Ok(())
@@ -209,11 +212,13 @@ impl Model for Lidar {
         self.trajectory.push(t, pose(io)?, 2.0 * period + h);
         if let Some(end_ns) = self.schedule.due(t + h) {
             let frame = self.capture(end_ns);
-            self.seq += 1;
             io.set_i32(POINTS_IN_FRAME, frame.cloud.width as i32);
             io.set_i32(RETURNS_IN_FRAME, frame.returns as i32);
-            io.set_binary(POINTS, &frame.cloud.to_cdr());
-            io.set_i64(POINTS_SEQ, self.seq);
+            let port = self.port.as_mut().ok_or("not initialized")?;
+            port.publish(frame.cloud.header.stamp.to_nanos(), frame.cloud.to_cdr());
+        }
+        if let Some(port) = self.port.as_mut() {
+            port.sync(io, to_ns(t + h), self.window_ns);
         }
         Ok(())
     }

@@ -6,7 +6,7 @@ use crate::datasheet as ds;
 use agrisim_fmi::{Start, Var};
 
 /// MIME type of the message port (FMI 3 Binary carrying ROS 2 CDR).
-pub const POINTS_MIME: &str = "application/x-ros2-cdr; type=sensor_msgs/msg/PointCloud2";
+pub const POINTS_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=sensor_msgs/msg/PointCloud2";
 
 /// maxSize of `points`: the most points a frame holds, plus 4 KiB for the header, field
 /// descriptions and frame_id.
@@ -41,12 +41,13 @@ agrisim_sensor_ports::sensor_variables! { pub VARIABLES {
         .desc("false: each point is measured from the pose at its own time, header.stamp = first point (as the sensor); true: all points from the pose at the frame's end, header.stamp = frame end"),
     DROP_NO_RETURN = Var::param("drop_no_return", Start::Boolean(false))
         .desc("Leave rays without a return out of the cloud (default: kept at (0,0,0), as the Livox driver does)"),
+    PORT_WINDOW = agrisim_fmi::port_window(),
   },
   ports: {
     // --- outputs (no frame at initialization: it would cover time before the run) ---
-    POINTS = Var::output_discrete("points", Start::Binary(&[])).mime(POINTS_MIME).max_size(MAX_CLOUD).init_depends_on(&[])
-        .desc("The latest frame as sensor_msgs/PointCloud2 (CDR) in lidar_link: float32 x, y, z, intensity, t"),
-    POINTS_SEQ = Var::output_discrete("points_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence counter of points"),
+    POINTS = Var::output_discrete("points", Start::Binary(&[])).mime(POINTS_MIME).max_size(agrisim_fmi::port::frames_max_size(MAX_CLOUD, 4)).init_depends_on(&[])
+        .desc("The frames of the last port_window as sensor_msgs/PointCloud2 (CDR frames) in lidar_link: float32 x, y, z, intensity, t"),
+    POINTS_SEQ = Var::output_discrete("points_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence number of the newest frame in points"),
     POINTS_IN_FRAME = Var::output_discrete("points_in_frame", Start::Int32(0)).init_depends_on(&[])
         .desc("Points in the latest cloud"),
     VISIBILITY = Var::output_discrete("visibility", Start::Float64(0.0)).unit("m").init_depends_on(&[ENVIRONMENT])

@@ -35,7 +35,7 @@ fn run(m: &mut Lidar, io: &mut Store, from: usize, steps: usize) -> Vec<PointClo
         let seq = io.i64(POINTS_SEQ);
         m.do_step(io, k as f64 * H, H, &mut Quiet).unwrap();
         if io.i64(POINTS_SEQ) != seq {
-            out.push(PointCloud2::from_cdr(io.binary(POINTS)).unwrap());
+            out.push(PointCloud2::from_cdr(agrisim_fmi::port::latest(&io, POINTS)).unwrap());
         }
     }
     out
@@ -272,9 +272,12 @@ fn through_the_fmi3_layer() {
         assert_eq!((seq, n), (2, 10_000), "20 Hz: two frames of 10,000 points in 0.1 s");
         let (mut size, mut data) = (0usize, std::ptr::null::<u8>());
         assert_eq!(fmi3::get_binary::<Lidar>(p, &vr(POINTS), 1, &mut size, &mut data, 1), Status::Ok);
-        let cloud = PointCloud2::from_cdr(std::slice::from_raw_parts(data, size)).unwrap();
+        let frames = agrisim_frames::decode(std::slice::from_raw_parts(data, size)).unwrap();
+        assert_eq!(frames.iter().map(|f| f.seq).collect::<Vec<_>>(), [1, 2], "both frames of the last 0.1 s");
+        let cloud = PointCloud2::from_cdr(frames[1].payload).unwrap();
         assert_eq!(cloud.width, 10_000);
         assert_eq!(cloud.header.stamp.to_nanos(), 50_000_000);
+        assert_eq!(frames[1].stamp_ns, 50_000_000);
         // A malformed scene is refused at initialization and named in the log.
         assert_eq!(fmi3::reset::<Lidar>(p), Status::Ok);
         let bad = std::ffi::CString::new("rows = -1").unwrap();

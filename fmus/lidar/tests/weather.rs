@@ -21,7 +21,7 @@ fn frame(environment: &str) -> (i32, f64, Vec<u8>, f64) {
     for k in 0..10 {
         m.do_step(&mut io, k as f64 * 0.02, 0.02, &mut Quiet).unwrap();
     }
-    let c = PointCloud2::from_cdr(io.binary(POINTS)).unwrap();
+    let c = PointCloud2::from_cdr(agrisim_fmi::port::latest(&io, POINTS)).unwrap();
     let far = cloud::read(&c)
         .unwrap()
         .iter()

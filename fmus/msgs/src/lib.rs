@@ -18,7 +18,7 @@
 //! let bytes = cmd.to_cdr(); // 4-byte CDR_LE header + 6 x f64
 //! assert_eq!(bytes.len(), 52);
 //! assert_eq!(Twist::from_cdr(&bytes).unwrap(), cmd);
-//! assert_eq!(Twist::MIME_TYPE, "application/x-ros2-cdr; type=geometry_msgs/msg/Twist");
+//! assert_eq!(Twist::MIME_TYPE, "application/x-ros2-cdr-frames; version=1; type=geometry_msgs/msg/Twist");
 //! let schema = agrisim_msgs::ros2msg_schema(Twist::TYPE_NAME).unwrap();
 //! assert!(schema.contains("MSG: geometry_msgs/Vector3"));
 //! ```

@@ -2,9 +2,10 @@
 
 use crate::cdr::{CdrError, CdrReader, CdrWriter};
 
-/// Prefix of the FMI 3 Binary `mimeType` for ports carrying a CDR-encoded ROS 2 message
-/// (DESIGN.md §3); the full value is `application/x-ros2-cdr; type=<TYPE_NAME>`.
-pub const MIME_PREFIX: &str = "application/x-ros2-cdr; type=";
+/// Prefix of the FMI 3 Binary `mimeType` of agrisim message ports: a frame list of CDR
+/// ROS 2 messages (the `agrisim-frames` format, version 1; DESIGN.md §3); the full value is
+/// `application/x-ros2-cdr-frames; version=1; type=<TYPE_NAME>`.
+pub const MIME_PREFIX: &str = "application/x-ros2-cdr-frames; version=1; type=";
 
 /// A ROS 2 message type with its CDR encoding.
 ///
@@ -35,7 +36,7 @@ pub trait Message: Sized {
     }
 }
 
-/// `application/x-ros2-cdr; type=<M::TYPE_NAME>`. Every built-in type also has an
+/// `application/x-ros2-cdr-frames; version=1; type=<M::TYPE_NAME>`. Every built-in type also has an
 /// inherent `MIME_TYPE` const with the same value for use in const contexts.
 pub fn mime_type<M: Message>() -> String {
     mime_type_for(M::TYPE_NAME)
@@ -46,18 +47,17 @@ pub fn mime_type_for(type_name: &str) -> String {
     format!("{MIME_PREFIX}{type_name}")
 }
 
-/// Inverse of [`mime_type_for`]: the ROS type name in a ROS 2 CDR mimeType, tolerating
-/// extra spaces around `;` and `=`. `None` for any other mimeType.
+/// The ROS type name of a message port's mimeType: a frame list
+/// (`application/x-ros2-cdr-frames; version=1; type=...`, see [`mime_type_for`]) or a single
+/// CDR message (`application/x-ros2-cdr; type=...`), parameters in any order, tolerating
+/// spaces around `;` and `=`. `None` for any other mimeType.
 pub fn type_name_from_mime(mime: &str) -> Option<&str> {
-    let (media, param) = mime.split_once(';')?;
-    if media.trim() != "application/x-ros2-cdr" {
+    let mut parts = mime.split(';');
+    let media = parts.next()?.trim();
+    if media != "application/x-ros2-cdr" && media != "application/x-ros2-cdr-frames" {
         return None;
     }
-    let (key, value) = param.split_once('=')?;
-    if key.trim() != "type" {
-        return None;
-    }
-    let value = value.trim();
+    let value = parts.find_map(|p| p.split_once('=').filter(|(k, _)| k.trim() == "type").map(|(_, v)| v.trim()))?;
     (!value.is_empty()).then_some(value)
 }
 
@@ -80,7 +80,7 @@ macro_rules! ros_message {
         impl $name {
             /// FMI Binary mimeType for ports carrying this type.
             pub const MIME_TYPE: &'static str =
-                concat!("application/x-ros2-cdr; type=", $type_name);
+                concat!("application/x-ros2-cdr-frames; version=1; type=", $type_name);
         }
 
         impl $crate::message::Message for $name {

@@ -346,7 +346,7 @@ fn time_constructors_are_exact() {
 fn mime_types() {
     assert_eq!(
         mime_type::<Twist>(),
-        "application/x-ros2-cdr; type=geometry_msgs/msg/Twist"
+        "application/x-ros2-cdr-frames; version=1; type=geometry_msgs/msg/Twist"
     );
     assert_eq!(Twist::MIME_TYPE, mime_type::<Twist>());
     assert_eq!(
@@ -357,6 +357,11 @@ fn mime_types() {
         type_name_from_mime("application/x-ros2-cdr ;type = a/msg/B"),
         Some("a/msg/B")
     );
+    assert_eq!(
+        type_name_from_mime("application/x-ros2-cdr-frames; type=a/msg/B; version=1"),
+        Some("a/msg/B")
+    );
+    assert_eq!(type_name_from_mime("application/x-ros2-cdr-frames; version=1"), None);
     assert_eq!(type_name_from_mime("application/octet-stream"), None);
     assert_eq!(type_name_from_mime("application/x-ros2-cdr; type="), None);
 }

@@ -9,10 +9,10 @@ use agrisim_fmi::{Start, Var};
 use agrisim_sensor_ports as sensor_ports;
 
 /// MIME types of the message ports (FMI 3 Binary variables carrying ROS 2 CDR).
-pub const COLLISION_STATE_MIME: &str = "application/x-ros2-cdr; type=agrisim_msgs/msg/CollisionState";
-pub const POSE_ARRAY_MIME: &str = "application/x-ros2-cdr; type=geometry_msgs/msg/PoseArray";
-pub const POSE_STAMPED_MIME: &str = "application/x-ros2-cdr; type=geometry_msgs/msg/PoseStamped";
-pub const PLANNING_SCENE_MIME: &str = "application/x-ros2-cdr; type=agrisim_msgs/msg/PlanningScene";
+pub const COLLISION_STATE_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=agrisim_msgs/msg/CollisionState";
+pub const POSE_ARRAY_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=geometry_msgs/msg/PoseArray";
+pub const POSE_STAMPED_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=geometry_msgs/msg/PoseStamped";
+pub const PLANNING_SCENE_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=agrisim_msgs/msg/PlanningScene";
 
 agrisim_fmi::variables! { pub VARIABLES {
     // --- scene (fixed parameters) ---
@@ -52,12 +52,12 @@ agrisim_fmi::variables! { pub VARIABLES {
     COLLISION_STATE = Var::output_discrete("collision_state", Start::Binary(&[])).mime(COLLISION_STATE_MIME).init_depends_on(&COLLISION_REPORT)
         .desc("agrisim_msgs/CollisionState in the map frame, at collision_rate and whenever the contact set changes"),
     COLLISION_STATE_SEQ = Var::output_discrete("collision_state_seq", Start::Int64(0)).init_depends_on(&[])
-        .desc("Sequence counter of collision_state"),
+        .desc("Sequence number of the newest message in collision_state"),
     // --- outputs: ground truth ---
     FRUIT_COUNT = Var::output_discrete("fruit_count", Start::Int32(0)).init_depends_on(&[SCENE, SEED]).desc("Number of fruit in the scene"),
     FRUIT_POSES = Var::output_discrete("fruit_poses", Start::Binary(&[])).mime(POSE_ARRAY_MIME).init_depends_on(&[SCENE, SEED, FRUIT_RATE, Var::TIME])
         .desc("geometry_msgs/PoseArray of every fruit centre (frame map), at fruit_rate"),
-    FRUIT_POSES_SEQ = Var::output_discrete("fruit_poses_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence counter of fruit_poses"),
+    FRUIT_POSES_SEQ = Var::output_discrete("fruit_poses_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence number of the newest message in fruit_poses"),
     TARGET_VALID = Var::output_discrete("target_valid", Start::Boolean(false)).init_depends_on(TARGET_CHOICE)
         .desc("target_fruit names an existing fruit"),
     TARGET_ID = Var::output_discrete("target_id", Start::Int32(-1)).init_depends_on(TARGET_CHOICE)
@@ -65,9 +65,9 @@ agrisim_fmi::variables! { pub VARIABLES {
     TARGET_X = Var::output("target_x").unit("m").init_depends_on(TARGET_CHOICE).desc("Target fruit centre in the map frame (0 when none)"),
     TARGET_Y = Var::output("target_y").unit("m").init_depends_on(TARGET_CHOICE),
     TARGET_Z = Var::output("target_z").unit("m").init_depends_on(TARGET_CHOICE),
-    TARGET = Var::output_discrete("target", Start::Binary(&[])).mime(POSE_STAMPED_MIME).max_size(1024).init_depends_on(&[SCENE, SEED, TARGET_FRUIT, Var::TIME])
+    TARGET = Var::output_discrete("target", Start::Binary(&[])).mime(POSE_STAMPED_MIME).max_size(agrisim_fmi::port::frames_max_size(1024, 1024)).init_depends_on(&[SCENE, SEED, TARGET_FRUIT, Var::TIME])
         .desc("geometry_msgs/PoseStamped of the target fruit (frame map), at fruit_rate and when target_fruit changes"),
-    TARGET_SEQ = Var::output_discrete("target_seq", Start::Int64(0)).init_depends_on(TARGET_CHOICE).desc("Sequence counter of target"),
+    TARGET_SEQ = Var::output_discrete("target_seq", Start::Int64(0)).init_depends_on(TARGET_CHOICE).desc("Sequence number of the newest message in target"),
     // --- harvest physics (appended: earlier value references stay as they were) ---
     LEFT_Q1 = Var::input("left_q1", READY_POSE[0]).unit("rad").desc("left_joint1 angle (default: Franka ready pose; clamped to the URDF limits)"),
     LEFT_Q2 = Var::input("left_q2", READY_POSE[1]).unit("rad").desc("left_joint2 angle"),
@@ -121,7 +121,8 @@ agrisim_fmi::variables! { pub VARIABLES {
         .desc("Publication rate of planning_scene"),
     PLANNING_SCENE = Var::output_discrete("planning_scene", Start::Binary(&[])).mime(PLANNING_SCENE_MIME).init_depends_on(&[SCENE, SEED, BASE_X, BASE_Y, PLANNING_SCENE_RADIUS, PLANNING_SCENE_RATE, Var::TIME])
         .desc("agrisim_msgs/PlanningScene: scene objects near the robot as primitives (frame map; ids = scene object ids), at planning_scene_rate"),
-    PLANNING_SCENE_SEQ = Var::output_discrete("planning_scene_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence counter of planning_scene"),
+    PLANNING_SCENE_SEQ = Var::output_discrete("planning_scene_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence number of the newest message in planning_scene"),
+    PORT_WINDOW = agrisim_fmi::port_window(),
 }}
 
 /// The robot's configuration inputs: base pose, lift, arm joints, finger gaps.

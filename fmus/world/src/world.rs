@@ -14,7 +14,7 @@ use crate::ports::*;
 use crate::robot_links::{base_pose, to_rapier};
 use crate::robot_model::{Coords, RobotModel, Side};
 use crate::scene_world::SceneWorld;
-use agrisim_fmi::{Log, Model, Store, Var};
+use agrisim_fmi::{Log, Model, OutPort, Store, Var};
 use agrisim_fmu_util::{to_ns, Schedule};
 use agrisim_greenhouse::config::GreenhouseConfig;
 use agrisim_msgs::Message;
@@ -64,12 +64,36 @@ struct Running {
     fruit_schedule: Schedule,
     scene_schedule: Schedule,
     scene_radius: f64,
-    scene_seq: i64,
-    collision_seq: i64,
-    fruit_seq: i64,
-    target_seq: i64,
+    ports: Ports,
+    window_ns: i64,
     /// `target_fruit` at the last target publication (a change publishes at once).
     published_target: Option<i32>,
+}
+
+/// The world's message ports.
+#[derive(Clone)]
+struct Ports {
+    scene: OutPort,
+    collision: OutPort,
+    fruit: OutPort,
+    target: OutPort,
+}
+
+impl Ports {
+    fn new() -> Ports {
+        Ports {
+            scene: OutPort::new(PLANNING_SCENE, PLANNING_SCENE_SEQ),
+            collision: OutPort::new(COLLISION_STATE, COLLISION_STATE_SEQ),
+            fruit: OutPort::new(FRUIT_POSES, FRUIT_POSES_SEQ),
+            target: OutPort::new(TARGET, TARGET_SEQ),
+        }
+    }
+
+    fn sync(&mut self, io: &mut Store, now_ns: i64, window_ns: i64) {
+        for p in [&mut self.scene, &mut self.collision, &mut self.fruit, &mut self.target] {
+            p.sync(io, now_ns, window_ns);
+        }
+    }
 }
 
 /// The Greenhouse world model (the FMU's `Model`).
@@ -150,10 +174,9 @@ impl Running {
         self.report_ground_truth(io, t);
         if let Some(stamp) = self.scene_schedule.due(t) {
             let [x, y, _] = self.robot.planar;
-            self.scene_seq += 1;
-            io.set_binary(PLANNING_SCENE, &planning_scene(&self.world, &self.harvest, [x, y], self.scene_radius, stamp).to_cdr());
-            io.set_i64(PLANNING_SCENE_SEQ, self.scene_seq);
+            self.ports.scene.publish(stamp, planning_scene(&self.world, &self.harvest, [x, y], self.scene_radius, stamp).to_cdr());
         }
+        self.ports.sync(io, to_ns(t), self.window_ns);
     }
 
     fn report_harvest(&mut self, io: &mut Store) {
@@ -229,18 +252,14 @@ impl Running {
         let due = self.collision_schedule.due(t);
         if changed || due.is_some() {
             let stamp = if changed { to_ns(t) } else { due.unwrap_or(to_ns(t)) };
-            self.collision_seq += 1;
-            io.set_binary(COLLISION_STATE, &collision_state(&self.world, &contacts, stamp).to_cdr());
-            io.set_i64(COLLISION_STATE_SEQ, self.collision_seq);
+            self.ports.collision.publish(stamp, collision_state(&self.world, &contacts, stamp).to_cdr());
         }
     }
 
     fn report_ground_truth(&mut self, io: &mut Store, t: f64) {
         let fruit_due = self.fruit_schedule.due(t);
         if let Some(stamp) = fruit_due {
-            self.fruit_seq += 1;
-            io.set_binary(FRUIT_POSES, &fruit_poses(&self.world, stamp).to_cdr());
-            io.set_i64(FRUIT_POSES_SEQ, self.fruit_seq);
+            self.ports.fruit.publish(stamp, fruit_poses(&self.world, stamp).to_cdr());
         }
         let index = io.i32(TARGET_FRUIT);
         let target = Target::select(&self.world, index);
@@ -253,9 +272,7 @@ impl Running {
         let reselected = self.published_target != Some(index);
         if let Some(target) = target.filter(|_| fruit_due.is_some() || reselected) {
             let stamp = if reselected { to_ns(t) } else { fruit_due.unwrap_or(to_ns(t)) };
-            self.target_seq += 1;
-            io.set_binary(TARGET, &target.message(stamp).to_cdr());
-            io.set_i64(TARGET_SEQ, self.target_seq);
+            self.ports.target.publish(stamp, target.message(stamp).to_cdr());
         }
         self.published_target = Some(index);
     }
@@ -334,10 +351,8 @@ impl Model for GreenhouseWorld {
             fruit_schedule,
             scene_schedule,
             scene_radius,
-            scene_seq: 0,
-            collision_seq: 0,
-            fruit_seq: 0,
-            target_seq: 0,
+            ports: Ports::new(),
+            window_ns: agrisim_fmi::port::window_ns(io, PORT_WINDOW)?,
             published_target: None,
         });
         run.report(io, start_time);

@@ -172,7 +172,7 @@ impl Sim {
     }
 
     fn collision_state(&self) -> CollisionState {
-        CollisionState::from_cdr(self.io.binary(COLLISION_STATE)).unwrap()
+        CollisionState::from_cdr(agrisim_fmi::port::latest(&self.io, COLLISION_STATE)).unwrap()
     }
 }
 
@@ -567,7 +567,7 @@ fn planning_scene_lists_the_objects_near_the_robot() {
     use agrisim_msgs::shape_msgs::SolidPrimitive;
     let (f, planar, c0) = grasp_setup(Side::Left);
     let mut sim = Sim::start(planar, &c0);
-    let scene = PlanningScene::from_cdr(sim.io.binary(PLANNING_SCENE)).unwrap();
+    let scene = PlanningScene::from_cdr(agrisim_fmi::port::latest(&sim.io, PLANNING_SCENE)).unwrap();
     assert_eq!((sim.io.i64(PLANNING_SCENE_SEQ), scene.header.frame_id.as_str()), (1, "map"));
     // Independent selection from the generator's own objects and bounding boxes.
     let cfg = agrisim_greenhouse::config::GreenhouseConfig::from_toml_str(SCENE).unwrap();
@@ -627,7 +627,7 @@ fn planning_scene_lists_the_objects_near_the_robot() {
         sim.step();
     }
     assert!((sim.t - 1.0).abs() < 1e-9, "published at t = 1 s, not {}", sim.t);
-    let scene = PlanningScene::from_cdr(sim.io.binary(PLANNING_SCENE)).unwrap();
+    let scene = PlanningScene::from_cdr(agrisim_fmi::port::latest(&sim.io, PLANNING_SCENE)).unwrap();
     let held = scene.objects.iter().find(|o| o.id == id.to_string()).expect("held fruit listed");
     assert_eq!(held.kind, "fruit_held");
 }

@@ -34,7 +34,7 @@ fn layout(scene: &str) -> Layout {
 }
 
 fn collision_state(io: &Store) -> CollisionState {
-    CollisionState::from_cdr(io.binary(COLLISION_STATE)).unwrap()
+    CollisionState::from_cdr(agrisim_fmi::port::latest(&io, COLLISION_STATE)).unwrap()
 }
 
 /// Steps the base from `from` toward `to` in `n` equal moves (one per step) until it collides;
@@ -200,10 +200,10 @@ fn ground_truth_fruit_and_target() {
     let (mut m, mut io) = start("", l.start_pose, |io| io.set_i32(TARGET_FRUIT, 17));
     let n = io.i32(FRUIT_COUNT) as usize;
     assert_eq!(n, 6 * 60 * 4 * 5, "6 rows x 60 plants x 4 trusses x 5 fruit");
-    let poses = PoseArray::from_cdr(io.binary(FRUIT_POSES)).unwrap();
+    let poses = PoseArray::from_cdr(agrisim_fmi::port::latest(&io, FRUIT_POSES)).unwrap();
     assert_eq!((poses.poses.len(), poses.header.frame_id.as_str()), (n, "map"));
     assert_eq!(io.i64(FRUIT_POSES_SEQ), 1);
-    let target = PoseStamped::from_cdr(io.binary(TARGET)).unwrap();
+    let target = PoseStamped::from_cdr(agrisim_fmi::port::latest(&io, TARGET)).unwrap();
     let p17 = poses.poses[17].position;
     assert_eq!(target.pose.position, p17);
     assert!(io.bool(TARGET_VALID) && io.i32(TARGET_ID) >= 0);
@@ -214,12 +214,12 @@ fn ground_truth_fruit_and_target() {
         m.do_step(&mut io, k as f64 * H, H, &mut Quiet).unwrap();
     }
     assert_eq!((io.i64(FRUIT_POSES_SEQ), io.i64(TARGET_SEQ)), (2, 2));
-    assert_eq!(PoseArray::from_cdr(io.binary(FRUIT_POSES)).unwrap().header.stamp.to_nanos(), 1_000_000_000);
+    assert_eq!(PoseArray::from_cdr(agrisim_fmi::port::latest(&io, FRUIT_POSES)).unwrap().header.stamp.to_nanos(), 1_000_000_000);
     // Selecting another fruit publishes it at once; -1 clears the scalars.
     io.set_i32(TARGET_FRUIT, 3);
     m.do_step(&mut io, 1.0, H, &mut Quiet).unwrap();
     assert_eq!(io.i64(TARGET_SEQ), 3);
-    assert_eq!(PoseStamped::from_cdr(io.binary(TARGET)).unwrap().pose.position, poses.poses[3].position);
+    assert_eq!(PoseStamped::from_cdr(agrisim_fmi::port::latest(&io, TARGET)).unwrap().pose.position, poses.poses[3].position);
     io.set_i32(TARGET_FRUIT, -1);
     m.do_step(&mut io, 1.02, H, &mut Quiet).unwrap();
     assert!(!io.bool(TARGET_VALID));

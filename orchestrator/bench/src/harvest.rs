@@ -12,7 +12,7 @@ use super::harvest_targets::{draw, eligible, HarvestTarget};
 use super::map::{building_plan, grid_message};
 use super::nav::trial_seed;
 use super::stats::{percentile, wilson, Z95};
-use agrisim_bus::Node;
+use agrisim_bus::{Node, Reader};
 use agrisim_error::{err, Context, Result};
 use agrisim_greenhouse::occupancy::OccupancyMap;
 use agrisim_harvest::{topics, HarvestNode};
@@ -119,8 +119,9 @@ pub fn builtin_node(fruit_index: usize, seed: u64) -> Box<dyn Node> {
 }
 
 /// The judge's view of the harvest node: only what it published.
-#[derive(Default)]
 struct Reports {
+    plans_reader: Reader,
+    status_reader: Reader,
     plans: Vec<PlanResult>,
     /// Wall time of each plan [s]: the node's step that asked for it, shared among the plans
     /// of that step.
@@ -130,15 +131,25 @@ struct Reports {
 }
 
 impl Reports {
+    fn subscribe(bus: &mut agrisim_bus::Bus) -> Reports {
+        Reports {
+            plans_reader: Reader::subscribe(bus, topics::PLANS),
+            status_reader: Reader::subscribe(bus, topics::STATUS),
+            plans: vec![],
+            planning_times: vec![],
+            outcome: None,
+        }
+    }
+
     /// Takes everything the node published since the last look.
     fn read(&mut self, m: &mut agrisim_session::Session, node: &str) -> Result<()> {
-        let plans: Vec<PlanResult> = m.bus.take_queued(topics::PLANS)?;
+        let plans: Vec<PlanResult> = self.plans_reader.take(&mut m.bus)?;
         if !plans.is_empty() {
             let wall = m.node_wall(node).unwrap_or(0.0) / plans.len() as f64;
             self.planning_times.extend(std::iter::repeat_n(wall, plans.len()));
             self.plans.extend(plans);
         }
-        for st in m.bus.take_queued::<HarvestStatus>(topics::STATUS)? {
+        for st in self.status_reader.take::<HarvestStatus>(&mut m.bus)? {
             if self.outcome.is_none() && (st.outcome == "success" || st.outcome == "failure") {
                 self.outcome = Some(st);
             }
@@ -179,20 +190,19 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
     ];
     let opts = RunOptions { seed: Some(seed), ..o.clone() };
     let mut m = prepare(&s, &opts, mcap, nodes)?;
-    m.bus.subscribe(topics::PLANS);
-    m.bus.subscribe(topics::STATUS);
     let (world, arm_l, arm_r) = (m.component("world", "harvest benchmark")?, m.component("arm_left", "harvest benchmark")?, m.component("arm_right", "harvest benchmark")?);
     let max_ticks = (timeout / s.timing.step).round() as u64;
-    let mut reports = Reports::default();
+    let mut reports = Reports::subscribe(&mut m.bus);
+    let mut collisions = Reader::subscribe(&mut m.bus, "/collision");
     let mut judged: Option<(Option<String>, String)> = None;
     let mut time_to_harvest = None;
-    let mut collision_seen = 0;
     let result: Result<()> = (|| {
         for k in 1..=max_ticks {
             m.advance()?;
             reports.read(&mut m, &node_name)?;
             // The base must touch nothing; the arms may brush plants (counted, not failures).
-            if let Some(cs) = m.bus.take_new::<CollisionState>("/collision", &mut collision_seen)? {
+            // Every collision state counts, however short the contact.
+            for cs in collisions.take::<CollisionState>(&mut m.bus)? {
                 if let Some(c) = cs.contacts.iter().find(|c| c.robot_link == "base_link") {
                     judged = Some((Some("collision".into()), format!("the base touched {} ({})", c.object_name, c.object_kind)));
                     return Ok(());

@@ -7,7 +7,7 @@
 
 use crate::error::Result;
 use agrisim_msgs::Message;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, VecDeque};
 
 /// The latest message on a topic.
 #[derive(Clone, Debug, PartialEq)]
@@ -34,8 +34,87 @@ pub struct Bus {
     latest: BTreeMap<String, Sample>,
     scalars: BTreeMap<String, f64>,
     outbox: Vec<Published>,
-    /// Subscribed topics: every message published on them since the subscriber last looked.
-    queues: BTreeMap<String, Vec<Sample>>,
+    /// Topics with [`Reader`]s: the messages some reader has not taken yet.
+    queues: BTreeMap<String, Queue>,
+}
+
+/// Messages of one topic kept for its readers, and where each reader is.
+#[derive(Default, Debug)]
+struct Queue {
+    samples: VecDeque<Sample>,
+    /// Per reader (index = reader id): the last sequence number it took.
+    cursors: Vec<u64>,
+}
+
+/// A reader that sees every message on a topic, in order (a localizer integrating every IMU
+/// sample, a judge counting every contact), unlike [`Bus::take_new`] which sees the newest.
+/// It joins the topic at its first [`Reader::take`]: from then on, the newest message
+/// then present and everything after.
+#[derive(Clone, Debug)]
+pub struct Reader {
+    topic: String,
+    id: Option<usize>,
+}
+
+impl Reader {
+    pub fn new(topic: &str) -> Reader {
+        Reader { topic: topic.to_string(), id: None }
+    }
+
+    /// A reader that joins `topic` now: it will take every message published from now on
+    /// (a judge that must see all of them).
+    pub fn subscribe(bus: &mut Bus, topic: &str) -> Reader {
+        let mut r = Reader::new(topic);
+        r.join(bus, false);
+        r
+    }
+
+    pub fn topic(&self) -> &str {
+        &self.topic
+    }
+
+    fn join(&mut self, bus: &mut Bus, with_latest: bool) -> usize {
+        if let Some(id) = self.id {
+            return id;
+        }
+        let latest = bus.latest.get(&self.topic);
+        let q = bus.queues.entry(self.topic.clone()).or_default();
+        let seq = latest.map_or(0, |s| s.seq);
+        q.cursors.push(if with_latest { seq.saturating_sub(1) } else { seq });
+        if let Some(s) = latest.filter(|_| with_latest) {
+            if q.samples.back().is_none_or(|b| b.seq < s.seq) {
+                q.samples.push_back(s.clone());
+            }
+        }
+        self.id = Some(q.cursors.len() - 1);
+        q.cursors.len() - 1
+    }
+
+    /// Every message since the last call, oldest first, as published.
+    pub fn take_samples(&mut self, bus: &mut Bus) -> Vec<Sample> {
+        let id = self.join(bus, true);
+        let q = bus.queues.get_mut(&self.topic).expect("joined");
+        let from = q.cursors[id];
+        let out: Vec<Sample> = q.samples.iter().filter(|s| s.seq > from).cloned().collect();
+        if let Some(s) = out.last() {
+            q.cursors[id] = s.seq;
+        }
+        let done = q.cursors.iter().copied().min().unwrap_or(u64::MAX);
+        while q.samples.front().is_some_and(|s| s.seq <= done) {
+            q.samples.pop_front();
+        }
+        out
+    }
+
+    /// Every message since the last call, oldest first, decoded.
+    pub fn take<M: Message>(&mut self, bus: &mut Bus) -> Result<Vec<M>> {
+        let samples = self.take_samples(bus);
+        let topic = &self.topic;
+        samples
+            .into_iter()
+            .map(|s| M::from_cdr(&s.cdr).map_err(|e| crate::err!("topic {topic}: message {} is not a valid {}: {e}", s.seq, M::TYPE_NAME)))
+            .collect()
+    }
 }
 
 impl Bus {
@@ -44,7 +123,7 @@ impl Bus {
         let seq = self.latest.get(topic).map_or(1, |s| s.seq + 1);
         let sample = Sample { type_name: type_name.to_string(), seq, time_ns, cdr: cdr.clone() };
         if let Some(q) = self.queues.get_mut(topic) {
-            q.push(sample.clone());
+            q.samples.push_back(sample.clone());
         }
         self.latest.insert(topic.to_string(), sample);
         self.outbox.push(Published { topic: topic.to_string(), type_name: type_name.to_string(), time_ns, cdr });
@@ -52,18 +131,6 @@ impl Bus {
 
     pub fn publish<M: Message>(&mut self, topic: &str, time_ns: i64, msg: &M) {
         self.publish_raw(topic, M::TYPE_NAME, time_ns, msg.to_cdr());
-    }
-
-    /// From now on, every message on `topic` is kept until [`Bus::take_queued`] (a reader
-    /// that must see all of them, e.g. a judge, unlike [`Bus::take_new`] which sees the latest).
-    pub fn subscribe(&mut self, topic: &str) {
-        self.queues.entry(topic.to_string()).or_default();
-    }
-
-    /// Every message on subscribed `topic` since the last call, in publication order, decoded.
-    pub fn take_queued<M: Message>(&mut self, topic: &str) -> Result<Vec<M>> {
-        let Some(q) = self.queues.get_mut(topic) else { return Err(crate::err!("topic {topic}: not subscribed")) };
-        std::mem::take(q).into_iter().map(|s| M::from_cdr(&s.cdr).map_err(|e| crate::err!("topic {topic}: message {} is not a valid {}: {e}", s.seq, M::TYPE_NAME))).collect()
     }
 
     pub fn latest(&self, topic: &str) -> Option<&Sample> {

@@ -12,7 +12,7 @@ pub mod node;
 pub mod recorder;
 
 pub use agrisim_error::{err, Context, Error, Result};
-pub use bus::{Bus, Published, Sample};
+pub use bus::{Bus, Published, Reader, Sample};
 pub use node::Node;
 pub use recorder::{Channel, Recorder};
 

@@ -40,9 +40,13 @@ enum Command {
         dirs: Dirs,
         #[command(flatten)]
         log: FmuLog,
-        /// Output directory.
+        /// Print how the master orders the system (step order, delayed connections,
+        /// initialization, exchange periods) and exit without running.
         #[arg(long)]
-        out: PathBuf,
+        explain: bool,
+        /// Output directory.
+        #[arg(long, required_unless_present = "explain")]
+        out: Option<PathBuf>,
     },
     /// Benchmarks.
     Bench {
@@ -226,9 +230,14 @@ fn real_main() -> Result<()> {
     let cli = Cli::parse();
     let (exe_dir, target) = build_dirs();
     match cli.command {
-        Command::Run { scenario, duration, seed, fmus, dirs, log, out } => {
+        Command::Run { scenario, duration, seed, fmus, dirs, log, explain, out } => {
             let s = Scenario::load(&scenario)?;
             let opts = run_options(dirs, &target, seed, duration, fmus.into_iter().collect(), log.categories());
+            if explain {
+                print!("{}", agrisim_session::run::explain(&s, &opts)?);
+                return Ok(());
+            }
+            let out = out.expect("clap requires --out without --explain");
             let summary = agrisim_session::run::run(&s, &opts, &out, progress_printer())?;
             println!("{} steps ({} s simulated) -> {}", summary.steps, summary.simulated, summary.mcap.display());
         }

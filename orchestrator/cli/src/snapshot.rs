@@ -41,10 +41,14 @@ fn open(s: &Scenario, o: &RunOptions, file: &str, name: &str, pose: [f64; 3]) ->
     Ok((a, inst))
 }
 
+/// The newest message in message port `name` (a frame list).
 fn get_bin(a: &FmuArchive, inst: &mut Instance, name: &str) -> Result<Vec<u8>> {
     let v = a.md.variable(name).cloned().ok_or_else(|| agrisim_error::err!("FMU '{}' has no variable '{name}'", inst.name()))?;
     match value::get(inst, &v)? {
-        Value::Bin(b) => Ok(b),
+        Value::Bin(b) => {
+            let frames = agrisim_frames::decode(&b).map_err(|e| agrisim_error::err!("FMU '{}': {name}: {e}", inst.name()))?;
+            frames.last().map(|f| f.payload.to_vec()).ok_or_else(|| agrisim_error::err!("FMU '{}': no message in {name}", inst.name()))
+        }
         other => Err(agrisim_error::err!("FMU '{}': {name} is {other:?}, expected Binary", inst.name())),
     }
 }

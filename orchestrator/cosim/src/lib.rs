@@ -25,6 +25,7 @@ pub mod archive;
 pub mod fmi3;
 pub mod master;
 pub mod model_description;
+pub mod order;
 pub mod seed;
 pub mod ssp;
 pub mod system;
@@ -32,6 +33,7 @@ pub mod value;
 
 pub use agrisim_error::{err, Context, Error, Result};
 pub use master::{Hooks, Master, NoHooks};
+pub use order::Order;
 pub use system::{LoadOptions, Port, Route, System};
 
 /// `crate::error::...` paths inside this crate.

@@ -1,28 +1,37 @@
-//! The master algorithm: fixed step on integer ticks, Jacobi exchange in a fixed order, each
-//! route at its own integer decimation of the step (physics every step, messages at their
+//! The master algorithm: fixed step on integer ticks, Gauss-Seidel in the order of
+//! [`crate::order`] (a one-step delay only on the connections that close a loop), each route
+//! at its own integer decimation of the step (physics every step, messages at their
 //! connection's period), and a message instant for the algorithm layer.
 //!
 //! One communication point k (time t_k = k * step):
-//!   1. FMU outputs due at k that go to system connectors reach the [`Hooks`] (messages only
-//!      when their counter moved);
+//!   1. FMU outputs due at k that go to system connectors reach the [`Hooks`]: every message
+//!      the port produced since the route last read it, each at its own stamp;
 //!   2. [`Hooks::exchange`] runs (the algorithm layer's nodes, at message instants);
-//!   3. routes into FMU inputs due at k are written (system connectors read from the hooks);
+//!   3. routes from system connectors into FMU inputs due at k are written;
 //!   4. [`Hooks::point`] closes the point (recording);
-//!   5. every FMU steps from t_k to t_k+1, in system-file order.
+//!   5. the components step from t_k to t_k+1 in order; before each steps, its FMU-to-FMU
+//!      inputs are read from their sources: at t_k+1 from a source that has already stepped,
+//!      at t_k from one that has not (a delayed connection).
+//!
+//! Message ports lose nothing: a framed port ([`agrisim_frames`]) holds every message of its
+//! FMU's `port_window`, and a route takes each one once, in order; a jump in the sequence
+//! numbers (the route reads less often than the window) is an error naming the FMU and port.
 //!
 //! Nothing here reads a clock or iterates a hash map, so a run is a pure function of its
 //! inputs and of what the hooks answer.
 
 use crate::error::Result;
+use crate::order::{self, Order};
 use crate::system::{Port, System};
 use crate::value::{self, Value};
+use agrisim_frames::Frame;
 
 /// What the engine exchanges with the program around it at each communication point: the
 /// system's own connectors (no component), and every message it moves.
 pub trait Hooks {
-    /// A message left an FMU on route `route` (an index into `system.routes`) at `t_ns`
-    /// (bound for a system connector, or for another FMU: then it is shown here too, on the
-    /// route's topic). An error stops the run.
+    /// A message left an FMU on route `route` (an index into `system.routes`), stamped
+    /// `t_ns` (bound for a system connector, or for another FMU: then it is shown here too,
+    /// on the route's topic). An error stops the run.
     fn message(&mut self, _system: &System, _route: usize, _t_ns: i64, _bytes: &[u8]) -> Result<()> {
         Ok(())
     }
@@ -32,10 +41,10 @@ pub trait Hooks {
     fn exchange(&mut self, _t_ns: i64, _message_instant: bool) -> Result<()> {
         Ok(())
     }
-    /// The newest message on system connector `connector` if its sequence number is above
-    /// `*seen` (then `*seen` is updated).
-    fn message_input(&mut self, _connector: &str, _seen: &mut i64) -> Option<Vec<u8>> {
-        None
+    /// Every message on system connector `connector` that route `route` has not delivered
+    /// yet, oldest first, as (stamp [ns], CDR bytes), appended to `out`.
+    fn message_input(&mut self, _route: usize, _connector: &str, _out: &mut Vec<(i64, Vec<u8>)>) -> Result<()> {
+        Ok(())
     }
     /// The current value of scalar system connector `connector`, if it has one.
     fn scalar_input(&self, _connector: &str) -> Option<f64> {
@@ -52,12 +61,23 @@ pub struct NoHooks;
 
 impl Hooks for NoHooks {}
 
+/// Most fixed-point passes initialization makes through a loop before giving up.
+const INIT_PASSES: usize = 50;
+
 pub struct Master {
     pub system: System,
+    order: Order,
+    /// FMU-to-FMU routes into each component, in route order.
+    inputs_of: Vec<Vec<usize>>,
+    /// Per route: delayed (read before its source steps).
+    delayed: Vec<bool>,
     step_ns: i64,
     message_ticks: u64,
     /// The next communication point.
     tick: u64,
+    /// Reused buffers.
+    inbound: Vec<(i64, Vec<u8>)>,
+    framed: Vec<u8>,
 }
 
 fn time_of(tick: u64, step_ns: i64) -> f64 {
@@ -71,7 +91,28 @@ impl Master {
             return Err(crate::err!("step {step} s is not a positive whole number of nanoseconds"));
         }
         let message_ticks = crate::system::ticks_of(message_period, step, "message rate")?;
-        Ok(Master { system, step_ns, message_ticks, tick: 0 })
+        let order = order::plan(&system);
+        let mut inputs_of = vec![vec![]; system.components.len()];
+        let mut delayed = vec![false; system.routes.len()];
+        for r in 0..system.routes.len() {
+            if let Some((_, b)) = order::fmu_link(&system, r) {
+                inputs_of[b].push(r);
+            }
+        }
+        for &r in &order.delayed {
+            delayed[r] = true;
+        }
+        Ok(Master { system, order, inputs_of, delayed, step_ns, message_ticks, tick: 0, inbound: vec![], framed: vec![] })
+    }
+
+    /// The stepping order and the delayed connections.
+    pub fn order(&self) -> &Order {
+        &self.order
+    }
+
+    /// The order in words (`agrisim run --explain`).
+    pub fn explain(&self) -> String {
+        order::explain(&self.system, &self.order)
     }
 
     /// Simulation time of the next communication point [s].
@@ -89,22 +130,45 @@ impl Master {
         self.tick as i64 * self.step_ns
     }
 
-    /// Initializes every FMU at t = 0.
+    /// Initializes every FMU at t = 0: one pass in the step order, each component's inputs
+    /// from the FMUs before it set before its own outputs are read (so each model computes
+    /// its initial state once), then passes over every scalar FMU-to-FMU connection until
+    /// none changes (only a loop through a delayed connection makes a second pass change
+    /// anything).
     pub fn initialize(&mut self) -> Result<()> {
         for c in &mut self.system.components {
             c.instance.enter_initialization_mode(0.0, None)?;
         }
-        // Consistent start: scalar FMU-to-FMU connections are propagated in initialization
-        // mode, once per component so chains (lift -> chassis -> world) settle, so that no
-        // FMU starts from its default inputs (e.g. the world from a base at the origin).
-        for _ in 0..self.system.components.len() {
-            for r in 0..self.system.routes.len() {
-                let route = &self.system.routes[r];
-                let (Port::Fmu { comp: src, var: sv, seq: None }, Port::Fmu { comp: dst, var: dv, seq: None }) = (&route.from, &route.to) else { continue };
-                let (src, dst, sv, dv) = (*src, *dst, sv.clone(), dv.clone());
-                let v = value::get(&mut self.system.components[src].instance, &sv)?;
-                value::set(&mut self.system.components[dst].instance, &dv, &v)?;
+        let mut last: Vec<Option<Value>> = vec![None; self.system.routes.len()];
+        for i in 0..self.order.step.len() {
+            let c = self.order.step[i];
+            for j in 0..self.inputs_of[c].len() {
+                let r = self.inputs_of[c][j];
+                if !self.delayed[r] {
+                    self.propagate_initial(r, &mut last)?;
+                }
             }
+        }
+        let mut converged = false;
+        for _ in 0..INIT_PASSES {
+            let mut changed = vec![];
+            for i in 0..self.order.step.len() {
+                let c = self.order.step[i];
+                for j in 0..self.inputs_of[c].len() {
+                    let r = self.inputs_of[c][j];
+                    if self.propagate_initial(r, &mut last)? {
+                        changed.push(r);
+                    }
+                }
+            }
+            if changed.is_empty() {
+                converged = true;
+                break;
+            }
+        }
+        if !converged {
+            let labels: Vec<&str> = self.order.init_loops.iter().map(|&r| self.system.routes[r].label.as_str()).collect();
+            return Err(crate::err!("initialization did not converge in {INIT_PASSES} passes through the loop(s) {}", labels.join(", ")));
         }
         for c in &mut self.system.components {
             c.instance.exit_initialization_mode()?;
@@ -112,11 +176,26 @@ impl Master {
         Ok(())
     }
 
+    /// Copies a scalar FMU-to-FMU route's source value to its destination in Initialization
+    /// Mode if it differs from what was last written there; returns whether it did.
+    fn propagate_initial(&mut self, r: usize, last: &mut [Option<Value>]) -> Result<bool> {
+        let route = &self.system.routes[r];
+        let (Port::Fmu { comp: src, var: sv, seq: None }, Port::Fmu { comp: dst, var: dv, seq: None }) = (&route.from, &route.to) else { return Ok(false) };
+        let (src, dst) = (*src, *dst);
+        let v = value::get(&mut self.system.components[src].instance, sv)?;
+        if last[r].as_ref().is_some_and(|l| l.identical(&v)) {
+            return Ok(false);
+        }
+        value::set(&mut self.system.components[dst].instance, dv, &v)?;
+        last[r] = Some(v);
+        Ok(true)
+    }
+
     /// One communication point and one step of every FMU. Callers that drive the master
     /// step by step call [`Master::finish_point`] at the end.
     pub fn advance(&mut self, hooks: &mut dyn Hooks) -> Result<()> {
         self.communicate(hooks)?;
-        self.step_all()
+        self.step_all(hooks)
     }
 
     /// True when the next communication point is a message instant (nodes run there).
@@ -136,7 +215,7 @@ impl Master {
         let t_ns = self.time_ns();
         self.collect_outputs(k, hooks)?;
         hooks.exchange(t_ns, k % self.message_ticks == 0)?;
-        self.deliver_inputs(k, hooks)?;
+        self.deliver_bus_inputs(k, hooks)?;
         hooks.point(&mut self.system, t_ns)
     }
 
@@ -150,9 +229,7 @@ impl Master {
             }
             match &route.from {
                 Port::Fmu { seq: Some(_), .. } => {
-                    if let Some(bytes) = self.take_message(r)? {
-                        hooks.message(&self.system, r, t_ns, &bytes)?;
-                    }
+                    self.take_messages(r, t_ns, &mut |system, frame| hooks.message(system, r, frame.stamp_ns, frame.payload))?;
                 }
                 Port::Fmu { comp, var, seq: None } => {
                     let Port::Bus { topic } = &route.to else { unreachable!("checked above") };
@@ -166,74 +243,147 @@ impl Master {
         Ok(())
     }
 
-    /// Step 3: routes into FMU inputs. FMU-to-FMU values are read now: every FMU is between
-    /// steps, so this is a Jacobi exchange whatever the order.
-    fn deliver_inputs(&mut self, k: u64, hooks: &mut dyn Hooks) -> Result<()> {
-        let t_ns = k as i64 * self.step_ns;
+    /// Step 3: routes from system connectors into FMU inputs.
+    fn deliver_bus_inputs(&mut self, k: u64, hooks: &mut dyn Hooks) -> Result<()> {
         for r in 0..self.system.routes.len() {
             let route = &self.system.routes[r];
-            if k % route.period_ticks != 0 || !matches!(route.to, Port::Fmu { .. }) {
+            if k % route.period_ticks != 0 {
                 continue;
             }
-            let value = match &route.from {
-                Port::Bus { topic } => match &route.to {
-                    Port::Fmu { seq: Some(_), .. } => {
-                        let mut seen = route.seen;
-                        let bytes = hooks.message_input(topic, &mut seen);
-                        self.system.routes[r].seen = seen;
-                        bytes.map(Value::Bin)
-                    }
-                    Port::Fmu { var, .. } => hooks.scalar_input(topic).map(|x| value::scalar_from_f64(var, x).map_err(|e| crate::err!("{}: {e}", route.label))).transpose()?,
-                    Port::Bus { .. } => None,
-                },
-                Port::Fmu { seq: Some(_), .. } => match self.take_message(r)? {
-                    Some(bytes) => {
-                        hooks.message(&self.system, r, t_ns, &bytes)?;
-                        Some(Value::Bin(bytes))
-                    }
-                    None => None,
-                },
-                Port::Fmu { comp, var, seq: None } => Some(value::get(&mut self.system.components[*comp].instance, var)?),
-            };
-            let Some(value) = value else { continue };
-            let System { routes, components, .. } = &mut self.system;
-            let route = &mut routes[r];
-            let Port::Fmu { comp: dst, var: dst_var, seq: dst_seq } = &route.to else { unreachable!("checked above") };
-            let inst = &mut components[*dst].instance;
-            value::set(inst, dst_var, &value)?;
-            if let Some(seq) = dst_seq {
-                route.written += 1;
-                value::set(inst, seq, &Value::I64(route.written))?;
+            let (Port::Bus { topic }, Port::Fmu { var, seq, .. }) = (&route.from, &route.to) else { continue };
+            if seq.is_some() {
+                let mut inbound = std::mem::take(&mut self.inbound);
+                inbound.clear();
+                hooks.message_input(r, topic, &mut inbound)?;
+                let res = self.write_messages(r, inbound.iter().map(|(t, b)| (*t, b.as_slice())));
+                self.inbound = inbound;
+                res?;
+            } else if let Some(x) = hooks.scalar_input(topic) {
+                let v = value::scalar_from_f64(var, x).map_err(|e| crate::err!("{}: {e}", route.label))?;
+                let Port::Fmu { comp, var, .. } = &self.system.routes[r].to else { unreachable!("matched above") };
+                value::set(&mut self.system.components[*comp].instance, var, &v)?;
             }
         }
         Ok(())
     }
 
-    /// The new message of route `r`'s FMU source, if its counter moved since the route last
-    /// looked.
-    fn take_message(&mut self, r: usize) -> Result<Option<Vec<u8>>> {
+    /// Writes `messages` (stamp, CDR) to route `r`'s destination message port: as a frame
+    /// list numbered on from the route's last one, or, for a port that takes one bare
+    /// message, the newest of them; the port's counter then names the newest.
+    fn write_messages<'a>(&mut self, r: usize, messages: impl ExactSizeIterator<Item = (i64, &'a [u8])>) -> Result<()> {
+        if messages.len() == 0 {
+            return Ok(());
+        }
         let System { routes, components, .. } = &mut self.system;
         let route = &mut routes[r];
-        let Port::Fmu { comp, var, seq: Some(seq) } = &route.from else { return Ok(None) };
+        let Port::Fmu { comp, var, seq: Some(seq) } = &route.to else { return Err(crate::err!("{}: not a message input", route.label)) };
         let inst = &mut components[*comp].instance;
-        let Value::I64(n) = value::get(inst, seq)? else { unreachable!("counter is Int64") };
-        if n == route.seen {
-            return Ok(None);
+        let first = route.written as u64 + 1;
+        let n = messages.len() as u64;
+        if route.framed_to {
+            self.framed.clear();
+            agrisim_frames::encode_into(&mut self.framed, messages.enumerate().map(|(i, (stamp_ns, payload))| Frame { seq: first + i as u64, stamp_ns, payload }));
+            inst.set_binary(var.value_reference, &self.framed)?;
+        } else {
+            let (_, newest) = messages.last().expect("not empty");
+            inst.set_binary(var.value_reference, newest)?;
         }
-        let Value::Bin(bytes) = value::get(inst, var)? else { unreachable!("message port is Binary") };
-        route.seen = n;
-        Ok(Some(bytes))
+        route.written += n as i64;
+        value::set(inst, seq, &Value::I64(route.written))?;
+        Ok(())
     }
 
-    fn step_all(&mut self) -> Result<()> {
+    /// The messages of route `r`'s FMU source port that the route has not taken yet, each
+    /// passed to `each` in order. A framed port yields its new frames (a sequence gap is an
+    /// error naming the FMU and port); a plain port yields its one message, stamped `t_ns`,
+    /// when its counter moved by one (by more: messages were lost, an error too).
+    fn take_messages(&mut self, r: usize, t_ns: i64, each: &mut dyn FnMut(&System, Frame) -> Result<()>) -> Result<()> {
+        let route = &self.system.routes[r];
+        let Port::Fmu { comp, var, seq: Some(seq) } = &route.from else { return Ok(()) };
+        let comp = *comp;
+        let inst = &mut self.system.components[comp].instance;
+        let Value::I64(n) = value::get(inst, seq)? else { unreachable!("counter is Int64") };
+        let n = n.max(0) as u64;
+        if n == route.cursor.last {
+            return Ok(());
+        }
+        let Value::Bin(bytes) = value::get(inst, var)? else { unreachable!("message port is Binary") };
+        let lost = |system: &System, e: agrisim_frames::Error| {
+            let route = &system.routes[r];
+            let Port::Fmu { var, .. } = &route.from else { unreachable!("FMU source") };
+            let hint = match e {
+                agrisim_frames::Error::Gap { .. } => format!(
+                    ": the route reads it every {} step(s); read it at least every port_window of the FMU, or lengthen that window",
+                    route.period_ticks
+                ),
+                agrisim_frames::Error::Malformed(_) => String::new(),
+            };
+            crate::err!("FMU '{}': message port '{}' at t={} s: {e}{hint} (route {})", system.components[comp].name, var.name, t_ns as f64 / 1e9, route.label)
+        };
+        let mut cursor = route.cursor;
+        if route.framed_from {
+            let frames = cursor.take(&bytes, n).map_err(|e| lost(&self.system, e));
+            self.system.routes[r].cursor = cursor;
+            for f in frames? {
+                each(&self.system, f)?;
+            }
+        } else {
+            let skipped = n > cursor.last + 1;
+            let first = cursor.last + 1;
+            cursor.last = n;
+            self.system.routes[r].cursor = cursor;
+            if skipped {
+                return Err(lost(&self.system, agrisim_frames::Error::Gap { first, last: n - 1 }));
+            }
+            each(&self.system, Frame { seq: n, stamp_ns: t_ns, payload: &bytes })?;
+        }
+        Ok(())
+    }
+
+    /// Step 5: every component steps in order, its FMU-to-FMU inputs read just before.
+    fn step_all(&mut self, hooks: &mut dyn Hooks) -> Result<()> {
+        let k = self.tick;
         let (t, h) = (self.time(), self.step_ns as f64 / 1e9);
-        for c in &mut self.system.components {
-            let r = c.instance.do_step(t, h)?;
-            if r.terminate_simulation {
-                return Err(crate::err!("FMU '{}' asked to terminate the simulation at t={t}", c.name));
+        for i in 0..self.order.step.len() {
+            let c = self.order.step[i];
+            for j in 0..self.inputs_of[c].len() {
+                let r = self.inputs_of[c][j];
+                // A source that has stepped already is at t_k+1.
+                let at = if self.delayed[r] { k } else { k + 1 };
+                if at % self.system.routes[r].period_ticks == 0 {
+                    self.propagate(r, at, hooks)?;
+                }
+            }
+            let comp = &mut self.system.components[c];
+            let res = comp.instance.do_step(t, h)?;
+            if res.terminate_simulation {
+                return Err(crate::err!("FMU '{}' asked to terminate the simulation at t={t}", comp.name));
             }
         }
         self.tick += 1;
         Ok(())
+    }
+
+    /// Moves FMU-to-FMU route `r`'s value (its source at tick `at`) to its destination.
+    fn propagate(&mut self, r: usize, at: u64, hooks: &mut dyn Hooks) -> Result<()> {
+        let route = &self.system.routes[r];
+        match (&route.from, &route.to) {
+            (Port::Fmu { seq: Some(_), .. }, _) => {
+                let mut taken: Vec<(i64, Vec<u8>)> = vec![];
+                self.take_messages(r, at as i64 * self.step_ns, &mut |system, f| {
+                    hooks.message(system, r, f.stamp_ns, f.payload)?;
+                    taken.push((f.stamp_ns, f.payload.to_vec()));
+                    Ok(())
+                })?;
+                self.write_messages(r, taken.iter().map(|(t, b)| (*t, b.as_slice())))
+            }
+            (Port::Fmu { comp: src, var: sv, seq: None }, Port::Fmu { .. }) => {
+                let v = value::get(&mut self.system.components[*src].instance, sv)?;
+                let System { routes, components, .. } = &mut self.system;
+                let Port::Fmu { comp: dst, var: dv, .. } = &routes[r].to else { unreachable!("matched above") };
+                value::set(&mut components[*dst].instance, dv, &v)
+            }
+            _ => Ok(()),
+        }
     }
 }

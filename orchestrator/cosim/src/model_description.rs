@@ -224,6 +224,12 @@ pub struct ModelDescription {
     pub log_categories: Vec<String>,
     pub default_step_size: Option<f64>,
     pub variables: Vec<ModelVariable>,
+    /// ModelStructure `<Output>`: value reference -> the knowns it depends on within a
+    /// communication point (`None`: not declared, so every input).
+    pub output_dependencies: BTreeMap<u32, Option<Vec<u32>>>,
+    /// ModelStructure `<InitialUnknown>`: value reference -> the knowns its value in
+    /// Initialization Mode depends on (`None`: not declared, so every known).
+    pub initial_dependencies: BTreeMap<u32, Option<Vec<u32>>>,
 }
 
 impl ModelDescription {
@@ -376,6 +382,28 @@ impl ModelDescription {
                 });
             }
         }
+        let mut output_dependencies = BTreeMap::new();
+        let mut initial_dependencies = BTreeMap::new();
+        if let Some(ms) = child(root, "ModelStructure") {
+            for node in ms.children().filter(|n| n.is_element()) {
+                let map = match node.tag_name().name() {
+                    "Output" => &mut output_dependencies,
+                    "InitialUnknown" => &mut initial_dependencies,
+                    _ => continue,
+                };
+                let what = format!("ModelStructure/{}", node.tag_name().name());
+                let vr: u32 = attr(node, "valueReference", &what)?.trim().parse().map_err(|e| err(format!("{what}: bad valueReference: {e}")))?;
+                let deps = match node.attribute("dependencies") {
+                    None => None,
+                    Some(text) => Some(
+                        text.split_whitespace()
+                            .map(|d| d.parse::<u32>().map_err(|e| err(format!("{what} {vr}: bad dependency {d:?}: {e}"))))
+                            .collect::<Result<Vec<u32>, _>>()?,
+                    ),
+                };
+                map.insert(vr, deps);
+            }
+        }
         Ok(ModelDescription {
             fmi_version,
             model_name,
@@ -385,7 +413,18 @@ impl ModelDescription {
             log_categories,
             default_step_size,
             variables,
+            output_dependencies,
+            initial_dependencies,
         })
+    }
+
+    /// Whether output `output`'s value in Initialization Mode may depend on input `input`
+    /// (true when the FMU does not say).
+    pub fn initial_depends(&self, output: u32, input: u32) -> bool {
+        match self.initial_dependencies.get(&output) {
+            Some(Some(deps)) => deps.contains(&input),
+            _ => true,
+        }
     }
 
     /// Variable by name.

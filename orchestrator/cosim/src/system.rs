@@ -1,9 +1,11 @@
 //! A composed system: the FMU instances of an SSP system structure and the routes that move
 //! values between them and the message bus.
 //!
-//! Message ports are FMI 3 Binary variables named `X` with an Int64 counter `X_seq`: a route
-//! moves a message only when the counter changed, and bumps the counter of the input it
-//! writes, so every consumer sees each message exactly once.
+//! Message ports are FMI 3 Binary variables named `X` with an Int64 counter `X_seq`: a
+//! framed port ([`agrisim_frames`]) holds every message of the FMU's last `port_window`, a
+//! plain one the newest message. A route takes each message once (by sequence number) and
+//! numbers on the messages it writes to an input, so every consumer sees each message
+//! exactly once.
 
 use crate::archive::FmuArchive;
 use crate::error::{Context, Result};
@@ -129,9 +131,13 @@ pub struct Route {
     pub mime_type: Option<String>,
     /// Topic a message route is recorded on.
     pub topic: String,
-    /// Last source counter seen (FMU source) or bus sequence delivered (bus source).
-    pub seen: i64,
-    /// Counter written to a message input.
+    /// An FMU source's message port: the last message taken.
+    pub cursor: agrisim_frames::Cursor,
+    /// The source / destination message port carries frame lists ([`agrisim_frames`]);
+    /// otherwise one message at a time.
+    pub framed_from: bool,
+    pub framed_to: bool,
+    /// Messages written to a message input (its counter).
     pub written: i64,
 }
 
@@ -283,7 +289,9 @@ impl System {
                 (_, None) => self.external_name(&c.end.connector),
                 (Some(e), Some(_)) => format!("/{e}/{}", c.start.connector),
             };
-            routes.push(Route { label, from, to, period_ticks, mime_type: mime, topic, seen: 0, written: 0 });
+            let framed = |p: &Port| matches!(p, Port::Fmu { var, .. } if var.mime_type.as_deref().is_some_and(agrisim_frames::is_framed_mime));
+            let (framed_from, framed_to) = (framed(&from), framed(&to));
+            routes.push(Route { label, from, to, period_ticks, mime_type: mime, topic, cursor: Default::default(), framed_from, framed_to, written: 0 });
         }
         Ok(routes)
     }

@@ -17,6 +17,15 @@ pub enum Value {
 }
 
 impl Value {
+    /// The very same value: floats bit for bit (a NaN equals itself, so a loop that settles
+    /// on NaN converges; -0.0 differs from 0.0, as an FMU could tell them apart).
+    pub fn identical(&self, other: &Value) -> bool {
+        match (self, other) {
+            (Value::F64(a), Value::F64(b)) => a.to_bits() == b.to_bits(),
+            _ => self == other,
+        }
+    }
+
     /// As a number for recording (Signals messages carry float64).
     pub fn as_f64(&self) -> Option<f64> {
         match *self {

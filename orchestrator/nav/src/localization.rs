@@ -13,7 +13,8 @@ use super::config::{LocalizationConfig, NavConfig, RobotConfig};
 use agrisim_math::pose2::{wrap_angle, Pose2};
 use super::scan_match::{correlative_match, LikelihoodField, Match};
 use super::{cloud, map::StaticMap, topics};
-use agrisim_bus::Bus;
+use agrisim_bus::{Bus, Reader};
+use std::collections::VecDeque;
 use agrisim_error::Result;
 use agrisim_bus::Node;
 use agrisim_msgs::builtin_interfaces::Time;
@@ -80,12 +81,15 @@ pub struct Localizer {
     cfg: LocalizationConfig,
     robot: RobotConfig,
     seen: [u64; 4],
+    imu: Reader,
+    odom: Reader,
+    /// Gyro yaw-rate samples (stamp [ns], rate [rad/s]) not yet integrated; the last one is
+    /// kept to hold its rate over the time after it.
+    gyro: VecDeque<(i64, f64)>,
     field: Option<LikelihoodField>,
     mean: Pose2,
     cov: Matrix3<f64>,
     last_odom: Option<(i64, Pose2)>,
-    imu_rate: Option<f64>,
-    imu_prev_rate: Option<f64>,
     gyro_bias: f64,
     last_match_ns: Option<i64>,
     rejections: usize,
@@ -103,12 +107,13 @@ impl Localizer {
             cfg,
             robot: config.robot,
             seen: [0; 4],
+            imu: Reader::new(topics::IMU),
+            odom: Reader::new(topics::ODOM),
+            gyro: VecDeque::new(),
             field: None,
             mean: Pose2::new(x, y, yaw),
             cov: diag(sx * sx, sy * sy, sa * sa),
             last_odom: None,
-            imu_rate: None,
-            imu_prev_rate: None,
             gyro_bias: 0.0,
             last_match_ns: None,
             rejections: 0,
@@ -216,6 +221,25 @@ impl Localizer {
         Ok(keyed.into_iter().step_by(stride).map(|k| k.1).collect())
     }
 
+    /// The yaw the gyro measured from `t0` to `t1` [ns] and the mean rate of its samples
+    /// there. A sample stands for the rate over the interval that ends at its stamp (from the
+    /// sample before, or `t0`); the newest one's rate is held on to `t1`. None without a
+    /// sample in the interval. Consumes the samples up to `t1`.
+    fn integrate_gyro(&mut self, t0: i64, t1: i64) -> Option<(f64, f64)> {
+        while self.gyro.front().is_some_and(|s| s.0 <= t0) {
+            self.gyro.pop_front();
+        }
+        let (mut turned, mut from, mut sum, mut n, mut last) = (0.0, t0, 0.0, 0usize, None);
+        while let Some(&(stamp, w)) = self.gyro.front().filter(|s| s.0 <= t1) {
+            turned += w * (stamp - from) as f64 * 1e-9;
+            (from, sum, n, last) = (stamp, sum + w, n + 1, Some(w));
+            self.gyro.pop_front();
+        }
+        let w = last?;
+        turned += w * (t1 - from) as f64 * 1e-9;
+        Some((turned, sum / n as f64))
+    }
+
     fn publish(&self, t_ns: i64, odom: &Pose2, bus: &mut Bus) {
         let stamp = Time::from_nanos(t_ns);
         let pose = PoseStamped { header: Header::new(stamp, "map"), pose: self.mean.to_msg() };
@@ -240,12 +264,11 @@ impl Node for Localizer {
         if let Some(m) = bus.take_new::<OccupancyGrid>(topics::MAP, &mut self.seen[0])? {
             self.set_map(&StaticMap::from_msg(&m, true)?);
         }
-        if let Some(imu) = bus.take_new::<Imu>(topics::IMU, &mut self.seen[1])? {
-            self.imu_prev_rate = self.imu_rate;
-            self.imu_rate = Some(imu.angular_velocity.z);
+        for imu in self.imu.take::<Imu>(bus)? {
+            self.gyro.push_back((imu.header.stamp.to_nanos(), imu.angular_velocity.z));
         }
         let mut odom_pose = None;
-        if let Some(o) = bus.take_new::<Odometry>(topics::ODOM, &mut self.seen[2])? {
+        for o in self.odom.take::<Odometry>(bus)? {
             let stamp = o.header.stamp.to_nanos();
             let stamp = if stamp > 0 { stamp } else { t_ns };
             let cur = Pose2::from_msg(&o.pose.pose);
@@ -253,13 +276,12 @@ impl Node for Localizer {
             if let Some((t_prev, prev)) = self.last_odom {
                 let mut d = prev.inverse().compose(&cur);
                 let dt = (stamp - t_prev) as f64 * 1e-9;
-                if let (Some(w), true) = (self.imu_rate, dt > 0.0) {
-                    let w_avg = 0.5 * (w + self.imu_prev_rate.unwrap_or(w));
+                if let (Some((turned, mean)), true) = (self.integrate_gyro(t_prev, stamp), dt > 0.0) {
                     let still = tw.linear.x.hypot(tw.linear.y) < 0.01 && tw.angular.z.abs() < 0.01 && d.x.hypot(d.y) < 1e-3;
                     if still {
-                        self.gyro_bias += 0.1 * (w - self.gyro_bias);
+                        self.gyro_bias += 0.1 * (mean - self.gyro_bias);
                     }
-                    let d_imu = if still { 0.0 } else { (w_avg - self.gyro_bias) * dt };
+                    let d_imu = if still { 0.0 } else { turned - self.gyro_bias * dt };
                     d.yaw = self.cfg.imu_weight * d_imu + (1.0 - self.cfg.imu_weight) * d.yaw;
                 }
                 self.predict(&d);

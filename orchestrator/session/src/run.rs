@@ -108,6 +108,15 @@ pub fn prepare(s: &Scenario, o: &RunOptions, mcap: &Path, nodes: Vec<Box<dyn Nod
     Ok(session)
 }
 
+/// How the master would step and initialize the scenario's system (`agrisim run --explain`):
+/// the order, the delayed connections and the exchange periods; nothing is run.
+pub fn explain(s: &Scenario, o: &RunOptions) -> Result<String> {
+    let lo = load_options(s, o);
+    let system = System::load(&s.system_path(), &lo)?;
+    let master = Master::new(system, s.timing.step, lo.message_period)?;
+    Ok(format!("System {} ({})\n{}", master.system.structure.name, s.system_path().display(), master.explain()))
+}
+
 /// Runs a scenario into `out_dir/run.mcap`.
 pub fn run(s: &Scenario, o: &RunOptions, out_dir: &Path, progress: impl FnMut(u64, u64)) -> Result<RunSummary> {
     std::fs::create_dir_all(out_dir).context(|| format!("cannot create {}", out_dir.display()))?;

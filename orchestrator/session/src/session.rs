@@ -7,7 +7,8 @@
 //! every FMU's scalar signals are recorded at the point's time.
 
 use agrisim_bus::check::{check_message, message_type};
-use agrisim_bus::{Bus, Node, Recorder};
+use agrisim_bus::{Bus, Node, Reader, Recorder};
+use std::collections::BTreeMap;
 use agrisim_cosim::{Hooks, Master, Port, System};
 use agrisim_error::{err, Error, Result};
 use agrisim_msgs::agrisim::{FmuStatus, Signals};
@@ -32,6 +33,8 @@ pub struct Session {
     /// values and stamp change), and the scalar system inputs' message.
     signals: Vec<(String, Signals)>,
     scalars: Signals,
+    /// Per route from a system connector into an FMU message input: its reader of the topic.
+    readers: BTreeMap<usize, Reader>,
 }
 
 /// The ROS 2 message type of every route of `system`, from its ports' mimeTypes; an error
@@ -51,7 +54,7 @@ impl Session {
             .iter()
             .map(|c| (format!("/fmu/{}/signals", c.name), Signals { header: Header::default(), names: c.signals.iter().map(|v| v.name.clone()).collect(), values: Vec::new() }))
             .collect();
-        Session { master, bus: Bus::default(), nodes, recorder, types, node_wall, signals, scalars: Signals::default() }
+        Session { master, bus: Bus::default(), nodes, recorder, types, node_wall, signals, scalars: Signals::default(), readers: BTreeMap::new() }
     }
 
     pub fn time(&self) -> f64 {
@@ -78,7 +81,7 @@ impl Session {
     }
 
     fn split(&mut self) -> (&mut Master, Link<'_>) {
-        (&mut self.master, Link { bus: &mut self.bus, nodes: &mut self.nodes, recorder: &mut self.recorder, types: &self.types, node_wall: &mut self.node_wall, signals: &mut self.signals, scalars: &mut self.scalars })
+        (&mut self.master, Link { bus: &mut self.bus, nodes: &mut self.nodes, recorder: &mut self.recorder, types: &self.types, node_wall: &mut self.node_wall, signals: &mut self.signals, scalars: &mut self.scalars, readers: &mut self.readers })
     }
 
     /// One communication point and one step of every FMU. Callers that drive the session
@@ -133,6 +136,7 @@ struct Link<'a> {
     node_wall: &'a mut [f64],
     signals: &'a mut [(String, Signals)],
     scalars: &'a mut Signals,
+    readers: &'a mut BTreeMap<usize, Reader>,
 }
 
 impl Hooks for Link<'_> {
@@ -161,14 +165,10 @@ impl Hooks for Link<'_> {
         Ok(())
     }
 
-    fn message_input(&mut self, connector: &str, seen: &mut i64) -> Option<Vec<u8>> {
-        match self.bus.latest(connector) {
-            Some(sample) if sample.seq as i64 > *seen => {
-                *seen = sample.seq as i64;
-                Some(sample.cdr.clone())
-            }
-            _ => None,
-        }
+    fn message_input(&mut self, route: usize, connector: &str, out: &mut Vec<(i64, Vec<u8>)>) -> Result<()> {
+        let reader = self.readers.entry(route).or_insert_with(|| Reader::new(connector));
+        out.extend(reader.take_samples(self.bus).into_iter().map(|s| (s.time_ns, s.cdr)));
+        Ok(())
     }
 
     fn scalar_input(&self, connector: &str) -> Option<f64> {
