@@ -32,7 +32,7 @@ pub mod system;
 pub mod value;
 
 pub use agrisim_error::{err, Context, Error, Result};
-pub use master::{Hooks, Master, NoHooks};
+pub use master::{Hooks, Master, NoHooks, Snapshot};
 pub use order::Order;
 pub use system::{LoadOptions, Port, Route, System};
 

@@ -61,6 +61,23 @@ pub struct NoHooks;
 
 impl Hooks for NoHooks {}
 
+/// The whole system's state between two communication points: every FMU's state
+/// (fmi3GetFMUState) and the master's own (its time and where each route stands). Restoring
+/// it and stepping gives exactly what stepping on from the snapshot gave. The program around
+/// the engine (its hooks: bus, nodes, recorder) keeps its own state.
+pub struct Snapshot {
+    fmus: Vec<crate::fmi3::FmuState>,
+    tick: u64,
+    routes: Vec<(agrisim_frames::Cursor, i64)>,
+}
+
+impl Snapshot {
+    /// Simulation time of the next communication point after a restore, in steps.
+    pub fn tick(&self) -> u64 {
+        self.tick
+    }
+}
+
 /// Most fixed-point passes initialization makes through a loop before giving up.
 const INIT_PASSES: usize = 50;
 
@@ -189,6 +206,40 @@ impl Master {
         value::set(&mut self.system.components[dst].instance, dv, &v)?;
         last[r] = Some(v);
         Ok(true)
+    }
+
+    /// Saves the whole system's state (every FMU needs canGetAndSetFMUState).
+    pub fn snapshot(&mut self) -> Result<Snapshot> {
+        let mut fmus = Vec::with_capacity(self.system.components.len());
+        for c in &mut self.system.components {
+            fmus.push(c.instance.get_state().map_err(|e| crate::err!("snapshot of FMU '{}': {e}", c.name))?);
+        }
+        let routes = self.system.routes.iter().map(|r| (r.cursor, r.written)).collect();
+        Ok(Snapshot { fmus, tick: self.tick, routes })
+    }
+
+    /// Returns the whole system to `snapshot` (taken from this master).
+    pub fn restore(&mut self, snapshot: &Snapshot) -> Result<()> {
+        if snapshot.fmus.len() != self.system.components.len() || snapshot.routes.len() != self.system.routes.len() {
+            return Err(crate::err!("snapshot of another system ({} FMUs, {} routes; this one has {} and {})", snapshot.fmus.len(), snapshot.routes.len(), self.system.components.len(), self.system.routes.len()));
+        }
+        for (c, s) in self.system.components.iter_mut().zip(&snapshot.fmus) {
+            c.instance.set_state(s).map_err(|e| crate::err!("restoring FMU '{}': {e}", c.name))?;
+        }
+        for (r, (cursor, written)) in self.system.routes.iter_mut().zip(&snapshot.routes) {
+            r.cursor = *cursor;
+            r.written = *written;
+        }
+        self.tick = snapshot.tick;
+        Ok(())
+    }
+
+    /// Frees a snapshot's FMU states now (otherwise they go with the instances).
+    pub fn free_snapshot(&mut self, snapshot: Snapshot) -> Result<()> {
+        for (c, s) in self.system.components.iter_mut().zip(snapshot.fmus) {
+            c.instance.free_state(s)?;
+        }
+        Ok(())
     }
 
     /// One communication point and one step of every FMU. Callers that drive the master
