@@ -8,12 +8,13 @@
 //! (robot against structure, arm against arm, base against anything), within the time
 //! limit. Planning success means every motion the trial asked for was planned.
 
+use crate::trials::{run_trials, write_summary};
 use super::harvest_targets::{draw, eligible, HarvestTarget};
 use super::map::{building_plan, grid_message};
 use super::nav::trial_seed;
 use super::stats::{percentile, wilson, Z95};
 use agrisim_bus::{Node, Reader};
-use agrisim_error::{err, Context, Result};
+use agrisim_error::{err, Result};
 use agrisim_greenhouse::occupancy::OccupancyMap;
 use agrisim_harvest::{topics, HarvestNode};
 use agrisim_math::Rng;
@@ -23,14 +24,13 @@ use agrisim_nodes::{FaultInjector, MapServer, OdomTf, RobotStatePublisher};
 use agrisim_session::{prepare, RunOptions, Scenario};
 use serde::Serialize;
 use std::collections::BTreeMap;
-use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
 /// Simulated-time limit of one harvest [s].
 pub const TRIAL_TIMEOUT: f64 = 120.0;
 
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, serde::Deserialize)]
 pub struct HarvestTrial {
     pub trial: u64,
     pub seed: u64,
@@ -39,7 +39,7 @@ pub struct HarvestTrial {
     pub fruit_name: String,
     pub fruit: [f64; 3],
     pub start: [f64; 3],
-    pub outcome: &'static str,
+    pub outcome: String,
     /// Failure category: planning, grasp, handover, placement, timeout, collision, error.
     pub failure: Option<String>,
     pub failed_stage: Option<String>,
@@ -269,7 +269,7 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
         fruit_name: target.name.clone(),
         fruit: target.center,
         start: target.start,
-        outcome: if failure.is_none() { "success" } else { "failure" },
+        outcome: if failure.is_none() { "success" } else { "failure" }.to_string(),
         failed_stage: failure.as_ref().and(failed_stage),
         failure,
         detail,
@@ -287,23 +287,12 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
 }
 
 /// Runs `trials` trials and writes trials.jsonl, summary.json and trials/*.mcap.
-pub fn bench_harvest(s: &Scenario, o: &RunOptions, trials: u64, seed: u64, out: &Path, mut progress: impl FnMut(u64, u64)) -> Result<HarvestSummary> {
-    let dir = out.join("trials");
-    std::fs::create_dir_all(&dir).context(|| format!("cannot create {}", dir.display()))?;
+pub fn bench_harvest(s: &Scenario, o: &RunOptions, trials: u64, seed: u64, out: &Path, resume: bool, progress: impl FnMut(u64, u64)) -> Result<HarvestSummary> {
+    let o = o.record_default(s, agrisim_session::Profile::Standard);
     let setup = HarvestSetup::new(s)?;
-    let jsonl_path = out.join("trials.jsonl");
-    let mut jsonl = std::fs::File::create(&jsonl_path).context(|| format!("cannot create {}", jsonl_path.display()))?;
-    let mut results = vec![];
-    for i in 0..trials {
-        let ts = trial_seed(seed, i);
-        let trial = run_trial(s, o, &setup, i, ts, &dir.join(format!("{i:04}.mcap")))?;
-        writeln!(jsonl, "{}", serde_json::to_string(&trial).expect("plain struct")).context(|| jsonl_path.display().to_string())?;
-        results.push(trial);
-        progress(i + 1, trials);
-    }
-    let summary = summarize(s, seed, &results);
-    let sp = out.join("summary.json");
-    std::fs::write(&sp, serde_json::to_string_pretty(&summary).expect("plain struct") + "\n").context(|| sp.display().to_string())?;
+    let done = run_trials(out, trials, resume, progress, |i, mcap| run_trial(s, &o, &setup, i, trial_seed(seed, i), mcap), |t| serde_json::to_string(t).expect("plain struct"))?;
+    let summary = summarize(s, seed, &done.results);
+    write_summary(out, &summary, done.interrupted)?;
     Ok(summary)
 }
 

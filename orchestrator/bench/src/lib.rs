@@ -13,5 +13,6 @@ pub mod overhead;
 pub mod report;
 pub mod stats;
 pub mod targets;
+pub mod trials;
 
 pub use overhead::{overhead, OverheadReport};

@@ -6,6 +6,7 @@
 //! or in failure with a reason: collision, timeout, no_path, stuck, goal_missed, error.
 //! Ground truth is read here only to judge; the navigation stack never sees it.
 
+use crate::trials::{run_trials, write_summary};
 use super::report::{render, TrialTrace};
 use super::stats::{wilson, Z95};
 use super::targets::draw_target;
@@ -21,16 +22,15 @@ use agrisim_msgs::geometry_msgs::PoseStamped;
 use agrisim_msgs::Message;
 use serde::Serialize;
 use std::collections::BTreeMap;
-use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, serde::Deserialize)]
 pub struct NavTrial {
     pub trial: u64,
     pub seed: u64,
     pub target: [f64; 3],
-    pub outcome: &'static str,
+    pub outcome: String,
     pub reason: Option<String>,
     pub time_to_goal: Option<f64>,
     pub path_length: f64,
@@ -165,7 +165,7 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &NavSetup, index: u64, see
         trial: index,
         seed,
         target,
-        outcome: if success { "success" } else { "failure" },
+        outcome: if success { "success" } else { "failure" }.to_string(),
         reason,
         time_to_goal: if success { time_to_goal } else { None },
         path_length: length,
@@ -179,26 +179,35 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &NavSetup, index: u64, see
 }
 
 /// Runs `trials` trials and writes trials.jsonl, summary.json, report.html and trials/*.mcap.
-pub fn bench_nav(s: &Scenario, o: &RunOptions, trials: u64, seed: u64, out: &Path, mut progress: impl FnMut(u64, u64)) -> Result<NavSummary> {
-    let dir = out.join("trials");
-    std::fs::create_dir_all(&dir).context(|| format!("cannot create {}", dir.display()))?;
+/// A nav trial as kept in trials/NNNN.json: the result and its path (every 10th point).
+#[derive(Serialize, serde::Deserialize)]
+struct NavRecord {
+    trial: NavTrial,
+    path: Vec<[f64; 2]>,
+}
+
+pub fn bench_nav(s: &Scenario, o: &RunOptions, trials: u64, seed: u64, out: &Path, resume: bool, progress: impl FnMut(u64, u64)) -> Result<NavSummary> {
+    let o = o.record_default(s, agrisim_session::Profile::Standard);
     let setup = NavSetup::new(s)?;
-    let jsonl_path = out.join("trials.jsonl");
-    let mut jsonl = std::fs::File::create(&jsonl_path).context(|| format!("cannot create {}", jsonl_path.display()))?;
-    let mut results = vec![];
-    let mut traces = vec![];
-    for i in 0..trials {
-        let ts = trial_seed(seed, i);
-        let (trial, path) = run_trial(s, o, &setup, i, ts, &dir.join(format!("{i:04}.mcap")))?;
-        // One line per trial as soon as it ends: a long benchmark that is stopped keeps them.
-        writeln!(jsonl, "{}", serde_json::to_string(&trial).expect("plain struct")).context(|| jsonl_path.display().to_string())?;
-        traces.push(TrialTrace { index: i, success: trial.outcome == "success", reason: trial.reason.clone().unwrap_or_else(|| "success".into()), target: trial.target, path: decimate(&path, 10) });
-        results.push(trial);
-        progress(i + 1, trials);
-    }
+    let done = run_trials(
+        out,
+        trials,
+        resume,
+        progress,
+        |i, mcap| {
+            let (trial, path) = run_trial(s, &o, &setup, i, trial_seed(seed, i), mcap)?;
+            Ok(NavRecord { trial, path: decimate(&path, 10) })
+        },
+        |r| serde_json::to_string(&r.trial).expect("plain struct"),
+    )?;
+    let traces: Vec<TrialTrace> = done
+        .results
+        .iter()
+        .map(|r| TrialTrace { index: r.trial.trial, success: r.trial.outcome == "success", reason: r.trial.reason.clone().unwrap_or_else(|| "success".into()), target: r.trial.target, path: r.path.clone() })
+        .collect();
+    let results: Vec<NavTrial> = done.results.into_iter().map(|r| r.trial).collect();
     let summary = summarize(s, seed, &results);
-    let sp = out.join("summary.json");
-    std::fs::write(&sp, serde_json::to_string_pretty(&summary).expect("plain struct") + "\n").context(|| sp.display().to_string())?;
+    write_summary(out, &summary, done.interrupted)?;
     let rows = vec![
         ("scenario".to_string(), summary.scenario.clone()),
         ("trials".to_string(), summary.trials.to_string()),

@@ -9,12 +9,14 @@
 pub mod bus;
 pub mod check;
 pub mod node;
+pub mod policy;
 pub mod recorder;
 
 pub use agrisim_error::{err, Context, Error, Result};
 pub use bus::{Bus, Published, Reader, Sample};
 pub use node::Node;
-pub use recorder::{Channel, Recorder};
+pub use policy::{Profile, RecordPolicy};
+pub use recorder::{part_path, Channel, Recorder};
 
 /// `crate::error::...` paths inside this crate.
 pub(crate) mod error {

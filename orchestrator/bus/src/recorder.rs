@@ -2,10 +2,15 @@
 //! encoding, `offered_qos_profiles` channel metadata, log time = simulation time. Files made
 //! this way open in Foxglove and decode with mcap-ros2-support and rosbags.
 //!
-//! Chunks are zstd-compressed. The writer is finished on drop as well, so a run that stops on an error still leaves a
-//! complete, readable file with everything recorded up to the failure.
+//! Chunks are zstd-compressed. The file is written under a temporary name (`NAME.part`)
+//! and renamed to its own name when finished: a file under its own name is always complete,
+//! and a killed process leaves a `.part` whose chunks up to the last one written an MCAP
+//! recovery reader salvages. The writer is finished on drop as well, so a run that stops on
+//! an error still leaves a complete, readable file with everything recorded up to the failure.
+//! A [`RecordPolicy`] says which messages are kept.
 
 use crate::error::{Context, Result};
+use crate::policy::{RecordPolicy, TopicFilter};
 use agrisim_msgs::Message;
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -19,17 +24,42 @@ const QOS_VOLATILE: &str = "- history: 3\n  depth: 0\n  reliability: 1\n  durabi
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub struct Channel(u16);
 
+/// One topic: its handle, type, filter and MCAP channel (created at its first kept message).
+struct Topic {
+    channel: Channel,
+    type_name: String,
+    filter: TopicFilter,
+    mcap_id: Option<u16>,
+    sequence: u32,
+}
+
 pub struct Recorder {
     writer: Option<mcap::Writer<BufWriter<File>>>,
     path: PathBuf,
+    policy: RecordPolicy,
     schemas: BTreeMap<String, u16>,
-    channels: BTreeMap<String, (Channel, String)>,
-    sequence: BTreeMap<Channel, u32>,
+    topics: Vec<Topic>,
+    by_name: BTreeMap<String, usize>,
+}
+
+/// The temporary name a recording is written under until it is finished.
+pub fn part_path(path: &Path) -> PathBuf {
+    let mut name = path.file_name().unwrap_or_default().to_os_string();
+    name.push(".part");
+    path.with_file_name(name)
 }
 
 impl Recorder {
+    /// Records everything to `path`.
     pub fn create(path: &Path) -> Result<Recorder> {
-        let file = File::create(path).context(|| format!("cannot create {}", path.display()))?;
+        Recorder::with_policy(path, RecordPolicy::default())
+    }
+
+    /// Records to `path` what `policy` keeps.
+    pub fn with_policy(path: &Path, policy: RecordPolicy) -> Result<Recorder> {
+        policy.validate().map_err(|e| crate::err!("{e}"))?;
+        let part = part_path(path);
+        let file = File::create(&part).context(|| format!("cannot create {}", part.display()))?;
         // zstd chunks, single-threaded: point clouds make trials large, and one compression thread
         // keeps the output a pure function of the input (byte-identical logs).
         let options = mcap::WriteOptions::new()
@@ -38,7 +68,7 @@ impl Recorder {
             .compression(Some(mcap::Compression::Zstd))
             .compression_threads(0);
         let writer = options.create(BufWriter::new(file)).context(|| format!("cannot start MCAP file {}", path.display()))?;
-        Ok(Recorder { writer: Some(writer), path: path.to_path_buf(), schemas: BTreeMap::new(), channels: BTreeMap::new(), sequence: BTreeMap::new() })
+        Ok(Recorder { writer: Some(writer), path: path.to_path_buf(), policy, schemas: BTreeMap::new(), topics: vec![], by_name: BTreeMap::new() })
     }
 
     fn writer(&mut self) -> Result<&mut mcap::Writer<BufWriter<File>>> {
@@ -49,33 +79,55 @@ impl Recorder {
     /// The channel for `topic` carrying `type_name` (e.g. `nav_msgs/msg/Odometry`), created
     /// on first use. A topic keeps one type: asking for another is an error.
     pub fn channel(&mut self, topic: &str, type_name: &str) -> Result<Channel> {
-        if let Some((ch, ty)) = self.channels.get(topic) {
-            if ty != type_name {
-                return Err(crate::err!("topic {topic} carries {ty}, cannot also record {type_name}"));
+        if let Some(&i) = self.by_name.get(topic) {
+            let t = &self.topics[i];
+            if t.type_name != type_name {
+                return Err(crate::err!("topic {topic} carries {}, cannot also record {type_name}", t.type_name));
             }
-            return Ok(*ch);
+            return Ok(t.channel);
         }
-        let schema_id = match self.schemas.get(type_name) {
+        if agrisim_msgs::ros2msg_schema(type_name).is_none() {
+            return Err(crate::err!("no .msg definition for {type_name} (topic {topic}) in models/msgs"));
+        }
+        let channel = Channel(self.topics.len() as u16);
+        let filter = TopicFilter::new(self.policy.rule(topic, type_name));
+        self.by_name.insert(topic.to_string(), self.topics.len());
+        self.topics.push(Topic { channel, type_name: type_name.to_string(), filter, mcap_id: None, sequence: 0 });
+        Ok(channel)
+    }
+
+    /// The MCAP channel of topic `i`, added to the file now if it is not there yet.
+    fn mcap_channel(&mut self, i: usize) -> Result<u16> {
+        if let Some(id) = self.topics[i].mcap_id {
+            return Ok(id);
+        }
+        let type_name = self.topics[i].type_name.clone();
+        let topic = self.by_name.iter().find(|(_, &j)| j == i).map(|(t, _)| t.clone()).expect("every topic has a name");
+        let schema_id = match self.schemas.get(&type_name) {
             Some(id) => *id,
             None => {
-                let text = agrisim_msgs::ros2msg_schema(type_name).ok_or_else(|| crate::err!("no .msg definition for {type_name} (topic {topic}) in models/msgs"))?;
-                let id = self.writer()?.add_schema(type_name, "ros2msg", text.as_bytes()).context(|| format!("MCAP schema {type_name}"))?;
-                self.schemas.insert(type_name.to_string(), id);
+                let text = agrisim_msgs::ros2msg_schema(&type_name).expect("checked when the channel was made");
+                let id = self.writer()?.add_schema(&type_name, "ros2msg", text.as_bytes()).context(|| format!("MCAP schema {type_name}"))?;
+                self.schemas.insert(type_name.clone(), id);
                 id
             }
         };
         let metadata = BTreeMap::from([("offered_qos_profiles".to_string(), QOS_VOLATILE.to_string())]);
-        let id = self.writer()?.add_channel(schema_id, topic, "cdr", &metadata).context(|| format!("MCAP channel {topic}"))?;
-        let ch = Channel(id);
-        self.channels.insert(topic.to_string(), (ch, type_name.to_string()));
-        Ok(ch)
+        let id = self.writer()?.add_channel(schema_id, &topic, "cdr", &metadata).context(|| format!("MCAP channel {topic}"))?;
+        self.topics[i].mcap_id = Some(id);
+        Ok(id)
     }
 
-    /// Records CDR bytes on a channel at simulation time `time_ns`.
+    /// Records CDR bytes on a channel at simulation time `time_ns`, if the policy keeps them.
     pub fn write(&mut self, channel: Channel, time_ns: i64, cdr: &[u8]) -> Result<()> {
-        let seq = self.sequence.entry(channel).or_insert(0);
-        *seq += 1;
-        let header = mcap::records::MessageHeader { channel_id: channel.0, sequence: *seq, log_time: time_ns as u64, publish_time: time_ns as u64 };
+        let i = channel.0 as usize;
+        if !self.topics[i].filter.keep(time_ns) {
+            return Ok(());
+        }
+        let id = self.mcap_channel(i)?;
+        let t = &mut self.topics[i];
+        t.sequence += 1;
+        let header = mcap::records::MessageHeader { channel_id: id, sequence: t.sequence, log_time: time_ns as u64, publish_time: time_ns as u64 };
         let path = self.path.display().to_string();
         self.writer()?.write_to_known_channel(&header, cdr).context(|| format!("writing {path}"))
     }
@@ -98,14 +150,26 @@ impl Recorder {
     }
 
     /// [`Recorder::finish`] for a recorder owned by something else; later writes are errors.
+    /// The file gets its own name once complete.
     pub fn finish_in_place(&mut self) -> Result<()> {
         if let Some(mut w) = self.writer.take() {
             w.finish().context(|| format!("finishing {}", self.path.display()))?;
+            drop(w);
+            let part = part_path(&self.path);
+            std::fs::rename(&part, &self.path).context(|| format!("renaming {} to {}", part.display(), self.path.display()))?;
         }
         Ok(())
     }
 
     pub fn path(&self) -> &Path {
         &self.path
+    }
+}
+
+impl Drop for Recorder {
+    /// A recorder dropped unfinished (a run that stopped on an error) still leaves a complete
+    /// file under its own name.
+    fn drop(&mut self) {
+        let _ = self.finish_in_place();
     }
 }

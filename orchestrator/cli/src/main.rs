@@ -6,7 +6,7 @@ mod png;
 mod snapshot;
 
 use agrisim_error::Result;
-use agrisim_session::{RunOptions, Scenario};
+use agrisim_session::{interrupt, Profile, RunOptions, Scenario};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
@@ -40,6 +40,10 @@ enum Command {
         dirs: Dirs,
         #[command(flatten)]
         log: FmuLog,
+        /// Recording profile: full (the default for a run), standard, judge or none;
+        /// replaces the scenario's [recording] profile.
+        #[arg(long)]
+        record: Option<Profile>,
         /// Print how the master orders the system (step order, delayed connections,
         /// initialization, exchange periods) and exit without running.
         #[arg(long)]
@@ -131,6 +135,14 @@ struct TrialArgs {
     dirs: Dirs,
     #[command(flatten)]
     log: FmuLog,
+    /// Recording profile of the trial MCAPs: standard (the default for benchmarks: point
+    /// clouds and images at 1 Hz, the fruit list once), full, judge or none; replaces the
+    /// scenario's [recording] profile.
+    #[arg(long)]
+    record: Option<Profile>,
+    /// Keep the trials already complete in DIR (an interrupted run) and run the others.
+    #[arg(long)]
+    resume: bool,
     #[arg(long)]
     out: PathBuf,
 }
@@ -207,11 +219,33 @@ fn run_options(dirs: Dirs, target: &std::path::Path, seed: Option<u64>, duration
         duration,
         fmu_overrides,
         fmu_log,
+        record: None,
     }
 }
 
+/// Exit status after a stop request (128 + SIGINT, as shells report it).
+const EXIT_INTERRUPTED: u8 = 130;
+
 fn main() -> ExitCode {
-    match real_main() {
+    // SIGINT/SIGTERM: stop at the next step boundary (files finished, completed trials
+    // summarized); a second one exits at once.
+    let _ = ctrlc::set_handler(|| {
+        if interrupt::request() {
+            eprintln!("agrisim: second interrupt: exiting now");
+            std::process::exit(EXIT_INTERRUPTED as i32);
+        }
+        eprintln!("agrisim: interrupt: stopping at the next step and finishing the files (interrupt again to exit at once)");
+    });
+    let result = real_main();
+    if interrupt::requested() {
+        match result {
+            Err(e) if !e.0.starts_with(interrupt::INTERRUPTED) => eprintln!("agrisim: error: {e}"),
+            Err(e) => eprintln!("agrisim: {e}; what was recorded up to there is complete"),
+            Ok(()) => eprintln!("agrisim: interrupted; the files of what completed are written"),
+        }
+        return ExitCode::from(EXIT_INTERRUPTED);
+    }
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("agrisim: error: {e}");
@@ -223,16 +257,19 @@ fn main() -> ExitCode {
 /// The scenario (or the benchmark's default) and run options of a many-trial benchmark.
 fn trial_setup(a: &TrialArgs, default_scenario: &str, target: &Path) -> Result<(Scenario, RunOptions)> {
     let s = Scenario::load(a.scenario.as_deref().unwrap_or(Path::new(default_scenario)))?;
-    Ok((s, run_options(a.dirs.clone(), target, None, None, BTreeMap::new(), a.log.categories())))
+    let mut o = run_options(a.dirs.clone(), target, None, None, BTreeMap::new(), a.log.categories());
+    o.record = a.record;
+    Ok((s, o))
 }
 
 fn real_main() -> Result<()> {
     let cli = Cli::parse();
     let (exe_dir, target) = build_dirs();
     match cli.command {
-        Command::Run { scenario, duration, seed, fmus, dirs, log, explain, out } => {
+        Command::Run { scenario, duration, seed, fmus, dirs, log, record, explain, out } => {
             let s = Scenario::load(&scenario)?;
-            let opts = run_options(dirs, &target, seed, duration, fmus.into_iter().collect(), log.categories());
+            let mut opts = run_options(dirs, &target, seed, duration, fmus.into_iter().collect(), log.categories());
+            opts.record = record;
             if explain {
                 print!("{}", agrisim_session::run::explain(&s, &opts)?);
                 return Ok(());
@@ -243,12 +280,12 @@ fn real_main() -> Result<()> {
         }
         Command::Bench { command: BenchCommand::Nav(a) } => {
             let (s, opts) = trial_setup(&a, "models/scenarios/default.toml", &target)?;
-            let summary = agrisim_bench::nav::bench_nav(&s, &opts, a.trials, a.seed, &a.out, progress_printer())?;
+            let summary = agrisim_bench::nav::bench_nav(&s, &opts, a.trials, a.seed, &a.out, a.resume, progress_printer())?;
             println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
         }
         Command::Bench { command: BenchCommand::Harvest(a) } => {
             let (s, opts) = trial_setup(&a, "models/scenarios/harvest.toml", &target)?;
-            let summary = agrisim_bench::harvest::bench_harvest(&s, &opts, a.trials, a.seed, &a.out, progress_printer())?;
+            let summary = agrisim_bench::harvest::bench_harvest(&s, &opts, a.trials, a.seed, &a.out, a.resume, progress_printer())?;
             println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
         }
         Command::Bench { command: BenchCommand::Overhead { scenario, steps, dirs, log, out } } => {

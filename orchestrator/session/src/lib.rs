@@ -7,11 +7,13 @@
 //! The engine knows nothing of the greenhouse: the scenario's `[greenhouse]` reaches the FMUs
 //! as the text of their `scene` parameter, and the robot's start pose as parameters.
 
+pub mod interrupt;
 pub mod run;
 pub mod scenario;
 pub mod scene;
 pub mod session;
 
 pub use run::{prepare, RunOptions, RunSummary};
+pub use agrisim_bus::{Profile, RecordPolicy};
 pub use scenario::Scenario;
 pub use session::Session;

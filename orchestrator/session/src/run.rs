@@ -24,6 +24,20 @@ pub struct RunOptions {
     /// `[logging] fmu`: see [`agrisim_cosim::LoadOptions::fmu_log`]. `None` leaves it to the
     /// scenario (off unless it says otherwise).
     pub fmu_log: Option<Vec<String>>,
+    /// Recording profile (CLI `--record`), replacing the scenario's `[recording] profile`.
+    pub record: Option<agrisim_bus::Profile>,
+}
+
+impl RunOptions {
+    /// These options with `profile` unless the CLI or the scenario chose one (benchmarks
+    /// default to `standard`).
+    pub fn record_default(&self, s: &Scenario, profile: agrisim_bus::Profile) -> RunOptions {
+        let mut o = self.clone();
+        if o.record.is_none() && s.recording.is_none() {
+            o.record = Some(profile);
+        }
+        o
+    }
 }
 
 /// What a finished run reports.
@@ -86,7 +100,11 @@ pub fn prepare(s: &Scenario, o: &RunOptions, mcap: &Path, nodes: Vec<Box<dyn Nod
         shared.insert("environment".to_string(), environment);
     }
     let applied = system.apply_parameters(&params, seed, &shared)?;
-    let mut recorder = Recorder::create(mcap)?;
+    let mut policy = s.recording.clone().unwrap_or_default();
+    if let Some(p) = o.record {
+        policy.profile = p;
+    }
+    let mut recorder = Recorder::with_policy(mcap, policy).map_err(|e| err!("scenario {}: {e}", s.path.display()))?;
     let mut run_info = BTreeMap::from([
         ("scenario".to_string(), s.name.clone()),
         ("scenario_file".to_string(), s.path.display().to_string()),

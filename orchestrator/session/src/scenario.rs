@@ -54,6 +54,10 @@ pub struct Scenario {
     /// What is logged beyond warnings and errors (which always reach the user).
     #[serde(default)]
     pub logging: Logging,
+    /// `[recording]`: which messages the MCAP keeps (profile, include/exclude, decimation);
+    /// absent: everything for `agrisim run`, the `standard` profile for benchmarks.
+    #[serde(default)]
+    pub recording: Option<agrisim_bus::RecordPolicy>,
     /// Where the file was read from (relative paths resolve against its directory).
     #[serde(skip)]
     pub path: PathBuf,

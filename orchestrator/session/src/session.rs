@@ -87,7 +87,12 @@ impl Session {
     /// One communication point and one step of every FMU. Callers that drive the session
     /// step by step (benchmarks deciding when a trial ends) call [`Session::finish_point`]
     /// at the end, and [`Session::record_failure`] on an error.
+    /// A stop request ([`crate::interrupt`]) ends the run here, between two steps, with the
+    /// error [`crate::interrupt::INTERRUPTED`].
     pub fn advance(&mut self) -> Result<()> {
+        if crate::interrupt::requested() {
+            return Err(err!("{} at t={} s", crate::interrupt::INTERRUPTED, self.master.time()));
+        }
         let (master, mut link) = self.split();
         master.advance(&mut link)
     }
