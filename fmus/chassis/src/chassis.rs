@@ -147,7 +147,7 @@ impl<D: Drive> Model for Chassis<D> {
         Self::default()
     }
 
-    fn initialize(&mut self, io: &mut Store, start_time: f64, _log: &mut dyn Log) -> Result<(), String> {
+    fn initialize(&mut self, io: &mut Store, start_time: f64, log: &mut dyn Log) -> Result<(), String> {
         self.layout = Some(WheelLayout::rectangular(positive(io, WHEEL_BASE)?, positive(io, TRACK)?, positive(io, WHEEL_RADIUS)?));
         self.limits = Limits {
             steer_max: non_negative(io, STEER_MAX)?,
@@ -159,7 +159,7 @@ impl<D: Drive> Model for Chassis<D> {
             non_negative(io, p)?;
         }
         self.drive.initialize(io)?;
-        self.commands.initialize(io, start_time)?;
+        self.commands.initialize(io, start_time, log)?;
         self.pose = Pose2 { x: io.f64(X0), y: io.f64(Y0), yaw: io.f64(YAW0) };
         self.odom = WheelOdometry { pose: self.pose, twist: Twist2::default() };
         self.odom_schedule = Schedule::new(io.f64(ODOM_RATE), start_time)?;
@@ -172,11 +172,11 @@ impl<D: Drive> Model for Chassis<D> {
         Ok(())
     }
 
-    fn do_step(&mut self, io: &mut Store, t: f64, h: f64, _log: &mut dyn Log) -> Result<(), String> {
+    fn do_step(&mut self, io: &mut Store, t: f64, h: f64, log: &mut dyn Log) -> Result<(), String> {
         if !(h > 0.0 && h <= D::MAX_STEP) {
             return Err(format!("communication step {h} s outside (0, {}] s that {} integrates", D::MAX_STEP, D::NAME));
         }
-        self.commands.poll(io, t)?;
+        self.commands.poll(io, t, log)?;
         let command = self.commands.active(t, io.f64(CMD_TIMEOUT));
         let l = self.limits.clone();
         let target = self.layout().inverse(command.unwrap_or_default(), &self.wheels, l.steer_max);

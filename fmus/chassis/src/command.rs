@@ -1,10 +1,13 @@
 //! Base velocity command intake: two sources (scalar ports with a counter, and a Twist
 //! message port with its sequence counter), latest command wins, plus a watchdog that stops
 //! the base when commands stop arriving (like a real base controller's cmd_vel timeout).
+//! A message that is not a valid, finite Twist is refused with a warning and the last valid
+//! command stays in force (a bad message from the network must not stop the run); the
+//! watchdog still stops the base when no valid command comes.
 
 use crate::ports::*;
 use crate::se2::Twist2;
-use agrisim_fmi::{InPort, Store};
+use agrisim_fmi::{InPort, Log, Store};
 use agrisim_msgs::geometry_msgs::Twist;
 use agrisim_msgs::Message;
 
@@ -24,36 +27,49 @@ impl Default for CommandIntake {
 
 impl CommandIntake {
     /// Takes the command present at initialization (scalar ports, or the message if one is set).
-    pub fn initialize(&mut self, io: &Store, t: f64) -> Result<(), String> {
+    pub fn initialize(&mut self, io: &Store, t: f64, log: &mut dyn Log) -> Result<(), String> {
         self.cmd_seq = io.i32(CMD_SEQ);
         self.cmd_vel.clear();
         self.latest = scalar_command(io)?;
-        self.take_messages(io)?;
+        self.take_messages(io, t, log)?;
         self.received_at = t;
         Ok(())
     }
 
     /// Looks for a fresh command at time `t` (start of a step). When both sources changed in
     /// the same step the message wins.
-    pub fn poll(&mut self, io: &Store, t: f64) -> Result<(), String> {
+    pub fn poll(&mut self, io: &Store, t: f64, log: &mut dyn Log) -> Result<(), String> {
         if io.i32(CMD_SEQ) != self.cmd_seq {
             self.cmd_seq = io.i32(CMD_SEQ);
             self.latest = scalar_command(io)?;
             self.received_at = t;
         }
-        if self.take_messages(io)? {
+        if self.take_messages(io, t, log)? {
             self.received_at = t;
         }
         Ok(())
     }
 
-    /// Every new Twist on cmd_vel, in order (each must be valid; the last one wins).
-    fn take_messages(&mut self, io: &Store) -> Result<bool, String> {
-        let msgs = self.cmd_vel.take(io, "cmd_vel")?;
+    /// Every new Twist on cmd_vel, in order (the last valid one wins); whether a valid one came.
+    fn take_messages(&mut self, io: &Store, t: f64, log: &mut dyn Log) -> Result<bool, String> {
+        let msgs = match self.cmd_vel.take(io, "cmd_vel") {
+            Ok(m) => m,
+            Err(e) => {
+                log.warning(format_args!("t={t} s: {e}; refused, the last valid command stays in force"));
+                return Ok(false);
+            }
+        };
+        let mut valid = false;
         for m in &msgs {
-            self.latest = decode_twist(m)?;
+            match decode_twist(m) {
+                Ok(c) => {
+                    self.latest = c;
+                    valid = true;
+                }
+                Err(e) => log.warning(format_args!("t={t} s: {e}; refused, the last valid command stays in force")),
+            }
         }
-        Ok(!msgs.is_empty())
+        Ok(valid)
     }
 
     /// The command to follow at `t`, or `None` when the watchdog has expired.

@@ -121,13 +121,39 @@ fn twist_message_is_followed_and_latest_wins() {
     assert!((io.f64(X) - 0.1).abs() < 1e-9 && (io.f64(Y) - 0.4).abs() < 1e-9);
 }
 
+/// Collects warnings.
+#[derive(Default)]
+struct Warnings(Vec<String>);
+
+impl agrisim_fmi::Log for Warnings {
+    fn info(&mut self, _: std::fmt::Arguments<'_>) {}
+    fn warning(&mut self, m: std::fmt::Arguments<'_>) {
+        self.0.push(m.to_string());
+    }
+}
+
 #[test]
-fn garbage_twist_is_an_error_naming_the_port() {
-    let (mut m, mut io) = start::<ChassisKinematic>(|_| {});
-    io.set_binary(CMD_VEL, &[0xde, 0xad, 0xbe]);
+fn garbage_twist_is_refused_with_a_warning_and_the_last_valid_command_stays() {
+    let (mut m, mut io) = start::<ChassisKinematic>(|io| {
+        ideal(io);
+        io.set_f64(CMD_TIMEOUT, 0.5);
+    });
+    let good = Twist { linear: Vector3 { x: 0.3, y: 0.0, z: 0.0 }, angular: Vector3::default() };
+    io.set_binary(CMD_VEL, &good.to_cdr());
     io.set_i64(CMD_VEL_SEQ, 1);
-    let err = m.do_step(&mut io, 0.0, H, &mut Quiet).unwrap_err();
-    assert!(err.contains("cmd_vel"), "{err}");
+    let mut log = Warnings::default();
+    m.do_step(&mut io, 0.0, H, &mut log).unwrap();
+    io.set_binary(CMD_VEL, &[0xde, 0xad, 0xbe]);
+    io.set_i64(CMD_VEL_SEQ, 2);
+    m.do_step(&mut io, H, H, &mut log).unwrap();
+    assert_eq!(log.0.len(), 1, "{:?}", log.0);
+    assert!(log.0[0].contains("cmd_vel") && log.0[0].contains("refused") && log.0[0].contains("t=0.02"), "{}", log.0[0]);
+    assert!(io.bool(CMD_ACTIVE) && (io.f64(VX) - 0.3).abs() < 1e-9, "the last valid command stays in force");
+    // ... until the watchdog: the refused message does not count as a command.
+    for k in 2..30 {
+        m.do_step(&mut io, k as f64 * H, H, &mut log).unwrap();
+    }
+    assert!(!io.bool(CMD_ACTIVE) && io.f64(VX).abs() < 1e-9, "the watchdog stopped the base");
 }
 
 #[test]

@@ -344,6 +344,20 @@ mod tests {
     }
 
     proptest! {
+        /// Random bytes, and valid lists with bytes flipped or cut: decode and the cursors
+        /// answer an error or frames, never panic.
+        #[test]
+        fn arbitrary_bytes_never_panic(bytes in prop::collection::vec(any::<u8>(), 0..200), flip in any::<usize>(), cut in any::<usize>()) {
+            let _ = decode(&bytes);
+            let mut good = list(&[(1, 0, &bytes[..bytes.len() / 2]), (2, 5, &bytes[bytes.len() / 2..])]);
+            let i = flip % good.len();
+            good[i] ^= 0x5a;
+            let good = &good[..good.len() - cut % good.len()];
+            let _ = decode(good);
+            let _ = Cursor::default().take(good, flip as u64);
+            let _ = Cursor::default().take_input(good, cut as u64);
+        }
+
         /// Any producer schedule read every `read` ns with a window of at least `read` ns
         /// delivers every message exactly once, in order; a shorter window is caught as a gap.
         #[test]

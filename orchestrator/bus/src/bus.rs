@@ -36,6 +36,8 @@ pub struct Bus {
     outbox: Vec<Published>,
     /// Topics with [`Reader`]s: the messages some reader has not taken yet.
     queues: BTreeMap<String, Queue>,
+    /// Messages a reader could not decode (skipped, not fatal), for the run's status log.
+    rejected: Vec<String>,
 }
 
 /// Messages of one topic kept for its readers, and where each reader is.
@@ -106,14 +108,17 @@ impl Reader {
         out
     }
 
-    /// Every message since the last call, oldest first, decoded.
+    /// Every message since the last call, oldest first, decoded; one that does not decode
+    /// is skipped and reported ([`Bus::take_rejected`]), never fatal.
     pub fn take<M: Message>(&mut self, bus: &mut Bus) -> Result<Vec<M>> {
         let samples = self.take_samples(bus);
-        let topic = &self.topic;
-        samples
-            .into_iter()
-            .map(|s| M::from_cdr(&s.cdr).map_err(|e| crate::err!("topic {topic}: message {} is not a valid {}: {e}", s.seq, M::TYPE_NAME)))
-            .collect()
+        let mut out = Vec::with_capacity(samples.len());
+        for s in samples {
+            if let Some(m) = bus.decode::<M>(&self.topic, &s) {
+                out.push(m);
+            }
+        }
+        Ok(out)
     }
 }
 
@@ -137,16 +142,32 @@ impl Bus {
         self.latest.get(topic)
     }
 
-    /// The latest message on `topic` if it is newer than `seen` (updated), decoded.
-    pub fn take_new<M: Message>(&self, topic: &str, seen: &mut u64) -> Result<Option<M>> {
+    /// The latest message on `topic` if it is newer than `seen` (updated), decoded; one
+    /// that does not decode is skipped and reported ([`Bus::take_rejected`]).
+    pub fn take_new<M: Message>(&mut self, topic: &str, seen: &mut u64) -> Result<Option<M>> {
         match self.latest.get(topic) {
             Some(s) if s.seq > *seen => {
                 *seen = s.seq;
-                let m = M::from_cdr(&s.cdr).map_err(|e| crate::err!("topic {topic}: message {} is not a valid {}: {e}", s.seq, M::TYPE_NAME))?;
-                Ok(Some(m))
+                let s = s.clone();
+                Ok(self.decode(topic, &s))
             }
             _ => Ok(None),
         }
+    }
+
+    fn decode<M: Message>(&mut self, topic: &str, s: &Sample) -> Option<M> {
+        match M::from_cdr(&s.cdr) {
+            Ok(m) => Some(m),
+            Err(e) => {
+                self.rejected.push(format!("topic {topic}: message {} ({} bytes, published at t={} s) is not a valid {}: {e}; skipped", s.seq, s.cdr.len(), s.time_ns as f64 / 1e9, M::TYPE_NAME));
+                None
+            }
+        }
+    }
+
+    /// Reports of messages readers skipped since the last call.
+    pub fn take_rejected(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.rejected)
     }
 
     pub fn set_scalar(&mut self, name: &str, value: f64) {

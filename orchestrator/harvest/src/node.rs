@@ -177,7 +177,7 @@ impl HarvestNode {
         v.commanded.or(v.q).unwrap_or(super::motion::HOME)
     }
 
-    fn read(&mut self, bus: &Bus) -> Result<()> {
+    fn read(&mut self, bus: &mut Bus) -> Result<()> {
         if let Some(p) = bus.take_new::<PoseStamped>(topics::TARGET, &mut self.target_seen)? {
             self.target_map = Some([p.pose.position.x, p.pose.position.y, p.pose.position.z]);
             self.target_stamp_ns = p.header.stamp.to_nanos();

@@ -19,15 +19,20 @@ pub fn decode_xyz(cloud: &PointCloud2) -> Result<Vec<[f32; 3]>> {
     let fy = field("y")?;
     let fz = field("z")?;
     let step = cloud.point_step as usize;
-    let n = cloud.width as usize * cloud.height.max(1) as usize;
-    let row_step = (cloud.row_step as usize).max(cloud.width as usize * step);
+    let (width, rows) = (cloud.width as usize, cloud.height.max(1) as usize);
     let need = |f: (usize, u8)| f.0 + if f.1 == PointField::FLOAT32 { 4 } else { 8 };
     if step == 0 || need(fx).max(need(fy)).max(need(fz)) > step {
         return Err(err!("PointCloud2 point_step {step} does not hold its x, y, z fields"));
     }
-    let rows = cloud.height.max(1) as usize;
-    if cloud.data.len() < (rows - 1) * row_step + cloud.width as usize * step {
-        return Err(err!("PointCloud2 data has {} bytes, fewer than {n} points of {step}", cloud.data.len()));
+    // Sizes from the header are untrusted: every product is checked, so a crafted header is
+    // an error, never an overflow or an out-of-bounds read.
+    let too_big = || err!("PointCloud2 of {width} x {rows} points of {step} bytes (row_step {}) does not fit in {} bytes of data", cloud.row_step, cloud.data.len());
+    let row_bytes = width.checked_mul(step).ok_or_else(too_big)?;
+    let row_step = (cloud.row_step as usize).max(row_bytes);
+    let n = width.checked_mul(rows).ok_or_else(too_big)?;
+    let end = (rows - 1).checked_mul(row_step).and_then(|b| b.checked_add(row_bytes)).ok_or_else(too_big)?;
+    if cloud.data.len() < end {
+        return Err(too_big());
     }
     let big = cloud.is_bigendian;
     let read = |p: &[u8], (off, dt): (usize, u8)| -> f32 {
@@ -86,5 +91,20 @@ mod tests {
         bad = c;
         bad.data.truncate(20);
         assert!(decode_xyz(&bad).is_err());
+    }
+
+    proptest::proptest! {
+        /// Crafted headers (sizes up to u32::MAX, fields anywhere) over a little data: an
+        /// error or points, never a panic or an overflow.
+        #[test]
+        fn crafted_clouds_never_panic(width in proptest::prelude::any::<u32>(), height in proptest::prelude::any::<u32>(), point_step in 0u32..64, row_step in proptest::prelude::any::<u32>(),
+                                      offsets in proptest::collection::vec(0u32..80, 3), datatypes in proptest::collection::vec(6u8..9, 3), len in 0usize..512, small in proptest::prelude::any::<bool>()) {
+            let fields = ["x", "y", "z"].iter().zip(offsets.iter().zip(&datatypes)).map(|(n, (&offset, &datatype))| PointField { name: n.to_string(), offset, datatype, count: 1 }).collect();
+            let (width, height) = if small { (width % 9, height % 5) } else { (width, height) };
+            let c = PointCloud2 { header: Header::default(), height, width, fields, is_bigendian: len % 2 == 0, point_step, row_step, data: vec![0x3f; len], is_dense: false };
+            if let Ok(points) = decode_xyz(&c) {
+                proptest::prop_assert!(points.len() <= len);
+            }
+        }
     }
 }

@@ -181,6 +181,20 @@ impl Hooks for Link<'_> {
     }
 
     fn point(&mut self, system: &mut System, t_ns: i64) -> Result<()> {
+        // Warnings of the point (a refused command, a message a node could not decode): on
+        // stderr and in the log, and the run goes on.
+        let header = Header { stamp: Time::from_nanos(t_ns), frame_id: String::new() };
+        for c in &mut system.components {
+            for m in c.instance.take_log().into_iter().filter(|m| m.status >= agrisim_cosim::fmi3::Status::Warning) {
+                let msg = FmuStatus { header: header.clone(), instance: c.name.clone(), status: "warning".into(), message: m.message };
+                self.recorder.publish(STATUS_TOPIC, t_ns, &msg)?;
+            }
+        }
+        for reason in self.bus.take_rejected() {
+            eprintln!("warning: {reason}");
+            let msg = FmuStatus { header: header.clone(), instance: String::new(), status: "warning".into(), message: reason };
+            self.recorder.publish(STATUS_TOPIC, t_ns, &msg)?;
+        }
         for m in self.bus.drain() {
             let ch = self.recorder.channel(&m.topic, &m.type_name)?;
             self.recorder.write(ch, m.time_ns, &m.cdr)?;
