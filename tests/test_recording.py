@@ -144,3 +144,25 @@ def test_profiles_change_the_recording_not_the_verdict(tmp_path):
     assert seen["standard"]["/cmd_vel"] == seen["full"]["/cmd_vel"] and seen["standard"]["/odom"] == seen["full"]["/odom"]
     assert seen["standard"]["/points"] <= seen["full"]["/points"] // 10 + 1
     assert seen["standard"]["/fruits"] == 1
+
+
+def test_a_trial_whose_process_dies_is_an_error_and_the_benchmark_goes_on(tmp_path):
+    """Trials run in worker processes: an abort in one (here SIGABRT sent to the worker, as a
+    foreign FMU's failed C assertion raises) is that trial's error outcome. (An external
+    SIGSEGV would not do: Rust's stack-overflow handler ignores a SIGSEGV that is not a fault.)"""
+    out = tmp_path / "bench"
+    p = start("bench", "nav", "--trials", "3", "--seed", "5", "--record", "none", "--jobs", "1", "--out", str(out))
+    try:
+        wait_for(out / "trials" / "0001.mcap.part")
+        worker = subprocess.run(["pgrep", "-f", "--", f"--out {out} --worker-trial 1"], capture_output=True, text=True).stdout.split()
+        assert len(worker) == 1, worker
+        subprocess.run(["kill", "-ABRT", worker[0]], check=True)
+        stdout, err = p.communicate(timeout=300)
+    finally:
+        p.kill()
+    assert p.returncode == 0, err
+    trials = [json.loads(l) for l in (out / "trials.jsonl").read_text().splitlines()]
+    assert [t["trial"] for t in trials] == [0, 1, 2]
+    assert trials[1]["outcome"] == "failure" and "signal 6 (SIGABRT)" in trials[1]["reason"], trials[1]
+    assert trials[2]["sim_time"] > 0, "the benchmark went on after the crash"
+    assert json.loads(stdout)["trials"] == 3

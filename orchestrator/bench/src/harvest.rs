@@ -8,7 +8,7 @@
 //! (robot against structure, arm against arm, base against anything), within the time
 //! limit. Planning success means every motion the trial asked for was planned.
 
-use crate::trials::{run_trials, write_summary};
+use crate::trials::{run_one, run_trials, write_summary, Exec};
 use super::harvest_targets::{draw, eligible, HarvestTarget};
 use super::map::{building_plan, grid_message};
 use super::nav::trial_seed;
@@ -287,13 +287,59 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
 }
 
 /// Runs `trials` trials and writes trials.jsonl, summary.json and trials/*.mcap.
-pub fn bench_harvest(s: &Scenario, o: &RunOptions, trials: u64, seed: u64, out: &Path, resume: bool, progress: impl FnMut(u64, u64)) -> Result<HarvestSummary> {
+#[allow(clippy::too_many_arguments)]
+pub fn bench_harvest(s: &Scenario, o: &RunOptions, trials: u64, seed: u64, out: &Path, resume: bool, exec: Exec, progress: impl FnMut(u64, u64)) -> Result<HarvestSummary> {
     let o = o.record_default(s, agrisim_session::Profile::Standard);
     let setup = HarvestSetup::new(s)?;
-    let done = run_trials(out, trials, resume, progress, |i, mcap| run_trial(s, &o, &setup, i, trial_seed(seed, i), mcap), |t| serde_json::to_string(t).expect("plain struct"))?;
+    let done = run_trials(
+        out,
+        trials,
+        resume,
+        exec,
+        progress,
+        |i, mcap| run_trial(s, &o, &setup, i, trial_seed(seed, i), mcap),
+        |i, reason| failed_trial(&setup, i, trial_seed(seed, i), reason),
+        |t| serde_json::to_string(t).expect("plain struct"),
+    )?;
     let summary = summarize(s, seed, &done.results);
     write_summary(out, &summary, done.interrupted)?;
     Ok(summary)
+}
+
+/// A worker process's job: harvest trial `i` of the benchmark `bench_harvest` runs.
+pub fn harvest_worker(s: &Scenario, o: &RunOptions, seed: u64, out: &Path, i: u64) -> Result<()> {
+    let o = o.record_default(s, agrisim_session::Profile::Standard);
+    let setup = HarvestSetup::new(s)?;
+    run_one(out, i, |i, mcap| run_trial(s, &o, &setup, i, trial_seed(seed, i), mcap))
+}
+
+/// The record of a trial whose process died: an error, with its target (drawn as the trial
+/// draws it) and the reason.
+fn failed_trial(setup: &HarvestSetup, index: u64, seed: u64, reason: String) -> HarvestTrial {
+    let target = draw(&setup.candidates, &setup.layout, &mut Rng::new(seed)).expect("candidates checked non-empty");
+    HarvestTrial {
+        trial: index,
+        seed,
+        fruit_index: target.fruit_index,
+        fruit_id: target.object_id,
+        fruit_name: target.name.clone(),
+        fruit: target.center,
+        start: target.start,
+        outcome: "failure".into(),
+        failure: Some("error".into()),
+        failed_stage: None,
+        detail: reason,
+        planning_ok: false,
+        plans: 0,
+        planning_times: vec![],
+        time_to_harvest: None,
+        placed_count: 0,
+        contacts: BTreeMap::new(),
+        tracking_rms: [0.0; 2],
+        sim_time: 0.0,
+        wall_time: 0.0,
+        mcap: format!("trials/{index:04}.mcap"),
+    }
 }
 
 pub fn summarize(s: &Scenario, seed: u64, results: &[HarvestTrial]) -> HarvestSummary {

@@ -6,7 +6,7 @@
 //! or in failure with a reason: collision, timeout, no_path, stuck, goal_missed, error.
 //! Ground truth is read here only to judge; the navigation stack never sees it.
 
-use crate::trials::{run_trials, write_summary};
+use crate::trials::{run_one, run_trials, write_summary, Exec};
 use super::report::{render, TrialTrace};
 use super::stats::{wilson, Z95};
 use super::targets::draw_target;
@@ -83,6 +83,35 @@ impl NavSetup {
         let truth = OccupancyMap::from_objects(&g.objects, MAP_RESOLUTION, MAP_BAND, g.layout.bounds);
         Ok(NavSetup { layout: g.layout, objects: g.objects, map, truth })
     }
+}
+
+/// A worker process's job: nav trial `i` of the benchmark `bench_nav` runs.
+pub fn nav_worker(s: &Scenario, o: &RunOptions, seed: u64, out: &Path, i: u64) -> Result<()> {
+    let o = o.record_default(s, agrisim_session::Profile::Standard);
+    let setup = NavSetup::new(s)?;
+    run_one(out, i, |i, mcap| nav_record(s, &o, &setup, seed, i, mcap))
+}
+
+/// The record of a trial whose process died: an error, with its target (drawn as the trial
+/// draws it) and the reason.
+fn failed_trial(s: &Scenario, setup: &NavSetup, index: u64, seed: u64, reason: String) -> NavRecord {
+    let nav = &s.nav;
+    let target = draw_target(&setup.layout, &setup.truth, &mut Rng::new(seed), nav.targets_in_headland, nav.aisle_margin, 0.7).unwrap_or([0.0; 3]);
+    let trial = NavTrial {
+        trial: index,
+        seed,
+        target,
+        outcome: "failure".into(),
+        reason: Some(format!("error: {reason}")),
+        time_to_goal: None,
+        path_length: 0.0,
+        min_clearance: 0.0,
+        final_localization_error: None,
+        sim_time: 0.0,
+        wall_time: 0.0,
+        mcap: format!("trials/{index:04}.mcap"),
+    };
+    NavRecord { trial, path: vec![] }
 }
 
 /// Runs one trial into `mcap`.
@@ -186,18 +215,23 @@ struct NavRecord {
     path: Vec<[f64; 2]>,
 }
 
-pub fn bench_nav(s: &Scenario, o: &RunOptions, trials: u64, seed: u64, out: &Path, resume: bool, progress: impl FnMut(u64, u64)) -> Result<NavSummary> {
+fn nav_record(s: &Scenario, o: &RunOptions, setup: &NavSetup, seed: u64, i: u64, mcap: &Path) -> Result<NavRecord> {
+    let (trial, path) = run_trial(s, o, setup, i, trial_seed(seed, i), mcap)?;
+    Ok(NavRecord { trial, path: decimate(&path, 10) })
+}
+
+#[allow(clippy::too_many_arguments)]
+pub fn bench_nav(s: &Scenario, o: &RunOptions, trials: u64, seed: u64, out: &Path, resume: bool, exec: Exec, progress: impl FnMut(u64, u64)) -> Result<NavSummary> {
     let o = o.record_default(s, agrisim_session::Profile::Standard);
     let setup = NavSetup::new(s)?;
     let done = run_trials(
         out,
         trials,
         resume,
+        exec,
         progress,
-        |i, mcap| {
-            let (trial, path) = run_trial(s, &o, &setup, i, trial_seed(seed, i), mcap)?;
-            Ok(NavRecord { trial, path: decimate(&path, 10) })
-        },
+        |i, mcap| nav_record(s, &o, &setup, seed, i, mcap),
+        |i, reason| failed_trial(s, &setup, i, trial_seed(seed, i), reason),
         |r| serde_json::to_string(&r.trial).expect("plain struct"),
     )?;
     let traces: Vec<TrialTrace> = done
@@ -278,6 +312,7 @@ pub fn summarize(s: &Scenario, seed: u64, results: &[NavTrial]) -> NavSummary {
         wall_time: wall,
         time_to_goal_mean: if ttg.is_empty() { None } else { Some(ttg.iter().sum::<f64>() / ttg.len() as f64) },
         path_length_mean: if n == 0 { 0.0 } else { results.iter().map(|t| t.path_length).sum::<f64>() / n as f64 },
-        min_clearance_min: results.iter().map(|t| t.min_clearance).fold(f64::INFINITY, f64::min),
+        // Over the trials that drove (a trial whose process died has no clearance).
+        min_clearance_min: results.iter().filter(|t| t.sim_time > 0.0).map(|t| t.min_clearance).fold(f64::INFINITY, f64::min),
     }
 }

@@ -2,15 +2,29 @@
 //! `trials/NNNN.json` (both written under a temporary name and renamed when complete), one
 //! line of `trials.jsonl` each; a stop request (Ctrl-C) ends the loop after the trial it
 //! interrupts, which is marked as such; `resume` keeps the trials whose files are complete.
-//! Trial i depends only on (seed, i), so a resumed benchmark sums up exactly as an
-//! uninterrupted one.
+//! Trials run in this process, or each in a worker process ([`Exec::Workers`], up to `jobs`
+//! at once): a trial whose process dies (an FMU that aborts or segfaults) is then recorded
+//! as an error with the reason, and the benchmark goes on. Trial i depends only on
+//! (seed, i), so the results are the same whatever the execution, and a resumed benchmark
+//! sums up exactly as an uninterrupted one.
 
 use agrisim_error::{err, Context, Result};
 use agrisim_session::interrupt;
 use serde::de::DeserializeOwned;
 use serde::Serialize;
+use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::process::{Child, Command, ExitStatus};
+
+/// How trials are executed.
+pub enum Exec<'a> {
+    /// One after the other in this process.
+    InProcess,
+    /// Each in its own process, `jobs` at once; `command(i)` runs trial i and writes its
+    /// files (the CLI runs itself with `--worker-trial i`, which calls [`run_one`]).
+    Workers { jobs: usize, command: &'a dyn Fn(u64) -> Command },
+}
 
 /// What the loop produced.
 pub struct Completed<R> {
@@ -34,8 +48,168 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 }
 
 /// Runs trials `0..n` in `out/trials/`. `trial(i, mcap)` runs one trial into `mcap`;
-/// `line(result)` is its trials.jsonl line.
+/// `failed(i, reason)` is the result of a trial whose worker process died; `line(result)`
+/// is its trials.jsonl line.
+#[allow(clippy::too_many_arguments)]
 pub fn run_trials<R: Serialize + DeserializeOwned>(
+    out: &Path,
+    n: u64,
+    resume: bool,
+    exec: Exec,
+    progress: impl FnMut(u64, u64),
+    trial: impl FnMut(u64, &Path) -> Result<R>,
+    failed: impl Fn(u64, String) -> R,
+    line: impl Fn(&R) -> String,
+) -> Result<Completed<R>> {
+    match exec {
+        Exec::InProcess => run_in_process(out, n, resume, progress, trial, line),
+        Exec::Workers { jobs, command } => run_in_workers(out, n, resume, jobs.max(1), command, progress, failed, line),
+    }
+}
+
+/// A worker's job: trial `i` into `out/trials/`, its result written when it completed
+/// (not when a stop request cut it short).
+pub fn run_one<R: Serialize>(out: &Path, i: u64, trial: impl FnOnce(u64, &Path) -> Result<R>) -> Result<()> {
+    let dir = out.join("trials");
+    std::fs::create_dir_all(&dir).context(|| format!("cannot create {}", dir.display()))?;
+    let r = trial(i, &trial_file(&dir, i, "mcap"))?;
+    if !interrupt::requested() {
+        write_atomic(&trial_file(&dir, i, "json"), serde_json::to_string(&r).expect("plain struct").as_bytes())?;
+    }
+    Ok(())
+}
+
+fn load<R: DeserializeOwned>(json: &Path) -> Result<R> {
+    let text = std::fs::read_to_string(json).context(|| format!("cannot read {}", json.display()))?;
+    serde_json::from_str::<R>(&text).map_err(|e| err!("{}: not a trial result of this benchmark ({e}); remove it to run the trial again", json.display()))
+}
+
+/// Why a worker process ended without a result.
+fn death(status: ExitStatus) -> String {
+    use std::os::unix::process::ExitStatusExt;
+    match status.signal() {
+        Some(sig) => {
+            let name = match sig {
+                4 => " (SIGILL)",
+                6 => " (SIGABRT)",
+                7 => " (SIGBUS)",
+                8 => " (SIGFPE)",
+                9 => " (SIGKILL)",
+                11 => " (SIGSEGV)",
+                15 => " (SIGTERM)",
+                _ => "",
+            };
+            format!("the trial's process was killed by signal {sig}{name}")
+        }
+        None => format!("the trial's process exited with status {} without a result", status.code().unwrap_or(-1)),
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run_in_workers<R: Serialize + DeserializeOwned>(
+    out: &Path,
+    n: u64,
+    resume: bool,
+    jobs: usize,
+    command: &dyn Fn(u64) -> Command,
+    mut progress: impl FnMut(u64, u64),
+    failed: impl Fn(u64, String) -> R,
+    line: impl Fn(&R) -> String,
+) -> Result<Completed<R>> {
+    let dir = out.join("trials");
+    std::fs::create_dir_all(&dir).context(|| format!("cannot create {}", dir.display()))?;
+    let jsonl_path = out.join("trials.jsonl");
+    let mut jsonl = std::fs::File::create(&jsonl_path).context(|| format!("cannot create {}", jsonl_path.display()))?;
+    let mut done = Completed { results: vec![], interrupted: None, resumed: 0 };
+    // Finished trials waiting for their turn in trials.jsonl (None: interrupted).
+    let mut finished: BTreeMap<u64, Option<R>> = BTreeMap::new();
+    let mut running: Vec<(u64, Child)> = vec![];
+    let (mut next, mut emitted) = (0u64, 0u64);
+    let mut forwarded = false;
+    loop {
+        if interrupt::requested() && !forwarded {
+            // A stop request reaches the running trials too (a terminal's Ctrl-C already
+            // does; a SIGTERM to this process alone would not).
+            for (_, child) in &running {
+                // SAFETY: kill(2) on a child of ours that has not been waited for.
+                unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) };
+            }
+            forwarded = true;
+        }
+        while running.len() < jobs && next < n && !interrupt::requested() {
+            let (mcap, json) = (trial_file(&dir, next, "mcap"), trial_file(&dir, next, "json"));
+            if resume && mcap.is_file() && json.is_file() {
+                finished.insert(next, Some(load(&json)?));
+                done.resumed += 1;
+            } else {
+                let _ = std::fs::remove_file(&json);
+                let child = command(next).spawn().context(|| format!("cannot start the worker of trial {next}"))?;
+                running.push((next, child));
+            }
+            next += 1;
+        }
+        if running.is_empty() && (next >= n || interrupt::requested()) && finished.is_empty() {
+            break;
+        }
+        let mut any = false;
+        let mut k = 0;
+        while k < running.len() {
+            match running[k].1.try_wait().context(|| format!("waiting for the worker of trial {}", running[k].0))? {
+                Some(status) => {
+                    let (i, _) = running.remove(k);
+                    let json = trial_file(&dir, i, "json");
+                    let result = if json.is_file() {
+                        Some(load(&json)?)
+                    } else if interrupt::requested() || status.code() == Some(130) {
+                        None
+                    } else {
+                        let r = failed(i, death(status));
+                        write_atomic(&json, serde_json::to_string(&r).expect("plain struct").as_bytes())?;
+                        Some(r)
+                    };
+                    finished.insert(i, result);
+                    any = true;
+                }
+                None => k += 1,
+            }
+        }
+        // In order: the next trial's result, if it is in.
+        while let Some(entry) = finished.remove(&emitted) {
+            match entry {
+                Some(r) if done.interrupted.is_none() => {
+                    writeln!(jsonl, "{}", line(&r)).context(|| jsonl_path.display().to_string())?;
+                    done.results.push(r);
+                    progress(emitted + 1, n);
+                }
+                Some(_) => {}
+                None => {
+                    if done.interrupted.is_none() {
+                        done.interrupted = Some(emitted);
+                        writeln!(jsonl, "{{\"trial\":{emitted},\"outcome\":\"interrupted\"}}").context(|| jsonl_path.display().to_string())?;
+                    }
+                }
+            }
+            emitted += 1;
+        }
+        if running.is_empty() && interrupt::requested() {
+            if done.interrupted.is_none() && emitted < n {
+                done.interrupted = Some(emitted);
+                writeln!(jsonl, "{{\"trial\":{emitted},\"outcome\":\"interrupted\"}}").context(|| jsonl_path.display().to_string())?;
+            }
+            break;
+        }
+        if running.is_empty() && next >= n && finished.is_empty() {
+            break;
+        }
+        if !any {
+            // Polling the workers' exit: wall-clock waiting, never an input to results.
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        }
+    }
+    Ok(done)
+}
+
+fn run_in_process<R: Serialize + DeserializeOwned>(
     out: &Path,
     n: u64,
     resume: bool,
@@ -51,8 +225,7 @@ pub fn run_trials<R: Serialize + DeserializeOwned>(
     for i in 0..n {
         let (mcap, json) = (trial_file(&dir, i, "mcap"), trial_file(&dir, i, "json"));
         let earlier = if resume && mcap.is_file() && json.is_file() {
-            let text = std::fs::read_to_string(&json).context(|| format!("cannot read {}", json.display()))?;
-            Some(serde_json::from_str::<R>(&text).map_err(|e| err!("{}: not a trial result of this benchmark ({e}); remove it to run the trial again", json.display()))?)
+            Some(load::<R>(&json)?)
         } else {
             None
         };

@@ -143,6 +143,16 @@ struct TrialArgs {
     /// Keep the trials already complete in DIR (an interrupted run) and run the others.
     #[arg(long)]
     resume: bool,
+    /// Trials run at once, each in its own worker process (a trial whose process dies, e.g.
+    /// a foreign FMU that segfaults, is recorded as an error and the benchmark goes on).
+    #[arg(long, default_value_t = 1)]
+    jobs: usize,
+    /// Run the trials one after the other inside this process (no worker processes).
+    #[arg(long, conflicts_with = "jobs")]
+    in_process: bool,
+    /// Internal: run trial N only, as a worker process of a benchmark.
+    #[arg(long, hide = true)]
+    worker_trial: Option<u64>,
     #[arg(long)]
     out: PathBuf,
 }
@@ -254,6 +264,23 @@ fn main() -> ExitCode {
     }
 }
 
+/// This very command line, as a worker process that runs trial `i` only.
+fn worker_command(i: u64) -> std::process::Command {
+    let exe = std::env::current_exe().unwrap_or_else(|_| PathBuf::from("agrisim"));
+    let mut c = std::process::Command::new(exe);
+    c.args(std::env::args_os().skip(1)).arg("--worker-trial").arg(i.to_string()).stdin(std::process::Stdio::null()).stdout(std::process::Stdio::null());
+    c
+}
+
+/// How a benchmark runs its trials.
+fn exec<'a>(a: &TrialArgs, command: &'a dyn Fn(u64) -> std::process::Command) -> agrisim_bench::trials::Exec<'a> {
+    if a.in_process {
+        agrisim_bench::trials::Exec::InProcess
+    } else {
+        agrisim_bench::trials::Exec::Workers { jobs: a.jobs, command }
+    }
+}
+
 /// The scenario (or the benchmark's default) and run options of a many-trial benchmark.
 fn trial_setup(a: &TrialArgs, default_scenario: &str, target: &Path) -> Result<(Scenario, RunOptions)> {
     let s = Scenario::load(a.scenario.as_deref().unwrap_or(Path::new(default_scenario)))?;
@@ -280,12 +307,20 @@ fn real_main() -> Result<()> {
         }
         Command::Bench { command: BenchCommand::Nav(a) } => {
             let (s, opts) = trial_setup(&a, "models/scenarios/default.toml", &target)?;
-            let summary = agrisim_bench::nav::bench_nav(&s, &opts, a.trials, a.seed, &a.out, a.resume, progress_printer())?;
+            if let Some(i) = a.worker_trial {
+                return agrisim_bench::nav::nav_worker(&s, &opts, a.seed, &a.out, i);
+            }
+            let command = worker_command;
+            let summary = agrisim_bench::nav::bench_nav(&s, &opts, a.trials, a.seed, &a.out, a.resume, exec(&a, &command), progress_printer())?;
             println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
         }
         Command::Bench { command: BenchCommand::Harvest(a) } => {
             let (s, opts) = trial_setup(&a, "models/scenarios/harvest.toml", &target)?;
-            let summary = agrisim_bench::harvest::bench_harvest(&s, &opts, a.trials, a.seed, &a.out, a.resume, progress_printer())?;
+            if let Some(i) = a.worker_trial {
+                return agrisim_bench::harvest::harvest_worker(&s, &opts, a.seed, &a.out, i);
+            }
+            let command = worker_command;
+            let summary = agrisim_bench::harvest::bench_harvest(&s, &opts, a.trials, a.seed, &a.out, a.resume, exec(&a, &command), progress_printer())?;
             println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
         }
         Command::Bench { command: BenchCommand::Overhead { scenario, steps, dirs, log, out } } => {
