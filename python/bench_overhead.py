@@ -12,7 +12,8 @@ FMUs (ChassisKinematic, Lift) through FMPy's FMU3Slave with the work the master 
     scalar input/output of both FMUs read one by one (as the recorder does), doStep on both;
 
 then a bare doStep loop on the same instances. The FMPy loop does not write an MCAP; the
-orchestrator's figure includes recording. As a sanity check, the FMPy loop's last scalar
+orchestrator's figure includes recording, and it is measured a second time without
+(`--record none`). As a sanity check, the FMPy loop's last scalar
 readings must equal the orchestrator's recorded ones (same work, same answers).
 
 Usage: .venv/bin/python python/bench_overhead.py --steps 20000
@@ -58,12 +59,17 @@ def main() -> int:
     ap.add_argument("--steps", type=int, default=20000)
     ap.add_argument("--scenario", type=Path, default=DEFAULT_SCENARIO)
     args = ap.parse_args()
+    if args.steps < 2:
+        ap.error("--steps must be at least 2")
     n = args.steps
 
     with tempfile.TemporaryDirectory(prefix="agrisim-bench-") as tmp:
         tmp = Path(tmp)
         p = run_agrisim("bench", "overhead", "--scenario", str(args.scenario), "--steps", str(n), "--out", str(tmp / "bench"))
         agrisim = json.loads(p.stdout)
+        # The same run without recording (the inputs the FMPy loop replays come from the one above).
+        p = run_agrisim("bench", "overhead", "--scenario", str(args.scenario), "--steps", str(n), "--record", "none", "--out", str(tmp / "bench_none"))
+        agrisim_unrecorded = json.loads(p.stdout)
         meta, cmd, setpoint, recorded = recorded_inputs(tmp / "bench" / "bench.mcap")
         step_ns = round(float(meta["agrisim.run"]["step"]) * 1e9)
         message_ticks = round(1e9 / float(meta["agrisim.run"]["message_rate"]) / step_ns)
@@ -139,7 +145,9 @@ def main() -> int:
         "fmus": 2,
         "agrisim": agrisim,
         "fmpy": fmpy,
+        "agrisim_without_recording": agrisim_unrecorded,
         "ratio_fmpy_loop_over_agrisim_master": fmpy["loop_us_per_fmu_step"] / agrisim["master_us_per_fmu_step"],
+        "ratio_fmpy_loop_over_agrisim_master_without_recording": fmpy["loop_us_per_fmu_step"] / agrisim_unrecorded["master_us_per_fmu_step"],
         "ratio_fmpy_overhead_over_agrisim_overhead": fmpy["overhead_us_per_fmu_step"] / agrisim["overhead_us_per_fmu_step"],
         "fmpy_loop_records_mcap": False,
         "fmpy_vs_recorded_last_signals_max_abs_error": err,

@@ -344,6 +344,7 @@ mod tests {
     }
 
     proptest! {
+        #![proptest_config(ProptestConfig::with_cases(20_000))]
         /// Random bytes, and valid lists with bytes flipped or cut: decode and the cursors
         /// answer an error or frames, never panic.
         #[test]

@@ -3,8 +3,9 @@
 //! Point clouds and images are nearly all of a run's bytes (84-86 % raw, 99 % compressed),
 //! while judges and most analyses need the commands, states and events. Profiles:
 //! - `full`: every message;
-//! - `standard` (benchmarks' default): every message except point clouds and images (one per
-//!   second), the fruit list (once: it rarely changes) and the FMUs' signals (10 Hz);
+//! - `standard` (benchmarks' default): every message except point clouds and images (one
+//!   every 5 s: a trial stays under 5 MB), the fruit list (once: it rarely changes) and the
+//!   FMUs' signals (10 Hz);
 //! - `judge`: what the judges read (harvest and navigation status and plans, collision
 //!   states, run status) and the world's and chassis' ground-truth signals at 10 Hz;
 //! - `none`: no messages (the file keeps its metadata).
@@ -73,6 +74,8 @@ fn matches(pattern: &str, topic: &str) -> bool {
     }
 }
 
+/// Period of point clouds and images in the `standard` profile [s].
+pub const HEAVY_PERIOD: f64 = 5.0;
 const HEAVY_TYPES: [&str; 2] = ["sensor_msgs/msg/PointCloud2", "sensor_msgs/msg/Image"];
 const JUDGE_TOPICS: [&str; 6] = ["/harvest/status", "/harvest/plans", "/navigate/status", "/collision", "/agrisim/status", "/harvest/target_id"];
 const GROUND_TRUTH_SIGNALS: [&str; 2] = ["/fmu/world/signals", "/fmu/chassis/signals"];
@@ -107,7 +110,7 @@ impl RecordPolicy {
         match self.profile {
             Profile::Full => Rule::Keep,
             Profile::None => Rule::Drop,
-            Profile::Standard if HEAVY_TYPES.contains(&type_name) => Rule::Every(1.0),
+            Profile::Standard if HEAVY_TYPES.contains(&type_name) => Rule::Every(HEAVY_PERIOD),
             Profile::Standard if topic == "/fruits" => Rule::Once,
             Profile::Standard if signals => Rule::Every(0.1),
             Profile::Standard => Rule::Keep,
@@ -154,7 +157,7 @@ mod tests {
     #[test]
     fn profiles_and_overrides() {
         let std = RecordPolicy::profile(Profile::Standard);
-        assert_eq!(std.rule("/points", "sensor_msgs/msg/PointCloud2"), Rule::Every(1.0));
+        assert_eq!(std.rule("/points", "sensor_msgs/msg/PointCloud2"), Rule::Every(5.0));
         assert_eq!(std.rule("/cmd_vel", "geometry_msgs/msg/Twist"), Rule::Keep);
         assert_eq!(std.rule("/fruits", "geometry_msgs/msg/PoseArray"), Rule::Once);
         assert_eq!(std.rule("/fmu/imu/signals", "agrisim_msgs/msg/Signals"), Rule::Every(0.1));

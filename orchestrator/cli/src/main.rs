@@ -116,6 +116,9 @@ enum BenchCommand {
         dirs: Dirs,
         #[command(flatten)]
         log: FmuLog,
+        /// Recording profile of the measured run (default full: every message and signal).
+        #[arg(long)]
+        record: Option<Profile>,
         #[arg(long)]
         out: PathBuf,
     },
@@ -323,9 +326,10 @@ fn real_main() -> Result<()> {
             let summary = agrisim_bench::harvest::bench_harvest(&s, &opts, a.trials, a.seed, &a.out, a.resume, exec(&a, &command), progress_printer())?;
             println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
         }
-        Command::Bench { command: BenchCommand::Overhead { scenario, steps, dirs, log, out } } => {
+        Command::Bench { command: BenchCommand::Overhead { scenario, steps, dirs, log, record, out } } => {
             let s = Scenario::load(&scenario)?;
-            let opts = run_options(dirs, &target, None, None, BTreeMap::new(), log.categories());
+            let mut opts = run_options(dirs, &target, None, None, BTreeMap::new(), log.categories());
+            opts.record = record;
             let report = agrisim_bench::overhead(&s, &opts, steps, &out)?;
             println!("{}", serde_json::to_string_pretty(&report).expect("plain struct serializes"));
         }

@@ -94,6 +94,7 @@ mod tests {
     }
 
     proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(20_000))]
         /// Crafted headers (sizes up to u32::MAX, fields anywhere) over a little data: an
         /// error or points, never a panic or an overflow.
         #[test]
