@@ -217,7 +217,7 @@ def test_profiles_change_the_recording_not_the_verdict(tmp_path):
     assert set(seen["judge"]) <= {"/navigate/status", "/collision", "/agrisim/status", "/fmu/world/signals", "/fmu/chassis/signals"}
     # standard: every command and pose message, the point clouds every 5 s, the fruit list once.
     assert seen["standard"]["/cmd_vel"] == seen["full"]["/cmd_vel"] and seen["standard"]["/odom"] == seen["full"]["/odom"]
-    assert seen["standard"]["/imu"] == seen["full"]["/imu"]
+    assert seen["standard"]["/imu"] <= seen["full"]["/imu"] // 4 + 1
     assert seen["standard"]["/points"] <= seen["full"]["/points"] // 50 + 1
     assert sizes["standard"] <= 5_000_000, sizes
     assert seen["standard"]["/fruits"] == 1

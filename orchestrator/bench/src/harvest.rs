@@ -262,13 +262,6 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
     }
     let planning_ok = reports.plans.iter().all(|p| p.ok || p.optional) && failure.as_deref() != Some("planning");
     Ok(HarvestTrial {
-        trial: index,
-        seed,
-        fruit_index: target.fruit_index,
-        fruit_id: target.object_id,
-        fruit_name: target.name.clone(),
-        fruit: target.center,
-        start: target.start,
         outcome: if failure.is_none() { "success" } else { "failure" }.to_string(),
         failed_stage: failure.as_ref().and(failed_stage),
         failure,
@@ -283,6 +276,7 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
         sim_time,
         wall_time: wall.elapsed().as_secs_f64(),
         mcap: mcap.file_name().map(|f| format!("trials/{}", f.to_string_lossy())).unwrap_or_default(),
+        ..HarvestTrial::of_target(index, seed, &target)
     })
 }
 
@@ -317,28 +311,35 @@ pub fn harvest_worker(s: &Scenario, o: &RunOptions, seed: u64, out: &Path, i: u6
 /// draws it) and the reason.
 fn failed_trial(setup: &HarvestSetup, index: u64, seed: u64, reason: String) -> HarvestTrial {
     let target = draw(&setup.candidates, &setup.layout, &mut Rng::new(seed)).expect("candidates checked non-empty");
-    HarvestTrial {
-        trial: index,
-        seed,
-        fruit_index: target.fruit_index,
-        fruit_id: target.object_id,
-        fruit_name: target.name.clone(),
-        fruit: target.center,
-        start: target.start,
-        outcome: "failure".into(),
-        failure: Some("error".into()),
-        failed_stage: None,
-        detail: reason,
-        planning_ok: false,
-        plans: 0,
-        planning_times: vec![],
-        time_to_harvest: None,
-        placed_count: 0,
-        contacts: BTreeMap::new(),
-        tracking_rms: [0.0; 2],
-        sim_time: 0.0,
-        wall_time: 0.0,
-        mcap: format!("trials/{index:04}.mcap"),
+    HarvestTrial { failure: Some("error".into()), detail: reason, ..HarvestTrial::of_target(index, seed, &target) }
+}
+
+impl HarvestTrial {
+    /// Trial `index` on `target`, a failure until said otherwise, nothing measured yet.
+    fn of_target(index: u64, seed: u64, target: &HarvestTarget) -> HarvestTrial {
+        HarvestTrial {
+            trial: index,
+            seed,
+            fruit_index: target.fruit_index,
+            fruit_id: target.object_id,
+            fruit_name: target.name.clone(),
+            fruit: target.center,
+            start: target.start,
+            outcome: "failure".into(),
+            failure: None,
+            failed_stage: None,
+            detail: String::new(),
+            planning_ok: false,
+            plans: 0,
+            planning_times: vec![],
+            time_to_harvest: None,
+            placed_count: 0,
+            contacts: BTreeMap::new(),
+            tracking_rms: [0.0; 2],
+            sim_time: 0.0,
+            wall_time: 0.0,
+            mcap: format!("trials/{index:04}.mcap"),
+        }
     }
 }
 

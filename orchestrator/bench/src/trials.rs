@@ -36,6 +36,30 @@ pub struct Completed<R> {
     pub resumed: u64,
 }
 
+/// trials.jsonl, written a line at a time (the trials/ directory is made with it).
+struct Jsonl {
+    path: PathBuf,
+    file: std::fs::File,
+}
+
+impl Jsonl {
+    fn create(out: &Path) -> Result<Jsonl> {
+        let dir = out.join("trials");
+        std::fs::create_dir_all(&dir).context(|| format!("cannot create {}", dir.display()))?;
+        let path = out.join("trials.jsonl");
+        let file = std::fs::File::create(&path).context(|| format!("cannot create {}", path.display()))?;
+        Ok(Jsonl { path, file })
+    }
+
+    fn line(&mut self, text: &str) -> Result<()> {
+        writeln!(self.file, "{text}").context(|| self.path.display().to_string())
+    }
+
+    fn interrupted(&mut self, i: u64) -> Result<()> {
+        self.line(&format!("{{\"trial\":{i},\"outcome\":\"interrupted\"}}"))
+    }
+}
+
 fn trial_file(dir: &Path, i: u64, ext: &str) -> PathBuf {
     dir.join(format!("{i:04}.{ext}"))
 }
@@ -116,10 +140,7 @@ fn run_in_workers<R: Serialize + DeserializeOwned>(
     failed: impl Fn(u64, String) -> R,
     line: impl Fn(&R) -> String,
 ) -> Result<Completed<R>> {
-    let dir = out.join("trials");
-    std::fs::create_dir_all(&dir).context(|| format!("cannot create {}", dir.display()))?;
-    let jsonl_path = out.join("trials.jsonl");
-    let mut jsonl = std::fs::File::create(&jsonl_path).context(|| format!("cannot create {}", jsonl_path.display()))?;
+    let (dir, mut jsonl) = (out.join("trials"), Jsonl::create(out)?);
     let mut done = Completed { results: vec![], interrupted: None, resumed: 0 };
     // Finished trials waiting for their turn in trials.jsonl (None: interrupted).
     let mut finished: BTreeMap<u64, Option<R>> = BTreeMap::new();
@@ -177,7 +198,7 @@ fn run_in_workers<R: Serialize + DeserializeOwned>(
         while let Some(entry) = finished.remove(&emitted) {
             match entry {
                 Some(r) if done.interrupted.is_none() => {
-                    writeln!(jsonl, "{}", line(&r)).context(|| jsonl_path.display().to_string())?;
+                    jsonl.line(&line(&r))?;
                     done.results.push(r);
                     progress(emitted + 1, n);
                 }
@@ -185,7 +206,7 @@ fn run_in_workers<R: Serialize + DeserializeOwned>(
                 None => {
                     if done.interrupted.is_none() {
                         done.interrupted = Some(emitted);
-                        writeln!(jsonl, "{{\"trial\":{emitted},\"outcome\":\"interrupted\"}}").context(|| jsonl_path.display().to_string())?;
+                        jsonl.interrupted(emitted)?;
                     }
                 }
             }
@@ -194,7 +215,7 @@ fn run_in_workers<R: Serialize + DeserializeOwned>(
         if running.is_empty() && interrupt::requested() {
             if done.interrupted.is_none() && emitted < n {
                 done.interrupted = Some(emitted);
-                writeln!(jsonl, "{{\"trial\":{emitted},\"outcome\":\"interrupted\"}}").context(|| jsonl_path.display().to_string())?;
+                jsonl.interrupted(emitted)?;
             }
             break;
         }
@@ -217,10 +238,7 @@ fn run_in_process<R: Serialize + DeserializeOwned>(
     mut trial: impl FnMut(u64, &Path) -> Result<R>,
     line: impl Fn(&R) -> String,
 ) -> Result<Completed<R>> {
-    let dir = out.join("trials");
-    std::fs::create_dir_all(&dir).context(|| format!("cannot create {}", dir.display()))?;
-    let jsonl_path = out.join("trials.jsonl");
-    let mut jsonl = std::fs::File::create(&jsonl_path).context(|| format!("cannot create {}", jsonl_path.display()))?;
+    let (dir, mut jsonl) = (out.join("trials"), Jsonl::create(out)?);
     let mut done = Completed { results: vec![], interrupted: None, resumed: 0 };
     for i in 0..n {
         let (mcap, json) = (trial_file(&dir, i, "mcap"), trial_file(&dir, i, "json"));
@@ -237,7 +255,7 @@ fn run_in_process<R: Serialize + DeserializeOwned>(
             None => {
                 if interrupt::requested() {
                     done.interrupted = Some(i);
-                    writeln!(jsonl, "{{\"trial\":{i},\"outcome\":\"interrupted\"}}").context(|| jsonl_path.display().to_string())?;
+                    jsonl.interrupted(i)?;
                     break;
                 }
                 let r = trial(i, &mcap)?;
@@ -245,7 +263,7 @@ fn run_in_process<R: Serialize + DeserializeOwned>(
                     // Stopped inside this trial: its files say so, its result is not counted.
                     let _ = std::fs::remove_file(&json);
                     done.interrupted = Some(i);
-                    writeln!(jsonl, "{{\"trial\":{i},\"outcome\":\"interrupted\"}}").context(|| jsonl_path.display().to_string())?;
+                    jsonl.interrupted(i)?;
                     break;
                 }
                 write_atomic(&json, serde_json::to_string(&r).expect("plain struct").as_bytes())?;
@@ -253,7 +271,7 @@ fn run_in_process<R: Serialize + DeserializeOwned>(
             }
         };
         // One line per trial as soon as it ends: a long benchmark that is killed keeps them.
-        writeln!(jsonl, "{}", line(&result)).context(|| jsonl_path.display().to_string())?;
+        jsonl.line(&line(&result))?;
         done.results.push(result);
         progress(i + 1, n);
     }

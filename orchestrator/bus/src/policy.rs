@@ -4,8 +4,8 @@
 //! while judges and most analyses need the commands, states and events. Profiles:
 //! - `full`: every message;
 //! - `standard` (benchmarks' default): every message except point clouds and images (one
-//!   every 5 s: a trial stays under 5 MB), the fruit list (once: it rarely changes) and the
-//!   FMUs' signals (10 Hz);
+//!   every 5 s: a trial stays under 5 MB), IMU samples (50 Hz), the fruit list (once: it
+//!   rarely changes) and the FMUs' signals (10 Hz);
 //! - `judge`: what the judges read (harvest and navigation status and plans, collision
 //!   states, run status) and the world's and chassis' ground-truth signals at 10 Hz;
 //! - `none`: no messages (the file keeps its metadata).
@@ -76,6 +76,8 @@ fn matches(pattern: &str, topic: &str) -> bool {
 
 /// Period of point clouds and images in the `standard` profile [s].
 pub const HEAVY_PERIOD: f64 = 5.0;
+/// Period of IMU samples in the `standard` profile [s] (50 Hz: noise compresses badly).
+pub const IMU_PERIOD: f64 = 0.02;
 const HEAVY_TYPES: [&str; 2] = ["sensor_msgs/msg/PointCloud2", "sensor_msgs/msg/Image"];
 const JUDGE_TOPICS: [&str; 6] = ["/harvest/status", "/harvest/plans", "/navigate/status", "/collision", "/agrisim/status", "/harvest/target_id"];
 const GROUND_TRUTH_SIGNALS: [&str; 2] = ["/fmu/world/signals", "/fmu/chassis/signals"];
@@ -112,6 +114,7 @@ impl RecordPolicy {
             Profile::None => Rule::Drop,
             Profile::Standard if HEAVY_TYPES.contains(&type_name) => Rule::Every(HEAVY_PERIOD),
             Profile::Standard if topic == "/fruits" => Rule::Once,
+            Profile::Standard if type_name == "sensor_msgs/msg/Imu" => Rule::Every(IMU_PERIOD),
             Profile::Standard if signals => Rule::Every(0.1),
             Profile::Standard => Rule::Keep,
             Profile::Judge if JUDGE_TOPICS.contains(&topic) => Rule::Keep,
@@ -160,6 +163,7 @@ mod tests {
         assert_eq!(std.rule("/points", "sensor_msgs/msg/PointCloud2"), Rule::Every(5.0));
         assert_eq!(std.rule("/cmd_vel", "geometry_msgs/msg/Twist"), Rule::Keep);
         assert_eq!(std.rule("/fruits", "geometry_msgs/msg/PoseArray"), Rule::Once);
+        assert_eq!(std.rule("/imu", "sensor_msgs/msg/Imu"), Rule::Every(0.02));
         assert_eq!(std.rule("/fmu/imu/signals", "agrisim_msgs/msg/Signals"), Rule::Every(0.1));
         let judge = RecordPolicy::profile(Profile::Judge);
         assert_eq!(judge.rule("/collision", "agrisim_msgs/msg/CollisionState"), Rule::Keep);
