@@ -137,7 +137,8 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &NavSetup, index: u64, see
     let max_ticks = (nav.trial_timeout / step).round() as u64;
     let mut path = vec![[m.number(chassis, "x")?, m.number(chassis, "y")?]];
     let (mut length, mut clearance) = (0.0, f64::INFINITY);
-    let mut status_seen = 0;
+    // Every status message (a node may publish more than one per exchange).
+    let mut statuses = agrisim_bus::Reader::subscribe(&mut m.bus, "/navigate/status");
     let mut outcome: Option<(bool, Option<String>)> = None;
     let mut time_to_goal = None;
     let result: Result<()> = (|| {
@@ -152,7 +153,7 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &NavSetup, index: u64, see
                 outcome = Some((false, Some("collision".into())));
                 return Ok(());
             }
-            if let Some(st) = m.bus.take_new::<NavigationStatus>("/navigate/status", &mut status_seen)? {
+            for st in statuses.take::<NavigationStatus>(&mut m.bus)? {
                 match st.state.as_str() {
                     "succeeded" => {
                         let d = (x - target[0]).hypot(y - target[1]);

@@ -80,7 +80,8 @@ pub struct LocalizerStats {
 pub struct Localizer {
     cfg: LocalizationConfig,
     robot: RobotConfig,
-    seen: [u64; 4],
+    /// Last map and point cloud taken (the newest is enough for both).
+    seen: [u64; 2],
     imu: Reader,
     odom: Reader,
     /// Gyro yaw-rate samples (stamp [ns], rate [rad/s]) not yet integrated; the last one is
@@ -106,7 +107,7 @@ impl Localizer {
         Localizer {
             cfg,
             robot: config.robot,
-            seen: [0; 4],
+            seen: [0; 2],
             imu: Reader::new(topics::IMU),
             odom: Reader::new(topics::ODOM),
             gyro: VecDeque::new(),
@@ -290,7 +291,7 @@ impl Node for Localizer {
             odom_pose = Some(cur);
         }
         let due = self.last_match_ns.is_none_or(|t| t_ns - t >= (self.cfg.scan_period * 1e9) as i64 - 1_000_000);
-        if let Some(cloud) = bus.take_new::<PointCloud2>(topics::POINTS, &mut self.seen[3])? {
+        if let Some(cloud) = bus.take_new::<PointCloud2>(topics::POINTS, &mut self.seen[1])? {
             if due && self.field.is_some() && self.last_odom.is_some() {
                 self.last_match_ns = Some(t_ns);
                 let pts = self.slice(&cloud)?;
