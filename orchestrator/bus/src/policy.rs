@@ -79,7 +79,7 @@ pub const HEAVY_PERIOD: f64 = 5.0;
 /// Period of IMU samples in the `standard` profile [s] (50 Hz: noise compresses badly).
 pub const IMU_PERIOD: f64 = 0.02;
 const HEAVY_TYPES: [&str; 2] = ["sensor_msgs/msg/PointCloud2", "sensor_msgs/msg/Image"];
-const JUDGE_TOPICS: [&str; 6] = ["/harvest/status", "/harvest/plans", "/navigate/status", "/collision", "/agrisim/status", "/harvest/target_id"];
+const JUDGE_TOPICS: [&str; 5] = ["/harvest/status", "/harvest/plans", "/navigate/status", "/collision", "/agrisim/status"];
 const GROUND_TRUTH_SIGNALS: [&str; 2] = ["/fmu/world/signals", "/fmu/chassis/signals"];
 
 impl RecordPolicy {

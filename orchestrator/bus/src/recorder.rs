@@ -26,6 +26,7 @@ pub struct Channel(u16);
 
 /// One topic: its handle, type, filter and MCAP channel (created at its first kept message).
 struct Topic {
+    name: String,
     channel: Channel,
     type_name: String,
     filter: TopicFilter,
@@ -92,7 +93,7 @@ impl Recorder {
         let channel = Channel(self.topics.len() as u16);
         let filter = TopicFilter::new(self.policy.rule(topic, type_name));
         self.by_name.insert(topic.to_string(), self.topics.len());
-        self.topics.push(Topic { channel, type_name: type_name.to_string(), filter, mcap_id: None, sequence: 0 });
+        self.topics.push(Topic { name: topic.to_string(), channel, type_name: type_name.to_string(), filter, mcap_id: None, sequence: 0 });
         Ok(channel)
     }
 
@@ -101,8 +102,7 @@ impl Recorder {
         if let Some(id) = self.topics[i].mcap_id {
             return Ok(id);
         }
-        let type_name = self.topics[i].type_name.clone();
-        let topic = self.by_name.iter().find(|(_, &j)| j == i).map(|(t, _)| t.clone()).expect("every topic has a name");
+        let (topic, type_name) = (self.topics[i].name.clone(), self.topics[i].type_name.clone());
         let schema_id = match self.schemas.get(&type_name) {
             Some(id) => *id,
             None => {

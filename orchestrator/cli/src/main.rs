@@ -40,10 +40,8 @@ enum Command {
         dirs: Dirs,
         #[command(flatten)]
         log: FmuLog,
-        /// Recording profile: full (the default for a run), standard, judge or none;
-        /// replaces the scenario's [recording] profile.
-        #[arg(long)]
-        record: Option<Profile>,
+        #[command(flatten)]
+        record: Record,
         /// Print how the master orders the system (step order, delayed connections,
         /// initialization, exchange periods) and exit without running.
         #[arg(long)]
@@ -116,9 +114,8 @@ enum BenchCommand {
         dirs: Dirs,
         #[command(flatten)]
         log: FmuLog,
-        /// Recording profile of the measured run (default full: every message and signal).
-        #[arg(long)]
-        record: Option<Profile>,
+        #[command(flatten)]
+        record: Record,
         #[arg(long)]
         out: PathBuf,
     },
@@ -138,11 +135,8 @@ struct TrialArgs {
     dirs: Dirs,
     #[command(flatten)]
     log: FmuLog,
-    /// Recording profile of the trial MCAPs: standard (the default for benchmarks: point
-    /// clouds and images at 1 Hz, the fruit list once), full, judge or none; replaces the
-    /// scenario's [recording] profile.
-    #[arg(long)]
-    record: Option<Profile>,
+    #[command(flatten)]
+    record: Record,
     /// Keep the trials already complete in DIR (an interrupted run) and run the others.
     #[arg(long)]
     resume: bool,
@@ -188,6 +182,15 @@ struct FmuLog {
     /// Replaces the scenario's [logging] fmu.
     #[arg(long = "fmu-log", value_name = "CATEGORIES", num_args = 0..=1, default_missing_value = "")]
     fmu_log: Option<String>,
+}
+
+#[derive(clap::Args, Clone)]
+struct Record {
+    /// Recording profile: full, standard, judge or none (default: full for `run` and
+    /// `bench overhead`, standard for the trial benchmarks); replaces the scenario's
+    /// [recording] profile.
+    #[arg(long = "record", value_name = "PROFILE")]
+    profile: Option<Profile>,
 }
 
 impl FmuLog {
@@ -288,7 +291,7 @@ fn exec<'a>(a: &TrialArgs, command: &'a dyn Fn(u64) -> std::process::Command) ->
 fn trial_setup(a: &TrialArgs, default_scenario: &str, target: &Path) -> Result<(Scenario, RunOptions)> {
     let s = Scenario::load(a.scenario.as_deref().unwrap_or(Path::new(default_scenario)))?;
     let mut o = run_options(a.dirs.clone(), target, None, None, BTreeMap::new(), a.log.categories());
-    o.record = a.record;
+    o.record = a.record.profile;
     Ok((s, o))
 }
 
@@ -299,7 +302,7 @@ fn real_main() -> Result<()> {
         Command::Run { scenario, duration, seed, fmus, dirs, log, record, explain, out } => {
             let s = Scenario::load(&scenario)?;
             let mut opts = run_options(dirs, &target, seed, duration, fmus.into_iter().collect(), log.categories());
-            opts.record = record;
+            opts.record = record.profile;
             if explain {
                 print!("{}", agrisim_session::run::explain(&s, &opts)?);
                 return Ok(());
@@ -329,7 +332,7 @@ fn real_main() -> Result<()> {
         Command::Bench { command: BenchCommand::Overhead { scenario, steps, dirs, log, record, out } } => {
             let s = Scenario::load(&scenario)?;
             let mut opts = run_options(dirs, &target, None, None, BTreeMap::new(), log.categories());
-            opts.record = record;
+            opts.record = record.profile;
             let report = agrisim_bench::overhead(&s, &opts, steps, &out)?;
             println!("{}", serde_json::to_string_pretty(&report).expect("plain struct serializes"));
         }

@@ -168,19 +168,19 @@ mod tests {
 
     #[test]
     fn exact_and_greedy_agree_on_acyclic_graphs() {
-        let mut rng = agrisim_test_rng(7);
+        let mut rng = agrisim_math::Rng::new(7);
         for _ in 0..200 {
-            let n = 1 + (rng() % 7) as usize;
+            let n = 1 + rng.below(7) as usize;
             // Random DAG over a random permutation.
             let mut perm: Vec<usize> = (0..n).collect();
             for i in (1..n).rev() {
-                perm.swap(i, (rng() % (i as u64 + 1)) as usize);
+                perm.swap(i, rng.below(i as u64 + 1) as usize);
             }
             let mut edges = vec![];
             for i in 0..n {
                 for j in i + 1..n {
-                    if rng() % 3 == 0 {
-                        edges.push((perm[i], perm[j], 1 + (rng() % 3) as u32));
+                    if rng.below(3) == 0 {
+                        edges.push((perm[i], perm[j], 1 + rng.below(3) as u32));
                     }
                 }
             }
@@ -189,18 +189,6 @@ mod tests {
                 let pos: Vec<usize> = (0..n).map(|c| order.iter().position(|&x| x == c).unwrap()).collect();
                 assert!(edges.iter().all(|&(a, b, _)| pos[a] < pos[b]), "{edges:?} -> {order:?}");
             }
-        }
-    }
-
-    /// A small deterministic generator (splitmix64) so the test needs no dependency.
-    fn agrisim_test_rng(seed: u64) -> impl FnMut() -> u64 {
-        let mut s = seed;
-        move || {
-            s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = s;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            z ^ (z >> 31)
         }
     }
 }

@@ -33,6 +33,8 @@ pub(crate) struct LogSink {
     /// Messages received so far (the next one's sequence number); written under the lock,
     /// read without it.
     received: AtomicU64,
+    /// `received` at the last [`LogSink::take`].
+    taken: AtomicU64,
 }
 
 impl LogSink {
@@ -65,7 +67,12 @@ impl LogSink {
     }
 
     pub(crate) fn take(&self) -> Vec<LogMessage> {
+        // Called every step by a session (for warnings): nothing new costs no lock.
+        if self.mark() == self.taken.load(Ordering::Acquire) {
+            return Vec::new();
+        }
         let mut g = self.inner.lock().unwrap_or_else(|p| p.into_inner());
+        self.taken.store(self.mark(), Ordering::Release);
         g.drain(..).map(|(_, m)| m).collect()
     }
 }
