@@ -51,7 +51,7 @@ fn clip(text: &str, max: usize) -> String {
 }
 
 /// Executor state as in TrajectoryStatus (REJECTED is a flag on top of it).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Exec {
     #[default]
     Idle,
@@ -60,7 +60,7 @@ pub enum Exec {
 }
 
 /// Tracking error over one trajectory.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ErrorStats {
     pub sum_sq: f64,
     pub samples: u64,
@@ -78,16 +78,19 @@ impl ErrorStats {
 }
 
 /// Data sampled at a joint_states instant.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 struct Snapshot {
     stamp_ns: i64,
     joints: dynamics::JointState,
     gripper: Gripper,
 }
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Arm {
+    /// Derived from the parameters: rebuilt, not serialized.
+    #[serde(skip)]
     arm: Option<ArmDescription>,
+    #[serde(skip)]
     params: [Option<JointParams>; N],
     mismatch: ModelMismatch,
     pub state: dynamics::JointState,
@@ -111,7 +114,7 @@ pub struct Arm {
 }
 
 /// The arm's message ports.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 struct Ports {
     trajectory: InPort,
     gripper_command: InPort,
@@ -350,6 +353,17 @@ impl Model for Arm {
     const NAME: &'static str = "Arm";
     const DESCRIPTION: &'static str = "7-DoF Panda-like arm with parallel gripper: JointTrajectory validation and interpolation, PD + feedforward joint dynamics at 1 kHz, GripperCommand, JointState";
     const VARIABLES: &'static [Var] = VARIABLES;
+
+    fn save_state(&self, out: &mut Vec<u8>) -> Result<(), agrisim_fmi::ModelError> {
+        agrisim_fmi::serial::write(self, out)
+    }
+
+    fn load_state(&mut self, bytes: &[u8]) -> Result<(), agrisim_fmi::ModelError> {
+        agrisim_fmi::serial::load_keeping(self, bytes, |new, old| {
+            new.arm = old.arm.take();
+            new.params = old.params;
+        })
+    }
 
     fn new() -> Self {
         Self::default()

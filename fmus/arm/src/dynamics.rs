@@ -38,7 +38,7 @@ pub const CONTROL_PERIOD_NS: i64 = 1_000_000;
 /// Coulomb and viscous friction. Defaults: inertia under-estimated by 10 %, Coulomb friction
 /// over-estimated by 20 %, viscous friction under-estimated by 30 % (typical identification
 /// errors of the order Gaz et al. report between models; chosen, not measured).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ModelMismatch {
     pub inertia: f64,
     pub coulomb: f64,
@@ -64,7 +64,7 @@ pub struct JointParams {
 }
 
 /// Actual joint state and the last torque applied.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct JointState {
     pub q: [f64; N],
     pub qd: [f64; N],

@@ -15,7 +15,7 @@ pub const MAX_FORCE: f64 = 70.0;
 /// `reached_goal` tolerance on the gap [m].
 pub const GOAL_TOLERANCE: f64 = 1e-3;
 
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Gripper {
     pub width: f64,
     /// Gap rate [m/s] over the last update.

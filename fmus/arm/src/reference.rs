@@ -22,7 +22,7 @@ impl Setpoint {
 }
 
 /// Polynomial segment per joint: `q(s) = sum c[k] s^k`, s in [0, T] seconds.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 struct Segment {
     t0_ns: i64,
     t1_ns: i64,
@@ -68,7 +68,7 @@ fn eval(c: &[f64; 6], s: f64) -> (f64, f64, f64) {
 }
 
 /// A trajectory being executed: starts at `start_ns` (absolute simulation time).
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Reference {
     start_ns: i64,
     segments: Vec<Segment>,

@@ -39,8 +39,10 @@ pub struct Config {
     pub base: [f64; 4],
 }
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Camera {
+    /// Derived from the parameters: rebuilt, not serialized.
+    #[serde(skip)]
     config: Option<Config>,
     schedule: Schedule,
     rng: Rng,
@@ -183,6 +185,14 @@ impl Model for Camera {
     const NAME: &'static str = "Camera";
     const DESCRIPTION: &'static str = "RGB-D camera modelled on the Intel RealSense D435i (1280x720, 87x58 deg, 10 Hz): rgb8 + 32FC1 depth with stereo noise + CameraInfo + instance labels, ray cast at the greenhouse scene";
     const VARIABLES: &'static [Var] = VARIABLES;
+
+    fn save_state(&self, out: &mut Vec<u8>) -> Result<(), agrisim_fmi::ModelError> {
+        agrisim_fmi::serial::write(self, out)
+    }
+
+    fn load_state(&mut self, bytes: &[u8]) -> Result<(), agrisim_fmi::ModelError> {
+        agrisim_fmi::serial::load_keeping(self, bytes, |new, old| new.config = old.config.take())
+    }
 
     fn new() -> Self {
         Self::default()

@@ -14,7 +14,7 @@ use agrisim_math::{Pose2, Rng};
 use agrisim_msgs::Message;
 
 /// Limits and geometry read from the parameters at initialization.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Limits {
     pub steer_max: f64,
     pub steer_rate_max: f64,
@@ -36,7 +36,7 @@ pub struct StepInput<'a> {
 }
 
 /// How wheels and base respond to the wheel set-points.
-pub trait Drive: Clone + Send + Default + 'static {
+pub trait Drive: Clone + Send + Default + serde::Serialize + serde::de::DeserializeOwned + 'static {
     const NAME: &'static str;
     const DESCRIPTION: &'static str;
     /// Longest communication step the drive integrates [s] (a dynamic model substeps).
@@ -68,7 +68,8 @@ pub fn mean_contact_velocities(layout: &WheelLayout, start: &[WheelState; 4], en
 }
 
 /// A chassis model: the shared part plus a drive.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
+#[serde(bound = "")]
 pub struct Chassis<D: Drive> {
     drive: D,
     layout: Option<WheelLayout>,
@@ -142,6 +143,8 @@ impl<D: Drive> Model for Chassis<D> {
     const NAME: &'static str = D::NAME;
     const DESCRIPTION: &'static str = D::DESCRIPTION;
     const VARIABLES: &'static [Var] = VARIABLES;
+
+    agrisim_fmi::whole_state!();
 
     fn new() -> Self {
         Self::default()

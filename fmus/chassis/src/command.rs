@@ -11,7 +11,7 @@ use agrisim_fmi::{InPort, Log, Store};
 use agrisim_msgs::geometry_msgs::Twist;
 use agrisim_msgs::Message;
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct CommandIntake {
     cmd_seq: i32,
     cmd_vel: InPort,

@@ -14,7 +14,7 @@ const MAX_SUBSTEP: f64 = 5e-4;
 /// Radius of gyration assumed for the payload about the base's vertical axis [m].
 const PAYLOAD_GYRATION: f64 = 0.25;
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct DynamicDrive {
     mass: f64,
     inertia_z: f64,

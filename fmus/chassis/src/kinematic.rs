@@ -7,7 +7,7 @@ use crate::se2::Twist2;
 use crate::wheels::WheelState;
 use agrisim_fmi::Store;
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct KinematicDrive {
     slip_mean: f64,
     slip_std: f64,

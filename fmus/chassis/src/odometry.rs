@@ -10,7 +10,7 @@ use agrisim_msgs::std_msgs::Header;
 
 /// Dead-reckoned pose in the odom frame. The odom frame starts at the initial base pose
 /// (REP 105: odom is continuous and drifts; map -> odom corrections come from localization).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct WheelOdometry {
     pub pose: Pose2,
     pub twist: Twist2,

@@ -4,7 +4,7 @@
 use agrisim_math::{wrap_angle_euclid, Pose2};
 
 /// Body-frame twist: forward `vx`, left `vy`, counter-clockwise `wz`.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Twist2 {
     pub vx: f64,
     pub vy: f64,

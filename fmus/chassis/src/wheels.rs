@@ -9,7 +9,7 @@ use std::f64::consts::PI;
 pub const WHEEL_NAMES: [&str; 4] = ["fl", "fr", "rl", "rr"];
 
 /// Where the four wheels sit in the base frame and how large they are.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 pub struct WheelLayout {
     /// Wheel contact points (x, y) in base_link [m].
     pub pos: [(f64, f64); 4],
@@ -17,7 +17,7 @@ pub struct WheelLayout {
 }
 
 /// State of one wheel: steering angle [rad] and spin rate [rad/s].
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct WheelState {
     pub steer: f64,
     pub spin: f64,

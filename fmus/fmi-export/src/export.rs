@@ -261,18 +261,18 @@ macro_rules! export_fmu {
         }
 
         #[unsafe(no_mangle)]
-        pub unsafe extern "C" fn fmi3SerializedFMUStateSize(instance: *mut ::std::ffi::c_void, _state: *mut ::std::ffi::c_void, _size: *mut usize) -> $crate::Status {
-            $crate::fmi3::unsupported::<$M>(instance, "fmi3SerializedFMUStateSize")
+        pub unsafe extern "C" fn fmi3SerializedFMUStateSize(instance: *mut ::std::ffi::c_void, state: *mut ::std::ffi::c_void, size: *mut usize) -> $crate::Status {
+            $crate::fmi3::serialized_fmu_state_size::<$M>(instance, state, size)
         }
 
         #[unsafe(no_mangle)]
-        pub unsafe extern "C" fn fmi3SerializeFMUState(instance: *mut ::std::ffi::c_void, _state: *mut ::std::ffi::c_void, _serialized_state: *mut u8, _size: usize) -> $crate::Status {
-            $crate::fmi3::unsupported::<$M>(instance, "fmi3SerializeFMUState")
+        pub unsafe extern "C" fn fmi3SerializeFMUState(instance: *mut ::std::ffi::c_void, state: *mut ::std::ffi::c_void, serialized_state: *mut u8, size: usize) -> $crate::Status {
+            $crate::fmi3::serialize_fmu_state::<$M>(instance, state, serialized_state, size)
         }
 
         #[unsafe(no_mangle)]
-        pub unsafe extern "C" fn fmi3DeserializeFMUState(instance: *mut ::std::ffi::c_void, _serialized_state: *const u8, _size: usize, _state: *mut *mut ::std::ffi::c_void) -> $crate::Status {
-            $crate::fmi3::unsupported::<$M>(instance, "fmi3DeserializeFMUState")
+        pub unsafe extern "C" fn fmi3DeserializeFMUState(instance: *mut ::std::ffi::c_void, serialized_state: *const u8, size: usize, state: *mut *mut ::std::ffi::c_void) -> $crate::Status {
+            $crate::fmi3::deserialize_fmu_state::<$M>(instance, serialized_state, size, state)
         }
 
         #[unsafe(no_mangle)]
@@ -521,18 +521,18 @@ macro_rules! export_fmu {
         }
 
         #[unsafe(no_mangle)]
-        pub unsafe extern "C" fn fmi2SerializedFMUstateSize(c: *mut ::std::ffi::c_void, _state: *mut ::std::ffi::c_void, _size: *mut usize) -> $crate::Status {
-            $crate::fmi2::unsupported::<$M>(c, "fmi2SerializedFMUstateSize")
+        pub unsafe extern "C" fn fmi2SerializedFMUstateSize(c: *mut ::std::ffi::c_void, state: *mut ::std::ffi::c_void, size: *mut usize) -> $crate::Status {
+            $crate::fmi2::serialized_fmu_state_size::<$M>(c, state, size)
         }
 
         #[unsafe(no_mangle)]
-        pub unsafe extern "C" fn fmi2SerializeFMUstate(c: *mut ::std::ffi::c_void, _state: *mut ::std::ffi::c_void, _serialized_state: *mut ::std::ffi::c_char, _size: usize) -> $crate::Status {
-            $crate::fmi2::unsupported::<$M>(c, "fmi2SerializeFMUstate")
+        pub unsafe extern "C" fn fmi2SerializeFMUstate(c: *mut ::std::ffi::c_void, state: *mut ::std::ffi::c_void, serialized_state: *mut ::std::ffi::c_char, size: usize) -> $crate::Status {
+            $crate::fmi2::serialize_fmu_state::<$M>(c, state, serialized_state, size)
         }
 
         #[unsafe(no_mangle)]
-        pub unsafe extern "C" fn fmi2DeSerializeFMUstate(c: *mut ::std::ffi::c_void, _serialized_state: *const ::std::ffi::c_char, _size: usize, _state: *mut *mut ::std::ffi::c_void) -> $crate::Status {
-            $crate::fmi2::unsupported::<$M>(c, "fmi2DeSerializeFMUstate")
+        pub unsafe extern "C" fn fmi2DeSerializeFMUstate(c: *mut ::std::ffi::c_void, serialized_state: *const ::std::ffi::c_char, size: usize, state: *mut *mut ::std::ffi::c_void) -> $crate::Status {
+            $crate::fmi2::deserialize_fmu_state::<$M>(c, serialized_state, size, state)
         }
 
         #[unsafe(no_mangle)]

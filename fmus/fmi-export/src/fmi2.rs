@@ -244,6 +244,30 @@ pub unsafe fn get_fmu_state<M: Model>(c: *mut c_void, state: *mut *mut c_void) -
     })
 }
 
+/// `fmi2SerializedFMUstateSize`.
+///
+/// # Safety
+/// `size` must be NULL or writable.
+pub unsafe fn serialized_fmu_state_size<M: Model>(c: *mut c_void, state: *mut c_void, size: *mut usize) -> Status {
+    crate::fmi3::serialized_size_impl::<M>(API, c, "fmi2SerializedFMUstateSize", mask::SERIALIZE_FMU_STATE, state, size)
+}
+
+/// `fmi2SerializeFMUstate`.
+///
+/// # Safety
+/// `serialized` must be NULL or point to `size` writable bytes.
+pub unsafe fn serialize_fmu_state<M: Model>(c: *mut c_void, state: *mut c_void, serialized: *mut c_char, size: usize) -> Status {
+    crate::fmi3::serialize_impl::<M>(API, c, "fmi2SerializeFMUstate", mask::SERIALIZE_FMU_STATE, state, serialized.cast(), size)
+}
+
+/// `fmi2DeSerializeFMUstate`.
+///
+/// # Safety
+/// `serialized` must be NULL or point to `size` readable bytes; `state` NULL or writable.
+pub unsafe fn deserialize_fmu_state<M: Model>(c: *mut c_void, serialized: *const c_char, size: usize, state: *mut *mut c_void) -> Status {
+    crate::fmi3::deserialize_impl::<M>(API, c, "fmi2DeSerializeFMUstate", mask::DESERIALIZE_FMU_STATE, serialized.cast(), size, state)
+}
+
 /// `fmi2SetFMUstate`.
 ///
 /// # Safety
@@ -358,9 +382,6 @@ pub unsafe fn get_string_status<M: Model>(c: *mut c_void, kind: c_int, value: *m
 /// Why each unsupported function is unsupported (logged with the error).
 pub fn unsupported_reason(function: &str) -> &'static str {
     match function {
-        "fmi2SerializedFMUstateSize" | "fmi2SerializeFMUstate" | "fmi2DeSerializeFMUstate" => {
-            "FMU states cannot be serialized (canSerializeFMUstate=false)"
-        }
         "fmi2GetDirectionalDerivative" => "no partial derivatives (providesDirectionalDerivative=false)",
         "fmi2SetRealInputDerivatives" => "inputs cannot be interpolated (canInterpolateInputs=false)",
         "fmi2GetRealOutputDerivatives" => "no output derivatives (maxOutputDerivativeOrder=0)",

@@ -435,6 +435,90 @@ pub unsafe fn free_fmu_state<M: Model>(instance: *mut c_void, state: *mut *mut c
     })
 }
 
+/// `fmi3SerializedFMUStateSize`.
+///
+/// # Safety
+/// `size` must be NULL or writable.
+pub unsafe fn serialized_fmu_state_size<M: Model>(instance: *mut c_void, state: *mut c_void, size: *mut usize) -> Status {
+    serialized_size_impl::<M>(API, instance, "fmi3SerializedFMUStateSize", mask::SERIALIZE_FMU_STATE, state, size)
+}
+
+/// `fmi3SerializeFMUState`: the bytes of [`serial`](crate::serial) into a buffer of `size` bytes.
+///
+/// # Safety
+/// `serialized` must be NULL or point to `size` writable bytes.
+pub unsafe fn serialize_fmu_state<M: Model>(instance: *mut c_void, state: *mut c_void, serialized: *mut u8, size: usize) -> Status {
+    serialize_impl::<M>(API, instance, "fmi3SerializeFMUState", mask::SERIALIZE_FMU_STATE, state, serialized, size)
+}
+
+/// `fmi3DeserializeFMUState`: a new FMU state (or `*state`, a live one, overwritten).
+///
+/// # Safety
+/// `serialized` must be NULL or point to `size` readable bytes; `state` NULL or writable.
+pub unsafe fn deserialize_fmu_state<M: Model>(instance: *mut c_void, serialized: *const u8, size: usize, state: *mut *mut c_void) -> Status {
+    deserialize_impl::<M>(API, instance, "fmi3DeserializeFMUState", mask::DESERIALIZE_FMU_STATE, serialized, size, state)
+}
+
+/// Shared by the FMI 3 and FMI 2 size functions.
+pub(crate) unsafe fn serialized_size_impl<M: Model>(
+    api: Api,
+    instance: *mut c_void,
+    function: &str,
+    mask: crate::state::Mask,
+    state: *mut c_void,
+    size: *mut usize,
+) -> Status {
+    with_instance::<M>(api, instance, function, mask, |inst| {
+        let size = out(size, "size")?;
+        *size = inst.serialized_state(state)?.len();
+        Ok(Status::Ok)
+    })
+}
+
+/// Shared by the FMI 3 and FMI 2 serialize functions.
+pub(crate) unsafe fn serialize_impl<M: Model>(
+    api: Api,
+    instance: *mut c_void,
+    function: &str,
+    mask: crate::state::Mask,
+    state: *mut c_void,
+    serialized: *mut u8,
+    size: usize,
+) -> Status {
+    with_instance::<M>(api, instance, function, mask, |inst| {
+        let buf = slice_mut(serialized, size, "serializedState")?;
+        let bytes = inst.serialized_state(state)?;
+        if bytes.len() > buf.len() {
+            return Err(format!(
+                "the buffer holds {} bytes but the state needs {} (ask for the size first)",
+                buf.len(),
+                bytes.len()
+            )
+            .into());
+        }
+        buf[..bytes.len()].copy_from_slice(bytes);
+        Ok(Status::Ok)
+    })
+}
+
+/// Shared by the FMI 3 and FMI 2 deserialize functions.
+pub(crate) unsafe fn deserialize_impl<M: Model>(
+    api: Api,
+    instance: *mut c_void,
+    function: &str,
+    mask: crate::state::Mask,
+    serialized: *const u8,
+    size: usize,
+    state: *mut *mut c_void,
+) -> Status {
+    with_instance::<M>(api, instance, function, mask, |inst| {
+        let bytes = slice(serialized, size, "serializedState")?;
+        let state = out(state, "FMUState")?;
+        *state = inst.deserialize_state(bytes, *state)?;
+        Ok(Status::Ok)
+    })
+}
+
 /// `fmi3DoStep`: never returns early, never requests events or termination.
 ///
 /// # Safety
@@ -476,9 +560,6 @@ pub fn unsupported_reason(function: &str) -> &'static str {
         | "fmi3SetIntervalFraction" | "fmi3SetShiftDecimal" | "fmi3SetShiftFraction"
         | "fmi3ActivateModelPartition" => "this FMU has no clocks",
         "fmi3EnterConfigurationMode" | "fmi3ExitConfigurationMode" => "this FMU has no structural parameters",
-        "fmi3SerializedFMUStateSize" | "fmi3SerializeFMUState" | "fmi3DeserializeFMUState" => {
-            "FMU states cannot be serialized (canSerializeFMUState=false)"
-        }
         "fmi3GetDirectionalDerivative" | "fmi3GetAdjointDerivative" => {
             "no partial derivatives (providesDirectionalDerivatives=false, providesAdjointDerivatives=false)"
         }

@@ -13,7 +13,8 @@ use crate::model::Model;
 use crate::registry::Api;
 use crate::state::{settable, Mode};
 use crate::store::{Store, Value};
-use crate::var::Var;
+use crate::serial;
+use crate::var::{Causality, Var};
 
 /// Where a value reference points.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -33,6 +34,8 @@ pub struct Snapshot<M: Model> {
     time: f64,
     start_time: f64,
     stop_time: Option<f64>,
+    /// Its serialized form, made once (SerializedFMUStateSize, then SerializeFMUState).
+    serialized: Option<Vec<u8>>,
 }
 
 pub struct Instance<M: Model> {
@@ -62,6 +65,31 @@ impl<M: Model> Drop for Instance<M> {
             drop(unsafe { Box::from_raw(s) });
         }
     }
+}
+
+/// Whether the model has run `initialize` in this mode (its state is worth saving).
+fn initialized(mode: Mode) -> bool {
+    matches!(mode, Mode::StepMode | Mode::Terminated)
+}
+
+/// Parameters (and everything else fixed before the run) bit for bit equal.
+fn same_parameters<M: Model>(a: &Store, b: &Store) -> bool {
+    M::VARIABLES.iter().enumerate().all(|(i, v)| {
+        !matches!(v.causality, Causality::Parameter | Causality::CalculatedParameter) || a.value(i).identical(b.value(i))
+    })
+}
+
+/// A deserialized store matches the variable table: count and types.
+fn check_store<M: Model>(store: &Store) -> Result<(), String> {
+    if store.len() != M::VARIABLES.len() {
+        return Err(format!("corrupt FMU state: {} values for {} variables", store.len(), M::VARIABLES.len()));
+    }
+    for (i, v) in M::VARIABLES.iter().enumerate() {
+        if std::mem::discriminant(store.value(i)) != std::mem::discriminant(&Value::from_start(&v.start)) {
+            return Err(format!("corrupt FMU state: variable '{}' has the wrong type", v.name));
+        }
+    }
+    Ok(())
 }
 
 /// Message of a caught panic payload.
@@ -319,6 +347,7 @@ impl<M: Model> Instance<M> {
             time: self.time,
             start_time: self.start_time,
             stop_time: self.stop_time,
+            serialized: None,
         }
     }
 
@@ -339,9 +368,9 @@ impl<M: Model> Instance<M> {
     pub fn set_state(&mut self, state: *mut c_void) -> Result<(), String> {
         let p = self.find_state(state)?;
         // SAFETY: `p` is a live state of this instance.
-        let s = unsafe { &*p }.clone();
-        self.model = s.model;
-        self.store = s.store;
+        let s = unsafe { &*p };
+        self.model = s.model.clone();
+        self.store = s.store.clone();
         self.mode = s.mode;
         self.time = s.time;
         self.start_time = s.start_time;
@@ -370,6 +399,88 @@ impl<M: Model> Instance<M> {
             .copied()
             .find(|&p| p.cast() == state)
             .ok_or_else(|| format!("{state:p} is not a live FMU state of this instance (freed, foreign or invalid)"))
+    }
+
+    /// A live state's serialized form (see [`serial`](crate::serial)), made on first request.
+    pub fn serialized_state(&mut self, state: *mut c_void) -> Result<&[u8], String> {
+        let p = self.find_state(state)?;
+        // SAFETY: `p` is a live state of this instance.
+        let snap = unsafe { &mut *p };
+        if snap.serialized.is_none() {
+            if matches!(snap.mode, Mode::Error | Mode::Fatal) {
+                return Err(format!("a state taken in mode {} cannot be serialized", snap.mode.name()));
+            }
+            let mut model = Vec::new();
+            if initialized(snap.mode) {
+                snap.model.save_state(&mut model)?;
+            }
+            let header = serial::Header {
+                model: M::NAME.to_string(),
+                token: M::TOKEN.to_string(),
+                mode: snap.mode,
+                time: snap.time,
+                start_time: snap.start_time,
+                stop_time: snap.stop_time,
+                store: snap.store.clone(),
+                model_len: model.len() as u64,
+            };
+            snap.serialized = Some(serial::encode(&header, &model)?);
+        }
+        Ok(snap.serialized.as_deref().unwrap_or_default())
+    }
+
+    /// A new state (or `existing`, a live state, overwritten) from serialized bytes.
+    ///
+    /// The model's derived parts come from this instance's model when it is initialized
+    /// with the very same parameter values, else from initializing a fresh model with the
+    /// saved values; then the saved model state is loaded over them.
+    pub fn deserialize_state(&mut self, bytes: &[u8], existing: *mut c_void) -> Result<*mut c_void, String> {
+        let (h, model_bytes) = serial::decode(bytes)?;
+        if h.model != M::NAME || h.token != M::TOKEN {
+            return Err(format!(
+                "the state belongs to model '{}' (token {}), not to '{}' (token {})",
+                h.model,
+                h.token,
+                M::NAME,
+                M::TOKEN
+            ));
+        }
+        check_store::<M>(&h.store)?;
+        let model = if initialized(h.mode) {
+            let mut model = if initialized(self.mode) && same_parameters::<M>(&self.store, &h.store) {
+                self.model.clone()
+            } else {
+                let mut model = catch_unwind(M::new).map_err(|p| format!("the model panicked in new(): {}", panic_message(&*p)))?;
+                model
+                    .initialize(&mut h.store.clone(), h.start_time, &mut self.logger)
+                    .map_err(|e| format!("the model failed to initialize (rebuilding a deserialized state): {e}"))?;
+                model
+            };
+            model.load_state(model_bytes).map_err(|e| format!("cannot load the model state: {e}"))?;
+            model
+        } else if model_bytes.is_empty() {
+            catch_unwind(M::new).map_err(|p| format!("the model panicked in new(): {}", panic_message(&*p)))?
+        } else {
+            return Err(format!("corrupt FMU state: model bytes in mode {}", h.mode.name()));
+        };
+        let snap = Snapshot {
+            model,
+            store: h.store,
+            mode: h.mode,
+            time: h.time,
+            start_time: h.start_time,
+            stop_time: h.stop_time,
+            serialized: Some(bytes.to_vec()),
+        };
+        if existing.is_null() {
+            let p = Box::into_raw(Box::new(snap));
+            self.states.push(p);
+            return Ok(p.cast());
+        }
+        let p = self.find_state(existing)?;
+        // SAFETY: `p` is a live state of this instance.
+        unsafe { *p = snap };
+        Ok(existing)
     }
 
     /// Number of FMU states not yet freed (for tests).

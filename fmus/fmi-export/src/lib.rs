@@ -17,6 +17,7 @@ pub mod logger;
 mod model;
 pub mod port;
 mod registry;
+pub mod serial;
 pub mod state;
 mod store;
 pub mod testing;

@@ -57,4 +57,12 @@ pub trait Model: Clone + Send + 'static {
 
     /// Advance from `t` to `t + h` with the inputs in `io`; write outputs for `t + h`.
     fn do_step(&mut self, io: &mut Store, t: f64, h: f64, log: &mut dyn Log) -> Result<(), ModelError>;
+
+    /// Appends what changes over a run to `out` (a serialized FMU state; see [`serial`](crate::serial)).
+    /// Leave out what `initialize` derives from the parameters alone: it is rebuilt.
+    fn save_state(&self, out: &mut Vec<u8>) -> Result<(), ModelError>;
+
+    /// Overwrites what [`save_state`](Model::save_state) wrote. Called on a model initialized
+    /// with the same parameter values, so derived parts are already in place.
+    fn load_state(&mut self, bytes: &[u8]) -> Result<(), ModelError>;
 }

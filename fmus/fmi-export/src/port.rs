@@ -29,7 +29,7 @@ pub fn window_ns(io: &Store, i: usize) -> Result<i64, String> {
 }
 
 /// An output message port: Binary variable `bin`, counter `seq`.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct OutPort {
     bin: usize,
     seq: usize,
@@ -67,7 +67,7 @@ impl OutPort {
 }
 
 /// An input message port: Binary variable `bin`, counter `seq`.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct InPort {
     bin: usize,
     seq: usize,

@@ -25,7 +25,7 @@ pub enum Status {
 /// Instance modes of the co-simulation state machine (FMI 3 names; FMI 2's
 /// "slaveInitialized"/"stepComplete" is `StepMode`). Event, configuration and intermediate
 /// update modes are not supported, so they do not exist here.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Mode {
     Instantiated,
     InitializationMode,
@@ -112,6 +112,8 @@ pub mod fmi3 {
     pub const GET_FMU_STATE: Mask = LIVE;
     pub const SET_FMU_STATE: Mask = LIVE | ERROR;
     pub const FREE_FMU_STATE: Mask = LIVE | ERROR;
+    pub const SERIALIZE_FMU_STATE: Mask = LIVE | ERROR;
+    pub const DESERIALIZE_FMU_STATE: Mask = LIVE | ERROR;
     pub const DO_STEP: Mask = STEP;
 }
 
@@ -130,6 +132,8 @@ pub mod fmi2 {
     pub const GET_FMU_STATE: Mask = LIVE | ERROR;
     pub const SET_FMU_STATE: Mask = LIVE | ERROR;
     pub const FREE_FMU_STATE: Mask = LIVE | ERROR;
+    pub const SERIALIZE_FMU_STATE: Mask = LIVE | ERROR;
+    pub const DESERIALIZE_FMU_STATE: Mask = LIVE | ERROR;
     pub const DO_STEP: Mask = STEP;
     pub const GET_STATUS: Mask = STEP | TERMINATED | ERROR;
 }

@@ -1,9 +1,10 @@
 //! Current values of all of a model's variables, indexed like its variable table.
 
 use crate::var::{Start, Var};
+use serde::{Deserialize, Serialize};
 
 /// One variable's current value.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum Value {
     Float64(f64),
     Int32(i32),
@@ -39,7 +40,7 @@ impl Value {
 ///
 /// Typed accessors panic on a type mismatch: that is a bug in the model (its table and its
 /// code disagree), caught by the model's own tests; the export layer catches the unwind.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Store {
     values: Vec<Value>,
 }

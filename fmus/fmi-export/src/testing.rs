@@ -191,6 +191,7 @@ mod spec3 {
     pub const GET_FMU_STATE: Mask = ALIVE;
     pub const SET_FMU_STATE: Mask = ALIVE | ERROR;
     pub const FREE_FMU_STATE: Mask = ALIVE | ERROR;
+    pub const DESERIALIZE_FMU_STATE: Mask = ALIVE | ERROR;
     pub const DO_STEP: Mask = STEP;
 }
 
@@ -208,6 +209,7 @@ mod spec2 {
     pub const GET_FMU_STATE: Mask = ALIVE | ERROR;
     pub const SET_FMU_STATE: Mask = ALIVE | ERROR;
     pub const FREE_FMU_STATE: Mask = ALIVE | ERROR;
+    pub const DESERIALIZE_FMU_STATE: Mask = ALIVE | ERROR;
     pub const DO_STEP: Mask = STEP;
     pub const GET_STATUS: Mask = STEP | TERMINATED | ERROR;
 }
@@ -297,6 +299,8 @@ enum Then {
     Restore(*mut c_void),
     NewState(*mut c_void),
     FreedState(*mut c_void),
+    /// A new state holding what the first one holds (a deserialized copy).
+    Copied(*mut c_void, *mut c_void),
     Stepped(f64),
 }
 
@@ -470,7 +474,6 @@ const UNSUPPORTED3: &[&str] = &[
     "fmi3GetClock",
     "fmi3SetIntervalDecimal",
     "fmi3EnterConfigurationMode",
-    "fmi3SerializeFMUState",
     "fmi3GetDirectionalDerivative",
     "fmi3GetNumberOfContinuousStates",
     "fmi3SetTime",
@@ -613,11 +616,69 @@ unsafe fn random_call3<M: Model>(rng: &mut FuzzRng, inst: *mut c_void, sh: &Shad
             let must = if good || orig.is_null() { Must::Succeed } else { Must::Fail };
             o("fmi3FreeFMUState", m::FREE_FMU_STATE, s, must, Then::FreedState(orig))
         }
+        20 => {
+            let (must, then, s) = round_trip(
+                rng,
+                sh,
+                |st, n| fmi3::serialized_fmu_state_size::<M>(inst, st, n),
+                |st, b, n| fmi3::serialize_fmu_state::<M>(inst, st, b, n),
+                |b, n, p| fmi3::deserialize_fmu_state::<M>(inst, b, n, p),
+                |p| fmi3::free_fmu_state::<M>(inst, p),
+            );
+            o("fmi3DeserializeFMUState", m::DESERIALIZE_FMU_STATE, s, must, then)
+        }
         _ => {
             let f = rng.pick(UNSUPPORTED3);
             o(f, state::NEVER, fmi3::unsupported::<M>(inst, f), Must::Fail, Then::Nothing)
         }
     }
+}
+
+/// Serializes a live state, deserializes it as a new state and checks that the copy
+/// serializes to the very same bytes; sometimes corrupts the bytes first (refused or
+/// accepted, never a crash). A state that cannot be serialized gets junk bytes, which must
+/// be refused. Only the deserialize call may fail (its outcome is the one checked).
+unsafe fn round_trip(
+    rng: &mut FuzzRng,
+    sh: &Shadow,
+    size: impl Fn(*mut c_void, *mut usize) -> Status,
+    serialize: impl Fn(*mut c_void, *mut u8, usize) -> Status,
+    deserialize: impl Fn(*const u8, usize, *mut *mut c_void) -> Status,
+    free: impl Fn(*mut *mut c_void) -> Status,
+) -> (Must, Then, Status) {
+    let (src, good) = pick_state(rng, sh);
+    let live = sh.mode != Mode::Fatal && good && sh.states.iter().any(|s| s.0 == src && s.1 != Mode::Error);
+    let mut p = std::ptr::null_mut();
+    if !live {
+        let junk = [b'A', b'G', b'S', 1, 0, 7];
+        let s = deserialize(junk.as_ptr(), rng.below(junk.len() + 1), &mut p);
+        return (Must::Fail, Then::Nothing, s);
+    }
+    let mut n = 0usize;
+    assert!(size(src, &mut n) <= Status::Warning, "SerializedFMUStateSize failed on a live state");
+    let mut bytes = vec![0u8; n];
+    assert!(serialize(src, bytes.as_mut_ptr(), n) <= Status::Warning, "SerializeFMUState failed on a live state");
+    if rng.chance(10) {
+        let i = rng.below(bytes.len());
+        bytes[i] ^= 1 << rng.below(8);
+        bytes.truncate(bytes.len() - rng.below(2) * rng.below(bytes.len()));
+        let s = deserialize(bytes.as_ptr(), bytes.len(), &mut p);
+        if s <= Status::Warning {
+            // Accepted (a flipped bit in a value): not tracked, so freed at once.
+            assert!(free(&mut p) <= Status::Warning);
+        }
+        return (Must::Any, Then::Nothing, s);
+    }
+    let s = deserialize(bytes.as_ptr(), bytes.len(), &mut p);
+    if s > Status::Warning {
+        return (Must::Succeed, Then::Nothing, s);
+    }
+    let mut again = 0usize;
+    assert!(size(p, &mut again) <= Status::Warning && again == n, "a deserialized state must serialize to the same size");
+    let mut copy = vec![0u8; again];
+    assert!(serialize(p, copy.as_mut_ptr(), again) <= Status::Warning);
+    assert!(copy == bytes, "a deserialized state must serialize to the same bytes");
+    (Must::Succeed, Then::Copied(src, p), s)
 }
 
 /// A state pointer: live (true), freed, garbage or NULL (false).
@@ -683,6 +744,11 @@ unsafe fn check<M: Model>(o: &Outcome, sh: &mut Shadow, inst: *mut c_void, logs:
                 let (_, m, t) = *sh.states.iter().find(|s| s.0 == p).expect("restored a state the shadow does not know");
                 sh.mode = m;
                 sh.time = t;
+            }
+            Then::Copied(src, p) => {
+                let (_, m, t) = *sh.states.iter().find(|s| s.0 == src).expect("copied a state the shadow does not know");
+                sh.freed.retain(|&q| q != p);
+                sh.states.push((p, m, t));
             }
             Then::FreedState(p) => {
                 if !p.is_null() {
@@ -778,7 +844,6 @@ pub fn fuzz_fmi3<M: Model>(seed: u64, cases: usize) {
 }
 
 const UNSUPPORTED2: &[&str] = &[
-    "fmi2SerializeFMUstate",
     "fmi2GetDirectionalDerivative",
     "fmi2EnterEventMode",
     "fmi2NewDiscreteStates",
@@ -877,6 +942,17 @@ unsafe fn random_call2<M: Model>(rng: &mut FuzzRng, c: *mut c_void, sh: &Shadow)
                 assert_eq!(t, (*c.cast::<Instance<M>>()).time);
             }
             o("fmi2GetRealStatus", m::GET_STATUS, s, Must::Succeed, Then::Nothing)
+        }
+        20 => {
+            let (must, then, s) = round_trip(
+                rng,
+                sh,
+                |st, n| fmi2::serialized_fmu_state_size::<M>(c, st, n),
+                |st, b, n| fmi2::serialize_fmu_state::<M>(c, st, b.cast(), n),
+                |b, n, p| fmi2::deserialize_fmu_state::<M>(c, b.cast(), n, p),
+                |p| fmi2::free_fmu_state::<M>(c, p),
+            );
+            o("fmi2DeSerializeFMUstate", m::DESERIALIZE_FMU_STATE, s, must, then)
         }
         _ => {
             let f = rng.pick(UNSUPPORTED2);
@@ -980,5 +1056,189 @@ macro_rules! fmu_conformance_tests {
                 $crate::testing::fuzz_fmi2::<$model>(seed, $cases);
             }
         }
+
+        #[test]
+        fn serialized_states_restore_exactly() {
+            let h = <$model as $crate::Model>::STEP_SIZE;
+            $crate::testing::assert_state_round_trip::<$model>(&[], h, 13, 12, &$crate::testing::wiggle_inputs::<$model>);
+        }
     };
+}
+
+/// Sets every Float64 input to a slow wave around its start value (inside its bounds) and
+/// every Int32 `*_seq` input (a scalar command counter) to a new value, so a model driven by
+/// it moves: a default drive for [`assert_state_round_trip`].
+pub fn wiggle_inputs<M: Model>(io: &mut Store, k: usize) {
+    for (i, v) in M::VARIABLES.iter().enumerate() {
+        match (v.causality, &v.start) {
+            (Causality::Input, Start::Float64(start)) => {
+                let x = start + 0.3 * (0.37 * k as f64 + i as f64).sin();
+                io.set_f64(i, x.clamp(v.min.unwrap_or(f64::MIN), v.max.unwrap_or(f64::MAX)));
+            }
+            (Causality::Input, Start::Int32(_)) if v.name.ends_with("_seq") => io.set_i32(i, k as i32 + 1),
+            _ => {}
+        }
+    }
+}
+
+/// One instance driven through the FMI 3 layer for [`assert_state_round_trip`].
+struct Driven<M: Model> {
+    p: *mut c_void,
+    logs: Box<Logs>,
+    _m: std::marker::PhantomData<M>,
+}
+
+impl<M: Model> Driven<M> {
+    /// Instantiated, `params` set (straight into the store: any type).
+    unsafe fn new(params: &[(usize, Value)]) -> Driven<M> {
+        let token = CString::new(M::TOKEN).unwrap_or_default();
+        let mut logs = Box::new(Logs::default());
+        let env = (&mut *logs as *mut Logs).cast::<c_void>();
+        let p = fmi3::instantiate_co_simulation::<M>(c"rt".as_ptr(), token.as_ptr(), std::ptr::null(), 0, 0, 0, 0, std::ptr::null(), 0, env, Some(log3), None);
+        assert!(!p.is_null(), "{}: instantiation failed: {:?}", M::NAME, logs.0);
+        let d = Driven { p, logs, _m: std::marker::PhantomData };
+        for (i, v) in params {
+            *d.inst().store.value_mut(*i) = v.clone();
+        }
+        d
+    }
+
+    unsafe fn inst(&self) -> &mut Instance<M> {
+        &mut *self.p.cast::<Instance<M>>()
+    }
+
+    unsafe fn ok(&self, s: Status, what: &str) {
+        assert!(s <= Status::Warning, "{}: {what} returned {s:?}; log: {:?}", M::NAME, self.logs.0);
+    }
+
+    unsafe fn initialize(&self) {
+        self.ok(fmi3::enter_initialization_mode::<M>(self.p, 0, 0.0, 0.0, 0, 0.0), "EnterInitializationMode");
+        self.ok(fmi3::exit_initialization_mode::<M>(self.p), "ExitInitializationMode");
+    }
+
+    /// Steps `n` times from step `first`, `drive` setting inputs before each; returns every
+    /// value after every step (time included).
+    unsafe fn run(&self, first: usize, n: usize, h: f64, drive: &dyn Fn(&mut Store, usize)) -> Vec<(f64, Store)> {
+        let mut out = Vec::with_capacity(n);
+        for k in first..first + n {
+            drive(&mut self.inst().store, k);
+            let t = self.inst().time;
+            let (mut e, mut term, mut early, mut last) = (0u8, 0u8, 0u8, 0.0);
+            self.ok(fmi3::do_step::<M>(self.p, t, h, 0, &mut e, &mut term, &mut early, &mut last), "DoStep");
+            out.push((self.inst().time, self.inst().store.clone()));
+        }
+        out
+    }
+
+    unsafe fn serialize(&self, state: *mut c_void) -> Vec<u8> {
+        let mut n = 0usize;
+        self.ok(fmi3::serialized_fmu_state_size::<M>(self.p, state, &mut n), "SerializedFMUStateSize");
+        let mut bytes = vec![0u8; n];
+        self.ok(fmi3::serialize_fmu_state::<M>(self.p, state, bytes.as_mut_ptr(), n), "SerializeFMUState");
+        bytes
+    }
+
+    unsafe fn restore(&self, bytes: &[u8]) {
+        let mut s = std::ptr::null_mut();
+        self.ok(fmi3::deserialize_fmu_state::<M>(self.p, bytes.as_ptr(), bytes.len(), &mut s), "DeserializeFMUState");
+        self.ok(fmi3::set_fmu_state::<M>(self.p, s), "SetFMUState");
+        self.ok(fmi3::free_fmu_state::<M>(self.p, &mut s), "FreeFMUState");
+    }
+}
+
+impl<M: Model> Drop for Driven<M> {
+    fn drop(&mut self) {
+        unsafe { fmi3::free_instance::<M>(self.p) };
+    }
+}
+
+fn assert_same_run<M: Model>(what: &str, expected: &[(f64, Store)], got: &[(f64, Store)]) {
+    assert_eq!(expected.len(), got.len());
+    for (k, ((t0, a), (t1, b))) in expected.iter().zip(got).enumerate() {
+        assert_eq!(t0.to_bits(), t1.to_bits(), "{}: {what}: time differs after step {k}", M::NAME);
+        for (i, v) in M::VARIABLES.iter().enumerate() {
+            assert!(
+                a.value(i).identical(b.value(i)),
+                "{}: {what}: variable '{}' differs {k} steps after the restore",
+                M::NAME,
+                v.name
+            );
+        }
+    }
+}
+
+/// Serialized FMU states restore exactly: a model run `before` steps, its state serialized,
+/// then `after` more steps; the same bytes deserialized into this instance and into a fresh
+/// instance (which rebuilds the model from the saved parameters), restored and stepped give
+/// every variable bit for bit as the uninterrupted run. `drive` sets inputs before step k.
+/// Also: a serialized Instantiated state restores, and corrupt or foreign bytes are refused.
+/// Returns the size of the serialized state.
+pub fn assert_state_round_trip<M: Model>(
+    params: &[(usize, Value)],
+    h: f64,
+    before: usize,
+    after: usize,
+    drive: &dyn Fn(&mut Store, usize),
+) -> usize {
+    unsafe {
+        let a = Driven::<M>::new(params);
+        let mut s0 = std::ptr::null_mut();
+        a.ok(fmi3::get_fmu_state::<M>(a.p, &mut s0), "GetFMUState (Instantiated)");
+        let instantiated = a.serialize(s0);
+        a.ok(fmi3::free_fmu_state::<M>(a.p, &mut s0), "FreeFMUState");
+        a.initialize();
+        a.run(0, before, h, drive);
+        let mut s = std::ptr::null_mut();
+        a.ok(fmi3::get_fmu_state::<M>(a.p, &mut s), "GetFMUState");
+        let bytes = a.serialize(s);
+        let expected = a.run(before, after, h, drive);
+        let moved = expected.windows(2).any(|w| {
+            M::VARIABLES.iter().enumerate().any(|(i, v)| v.causality == Causality::Output && !w[0].1.value(i).identical(w[1].1.value(i)))
+        });
+        assert!(moved, "{}: no output changes after the saved point: the comparison would say nothing", M::NAME);
+
+        // This instance: same parameters, its own model is reused.
+        a.restore(&bytes);
+        assert_eq!(a.inst().mode, Mode::StepMode);
+        assert_same_run::<M>("restored in the same instance", &expected, &a.run(before, after, h, drive));
+
+        // A fresh instance with default parameters: the model is rebuilt from the saved ones.
+        let b = Driven::<M>::new(&[]);
+        b.restore(&bytes);
+        assert_same_run::<M>("restored in a fresh instance", &expected, &b.run(before, after, h, drive));
+        assert!(b.serialize_current() == a.serialize_current(), "{}: the two restored runs end in different states", M::NAME);
+
+        // Instantiated state: back to the start, initializes and runs as the first time.
+        b.restore(&instantiated);
+        assert_eq!(b.inst().mode, Mode::Instantiated);
+        b.initialize();
+        let first = b.run(0, before, h, drive);
+        let c = Driven::<M>::new(params);
+        c.initialize();
+        assert_same_run::<M>("restored Instantiated state", &c.run(0, before, h, drive), &first);
+
+        // Corrupt, truncated and foreign bytes: an error, never a crash.
+        for bad in [&bytes[..bytes.len() / 2], &bytes[..4], b"AGS\x02....", &[][..]] {
+            let mut p = std::ptr::null_mut();
+            let st = fmi3::deserialize_fmu_state::<M>(c.p, bad.as_ptr(), bad.len(), &mut p);
+            assert_eq!(st, Status::Error, "{}: bad serialized state accepted", M::NAME);
+            assert!(p.is_null());
+            assert!(c.logs.0.iter().any(|(_, m)| m.contains("fmi3DeserializeFMUState")), "{}: refusal not logged", M::NAME);
+            fmi3::reset::<M>(c.p);
+        }
+        let mut short = vec![0u8; bytes.len() - 1];
+        assert_eq!(fmi3::serialize_fmu_state::<M>(a.p, s, short.as_mut_ptr(), short.len()), Status::Error, "{}: short buffer accepted", M::NAME);
+        bytes.len()
+    }
+}
+
+impl<M: Model> Driven<M> {
+    /// The serialized form of the current state.
+    unsafe fn serialize_current(&self) -> Vec<u8> {
+        let mut s = std::ptr::null_mut();
+        self.ok(fmi3::get_fmu_state::<M>(self.p, &mut s), "GetFMUState");
+        let bytes = self.serialize(s);
+        self.ok(fmi3::free_fmu_state::<M>(self.p, &mut s), "FreeFMUState");
+        bytes
+    }
 }

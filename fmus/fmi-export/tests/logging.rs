@@ -28,13 +28,14 @@ agrisim_fmi::variables! { VARIABLES {
 }}
 
 /// Logs an info message every step, and a warning when `warn` is set.
-#[derive(Clone)]
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
 struct Chatty;
 
 impl Model for Chatty {
     const NAME: &'static str = "Chatty";
     const DESCRIPTION: &'static str = "logs on every step";
     const VARIABLES: &'static [Var] = VARIABLES;
+    agrisim_fmi::whole_state!();
     fn new() -> Self {
         Chatty
     }

@@ -141,7 +141,7 @@ pub fn decode(bytes: &[u8]) -> Result<Vec<Frame<'_>>, Error> {
 }
 
 /// A consumer's position in one port: the last sequence number taken.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Cursor {
     pub last: u64,
 }
@@ -186,7 +186,7 @@ impl Cursor {
     }
 }
 
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 struct Pending {
     seq: u64,
     stamp_ns: i64,
@@ -196,7 +196,7 @@ struct Pending {
 }
 
 /// A producer's side of one port: the frames of the last window, and the sequence counter.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Outbox {
     frames: VecDeque<Pending>,
     last_seq: u64,

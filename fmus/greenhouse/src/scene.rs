@@ -6,7 +6,7 @@
 //! writes it as glTF. All generated deterministically from a scenario and a seed.
 
 /// What an object is (for labels, collision reports, colours).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize, serde::Deserialize)]
 pub enum Kind {
     Floor,
     Wall,
@@ -25,7 +25,7 @@ pub enum Kind {
 }
 
 /// A solid primitive in its own frame (centred at the origin).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Shape {
     /// Axis-aligned box with half extents (x, y, z) before the object's rotation.
     Box { half: [f64; 3] },
@@ -35,7 +35,7 @@ pub enum Shape {
 }
 
 /// Rigid placement: translation and a unit quaternion (x, y, z, w).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Placement {
     pub translation: [f64; 3],
     pub rotation: [f64; 4],
@@ -49,7 +49,7 @@ impl Placement {
     }
 }
 
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Object {
     /// Unique within the scene, dense from 0 (usable as an index and as a label value).
     pub id: u32,

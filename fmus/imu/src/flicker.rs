@@ -20,7 +20,7 @@ pub const PER_DECADE: usize = 2;
 /// Each process updates after 1 % of its correlation time (see [`GaussMarkov::hold`]).
 pub const HOLD_FRACTION: f64 = 0.01;
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct FlickerBias {
     processes: Vec<GaussMarkov>,
 }

@@ -2,7 +2,7 @@
 
 pub type Vec3 = [f64; 3];
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Quat {
     pub x: f64,
     pub y: f64,

@@ -12,7 +12,7 @@
 
 use agrisim_math::Rng;
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct GaussMarkov {
     /// Driving noise density q [unit/sqrt(s)].
     pub drive: f64,

@@ -14,7 +14,7 @@ use agrisim_msgs::sensor_msgs;
 use agrisim_msgs::std_msgs::Header;
 use agrisim_msgs::Message;
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Imu {
     sensor: ImuSensor,
     motion: HeldMotion,
@@ -129,6 +129,8 @@ impl Model for Imu {
     const NAME: &'static str = "Imu";
     const DESCRIPTION: &'static str = "IMU on the mobile base (ICM-40609-D noise figures, gz-sensors noise model): sensor_msgs/Imu at a configurable rate";
     const VARIABLES: &'static [Var] = VARIABLES;
+
+    agrisim_fmi::whole_state!();
 
     fn new() -> Self {
         Self::default()

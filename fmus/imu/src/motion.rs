@@ -14,7 +14,7 @@
 use crate::frame::{add, cross, Quat, Vec3};
 
 /// Chassis ground truth at one instant (inputs of the FMU).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BaseState {
     pub yaw: f64,
     /// Body-frame velocity [m/s] and yaw rate [rad/s].
@@ -24,7 +24,7 @@ pub struct BaseState {
 }
 
 /// IMU pose on base_link.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Mount {
     pub translation: Vec3,
     pub rotation: Quat,
@@ -49,7 +49,7 @@ pub fn specific_force_base(state: &BaseState, accel: [f64; 2], yaw_accel: f64, r
 }
 
 /// The latest chassis inputs and the accelerations estimated from the two latest ones.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct HeldMotion {
     time: f64,
     state: BaseState,

@@ -57,7 +57,7 @@ impl NoiseParams {
 }
 
 /// Noise state of one axis.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct AxisNoise {
     white_stddev: f64,
     turn_on_bias: f64,
@@ -98,7 +98,7 @@ impl AxisNoise {
 }
 
 /// Noise of a three-axis sensor.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct TriadNoise {
     pub axes: [AxisNoise; 3],
 }

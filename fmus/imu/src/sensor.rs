@@ -20,7 +20,7 @@ pub struct Sample {
     pub orientation: Quat,
 }
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct ImuSensor {
     pub mount: Mount,
     pub gravity: f64,

@@ -16,7 +16,7 @@ pub const POINT_STEP: usize = 20;
 pub const FIELDS: [&str; 5] = ["x", "y", "z", "intensity", "t"];
 
 /// One point as published.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Point {
     pub xyz: [f32; 3],
     pub intensity: f32,

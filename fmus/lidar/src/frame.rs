@@ -3,7 +3,7 @@
 pub type Vec3 = [f64; 3];
 
 /// Rotation as a row-major 3x3 matrix plus translation.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Mount {
     pub translation: Vec3,
     pub rotation: [[f64; 3]; 3],

@@ -53,8 +53,10 @@ pub struct Frame {
     pub returns: usize,
 }
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Lidar {
+    /// Derived from the parameters: rebuilt, not serialized.
+    #[serde(skip)]
     config: Option<Config>,
     base: Option<BaseBox>,
     trajectory: Trajectory,
@@ -184,6 +186,14 @@ impl Model for Lidar {
     const NAME: &'static str = "Lidar";
     const DESCRIPTION: &'static str = "LiDAR modelled on the Livox MID-360 (non-repetitive pattern, 200k points/s, 10 Hz frames) cast at the greenhouse scene: sensor_msgs/PointCloud2";
     const VARIABLES: &'static [Var] = VARIABLES;
+
+    fn save_state(&self, out: &mut Vec<u8>) -> Result<(), agrisim_fmi::ModelError> {
+        agrisim_fmi::serial::write(self, out)
+    }
+
+    fn load_state(&mut self, bytes: &[u8]) -> Result<(), agrisim_fmi::ModelError> {
+        agrisim_fmi::serial::load_keeping(self, bytes, |new, old| new.config = old.config.take())
+    }
 
     fn new() -> Self {
         Self::default()

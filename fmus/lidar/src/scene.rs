@@ -7,7 +7,7 @@ use agrisim_greenhouse::Object;
 pub use agrisim_greenhouse::cast_scene::{load_cached as load, CastScene as Scene};
 
 /// The robot base box, re-placed at every pose the scan is taken from.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct BaseBox {
     pub object: Object,
     dims: [f64; 4],

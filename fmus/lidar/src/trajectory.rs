@@ -9,7 +9,7 @@
 use agrisim_math::Pose2;
 use std::collections::VecDeque;
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Trajectory {
     /// (time, pose) in time order; yaw unwrapped so neighbours differ by less than pi.
     samples: VecDeque<(f64, Pose2)>,

@@ -46,7 +46,7 @@ agrisim_fmi::variables! { pub VARIABLES {
 /// where the lift starts.
 const SETPOINT_CHOICE: &[usize] = &[POS_MIN, POS_MAX, POS0, SETPOINT];
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Lift {
     profile: Profile,
     target: f64,
@@ -93,6 +93,8 @@ impl Model for Lift {
     const NAME: &'static str = "Lift";
     const DESCRIPTION: &'static str = "Prismatic lift with position set-point, velocity/acceleration limits and range check";
     const VARIABLES: &'static [Var] = VARIABLES;
+
+    agrisim_fmi::whole_state!();
 
     fn new() -> Self {
         Self::default()

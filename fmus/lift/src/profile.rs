@@ -3,14 +3,14 @@
 //! evaluated in closed form, so the lift's trajectory is exact at every communication point.
 
 /// A constant-acceleration segment.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 struct Segment {
     duration: f64,
     accel: f64,
 }
 
 /// A planned motion starting at time `t0`.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Profile {
     t0: f64,
     p0: f64,

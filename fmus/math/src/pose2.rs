@@ -11,7 +11,7 @@
 use agrisim_msgs::geometry_msgs::{Pose, Quaternion};
 
 /// A pose in the plane, or the transform from a child frame to its parent.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Pose2 {
     pub x: f64,
     pub y: f64,

@@ -37,7 +37,7 @@ use std::f64::consts::{PI, TAU};
 const GOLDEN: u64 = 0x9E37_79B9_7F4A_7C15;
 
 /// SplitMix64 generator; see the [module docs](self) for the two flavours of methods.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Rng {
     state: u64,
     /// Second Box-Muller deviate of [`Rng::normal`] (noise flavour only).

@@ -5,7 +5,7 @@ use crate::message::ros_message;
 ros_message! {
     /// `builtin_interfaces/msg/Time`: seconds plus nanoseconds in `[0, 1e9)`, also for
     /// negative times (-1.7 s = `{sec: -2, nanosec: 300_000_000}`).
-    #[derive(Debug, Default, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    #[derive(Debug, Default, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
     pub struct Time = "builtin_interfaces/msg/Time" {
         pub sec: i32,
         pub nanosec: u32,

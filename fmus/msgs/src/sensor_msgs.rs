@@ -6,7 +6,7 @@ use crate::std_msgs::Header;
 ros_message! {
     /// `sensor_msgs/msg/JointState`: parallel arrays indexed like `name`; any of
     /// position/velocity/effort may be empty.
-    #[derive(Debug, Default, Clone, PartialEq)]
+    #[derive(Debug, Default, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
     pub struct JointState = "sensor_msgs/msg/JointState" {
         pub header: Header,
         pub name: Vec<String>,

@@ -5,7 +5,7 @@ use crate::message::ros_message;
 
 ros_message! {
     /// `std_msgs/msg/Header`: timestamp and coordinate frame of stamped data.
-    #[derive(Debug, Default, Clone, PartialEq)]
+    #[derive(Debug, Default, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
     pub struct Header = "std_msgs/msg/Header" {
         pub stamp: Time,
         pub frame_id: String,

@@ -2,7 +2,7 @@
 //! roll-pitch-yaw convention, which does not justify a linear-algebra dependency here.
 
 /// A rigid transform: `p_parent = rot * p_child + trans`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Pose {
     /// Row-major rotation matrix.
     pub rot: [[f64; 3]; 3],

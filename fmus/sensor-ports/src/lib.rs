@@ -89,7 +89,7 @@ pub const BASE_POSE: [Var; 3] = [
 ];
 
 /// Where a sensor is on base_link: position and fixed-axis roll-pitch-yaw (URDF).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Mount {
     pub translation: [f64; 3],
     pub roll: f64,

@@ -33,7 +33,7 @@ agrisim_fmi::variables! { pub VARIABLES {
 /// maxSize of msg_in, and so of its echo msg_out.
 pub const MAX_MESSAGE: usize = 1 << 20;
 
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct TestModel {
     x: f64,
     steps: i32,
@@ -75,6 +75,8 @@ impl Model for TestModel {
         log.info(format_args!("initialized with label {:?}", io.string(LABEL)));
         Ok(())
     }
+
+    agrisim_fmi::whole_state!();
 
     fn do_step(&mut self, io: &mut Store, t: f64, h: f64, _log: &mut dyn Log) -> Result<(), ModelError> {
         match io.i32(FAULT) {

@@ -34,3 +34,15 @@ fn model_structure_dependencies_hold() {
     agrisim_fmi::testing::assert_initial_dependencies::<TestModel>(&[]);
     agrisim_fmi::testing::assert_no_direct_feedthrough::<TestModel>();
 }
+
+#[test]
+fn serialized_states_restore_exactly() {
+    use agrisim_fmi::Value;
+    use agrisim_fmu_testmodel::*;
+    let params = [(X0, Value::Float64(2.5)), (LABEL, Value::String("saved".into()))];
+    let n = agrisim_fmi::testing::assert_state_round_trip::<TestModel>(&params, 0.02, 7, 9, &|io, k| {
+        io.set_f64(U, (k as f64 * 0.3).sin());
+        io.set_binary(MSG_IN, &[k as u8; 3]);
+    });
+    assert!(n > 50, "{n} bytes");
+}

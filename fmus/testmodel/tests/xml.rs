@@ -12,7 +12,7 @@ fn fmi3_description_has_the_required_parts() {
         r#"<CoSimulation modelIdentifier="TestModel""#,
         r#"canHandleVariableCommunicationStepSize="true""#,
         r#"canGetAndSetFMUState="true""#,
-        r#"canSerializeFMUState="false""#,
+        r#"canSerializeFMUState="true""#,
         r#"<Float64 name="time" valueReference="0""#,
         r#"causality="independent""#,
         r#"<Unit name="1/s">"#,

@@ -2,7 +2,7 @@
 //! the importer's communication step is (FMI 3 clocks are too rarely supported to rely on).
 
 /// Tracks which publication instants have passed, in integer nanoseconds (no float drift).
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Schedule {
     period_ns: i64,
     next: i64,

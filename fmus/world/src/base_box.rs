@@ -7,7 +7,7 @@ use crate::ports::*;
 use agrisim_fmi::Store;
 use rapier3d::prelude::{Pose, SharedShape};
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BaseBox {
     pub length: f64,
     pub width: f64,

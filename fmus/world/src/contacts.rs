@@ -27,7 +27,7 @@ use rapier3d::parry::query;
 use rapier3d::prelude::{Collider, Real, Vector};
 
 /// What a robot part touches.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
 pub enum Other {
     /// Index into [`SceneWorld::objects`].
     Object(usize),
@@ -35,7 +35,7 @@ pub enum Other {
     Part(usize),
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
 pub enum Category {
     Plant,
     Structure,
@@ -146,7 +146,7 @@ fn arm_arm_contacts(world: &SceneWorld, aabbs: &[Aabb], out: &mut Vec<RobotConta
 /// part touched the step before; for arm-arm a (left link part, right link part) pair that
 /// was not in contact. So a leaf pressed by the base box and then also by an arm is one
 /// onset; touching it again after letting go is another.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ContactTracker {
     /// (category, robot part or 0, other) in contact, sorted: plant and structure contacts
     /// are keyed by the object alone, arm-arm ones by both parts.

@@ -43,7 +43,7 @@ pub const MAX_FALL_TIME: f64 = 10.0;
 pub const FLOOR_EPS: f64 = 0.005;
 
 /// Where a fruit is in the harvest.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum FruitState {
     OnPlant,
     /// Held by one or both grippers, following `leader`'s hand.
@@ -56,7 +56,7 @@ pub enum FruitState {
     Dropped,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Gripper {
     /// Gap at the end of the last step [m].
     pub width: f64,
@@ -66,13 +66,13 @@ pub struct Gripper {
     pub grip: RPose,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct HarvestParams {
     pub grasp_tolerance: f64,
     pub release_margin: f64,
 }
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Harvest {
     pub params: HarvestParams,
     /// States of the fruit that left their plant (absent = on the plant), by fruit index.

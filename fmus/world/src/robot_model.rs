@@ -21,7 +21,7 @@ pub const READY_POSE: [f64; 7] = [0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785];
 pub const OPEN_WIDTH: f64 = 0.08;
 
 /// The two arms, in a fixed order (left first) wherever both appear.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
 pub enum Side {
     Left = 0,
     Right = 1,
@@ -46,7 +46,7 @@ impl Side {
 }
 
 /// Every robot coordinate the world takes as input.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Coords {
     pub lift: f64,
     /// Joint angles [rad] of `<side>_joint1..7`, indexed by [`Side`].

@@ -25,7 +25,7 @@ pub struct RobotPart {
 }
 
 /// A link's kinematic body and the map-frame pose it was last put at.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LinkBody {
     /// Index into [`RobotModel::link_names`](crate::robot_model::RobotModel::link_names).
     pub link: usize,

@@ -28,7 +28,7 @@ pub struct SceneObject {
 }
 
 /// A fruit's rigid body, in the order of the fruit list (`target_fruit` indexes it).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Fruit {
     /// Index into [`SceneWorld::objects`].
     pub object: usize,
@@ -43,7 +43,7 @@ pub const FRUIT_DENSITY: f32 = 1000.0;
 pub const GRAVITY: f32 = 9.81;
 
 /// The robot base: a kinematic body with one box collider.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Robot {
     pub body: RigidBodyHandle,
     pub collider: ColliderHandle,
@@ -55,13 +55,21 @@ pub struct Robot {
 /// state) starts with fresh ones.
 struct Scratch(CollisionPipeline, PhysicsPipeline);
 
+impl Default for Scratch {
+    fn default() -> Self {
+        Scratch(CollisionPipeline::new(), PhysicsPipeline::new())
+    }
+}
+
 impl Clone for Scratch {
     fn clone(&self) -> Self {
         Scratch(CollisionPipeline::new(), PhysicsPipeline::new())
     }
 }
 
-#[derive(Clone)]
+/// Serialized (an FMU state) without what the scene's parameters fix: the scene objects'
+/// names and kinds and the robot parts ([`SceneWorld::adopt`] takes them over).
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
 pub struct SceneWorld {
     pub bodies: RigidBodySet,
     pub colliders: ColliderSet,
@@ -69,21 +77,32 @@ pub struct SceneWorld {
     pub broad_phase: BroadPhaseBvh,
     pub narrow_phase: NarrowPhase,
     pub params: IntegrationParameters,
+    #[serde(skip)]
     pub objects: Vec<SceneObject>,
     pub fruit: Vec<Fruit>,
     pub robot: Robot,
     /// The URDF links (empty until [`SceneWorld::add_robot_links`]).
     pub links: Vec<LinkBody>,
     /// Every robot collider: part 0 is the base box, then the link primitives.
+    #[serde(skip)]
     pub parts: Vec<RobotPart>,
     impulse_joints: ImpulseJointSet,
     multibody_joints: MultibodyJointSet,
     soft_bodies: SoftBodySet,
     ccd: CCDSolver,
+    #[serde(skip)]
     scratch: Scratch,
 }
 
 impl SceneWorld {
+    /// Becomes `loaded` (a deserialized world of the same scene), keeping this world's scene
+    /// objects and robot parts, which serialization leaves out.
+    pub fn adopt(&mut self, mut loaded: SceneWorld) {
+        loaded.objects = std::mem::take(&mut self.objects);
+        loaded.parts = std::mem::take(&mut self.parts);
+        *self = loaded;
+    }
+
     /// Builds the world from the scene's objects (in their order) and the robot base at `robot_pose`.
     pub fn build(objects: &[Object], base: BaseBox, robot_pose: Pose) -> Result<SceneWorld, String> {
         let mut bodies = RigidBodySet::new();

@@ -70,8 +70,11 @@ struct Running {
     published_target: Option<i32>,
 }
 
+/// A serialized [`Running`] (see `save_state`).
+type SavedRun = (SceneWorld, (Coords, [f64; 3], Vec<RPose>, RPose), Harvest, ContactTracker, (Schedule, Schedule, Schedule), Ports, Option<i32>);
+
 /// The world's message ports.
-#[derive(Clone)]
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
 struct Ports {
     scene: OutPort,
     collision: OutPort,
@@ -357,6 +360,29 @@ impl Model for GreenhouseWorld {
         });
         run.report(io, start_time);
         self.run = Some(run);
+        Ok(())
+    }
+
+    /// The physics world, the robot's applied pose, harvest, contacts, schedules and ports;
+    /// the rest of [`Running`] follows from the parameters.
+    fn save_state(&self, out: &mut Vec<u8>) -> Result<(), String> {
+        let r = self.run.as_ref().ok_or("the world is not initialized")?;
+        let robot = (&r.robot.coords, &r.robot.planar, &r.robot.link_in_base, &r.robot.box_pose);
+        let schedules = (&r.collision_schedule, &r.fruit_schedule, &r.scene_schedule);
+        agrisim_fmi::serial::write(&(&r.world, robot, &r.harvest, &r.tracker, schedules, &r.ports, r.published_target), out)
+    }
+
+    fn load_state(&mut self, bytes: &[u8]) -> Result<(), String> {
+        let r = self.run.as_mut().ok_or("the world is not initialized")?;
+        let saved: SavedRun = agrisim_fmi::serial::read(bytes)?;
+        let (world, (coords, planar, link_in_base, box_pose), harvest, tracker, schedules, ports, published_target) = saved;
+        if world.fruit.len() != r.world.fruit.len() || link_in_base.len() != r.robot.link_in_base.len() {
+            return Err("the saved world is of another scene or robot".into());
+        }
+        r.world.adopt(world);
+        (r.robot.coords, r.robot.planar, r.robot.link_in_base, r.robot.box_pose) = (coords, planar, link_in_base, box_pose);
+        (r.harvest, r.tracker, r.ports, r.published_target) = (harvest, tracker, ports, published_target);
+        (r.collision_schedule, r.fruit_schedule, r.scene_schedule) = schedules;
         Ok(())
     }
 

@@ -26,6 +26,7 @@ pub mod fmi3;
 pub mod master;
 pub mod model_description;
 pub mod order;
+pub mod saved;
 pub mod seed;
 pub mod ssp;
 pub mod system;

@@ -66,9 +66,9 @@ impl Hooks for NoHooks {}
 /// it and stepping gives exactly what stepping on from the snapshot gave. The program around
 /// the engine (its hooks: bus, nodes, recorder) keeps its own state.
 pub struct Snapshot {
-    fmus: Vec<crate::fmi3::FmuState>,
-    tick: u64,
-    routes: Vec<(agrisim_frames::Cursor, i64)>,
+    pub(crate) fmus: Vec<crate::fmi3::FmuState>,
+    pub(crate) tick: u64,
+    pub(crate) routes: Vec<(agrisim_frames::Cursor, i64)>,
 }
 
 impl Snapshot {

@@ -220,6 +220,7 @@ pub struct ModelDescription {
     /// `CoSimulation/@modelIdentifier`: the shared library's file stem.
     pub model_identifier: String,
     pub can_get_and_set_fmu_state: bool,
+    pub can_serialize_fmu_state: bool,
     /// Names of `<LogCategories>` (empty when the FMU declares none).
     pub log_categories: Vec<String>,
     pub default_step_size: Option<f64>,
@@ -289,6 +290,15 @@ impl ModelDescription {
             Some(v) => parse_bool(v).ok_or_else(|| {
                 err(format!(
                     "<CoSimulation> canGetAndSetFMUState=\"{v}\" is not a boolean"
+                ))
+            })?,
+        };
+
+        let can_serialize_fmu_state = match cs.attribute("canSerializeFMUState") {
+            None => false,
+            Some(v) => parse_bool(v).ok_or_else(|| {
+                err(format!(
+                    "<CoSimulation> canSerializeFMUState=\"{v}\" is not a boolean"
                 ))
             })?,
         };
@@ -410,6 +420,7 @@ impl ModelDescription {
             instantiation_token,
             model_identifier,
             can_get_and_set_fmu_state,
+            can_serialize_fmu_state,
             log_categories,
             default_step_size,
             variables,

@@ -1,7 +1,8 @@
 //! A whole-system snapshot, restored, steps on exactly as the run it was taken from: every
 //! message and every FMU signal byte-identical. Covers every FMU kind: harvest.ssd (both
 //! chassis models, lift, LiDAR, IMU, both arms with a trajectory and a gripper command, the
-//! world) and sensors.ssd (the camera, small). Needs the packed FMUs (target/fmu).
+//! world) and sensors.ssd (the camera, small), in memory and serialized to bytes restored in
+//! a fresh master. Needs the packed FMUs (target/fmu).
 
 use agrisim_cosim::{Hooks, LoadOptions, Master, System};
 use agrisim_error::Result;
@@ -86,9 +87,14 @@ fn run(m: &mut Master, n: usize) -> Vec<u8> {
     d.log
 }
 
-fn check(mut m: Master, before: usize, after: usize) {
+/// Runs `before` steps, snapshots, runs `after` more; the snapshot restored in this master,
+/// and its serialized bytes restored in a fresh master of the same system (as another
+/// process would), step on to the very same bytes.
+fn check(make: impl Fn() -> Master, before: usize, after: usize) {
+    let mut m = make();
     run(&mut m, before);
     let snap = m.snapshot().unwrap();
+    let bytes = m.serialize_snapshot(&snap).unwrap();
     let first = run(&mut m, after);
     m.restore(&snap).unwrap();
     assert_eq!(m.tick(), before as u64);
@@ -99,13 +105,33 @@ fn check(mut m: Master, before: usize, after: usize) {
     m.restore(&snap).unwrap();
     assert!(run(&mut m, after) == first);
     m.free_snapshot(snap).unwrap();
+
+    // Serialized: a fresh master (its FMUs rebuild their scenes) goes on exactly the same.
+    let mut fresh = make();
+    let snap = fresh.deserialize_snapshot(&bytes).unwrap();
+    fresh.restore(&snap).unwrap();
+    assert_eq!(fresh.tick(), before as u64);
+    assert!(run(&mut fresh, after) == first, "the run after restoring the serialized snapshot differs");
+    // Loaded into the master it came from (its FMUs reuse their scenes): the same again.
+    let snap = m.deserialize_snapshot(&bytes).unwrap();
+    m.restore(&snap).unwrap();
+    assert!(run(&mut m, after) == first, "the serialized snapshot restored in its own master differs");
+
+    // Damaged bytes are refused with a reason, and the master stays usable.
+    for bad in [&bytes[..bytes.len() / 3], &bytes[6..], &b"AGSYS\x01"[..]] {
+        let e = fresh.deserialize_snapshot(bad).err().expect("damaged snapshot accepted").to_string();
+        assert!(e.contains("snapshot") || e.contains("FMU"), "{e}");
+    }
+    let snap = fresh.deserialize_snapshot(&bytes).unwrap();
+    fresh.restore(&snap).unwrap();
+    assert!(run(&mut fresh, after) == first);
 }
 
 #[test]
 fn harvest_system_restores_byte_identically() {
     for chassis in ["ChassisKinematic.fmu", "ChassisDynamic.fmu"] {
         let cache = tempfile::tempdir().unwrap();
-        check(master("harvest.ssd", "harvest.toml", &[], &[("chassis", chassis)], cache.path()), 30, 40);
+        check(|| master("harvest.ssd", "harvest.toml", &[], &[("chassis", chassis)], cache.path()), 30, 40);
     }
 }
 
@@ -113,5 +139,5 @@ fn harvest_system_restores_byte_identically() {
 fn sensor_system_with_camera_restores_byte_identically() {
     let cache = tempfile::tempdir().unwrap();
     let small = [("camera", "width", toml::Value::Integer(64)), ("camera", "height", toml::Value::Integer(48))];
-    check(master("sensors.ssd", "sensors.toml", &small, &[], cache.path()), 12, 15);
+    check(|| master("sensors.ssd", "sensors.toml", &small, &[], cache.path()), 12, 15);
 }

@@ -118,3 +118,17 @@ pub type SetFmuState =
     unsafe extern "C" fn(instance: Fmi3Instance, state: Fmi3FmuState) -> Fmi3Status;
 pub type FreeFmuState =
     unsafe extern "C" fn(instance: Fmi3Instance, state: *mut Fmi3FmuState) -> Fmi3Status;
+pub type SerializedFmuStateSize =
+    unsafe extern "C" fn(instance: Fmi3Instance, state: Fmi3FmuState, size: *mut usize) -> Fmi3Status;
+pub type SerializeFmuState = unsafe extern "C" fn(
+    instance: Fmi3Instance,
+    state: Fmi3FmuState,
+    serialized_state: *mut u8,
+    size: usize,
+) -> Fmi3Status;
+pub type DeserializeFmuState = unsafe extern "C" fn(
+    instance: Fmi3Instance,
+    serialized_state: *const u8,
+    size: usize,
+    state: *mut Fmi3FmuState,
+) -> Fmi3Status;

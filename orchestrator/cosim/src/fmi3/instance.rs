@@ -29,7 +29,7 @@ use super::status::{Status, StepResult};
 use crate::archive::FmuArchive;
 
 /// Where the instance is in the FMI co-simulation state machine, as far as the wrapper knows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum InstanceState {
     Instantiated,
     InitializationMode,
@@ -78,6 +78,7 @@ pub struct Instance {
     name: String,
     model: String,
     can_get_and_set_state: bool,
+    can_serialize_state: bool,
     /// `<LogCategories>` of the modelDescription (empty: none declared).
     log_categories: Vec<String>,
     /// Debug logging is on: the FMU's debug messages are printed to stderr.
@@ -198,6 +199,7 @@ impl Instance {
             name: instance_name.to_string(),
             model: md.model_name.clone(),
             can_get_and_set_state: md.can_get_and_set_fmu_state,
+            can_serialize_state: md.can_serialize_fmu_state,
             log_categories: md.log_categories.clone(),
             debug_logging: logging_on,
             names: Arc::new(names),
@@ -540,6 +542,40 @@ impl Instance {
         Ok(())
     }
 
+    /// The bytes of a saved state (needs canSerializeFMUState), and the wrapper's state it
+    /// was saved in (give both back to [`Instance::deserialize_state`]).
+    pub fn serialize_state(&mut self, state: &FmuState) -> Result<(Vec<u8>, InstanceState), FmiError> {
+        let (size_fn, ser) = self.serial_fns("fmi3SerializeFMUState", |f| Some((f.serialized_fmu_state_size?, f.serialize_fmu_state?)))?;
+        let (s, saved_in) = self.own_state("fmi3SerializeFMUState", state)?;
+        let mut size = 0usize;
+        self.call("fmi3SerializedFMUStateSize", &[], Ctx::None, |_, h| unsafe {
+            size_fn(h, s, &mut size)
+        })?;
+        let mut bytes = vec![0u8; size];
+        self.call("fmi3SerializeFMUState", &[], Ctx::None, |_, h| unsafe {
+            ser(h, s, bytes.as_mut_ptr(), size)
+        })?;
+        Ok((bytes, saved_in))
+    }
+
+    /// A new saved state of this instance from bytes of [`Instance::serialize_state`] (of
+    /// this FMU, possibly from another instance or process); `saved_in` is restored with it.
+    pub fn deserialize_state(&mut self, bytes: &[u8], saved_in: InstanceState) -> Result<FmuState, FmiError> {
+        let de = self.serial_fns("fmi3DeserializeFMUState", |f| f.deserialize_fmu_state)?;
+        let mut s: Fmi3FmuState = ptr::null_mut();
+        self.call("fmi3DeserializeFMUState", &[], Ctx::None, |_, h| unsafe {
+            de(h, bytes.as_ptr(), bytes.len(), &mut s)
+        })?;
+        if s.is_null() {
+            return Err(self.refuse("fmi3DeserializeFMUState", &[], "the FMU returned a NULL state"));
+        }
+        self.fmu_states.push(Some((s, saved_in)));
+        Ok(FmuState {
+            slot: self.fmu_states.len() - 1,
+            owner: self.id,
+        })
+    }
+
     /// Frees a saved state now (otherwise it is freed with the instance).
     pub fn free_state(&mut self, state: FmuState) -> Result<(), FmiError> {
         let free = self.state_fn("fmi3FreeFMUState", |f| f.free_fmu_state)?;
@@ -697,6 +733,21 @@ impl Instance {
                 "refused: the shared library does not export this function (not called; instance state unchanged)",
             )
         })
+    }
+
+    fn serial_fns<T>(
+        &self,
+        function: &str,
+        pick: impl FnOnce(&Functions) -> Option<T>,
+    ) -> Result<T, FmiError> {
+        if !self.can_serialize_state {
+            return Err(self.refuse(
+                function,
+                &[],
+                "refused: not supported, the FMU declares canSerializeFMUState=\"false\" (not called; instance state unchanged)",
+            ));
+        }
+        self.state_fn(function, pick)
     }
 
     fn own_state(

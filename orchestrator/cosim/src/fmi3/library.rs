@@ -39,6 +39,10 @@ pub(crate) struct Functions {
     pub get_fmu_state: Option<ffi::GetFmuState>,
     pub set_fmu_state: Option<ffi::SetFmuState>,
     pub free_fmu_state: Option<ffi::FreeFmuState>,
+    /// Optional: only needed when the FMU declares canSerializeFMUState.
+    pub serialized_fmu_state_size: Option<ffi::SerializedFmuStateSize>,
+    pub serialize_fmu_state: Option<ffi::SerializeFmuState>,
+    pub deserialize_fmu_state: Option<ffi::DeserializeFmuState>,
 }
 
 /// A loaded FMU binary.
@@ -116,6 +120,9 @@ impl Fmi3Library {
             get_fmu_state: opt_sym!("fmi3GetFMUState"),
             set_fmu_state: opt_sym!("fmi3SetFMUState"),
             free_fmu_state: opt_sym!("fmi3FreeFMUState"),
+            serialized_fmu_state_size: opt_sym!("fmi3SerializedFMUStateSize"),
+            serialize_fmu_state: opt_sym!("fmi3SerializeFMUState"),
+            deserialize_fmu_state: opt_sym!("fmi3DeserializeFMUState"),
         };
         Ok(Fmi3Library {
             f,
