@@ -354,6 +354,11 @@ impl<M: Model> Instance<M> {
     /// GetFMUState: a new state, or `existing` (a state of this instance) overwritten.
     pub fn get_state(&mut self, existing: *mut c_void) -> Result<*mut c_void, String> {
         let snap = self.snapshot();
+        self.store_state(snap, existing)
+    }
+
+    /// `snap` as a new live state, or written over `existing` (a live state of this instance).
+    fn store_state(&mut self, snap: Snapshot<M>, existing: *mut c_void) -> Result<*mut c_void, String> {
         if existing.is_null() {
             let p = Box::into_raw(Box::new(snap));
             self.states.push(p);
@@ -472,15 +477,7 @@ impl<M: Model> Instance<M> {
             stop_time: h.stop_time,
             serialized: Some(bytes.to_vec()),
         };
-        if existing.is_null() {
-            let p = Box::into_raw(Box::new(snap));
-            self.states.push(p);
-            return Ok(p.cast());
-        }
-        let p = self.find_state(existing)?;
-        // SAFETY: `p` is a live state of this instance.
-        unsafe { *p = snap };
-        Ok(existing)
+        self.store_state(snap, existing)
     }
 
     /// Number of FMU states not yet freed (for tests).

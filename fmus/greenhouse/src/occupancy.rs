@@ -142,6 +142,11 @@ impl OccupancyMap {
         [x0, y0, x0 + r, y0 + r]
     }
 
+    /// Marks every cell overlapping the axis-aligned rectangle [x0, x1] x [y0, y1].
+    pub fn fill_rect(&mut self, x0: f64, y0: f64, x1: f64, y1: f64) {
+        self.fill_convex(&[[x0, y0], [x1, y0], [x1, y1], [x0, y1]]);
+    }
+
     fn fill_disc(&mut self, cx: f64, cy: f64, r: f64) {
         let (Some((i0, i1)), Some((j0, j1))) = (self.span(cx - r, cx + r, 0), self.span(cy - r, cy + r, 1)) else {
             return;

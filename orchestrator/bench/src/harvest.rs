@@ -10,7 +10,8 @@
 
 use crate::trials::{run_one, run_trials, write_summary, Exec};
 use super::harvest_targets::{draw, eligible, HarvestTarget};
-use super::map::{building_plan, grid_message};
+use crate::initial_pose::initial_estimate;
+use super::map::{grid_message, prior_map};
 use super::nav::trial_seed;
 use super::stats::{percentile, wilson, Z95};
 use agrisim_bus::{Node, Reader};
@@ -100,7 +101,7 @@ pub struct HarvestSetup {
 impl HarvestSetup {
     pub fn new(s: &Scenario) -> Result<HarvestSetup> {
         let g = agrisim_session::scene::generate_scene(s)?;
-        let map = building_plan(&g);
+        let map = prior_map(s, &g)?;
         let candidates = eligible(&g.objects, &g.layout);
         if candidates.is_empty() {
             return Err(err!("scenario {}: no ripe fruit faces an aisle at a harvestable height", s.path.display()));
@@ -176,7 +177,9 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
     for (k, v) in ["x0", "y0", "yaw0"].iter().zip(target.start) {
         chassis.insert(k.to_string(), toml::Value::Float(v));
     }
-    let mut nav_cfg = NavConfig::for_start(target.start);
+    // The localizer starts from an operator's estimate of the start pose, never the true one.
+    let (estimate, _) = initial_estimate(target.start, s.nav.initial_pose_std, seed);
+    let mut nav_cfg = NavConfig::for_estimate(estimate, s.nav.initial_pose_std);
     nav_cfg.embedded_localizer = false;
     let harvest = node(target.fruit_index, seed);
     let node_name = harvest.name().to_string();

@@ -7,6 +7,7 @@
 
 pub mod harvest;
 pub mod harvest_targets;
+pub mod initial_pose;
 pub mod map;
 pub mod nav;
 pub mod overhead;

@@ -11,7 +11,8 @@ use super::report::{render, TrialTrace};
 use super::stats::{wilson, Z95};
 use super::targets::draw_target;
 use agrisim_error::{Context, Result};
-use crate::map::{building_plan, grid_message, MAP_BAND, MAP_RESOLUTION};
+use crate::initial_pose::initial_estimate;
+use crate::map::{grid_message, prior_map, MAP_BAND, MAP_RESOLUTION};
 use agrisim_bus::Node;
 use agrisim_math::Rng;
 use agrisim_nodes::{FaultInjector, GoalPublisher, MapServer, OdomTf};
@@ -36,6 +37,8 @@ pub struct NavTrial {
     pub path_length: f64,
     pub min_clearance: f64,
     pub final_localization_error: Option<f64>,
+    /// Error of the localizer's initial estimate (x, y, yaw) [m, m, rad], seeded.
+    pub initial_pose_error: [f64; 3],
     pub sim_time: f64,
     pub wall_time: f64,
     pub mcap: String,
@@ -79,7 +82,7 @@ pub struct NavSetup {
 impl NavSetup {
     pub fn new(s: &Scenario) -> Result<NavSetup> {
         let g = agrisim_session::scene::generate_scene(s)?;
-        let map = building_plan(&g);
+        let map = prior_map(s, &g)?;
         let truth = OccupancyMap::from_objects(&g.objects, MAP_RESOLUTION, MAP_BAND, g.layout.bounds);
         Ok(NavSetup { layout: g.layout, objects: g.objects, map, truth })
     }
@@ -107,6 +110,7 @@ fn failed_trial(s: &Scenario, setup: &NavSetup, index: u64, seed: u64, reason: S
         path_length: 0.0,
         min_clearance: 0.0,
         final_localization_error: None,
+        initial_pose_error: initial_estimate(setup.layout.start_pose, nav.initial_pose_std, seed).1,
         sim_time: 0.0,
         wall_time: 0.0,
         mcap: format!("trials/{index:04}.mcap"),
@@ -121,7 +125,9 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &NavSetup, index: u64, see
     let nav = &s.nav;
     let target = draw_target(&setup.layout, &setup.truth, &mut rng, nav.targets_in_headland, nav.aisle_margin, 0.7)
         .ok_or_else(|| agrisim_error::err!("scenario {}: no free navigation target could be drawn", s.path.display()))?;
-    let navigator = agrisim_nav::Navigator::new(agrisim_nav::NavConfig::for_start(setup.layout.start_pose));
+    // The localizer starts from an operator's estimate of the start pose, never the true one.
+    let (estimate, initial_pose_error) = initial_estimate(setup.layout.start_pose, nav.initial_pose_std, seed);
+    let navigator = agrisim_nav::Navigator::new(agrisim_nav::NavConfig::for_estimate(estimate, nav.initial_pose_std));
     let nodes: Vec<Box<dyn Node>> = vec![
         Box::new(MapServer::new(grid_message(&setup.map, 0))),
         Box::new(OdomTf::default()),
@@ -201,6 +207,7 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &NavSetup, index: u64, see
         path_length: length,
         min_clearance: clearance,
         final_localization_error: loc_err,
+        initial_pose_error,
         sim_time,
         wall_time: wall.elapsed().as_secs_f64(),
         mcap: mcap.file_name().map(|f| format!("trials/{}", f.to_string_lossy())).unwrap_or_default(),

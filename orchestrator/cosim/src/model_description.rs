@@ -285,23 +285,15 @@ impl ModelDescription {
                 "<CoSimulation> modelIdentifier \"{model_identifier}\" is not a valid file stem"
             )));
         }
-        let can_get_and_set_fmu_state = match cs.attribute("canGetAndSetFMUState") {
-            None => false,
-            Some(v) => parse_bool(v).ok_or_else(|| {
-                err(format!(
-                    "<CoSimulation> canGetAndSetFMUState=\"{v}\" is not a boolean"
-                ))
-            })?,
+        // A capability flag: absent is false.
+        let flag = |name: &str| -> Result<bool, _> {
+            match cs.attribute(name) {
+                None => Ok(false),
+                Some(v) => parse_bool(v).ok_or_else(|| err(format!("<CoSimulation> {name}=\"{v}\" is not a boolean"))),
+            }
         };
-
-        let can_serialize_fmu_state = match cs.attribute("canSerializeFMUState") {
-            None => false,
-            Some(v) => parse_bool(v).ok_or_else(|| {
-                err(format!(
-                    "<CoSimulation> canSerializeFMUState=\"{v}\" is not a boolean"
-                ))
-            })?,
-        };
+        let can_get_and_set_fmu_state = flag("canGetAndSetFMUState")?;
+        let can_serialize_fmu_state = flag("canSerializeFMUState")?;
 
         let log_categories = match child(root, "LogCategories") {
             None => Vec::new(),

@@ -246,6 +246,15 @@ impl NavConfig {
         c.localization.initial_pose = start;
         c
     }
+
+    /// Defaults with the localizer starting from an estimate of the start pose whose error
+    /// has standard deviations `std` [m, m, rad] (at least the default initial spread).
+    pub fn for_estimate(estimate: [f64; 3], std: [f64; 3]) -> NavConfig {
+        let mut c = NavConfig::for_start(estimate);
+        let s = &mut c.localization.initial_std;
+        *s = [s[0].max(std[0]), s[1].max(std[1]), s[2].max(std[2])];
+        c
+    }
 }
 
 #[cfg(test)]

@@ -146,9 +146,9 @@ pub struct Match {
     pub inliers: f64,
 }
 
-/// Covariance of the tempered score distribution over the coarse `grid` around its `best`
-/// pose (Olson 2009, eq. 15-17), plus `floors` on the diagonal.
-fn score_covariance(grid: &[(f64, f64, f64, f64)], best: &(f64, f64, f64, f64), temper: f64, floors: &Vector3<f64>) -> Matrix3<f64> {
+/// Mean (relative to `best`) and covariance of the tempered score distribution over the
+/// coarse `grid` (Olson 2009, eq. 15-17), plus `floors` on the covariance's diagonal.
+fn score_moments(grid: &[(f64, f64, f64, f64)], best: &(f64, f64, f64, f64), temper: f64, floors: &Vector3<f64>) -> (Vector3<f64>, Matrix3<f64>) {
     let (mut w_sum, mut m, mut s) = (0.0, Vector3::zeros(), Matrix3::zeros());
     for &(x, y, yaw, sc) in grid {
         let w = ((sc - best.3) * temper).exp();
@@ -162,7 +162,7 @@ fn score_covariance(grid: &[(f64, f64, f64, f64)], best: &(f64, f64, f64, f64), 
     let mut cov = s / w_sum - mean * mean.transpose();
     // Only the diagonal: adding a diagonal matrix would turn -0.0 off-diagonals into +0.0.
     cov.set_diagonal(&(cov.diagonal() + floors));
-    cov
+    (mean, cov)
 }
 
 /// Matches base-frame 2-D points against the field around `prior`; `None` when too few
@@ -176,27 +176,33 @@ pub fn correlative_match(field: &LikelihoodField, pts: &[(f64, f64)], prior: &Po
     let k = (cfg.search_xy / res).round().max(0.0) as i64;
     let ny = (cfg.search_yaw / cfg.yaw_step).round().max(0.0) as i64;
     let n_side = (2 * k + 1) as usize;
-    // Coarse search, re-centred when its best pose lies on the window's edge (the prior was
-    // off by more than the window): the covariance needs the peak inside the window.
+    // Coarse search. The estimate is the mean of the tempered score distribution, not its
+    // arg max: where the map leaves a direction free (down an aisle between two foliage
+    // envelopes) the scores tie, and an arg max would take the window's first cell, pulling
+    // the pose backward at every scan. The window is re-centred when that mean lies in its
+    // outer half (the prior was off by about the window or more).
     let mut centre = *prior;
     let mut grid: Vec<(f64, f64, f64, f64)> = Vec::with_capacity(n_side * n_side * (2 * ny + 1) as usize);
-    let mut best = (0.0, 0.0, 0.0, f64::NEG_INFINITY);
+    let floors = Vector3::new(cfg.min_std_xy.powi(2), cfg.min_std_xy.powi(2), cfg.min_std_yaw.powi(2));
+    let temper = cfg.effective_points / pts.len() as f64;
+    let (mut est, mut cov) = (*prior, Matrix3::zeros());
     for _ in 0..4 {
         grid.clear();
         coarse_grid(field, pts, &centre, k, ny, cfg.yaw_step, &mut grid);
-        let (bi, b) = grid.iter().copied().enumerate().fold((0, (0.0, 0.0, 0.0, f64::NEG_INFINITY)), |acc, (i, c)| if c.3 > acc.1 .3 { (i, c) } else { acc });
-        best = b;
-        let (i, j, a) = ((bi % n_side) as i64 - k, ((bi / n_side) % n_side) as i64 - k, (bi / (n_side * n_side)) as i64 - ny);
-        let inside = |v: i64, lim: i64| lim == 0 || v.abs() < lim;
-        if inside(i, k) && inside(j, k) && inside(a, ny) {
+        let best = grid.iter().copied().fold((0.0, 0.0, 0.0, f64::NEG_INFINITY), |acc, c| if c.3 > acc.3 { c } else { acc });
+        let (mean, c) = score_moments(&grid, &best, temper, &floors);
+        cov = c;
+        est = Pose2::new(best.0 + mean[0], best.1 + mean[1], wrap_angle(best.2 + mean[2]));
+        let off = [est.x - centre.x, est.y - centre.y, wrap_angle(est.yaw - centre.yaw)];
+        let inside = |v: f64, lim: f64| lim == 0.0 || v.abs() < 0.5 * lim;
+        if inside(off[0], k as f64 * res) && inside(off[1], k as f64 * res) && inside(off[2], ny as f64 * cfg.yaw_step) {
             break;
         }
-        centre = Pose2::new(b.0, b.1, b.2);
+        centre = est;
     }
-    let floors = Vector3::new(cfg.min_std_xy.powi(2), cfg.min_std_xy.powi(2), cfg.min_std_yaw.powi(2));
-    let cov = score_covariance(&grid, &best, cfg.effective_points / pts.len() as f64, &floors);
-    // Refinement: coordinate descent with halving steps on the interpolated field.
-    let mut pose = Pose2::new(best.0, best.1, best.2);
+    // Refinement: coordinate descent with halving steps on the interpolated field (a free
+    // direction stays where the mean put it: only strict improvements move).
+    let mut pose = est;
     let mut sc = field.score(&pose, pts);
     let mut step = [0.5 * res, 0.5 * res, 0.5 * cfg.yaw_step];
     for _ in 0..4 {
@@ -318,7 +324,7 @@ mod tests {
             let best = grid[rng.below(grid.len() as u64) as usize];
             let temper = 10f64.powf(rng.uniform() * 3.0 - 2.0);
             let floors = [1e-4 * rng.uniform(), 1e-4 * rng.uniform(), 1e-5 * rng.uniform()];
-            let new = score_covariance(&grid, &best, temper, &Vector3::from(floors));
+            let (_, new) = score_moments(&grid, &best, temper, &Vector3::from(floors));
             let old = score_covariance_reference(&grid, &best, temper, floors);
             for (r, row) in old.iter().enumerate() {
                 for (c, v) in row.iter().enumerate() {
@@ -338,5 +344,37 @@ mod tests {
         assert!((m.pose.x - 5.0).abs() < 0.03 && (m.pose.y - 4.0).abs() < 0.03 && (m.pose.yaw - 0.3).abs() < 0.01, "{:?}", m.pose);
         assert!(m.inliers > 0.9);
         assert!(m.cov[(0, 0)] > 0.0 && m.cov[(0, 0)].sqrt() < 0.05);
+    }
+
+    /// Regression: down a featureless corridor (two long walls) the scores tie along it. The
+    /// arg max took the window's first cell, so every scan pulled the pose 0.25 m backward
+    /// (20 m behind after a 30 m aisle with a foliage-envelope map). Now the free direction
+    /// keeps the prior and says so in its covariance; the walls still pin y and yaw.
+    #[test]
+    fn a_free_direction_keeps_the_prior() {
+        let geom = GridGeom { origin_x: 0.0, origin_y: 0.0, resolution: 0.05, width: 800, height: 60 };
+        let mut occ = vec![false; geom.len()];
+        for y in 0..60 {
+            for x in 0..800 {
+                occ[y * 800 + x] = y < 10 || y >= 50;
+            }
+        }
+        let map = StaticMap::from_cells(geom, occ, "map".into());
+        let field = LikelihoodField::new(&map, &ScanMatchConfig::default());
+        let truth = Pose2::new(20.0, 1.5, 0.0);
+        let mut pts = Vec::new();
+        for k in 0..200 {
+            let x = -5.0 + 0.05 * k as f64;
+            pts.push((x, 0.49 - truth.y)); // the walls' faces at y = 0.5 and 2.5
+            pts.push((x, 2.51 - truth.y));
+        }
+        for dx in [-0.1, 0.0, 0.12] {
+            let prior = Pose2::new(truth.x + dx, truth.y + 0.08, 0.02);
+            let m = correlative_match(&field, &pts, &prior, &ScanMatchConfig::default()).expect("match");
+            assert!((m.pose.x - prior.x).abs() < 0.03, "x moved from the prior {} to {}", prior.x, m.pose.x);
+            assert!((m.pose.y - truth.y).abs() < 0.03 && m.pose.yaw.abs() < 0.01, "{:?}", m.pose);
+            assert!(m.cov[(0, 0)].sqrt() > 0.1, "x std {} claims knowledge the map cannot give", m.cov[(0, 0)].sqrt());
+            assert!(m.cov[(1, 1)].sqrt() < 0.05);
+        }
     }
 }

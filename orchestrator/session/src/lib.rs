@@ -15,5 +15,5 @@ pub mod session;
 
 pub use run::{prepare, RunOptions, RunSummary};
 pub use agrisim_bus::{Profile, RecordPolicy};
-pub use scenario::Scenario;
+pub use scenario::{PriorMap, Scenario};
 pub use session::Session;

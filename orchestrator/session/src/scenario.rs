@@ -92,11 +92,35 @@ pub struct NavSettings {
     pub targets_in_headland: bool,
     /// Keep targets at least this far from the aisle ends [m].
     pub aisle_margin: f64,
+    /// Standard deviations [m, m, rad] of the error of the localizer's initial pose estimate
+    /// (an operator's estimate of the start pose; the robot must converge from it).
+    pub initial_pose_std: [f64; 3],
+    /// The robot's prior map (never the trial scene's own plant parts).
+    pub prior_map: PriorMap,
+}
+
+/// Where the robot's prior map comes from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PriorMap {
+    /// The building plan: structure, and each crop row as its foliage envelope.
+    #[default]
+    Plan,
+    /// A mapping run through the same greenhouse with the crop grown from another plant
+    /// seed (the crop a week earlier): stems where they stand, other leaves and fruit.
+    MappingRun,
 }
 
 impl Default for NavSettings {
     fn default() -> Self {
-        NavSettings { trial_timeout: 120.0, goal_tolerance: 0.25, targets_in_headland: true, aisle_margin: 1.0 }
+        NavSettings {
+            trial_timeout: 120.0,
+            goal_tolerance: 0.25,
+            targets_in_headland: true,
+            aisle_margin: 1.0,
+            initial_pose_std: [0.1, 0.1, 3f64.to_radians()],
+            prior_map: PriorMap::Plan,
+        }
     }
 }
 

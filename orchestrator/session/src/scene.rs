@@ -15,6 +15,16 @@ pub fn generate_scene(s: &Scenario) -> Result<Greenhouse> {
     Ok(generate(&cfg, cfg.seed))
 }
 
+/// Seed offset of the crop a mapping run saw (the same greenhouse, a week earlier).
+const MAPPING_RUN_SEED: u64 = 0x0005_EED0_F0CA_11ED;
+
+/// The scenario's greenhouse with its crop grown from another plant seed: what a mapping
+/// run through the same house saw before the trial (see `[nav] prior_map`).
+pub fn mapping_run_scene(s: &Scenario) -> Result<Greenhouse> {
+    let cfg = config(s)?;
+    Ok(generate(&cfg, cfg.seed ^ MAPPING_RUN_SEED))
+}
+
 /// The layout alone (rows, aisles, headland, start pose): cheap, no plants generated.
 pub fn layout(s: &Scenario) -> Result<Layout> {
     Ok(Layout::from_config(&config(s)?))
