@@ -40,10 +40,12 @@ def test_files_and_summary(bench):
         assert len(t["planning_times"]) == t["plans"]
     s = json.loads((bench / "summary.json").read_text())
     k = sum(t["outcome"] == "success" for t in ts)
+    assert all(t["planning"] in ("ok", "failed", "not_reached") and t["planning_ok"] == (t["planning"] == "ok") for t in ts)
     p = sum(t["planning_ok"] for t in ts)
+    decided = sum(t["planning"] != "not_reached" for t in ts)
     kp = sum(t["planning_ok"] and t["outcome"] == "success" for t in ts)
-    assert s["trials"] == TRIALS and s["successes"] == k and s["planning_successes"] == p
-    for key, (a, b) in (("wilson95", (k, TRIALS)), ("planning_wilson95", (p, TRIALS)), ("conditional_wilson95", (kp, p))):
+    assert s["trials"] == TRIALS and s["successes"] == k and s["planning_successes"] == p and s["planning_decided"] == decided
+    for key, (a, b) in (("wilson95", (k, TRIALS)), ("planning_wilson95", (p, decided)), ("conditional_wilson95", (kp, p))):
         lo, hi = wilson(a, b)
         assert abs(s[key][0] - lo) < 1e-12 and abs(s[key][1] - hi) < 1e-12, key
     assert sum(s["failures"].values()) == TRIALS - k
@@ -99,3 +101,29 @@ def test_same_seed_gives_byte_identical_trial(bench, tmp_path):
     run_agrisim("bench", "harvest", "--scenario", str(SCENARIO), "--trials", "1", "--seed", "3", "--out", str(again))
     first = trials(bench)[0]
     assert (again / "trials" / "0000.mcap").read_bytes() == (bench / first["mcap"]).read_bytes()
+
+
+def test_scenes_spread_the_trials_and_every_fmu_grows_the_trial_scene(tmp_path):
+    out = tmp_path / "scenes"
+    run_agrisim("bench", "harvest", "--scenario", str(SCENARIO), "--trials", "2", "--scenes", "2", "--seed", "3",
+                "--record", "standard", "--out", str(out))
+    ts = trials(out)
+    assert [t["scene"] for t in ts] == [0, 1]
+    s = json.loads((out / "summary.json").read_text())
+    assert s["scenes"] == 2 and [p["trials"] for p in s["per_scene"]] == [1, 1]
+    assert [p["scene_seed"] for p in s["per_scene"]] == [1, 2]  # harvest.toml: seed 1, no [greenhouse] seed
+    assert [p["successes"] for p in s["per_scene"]] == [int(t["outcome"] == "success") for t in ts]
+    rates = [p["successes"] / p["trials"] for p in s["per_scene"]]
+    lo, hi = s["cluster_bootstrap95"]
+    assert min(rates) <= lo <= hi <= max(rates)
+    assert s["distinct_targets"] == 2
+    # The world FMU publishes the target from the scene it grew itself; it must be where the
+    # orchestrator's copy of the trial's scene puts that fruit (scene 1 is not scene 0).
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+    for t in ts:
+        with open(out / t["mcap"], "rb") as f:
+            reader = make_reader(f, decoder_factories=[DecoderFactory()])
+            pose = next(d.pose.position for _, _, _, d in reader.iter_decoded_messages(topics=["/target_fruit"]))
+        assert max(abs(a - b) for a, b in zip((pose.x, pose.y, pose.z), t["fruit"])) < 1e-6, (t["scene"], pose, t["fruit"])
+    assert ts[0]["fruit"] != ts[1]["fruit"]

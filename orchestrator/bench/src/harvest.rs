@@ -8,9 +8,10 @@
 //! (robot against structure, arm against arm, base against anything), within the time
 //! limit. Planning success means every motion the trial asked for was planned.
 
-use crate::trials::{run_one, run_trials, write_summary, Exec};
+use crate::trials::{run_one, run_trials, write_summary, Exec, TrialPlan};
 use super::harvest_targets::{draw, eligible, HarvestTarget};
 use crate::initial_pose::initial_estimate;
+use crate::scenes::{by_scene, in_scene, scene_of, SceneResult};
 use super::map::{grid_message, prior_map};
 use super::nav::trial_seed;
 use super::stats::{percentile, wilson, Z95};
@@ -34,6 +35,9 @@ pub const TRIAL_TIMEOUT: f64 = 120.0;
 #[derive(Debug, Clone, Serialize, serde::Deserialize)]
 pub struct HarvestTrial {
     pub trial: u64,
+    /// Scene index (`--scenes`): the greenhouse grown from the scenario's seed + scene.
+    #[serde(default)]
+    pub scene: u64,
     pub seed: u64,
     pub fruit_index: usize,
     pub fruit_id: u32,
@@ -45,6 +49,12 @@ pub struct HarvestTrial {
     pub failure: Option<String>,
     pub failed_stage: Option<String>,
     pub detail: String,
+    /// The planning verdict: "ok" (the harvest got to placing the fruit, so every plan it
+    /// needed was made),
+    /// "failed" (a plan without a fallback failed) or "not_reached" (no plan failed, but the
+    /// trial ended for another reason before every plan was asked for: unknown).
+    pub planning: String,
+    /// `planning == "ok"`.
     pub planning_ok: bool,
     pub plans: usize,
     /// Wall time of each plan [s]: the harvest node's step that asked for it (IK + RRT-Connect
@@ -67,8 +77,17 @@ pub struct HarvestSummary {
     pub trials: u64,
     pub successes: u64,
     pub success_rate: f64,
+    /// Counts every trial as independent (right for one scene's trials only).
     pub wilson95: [f64; 2],
+    pub scenes: u64,
+    pub per_scene: Vec<SceneResult>,
+    /// Resamples whole scenes: the interval to quote when trials share scenes.
+    pub cluster_bootstrap95: [f64; 2],
+    /// Distinct (scene, fruit) targets among the trials.
+    pub distinct_targets: u64,
     pub planning_successes: u64,
+    /// Trials whose planning verdict is "ok" or "failed" (the rate's denominator).
+    pub planning_decided: u64,
     pub planning_success_rate: f64,
     pub planning_wilson95: [f64; 2],
     /// Harvest successes among the trials whose planning succeeded.
@@ -263,13 +282,21 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
         failure = Some("placement".into());
         detail = "the node reported success but the world has not placed the target fruit".into();
     }
-    let planning_ok = reports.plans.iter().all(|p| p.ok || p.optional) && failure.as_deref() != Some("planning");
+    let planning = if failure.as_deref() == Some("planning") || reports.plans.iter().any(|p| !p.ok && !p.optional) {
+        "failed"
+    } else if failure.is_none() || failure.as_deref() == Some("placement") {
+        // Placement is judged after the node's last motion: every plan was made.
+        "ok"
+    } else {
+        "not_reached"
+    };
     Ok(HarvestTrial {
         outcome: if failure.is_none() { "success" } else { "failure" }.to_string(),
         failed_stage: failure.as_ref().and(failed_stage),
         failure,
         detail,
-        planning_ok,
+        planning: planning.into(),
+        planning_ok: planning == "ok",
         plans: reports.plans.len(),
         planning_times: reports.planning_times,
         time_to_harvest,
@@ -285,29 +312,44 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
 
 /// Runs `trials` trials and writes trials.jsonl, summary.json and trials/*.mcap.
 #[allow(clippy::too_many_arguments)]
-pub fn bench_harvest(s: &Scenario, o: &RunOptions, trials: u64, seed: u64, out: &Path, resume: bool, exec: Exec, progress: impl FnMut(u64, u64)) -> Result<HarvestSummary> {
+pub fn bench_harvest(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, resume: bool, exec: Exec, progress: impl FnMut(u64, u64)) -> Result<HarvestSummary> {
     let o = o.record_default(s, agrisim_session::Profile::Standard);
-    let setup = HarvestSetup::new(s)?;
+    let seed = plan.seed;
+    let scenes: Vec<(Scenario, HarvestSetup)> = (0..plan.scenes.max(1))
+        .map(|k| {
+            let s = in_scene(s, k);
+            HarvestSetup::new(&s).map(|setup| (s, setup))
+        })
+        .collect::<Result<_>>()?;
+    let at = |i: u64| (scene_of(i, plan.scenes), &scenes[scene_of(i, plan.scenes) as usize]);
     let done = run_trials(
         out,
-        trials,
+        plan.trials,
         resume,
         exec,
         progress,
-        |i, mcap| run_trial(s, &o, &setup, i, trial_seed(seed, i), mcap),
-        |i, reason| failed_trial(&setup, i, trial_seed(seed, i), reason),
+        |i, mcap| {
+            let (k, (s, setup)) = at(i);
+            run_trial(s, &o, setup, i, trial_seed(seed, i), mcap).map(|t| HarvestTrial { scene: k, ..t })
+        },
+        |i, reason| {
+            let (k, (_, setup)) = at(i);
+            HarvestTrial { scene: k, ..failed_trial(setup, i, trial_seed(seed, i), reason) }
+        },
         |t| serde_json::to_string(t).expect("plain struct"),
     )?;
-    let summary = summarize(s, seed, &done.results);
+    let summary = summarize(s, plan, &done.results);
     write_summary(out, &summary, done.interrupted)?;
     Ok(summary)
 }
 
 /// A worker process's job: harvest trial `i` of the benchmark `bench_harvest` runs.
-pub fn harvest_worker(s: &Scenario, o: &RunOptions, seed: u64, out: &Path, i: u64) -> Result<()> {
+pub fn harvest_worker(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, i: u64) -> Result<()> {
     let o = o.record_default(s, agrisim_session::Profile::Standard);
-    let setup = HarvestSetup::new(s)?;
-    run_one(out, i, |i, mcap| run_trial(s, &o, &setup, i, trial_seed(seed, i), mcap))
+    let scene = scene_of(i, plan.scenes);
+    let s = in_scene(s, scene);
+    let setup = HarvestSetup::new(&s)?;
+    run_one(out, i, |i, mcap| run_trial(&s, &o, &setup, i, trial_seed(plan.seed, i), mcap).map(|t| HarvestTrial { scene, ..t }))
 }
 
 /// The record of a trial whose process died: an error, with its target (drawn as the trial
@@ -322,6 +364,7 @@ impl HarvestTrial {
     fn of_target(index: u64, seed: u64, target: &HarvestTarget) -> HarvestTrial {
         HarvestTrial {
             trial: index,
+            scene: 0,
             seed,
             fruit_index: target.fruit_index,
             fruit_id: target.object_id,
@@ -332,6 +375,7 @@ impl HarvestTrial {
             failure: None,
             failed_stage: None,
             detail: String::new(),
+            planning: "not_reached".into(),
             planning_ok: false,
             plans: 0,
             planning_times: vec![],
@@ -346,10 +390,17 @@ impl HarvestTrial {
     }
 }
 
-pub fn summarize(s: &Scenario, seed: u64, results: &[HarvestTrial]) -> HarvestSummary {
+pub fn summarize(s: &Scenario, plan: TrialPlan, results: &[HarvestTrial]) -> HarvestSummary {
+    let seed = plan.seed;
     let n = results.len() as u64;
+    let outcomes: Vec<(u64, bool)> = results.iter().map(|t| (t.scene, t.outcome == "success")).collect();
+    let (per_scene, cluster_bootstrap95) = by_scene(s, plan.scenes, seed, &outcomes);
+    let distinct_targets = results.iter().map(|t| (t.scene, t.fruit_id)).collect::<std::collections::BTreeSet<_>>().len() as u64;
     let ok = results.iter().filter(|t| t.outcome == "success").count() as u64;
     let planned = results.iter().filter(|t| t.planning_ok).count() as u64;
+    // Planning is judged only where it was decided: a trial that failed before asking for
+    // every plan says nothing of the plans it never asked for.
+    let decided = results.iter().filter(|t| t.planning != "not_reached").count() as u64;
     let ok_given_planned = results.iter().filter(|t| t.planning_ok && t.outcome == "success").count() as u64;
     let mut failures = BTreeMap::new();
     for t in results.iter().filter_map(|t| t.failure.as_ref()) {
@@ -368,9 +419,14 @@ pub fn summarize(s: &Scenario, seed: u64, results: &[HarvestTrial]) -> HarvestSu
         successes: ok,
         success_rate: rate(ok, n),
         wilson95: wilson(ok, n, Z95),
+        scenes: plan.scenes.max(1),
+        per_scene,
+        cluster_bootstrap95,
+        distinct_targets,
         planning_successes: planned,
-        planning_success_rate: rate(planned, n),
-        planning_wilson95: wilson(planned, n, Z95),
+        planning_decided: decided,
+        planning_success_rate: rate(planned, decided),
+        planning_wilson95: wilson(planned, decided, Z95),
         conditional_success_rate: rate(ok_given_planned, planned),
         conditional_wilson95: wilson(ok_given_planned, planned, Z95),
         failures,

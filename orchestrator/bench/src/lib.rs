@@ -12,6 +12,7 @@ pub mod map;
 pub mod nav;
 pub mod overhead;
 pub mod report;
+pub mod scenes;
 pub mod stats;
 pub mod targets;
 pub mod trials;

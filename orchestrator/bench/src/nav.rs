@@ -6,12 +6,13 @@
 //! or in failure with a reason: collision, timeout, no_path, stuck, goal_missed, error.
 //! Ground truth is read here only to judge; the navigation stack never sees it.
 
-use crate::trials::{run_one, run_trials, write_summary, Exec};
+use crate::trials::{run_one, run_trials, write_summary, Exec, TrialPlan};
 use super::report::{render, TrialTrace};
 use super::stats::{wilson, Z95};
 use super::targets::draw_target;
 use agrisim_error::{Context, Result};
 use crate::initial_pose::initial_estimate;
+use crate::scenes::{by_scene, in_scene, scene_of, SceneResult};
 use crate::map::{grid_message, prior_map, MAP_BAND, MAP_RESOLUTION};
 use agrisim_bus::Node;
 use agrisim_math::Rng;
@@ -29,6 +30,9 @@ use std::time::Instant;
 #[derive(Debug, Clone, Serialize, serde::Deserialize)]
 pub struct NavTrial {
     pub trial: u64,
+    /// Scene index (`--scenes`): the greenhouse grown from the scenario's seed + scene.
+    #[serde(default)]
+    pub scene: u64,
     pub seed: u64,
     pub target: [f64; 3],
     pub outcome: String,
@@ -51,7 +55,12 @@ pub struct NavSummary {
     pub trials: u64,
     pub successes: u64,
     pub success_rate: f64,
+    /// Counts every trial as independent (right for one scene's trials only).
     pub wilson95: [f64; 2],
+    pub scenes: u64,
+    pub per_scene: Vec<SceneResult>,
+    /// Resamples whole scenes: the interval to quote when trials share scenes.
+    pub cluster_bootstrap95: [f64; 2],
     pub failures: BTreeMap<String, u64>,
     /// Simulated time / wall time over all trials.
     pub rtf: f64,
@@ -89,10 +98,12 @@ impl NavSetup {
 }
 
 /// A worker process's job: nav trial `i` of the benchmark `bench_nav` runs.
-pub fn nav_worker(s: &Scenario, o: &RunOptions, seed: u64, out: &Path, i: u64) -> Result<()> {
+pub fn nav_worker(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, i: u64) -> Result<()> {
     let o = o.record_default(s, agrisim_session::Profile::Standard);
-    let setup = NavSetup::new(s)?;
-    run_one(out, i, |i, mcap| nav_record(s, &o, &setup, seed, i, mcap))
+    let scene = scene_of(i, plan.scenes);
+    let s = in_scene(s, scene);
+    let setup = NavSetup::new(&s)?;
+    run_one(out, i, |i, mcap| nav_record(&s, &o, &setup, plan.seed, scene, i, mcap))
 }
 
 /// The record of a trial whose process died: an error, with its target (drawn as the trial
@@ -102,6 +113,7 @@ fn failed_trial(s: &Scenario, setup: &NavSetup, index: u64, seed: u64, reason: S
     let target = draw_target(&setup.layout, &setup.truth, &mut Rng::new(seed), nav.targets_in_headland, nav.aisle_margin, 0.7).unwrap_or([0.0; 3]);
     let trial = NavTrial {
         trial: index,
+        scene: 0,
         seed,
         target,
         outcome: "failure".into(),
@@ -199,6 +211,7 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &NavSetup, index: u64, see
     m.recorder_finish()?;
     let trial = NavTrial {
         trial: index,
+        scene: 0,
         seed,
         target,
         outcome: if success { "success" } else { "failure" }.to_string(),
@@ -223,32 +236,45 @@ struct NavRecord {
     path: Vec<[f64; 2]>,
 }
 
-fn nav_record(s: &Scenario, o: &RunOptions, setup: &NavSetup, seed: u64, i: u64, mcap: &Path) -> Result<NavRecord> {
+fn nav_record(s: &Scenario, o: &RunOptions, setup: &NavSetup, seed: u64, scene: u64, i: u64, mcap: &Path) -> Result<NavRecord> {
     let (trial, path) = run_trial(s, o, setup, i, trial_seed(seed, i), mcap)?;
-    Ok(NavRecord { trial, path: decimate(&path, 10) })
+    Ok(NavRecord { trial: NavTrial { scene, ..trial }, path: decimate(&path, 10) })
 }
 
-#[allow(clippy::too_many_arguments)]
-pub fn bench_nav(s: &Scenario, o: &RunOptions, trials: u64, seed: u64, out: &Path, resume: bool, exec: Exec, progress: impl FnMut(u64, u64)) -> Result<NavSummary> {
+pub fn bench_nav(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, resume: bool, exec: Exec, progress: impl FnMut(u64, u64)) -> Result<NavSummary> {
     let o = o.record_default(s, agrisim_session::Profile::Standard);
-    let setup = NavSetup::new(s)?;
+    let seed = plan.seed;
+    let scenes: Vec<(Scenario, NavSetup)> = (0..plan.scenes.max(1))
+        .map(|k| {
+            let s = in_scene(s, k);
+            NavSetup::new(&s).map(|setup| (s, setup))
+        })
+        .collect::<Result<_>>()?;
+    let at = |i: u64| (scene_of(i, plan.scenes), &scenes[scene_of(i, plan.scenes) as usize]);
     let done = run_trials(
         out,
-        trials,
+        plan.trials,
         resume,
         exec,
         progress,
-        |i, mcap| nav_record(s, &o, &setup, seed, i, mcap),
-        |i, reason| failed_trial(s, &setup, i, trial_seed(seed, i), reason),
+        |i, mcap| {
+            let (k, (s, setup)) = at(i);
+            nav_record(s, &o, setup, seed, k, i, mcap)
+        },
+        |i, reason| {
+            let (k, (s, setup)) = at(i);
+            NavRecord { trial: NavTrial { scene: k, ..failed_trial(s, setup, i, trial_seed(seed, i), reason).trial }, path: vec![] }
+        },
         |r| serde_json::to_string(&r.trial).expect("plain struct"),
     )?;
+    let setup = &scenes[0].1;
     let traces: Vec<TrialTrace> = done
         .results
         .iter()
         .map(|r| TrialTrace { index: r.trial.trial, success: r.trial.outcome == "success", reason: r.trial.reason.clone().unwrap_or_else(|| "success".into()), target: r.trial.target, path: r.path.clone() })
         .collect();
     let results: Vec<NavTrial> = done.results.into_iter().map(|r| r.trial).collect();
-    let summary = summarize(s, seed, &results);
+    let summary = summarize(s, plan, &results);
     write_summary(out, &summary, done.interrupted)?;
     let rows = vec![
         ("scenario".to_string(), summary.scenario.clone()),
@@ -295,8 +321,11 @@ fn decimate(path: &[[f64; 2]], every: usize) -> Vec<[f64; 2]> {
     v
 }
 
-pub fn summarize(s: &Scenario, seed: u64, results: &[NavTrial]) -> NavSummary {
+pub fn summarize(s: &Scenario, plan: TrialPlan, results: &[NavTrial]) -> NavSummary {
+    let seed = plan.seed;
     let n = results.len() as u64;
+    let outcomes: Vec<(u64, bool)> = results.iter().map(|t| (t.scene, t.outcome == "success")).collect();
+    let (per_scene, cluster_bootstrap95) = by_scene(s, plan.scenes, seed, &outcomes);
     let ok: Vec<&NavTrial> = results.iter().filter(|t| t.outcome == "success").collect();
     let mut failures = BTreeMap::new();
     for t in results.iter().filter(|t| t.outcome != "success") {
@@ -314,6 +343,9 @@ pub fn summarize(s: &Scenario, seed: u64, results: &[NavTrial]) -> NavSummary {
         successes: ok.len() as u64,
         success_rate: if n == 0 { 0.0 } else { ok.len() as f64 / n as f64 },
         wilson95: wilson(ok.len() as u64, n, Z95),
+        scenes: plan.scenes.max(1),
+        per_scene,
+        cluster_bootstrap95,
         failures,
         rtf: if wall > 0.0 { sim / wall } else { 0.0 },
         sim_time: sim,

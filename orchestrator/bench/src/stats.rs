@@ -28,9 +28,55 @@ pub fn percentile(sorted: &[f64], q: f64) -> Option<f64> {
     Some(sorted[lo] + (sorted[hi] - sorted[lo]) * (pos - lo as f64))
 }
 
+/// 95 % interval of the pooled success rate when trials come in clusters (scenes) that share
+/// their cause of success: whole clusters are resampled with replacement (the cluster
+/// bootstrap; Field and Welsh 2007), `resamples` times from `seed`, and the 2.5th and 97.5th
+/// percentiles of the pooled rate taken. `clusters` holds (successes, trials) per cluster.
+/// With one cluster it knows nothing of between-scene spread and says so: [0, 1].
+pub fn cluster_bootstrap95(clusters: &[(u64, u64)], resamples: usize, seed: u64) -> [f64; 2] {
+    let k = clusters.len();
+    if k < 2 || clusters.iter().all(|c| c.1 == 0) {
+        return [0.0, 1.0];
+    }
+    let mut rng = agrisim_math::Rng::new(seed);
+    let mut rates = Vec::with_capacity(resamples);
+    for _ in 0..resamples {
+        let (mut s, mut n) = (0u64, 0u64);
+        for _ in 0..k {
+            let c = clusters[rng.below(k as u64) as usize];
+            s += c.0;
+            n += c.1;
+        }
+        if n > 0 {
+            rates.push(s as f64 / n as f64);
+        }
+    }
+    rates.sort_by(f64::total_cmp);
+    [percentile(&rates, 0.025).unwrap_or(0.0), percentile(&rates, 0.975).unwrap_or(1.0)]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Scenes that all succeed at the same rate give an interval around it; scenes that
+    /// either all succeed or all fail (the same pooled rate) give a much wider one than
+    /// Wilson's, which counts every trial as independent.
+    #[test]
+    fn cluster_bootstrap_widens_with_the_spread_between_scenes() {
+        let even = vec![(5, 10); 10];
+        let split: Vec<(u64, u64)> = (0..10).map(|i| if i % 2 == 0 { (10, 10) } else { (0, 10) }).collect();
+        let [a0, a1] = cluster_bootstrap95(&even, 2000, 1);
+        assert!(a0 == 0.5 && a1 == 0.5, "no spread between identical scenes: [{a0}, {a1}]");
+        let [b0, b1] = cluster_bootstrap95(&split, 2000, 1);
+        let [w0, w1] = wilson(50, 100, Z95);
+        assert!(b0 < 0.5 && b1 > 0.5 && b1 - b0 > 1.5 * (w1 - w0), "[{b0}, {b1}] vs Wilson [{w0}, {w1}]");
+        // Analytic check: the resampled rate is the mean of 10 draws of 0 or 1 (p = 1/2), a
+        // binomial(10, 1/2) / 10, whose 2.5 % and 97.5 % quantiles are 0.2 and 0.8.
+        assert!((b0 - 0.2).abs() <= 0.1 + 1e-12 && (b1 - 0.8).abs() <= 0.1 + 1e-12, "[{b0}, {b1}]");
+        assert_eq!(cluster_bootstrap95(&split, 500, 9), cluster_bootstrap95(&split, 500, 9));
+        assert_eq!(cluster_bootstrap95(&[(3, 5)], 100, 1), [0.0, 1.0]);
+    }
 
     #[test]
     fn wilson_matches_published_values() {

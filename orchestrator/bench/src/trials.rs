@@ -17,6 +17,15 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus};
 
+/// Which trials a benchmark runs: `trials` of them, trial i seeded from (`seed`, i) and run
+/// in scene i mod `scenes` (see [`scenes`](crate::scenes)).
+#[derive(Clone, Copy, Debug)]
+pub struct TrialPlan {
+    pub trials: u64,
+    pub seed: u64,
+    pub scenes: u64,
+}
+
 /// How trials are executed.
 pub enum Exec<'a> {
     /// One after the other in this process.
