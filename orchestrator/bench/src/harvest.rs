@@ -63,6 +63,11 @@ pub struct HarvestTrial {
     pub time_to_harvest: Option<f64>,
     pub placed_count: i64,
     pub contacts: BTreeMap<String, i64>,
+    /// Scene objects the robot began to touch, by kind (stem, leaf, truss, fruit: fruit other
+    /// than the target; post, gutter...), from every /collision message: what a grower would
+    /// call damage risk. Counted, not failures (only base and structure contacts fail).
+    #[serde(default)]
+    pub touches: BTreeMap<String, u64>,
     /// RMS joint tracking error of the last trajectory of each arm [rad].
     pub tracking_rms: [f64; 2],
     pub sim_time: f64,
@@ -99,10 +104,36 @@ pub struct HarvestSummary {
     pub planning_time_p95: Option<f64>,
     pub planning_time_max: Option<f64>,
     pub tracking_rms_mean: f64,
+    /// Mean per trial of the scene objects the robot began to touch, by kind.
+    pub touches_per_trial: BTreeMap<String, f64>,
     pub time_to_harvest_mean: Option<f64>,
     pub rtf: f64,
     pub sim_time: f64,
     pub wall_time: f64,
+}
+
+/// Onsets of contact with scene objects, by kind, from /collision messages.
+#[derive(Default)]
+struct Touches {
+    /// Objects in contact in the last message.
+    now: std::collections::BTreeSet<u32>,
+    by_kind: BTreeMap<String, u64>,
+}
+
+impl Touches {
+    /// Counts every object in `cs` not touched in the previous message, except the target.
+    fn update(&mut self, cs: &CollisionState, target: u32) {
+        let mut next = std::collections::BTreeSet::new();
+        for c in &cs.contacts {
+            if c.object_id == target || c.object_kind == "robot_arm" || !next.insert(c.object_id) {
+                continue;
+            }
+            if !self.now.contains(&c.object_id) {
+                *self.by_kind.entry(c.object_kind.clone()).or_insert(0) += 1;
+            }
+        }
+        self.now = next;
+    }
 }
 
 /// Contact counters of the world FMU that end a trial as a collision.
@@ -218,6 +249,7 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
     let mut collisions = Reader::subscribe(&mut m.bus, "/collision");
     let mut judged: Option<(Option<String>, String)> = None;
     let mut time_to_harvest = None;
+    let mut touches = Touches::default();
     let result: Result<()> = (|| {
         for k in 1..=max_ticks {
             m.advance()?;
@@ -225,6 +257,7 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
             // The base must touch nothing; the arms may brush plants (counted, not failures).
             // Every collision state counts, however short the contact.
             for cs in collisions.take::<CollisionState>(&mut m.bus)? {
+                touches.update(&cs, target.object_id);
                 if let Some(c) = cs.contacts.iter().find(|c| c.robot_link == "base_link") {
                     judged = Some((Some("collision".into()), format!("the base touched {} ({})", c.object_name, c.object_kind)));
                     return Ok(());
@@ -302,6 +335,7 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
         time_to_harvest,
         placed_count: placed,
         contacts,
+        touches: touches.by_kind,
         tracking_rms: tracking,
         sim_time,
         wall_time: wall.elapsed().as_secs_f64(),
@@ -382,6 +416,7 @@ impl HarvestTrial {
             time_to_harvest: None,
             placed_count: 0,
             contacts: BTreeMap::new(),
+            touches: BTreeMap::new(),
             tracking_rms: [0.0; 2],
             sim_time: 0.0,
             wall_time: 0.0,
@@ -434,10 +469,45 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, results: &[HarvestTrial]) -> Har
         planning_time_p50: percentile(&times, 0.5),
         planning_time_p95: percentile(&times, 0.95),
         planning_time_max: times.last().copied(),
+        touches_per_trial: {
+            let mut m: BTreeMap<String, f64> = BTreeMap::new();
+            for (k, v) in results.iter().flat_map(|t| t.touches.iter()) {
+                *m.entry(k.clone()).or_insert(0.0) += *v as f64 / n.max(1) as f64;
+            }
+            m
+        },
         tracking_rms_mean: if n == 0 { 0.0 } else { results.iter().map(|t| 0.5 * (t.tracking_rms[0] + t.tracking_rms[1])).sum::<f64>() / n as f64 },
         time_to_harvest_mean: if tth.is_empty() { None } else { Some(tth.iter().sum::<f64>() / tth.len() as f64) },
         rtf: if wall > 0.0 { sim / wall } else { 0.0 },
         sim_time: sim,
         wall_time: wall,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use agrisim_msgs::agrisim::Contact;
+
+    fn state(contacts: &[(u32, &str, &str)]) -> CollisionState {
+        CollisionState {
+            contacts: contacts
+                .iter()
+                .map(|&(id, kind, link)| Contact { object_id: id, object_kind: kind.into(), robot_link: link.into(), ..Contact::default() })
+                .collect(),
+            ..CollisionState::default()
+        }
+    }
+
+    /// An object counts once per onset, however many links touch it and however long; the
+    /// target fruit and arm-arm contacts do not count; letting go and touching again does.
+    #[test]
+    fn touches_count_onsets_by_kind() {
+        let mut t = Touches::default();
+        t.update(&state(&[(5, "leaf", "left_link5"), (5, "leaf", "left_link6"), (9, "fruit", "left_hand")]), 9);
+        t.update(&state(&[(5, "leaf", "left_link5"), (7, "stem", "left_link4"), (0, "robot_arm", "left_link7")]), 9);
+        t.update(&state(&[]), 9);
+        t.update(&state(&[(5, "leaf", "left_link5"), (11, "fruit", "right_hand")]), 9);
+        assert_eq!(t.by_kind, BTreeMap::from([("leaf".to_string(), 2), ("stem".to_string(), 1), ("fruit".to_string(), 1)]));
     }
 }
