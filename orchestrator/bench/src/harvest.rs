@@ -9,7 +9,7 @@
 //! limit. Planning success means every motion the trial asked for was planned.
 
 use crate::trials::{run_one, run_trials, write_summary, Exec, TrialPlan};
-use super::harvest_targets::{draw, eligible, HarvestTarget};
+use super::harvest_targets::{draw, eligible, HarvestTarget, Visibility};
 use crate::initial_pose::initial_estimate;
 use crate::scenes::{by_scene, in_scene, scene_of, SceneResult};
 use super::map::{grid_message, prior_map};
@@ -43,6 +43,9 @@ pub struct HarvestTrial {
     pub fruit_id: u32,
     pub fruit_name: String,
     pub fruit: [f64; 3],
+    /// What lies between the fruit and its aisle: free, partly_occluded, behind_stem.
+    #[serde(default)]
+    pub visibility: String,
     pub start: [f64; 3],
     pub outcome: String,
     /// Failure category: planning, grasp, handover, placement, timeout, collision, error.
@@ -90,6 +93,8 @@ pub struct HarvestSummary {
     pub cluster_bootstrap95: [f64; 2],
     /// Distinct (scene, fruit) targets among the trials.
     pub distinct_targets: u64,
+    /// Trials and successes by the target's visibility class.
+    pub per_visibility: BTreeMap<String, ClassResult>,
     pub planning_successes: u64,
     /// Trials whose planning verdict is "ok" or "failed" (the rate's denominator).
     pub planning_decided: u64,
@@ -110,6 +115,14 @@ pub struct HarvestSummary {
     pub rtf: f64,
     pub sim_time: f64,
     pub wall_time: f64,
+}
+
+/// One class of trials (e.g. a visibility class).
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct ClassResult {
+    pub trials: u64,
+    pub successes: u64,
+    pub wilson95: [f64; 2],
 }
 
 /// Onsets of contact with scene objects, by kind, from /collision messages.
@@ -152,9 +165,16 @@ impl HarvestSetup {
     pub fn new(s: &Scenario) -> Result<HarvestSetup> {
         let g = agrisim_session::scene::generate_scene(s)?;
         let map = prior_map(s, &g)?;
-        let candidates = eligible(&g.objects, &g.layout);
+        let classes = &s.harvest.visibility;
+        for c in classes {
+            if ![Visibility::Free, Visibility::PartlyOccluded, Visibility::BehindStem].iter().any(|v| v.name() == c) {
+                return Err(err!("scenario {}: [harvest] visibility: unknown class \"{c}\" (free, partly_occluded, behind_stem)", s.path.display()));
+            }
+        }
+        let mut candidates = eligible(&g.objects, &g.layout);
+        candidates.retain(|t| classes.iter().any(|c| c == t.visibility.name()));
         if candidates.is_empty() {
-            return Err(err!("scenario {}: no ripe fruit faces an aisle at a harvestable height", s.path.display()));
+            return Err(err!("scenario {}: no ripe fruit of the visibility classes {classes:?} faces an aisle at a harvestable height", s.path.display()));
         }
         Ok(HarvestSetup { layout: g.layout, map, candidates })
     }
@@ -404,6 +424,7 @@ impl HarvestTrial {
             fruit_id: target.object_id,
             fruit_name: target.name.clone(),
             fruit: target.center,
+            visibility: target.visibility.name().into(),
             start: target.start,
             outcome: "failure".into(),
             failure: None,
@@ -458,6 +479,18 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, results: &[HarvestTrial]) -> Har
         per_scene,
         cluster_bootstrap95,
         distinct_targets,
+        per_visibility: {
+            let mut m: BTreeMap<String, ClassResult> = BTreeMap::new();
+            for t in results {
+                let c = m.entry(t.visibility.clone()).or_default();
+                c.trials += 1;
+                c.successes += (t.outcome == "success") as u64;
+            }
+            for c in m.values_mut() {
+                c.wilson95 = wilson(c.successes, c.trials, Z95);
+            }
+            m
+        },
         planning_successes: planned,
         planning_decided: decided,
         planning_success_rate: rate(planned, decided),

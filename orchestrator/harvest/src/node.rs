@@ -401,8 +401,10 @@ impl HarvestNode {
                 bus.set_scalar(topics::TARGET_ID, self.fruit_index as f64);
                 if self.target_map.is_some() && self.pose.is_some() && self.arms.iter().all(|a| a.q.is_some()) {
                     let t = self.target_map.expect("checked");
-                    // The row is on the side of the robot where it sees the fruit.
-                    self.side = if self.target_base().expect("target and pose known")[1] >= 0.0 { 1.0 } else { -1.0 };
+                    // The base harvests facing +x (the stand-off's heading), whichever way it
+                    // starts: the row is on its left when the fruit is at larger y.
+                    let pose = self.pose.expect("checked");
+                    self.side = if t[1] >= pose.y { 1.0 } else { -1.0 };
                     self.grasp = geo::grasp([0.0; 3], self.side);
                     self.base_goal = geo::standoff(t, self.side);
                     self.lift_target = geo::lift_for(t[2]);

@@ -39,6 +39,9 @@ pub struct Scenario {
     /// Navigation benchmark settings.
     #[serde(default)]
     pub nav: NavSettings,
+    /// Harvest benchmark settings.
+    #[serde(default)]
+    pub harvest: HarvestSettings,
     /// Parameter overrides: component name -> parameter name -> value.
     #[serde(default)]
     pub parameters: BTreeMap<String, BTreeMap<String, toml::Value>>,
@@ -97,6 +100,21 @@ pub struct NavSettings {
     pub initial_pose_std: [f64; 3],
     /// The robot's prior map (never the trial scene's own plant parts).
     pub prior_map: PriorMap,
+}
+
+/// `[harvest]`: how harvest trials draw their targets.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct HarvestSettings {
+    /// Visibility classes targets are drawn from (free, partly_occluded, behind_stem); all
+    /// by default. `["free"]` is close to the paper's experiment (fruit in plain view).
+    pub visibility: Vec<String>,
+}
+
+impl Default for HarvestSettings {
+    fn default() -> Self {
+        HarvestSettings { visibility: ["free", "partly_occluded", "behind_stem"].map(String::from).to_vec() }
+    }
 }
 
 /// Where the robot's prior map comes from.
