@@ -11,7 +11,7 @@
 use crate::trials::{run_one, run_trials, write_summary, Exec, TrialPlan};
 use super::harvest_targets::{draw, eligible, HarvestTarget, Visibility};
 use crate::initial_pose::initial_estimate;
-use crate::scenes::{by_scene, in_scene, scene_of, SceneResult};
+use crate::scenes::{by_scene, in_scene, per_scene_setups, scene_of, SceneResult};
 use super::map::{grid_message, prior_map};
 use super::nav::trial_seed;
 use super::stats::{percentile, wilson, Z95};
@@ -369,12 +369,7 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
 pub fn bench_harvest(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, resume: bool, exec: Exec, progress: impl FnMut(u64, u64)) -> Result<HarvestSummary> {
     let o = o.record_default(s, agrisim_session::Profile::Standard);
     let seed = plan.seed;
-    let scenes: Vec<(Scenario, HarvestSetup)> = (0..plan.scenes.max(1))
-        .map(|k| {
-            let s = in_scene(s, k);
-            HarvestSetup::new(&s).map(|setup| (s, setup))
-        })
-        .collect::<Result<_>>()?;
+    let scenes = per_scene_setups(s, plan.scenes, HarvestSetup::new)?;
     let at = |i: u64| (scene_of(i, plan.scenes), &scenes[scene_of(i, plan.scenes) as usize]);
     let done = run_trials(
         out,

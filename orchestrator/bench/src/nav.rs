@@ -12,7 +12,7 @@ use super::stats::{wilson, Z95};
 use super::targets::draw_target;
 use agrisim_error::{Context, Result};
 use crate::initial_pose::initial_estimate;
-use crate::scenes::{by_scene, in_scene, scene_of, SceneResult};
+use crate::scenes::{by_scene, in_scene, per_scene_setups, scene_of, SceneResult};
 use crate::map::{grid_message, prior_map, MAP_BAND, MAP_RESOLUTION};
 use agrisim_bus::Node;
 use agrisim_math::Rng;
@@ -244,12 +244,7 @@ fn nav_record(s: &Scenario, o: &RunOptions, setup: &NavSetup, seed: u64, scene: 
 pub fn bench_nav(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, resume: bool, exec: Exec, progress: impl FnMut(u64, u64)) -> Result<NavSummary> {
     let o = o.record_default(s, agrisim_session::Profile::Standard);
     let seed = plan.seed;
-    let scenes: Vec<(Scenario, NavSetup)> = (0..plan.scenes.max(1))
-        .map(|k| {
-            let s = in_scene(s, k);
-            NavSetup::new(&s).map(|setup| (s, setup))
-        })
-        .collect::<Result<_>>()?;
+    let scenes = per_scene_setups(s, plan.scenes, NavSetup::new)?;
     let at = |i: u64| (scene_of(i, plan.scenes), &scenes[scene_of(i, plan.scenes) as usize]);
     let done = run_trials(
         out,

@@ -33,6 +33,16 @@ pub fn in_scene(s: &Scenario, scene: u64) -> Scenario {
     s
 }
 
+/// Every scene's scenario and what `setup` makes of it (map, targets), scene 0 first.
+pub fn per_scene_setups<T>(s: &Scenario, scenes: u64, setup: impl Fn(&Scenario) -> agrisim_error::Result<T>) -> agrisim_error::Result<Vec<(Scenario, T)>> {
+    (0..scenes.max(1))
+        .map(|k| {
+            let s = in_scene(s, k);
+            setup(&s).map(|t| (s, t))
+        })
+        .collect()
+}
+
 /// One scene's share of a benchmark.
 #[derive(Debug, Clone, Serialize)]
 pub struct SceneResult {
