@@ -401,12 +401,15 @@ impl HarvestNode {
                 bus.set_scalar(topics::TARGET_ID, self.fruit_index as f64);
                 if self.target_map.is_some() && self.pose.is_some() && self.arms.iter().all(|a| a.q.is_some()) {
                     let t = self.target_map.expect("checked");
-                    // The base harvests facing +x (the stand-off's heading), whichever way it
-                    // starts: the row is on its left when the fruit is at larger y.
+                    // The base harvests facing along the aisle the way it already faces (+x or
+                    // -x: no turning round in the aisle); the row is on the side of that
+                    // heading where the fruit is.
                     let pose = self.pose.expect("checked");
-                    self.side = if t[1] >= pose.y { 1.0 } else { -1.0 };
+                    let heading = if pose.yaw.cos() >= 0.0 { 0.0 } else { std::f64::consts::PI };
+                    let (s, c) = f64::sin_cos(heading);
+                    self.side = if -s * (t[0] - pose.x) + c * (t[1] - pose.y) >= 0.0 { 1.0 } else { -1.0 };
                     self.grasp = geo::grasp([0.0; 3], self.side);
-                    self.base_goal = geo::standoff(t, self.side);
+                    self.base_goal = geo::standoff_facing(t, self.side, heading);
                     self.lift_target = geo::lift_for(t[2]);
                     self.enter(Stage::PositionBase, t_ns, bus, &format!("fruit {} at ({:.3}, {:.3}, {:.3})", self.fruit_index, t[0], t[1], t[2]));
                 }
