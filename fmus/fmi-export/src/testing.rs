@@ -1138,6 +1138,15 @@ impl<M: Model> Driven<M> {
         bytes
     }
 
+    /// The serialized form of the current state.
+    unsafe fn serialize_current(&self) -> Vec<u8> {
+        let mut s = std::ptr::null_mut();
+        self.ok(fmi3::get_fmu_state::<M>(self.p, &mut s), "GetFMUState");
+        let bytes = self.serialize(s);
+        self.ok(fmi3::free_fmu_state::<M>(self.p, &mut s), "FreeFMUState");
+        bytes
+    }
+
     unsafe fn restore(&self, bytes: &[u8]) {
         let mut s = std::ptr::null_mut();
         self.ok(fmi3::deserialize_fmu_state::<M>(self.p, bytes.as_ptr(), bytes.len(), &mut s), "DeserializeFMUState");
@@ -1232,13 +1241,3 @@ pub fn assert_state_round_trip<M: Model>(
     }
 }
 
-impl<M: Model> Driven<M> {
-    /// The serialized form of the current state.
-    unsafe fn serialize_current(&self) -> Vec<u8> {
-        let mut s = std::ptr::null_mut();
-        self.ok(fmi3::get_fmu_state::<M>(self.p, &mut s), "GetFMUState");
-        let bytes = self.serialize(s);
-        self.ok(fmi3::free_fmu_state::<M>(self.p, &mut s), "FreeFMUState");
-        bytes
-    }
-}

@@ -11,7 +11,7 @@
 use crate::trials::{run_one, run_trials, write_summary, Exec, TrialPlan};
 use super::harvest_targets::{draw, eligible, HarvestTarget, Visibility};
 use crate::initial_pose::initial_estimate;
-use crate::scenes::{by_scene, in_scene, per_scene_setups, scene_of, SceneResult};
+use crate::scenes::{by_scene, SceneResult, Scenes};
 use super::map::{grid_message, prior_map};
 use super::nav::trial_seed;
 use super::stats::{percentile, wilson, Z95};
@@ -365,12 +365,10 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
 }
 
 /// Runs `trials` trials and writes trials.jsonl, summary.json and trials/*.mcap.
-#[allow(clippy::too_many_arguments)]
 pub fn bench_harvest(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, resume: bool, exec: Exec, progress: impl FnMut(u64, u64)) -> Result<HarvestSummary> {
     let o = o.record_default(s, agrisim_session::Profile::Standard);
     let seed = plan.seed;
-    let scenes = per_scene_setups(s, plan.scenes, HarvestSetup::new)?;
-    let at = |i: u64| (scene_of(i, plan.scenes), &scenes[scene_of(i, plan.scenes) as usize]);
+    let scenes = Scenes::all(s, plan.scenes, HarvestSetup::new)?;
     let done = run_trials(
         out,
         plan.trials,
@@ -378,11 +376,11 @@ pub fn bench_harvest(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, 
         exec,
         progress,
         |i, mcap| {
-            let (k, (s, setup)) = at(i);
+            let (k, s, setup) = scenes.of(i);
             run_trial(s, &o, setup, i, trial_seed(seed, i), mcap).map(|t| HarvestTrial { scene: k, ..t })
         },
         |i, reason| {
-            let (k, (_, setup)) = at(i);
+            let (k, _, setup) = scenes.of(i);
             HarvestTrial { scene: k, ..failed_trial(setup, i, trial_seed(seed, i), reason) }
         },
         |t| serde_json::to_string(t).expect("plain struct"),
@@ -395,10 +393,9 @@ pub fn bench_harvest(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, 
 /// A worker process's job: harvest trial `i` of the benchmark `bench_harvest` runs.
 pub fn harvest_worker(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, i: u64) -> Result<()> {
     let o = o.record_default(s, agrisim_session::Profile::Standard);
-    let scene = scene_of(i, plan.scenes);
-    let s = in_scene(s, scene);
-    let setup = HarvestSetup::new(&s)?;
-    run_one(out, i, |i, mcap| run_trial(&s, &o, &setup, i, trial_seed(plan.seed, i), mcap).map(|t| HarvestTrial { scene, ..t }))
+    let scenes = Scenes::for_trial(s, plan.scenes, i, HarvestSetup::new)?;
+    let (k, s, setup) = scenes.of(i);
+    run_one(out, i, |i, mcap| run_trial(s, &o, setup, i, trial_seed(plan.seed, i), mcap).map(|t| HarvestTrial { scene: k, ..t }))
 }
 
 /// The record of a trial whose process died: an error, with its target (drawn as the trial

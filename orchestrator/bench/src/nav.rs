@@ -12,7 +12,7 @@ use super::stats::{wilson, Z95};
 use super::targets::draw_target;
 use agrisim_error::{Context, Result};
 use crate::initial_pose::initial_estimate;
-use crate::scenes::{by_scene, in_scene, per_scene_setups, scene_of, SceneResult};
+use crate::scenes::{by_scene, SceneResult, Scenes};
 use crate::map::{grid_message, prior_map, MAP_BAND, MAP_RESOLUTION};
 use agrisim_bus::Node;
 use agrisim_math::Rng;
@@ -100,10 +100,9 @@ impl NavSetup {
 /// A worker process's job: nav trial `i` of the benchmark `bench_nav` runs.
 pub fn nav_worker(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, i: u64) -> Result<()> {
     let o = o.record_default(s, agrisim_session::Profile::Standard);
-    let scene = scene_of(i, plan.scenes);
-    let s = in_scene(s, scene);
-    let setup = NavSetup::new(&s)?;
-    run_one(out, i, |i, mcap| nav_record(&s, &o, &setup, plan.seed, scene, i, mcap))
+    let scenes = Scenes::for_trial(s, plan.scenes, i, NavSetup::new)?;
+    let (k, s, setup) = scenes.of(i);
+    run_one(out, i, |i, mcap| nav_record(s, &o, setup, plan.seed, k, i, mcap))
 }
 
 /// The record of a trial whose process died: an error, with its target (drawn as the trial
@@ -244,8 +243,7 @@ fn nav_record(s: &Scenario, o: &RunOptions, setup: &NavSetup, seed: u64, scene: 
 pub fn bench_nav(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, resume: bool, exec: Exec, progress: impl FnMut(u64, u64)) -> Result<NavSummary> {
     let o = o.record_default(s, agrisim_session::Profile::Standard);
     let seed = plan.seed;
-    let scenes = per_scene_setups(s, plan.scenes, NavSetup::new)?;
-    let at = |i: u64| (scene_of(i, plan.scenes), &scenes[scene_of(i, plan.scenes) as usize]);
+    let scenes = Scenes::all(s, plan.scenes, NavSetup::new)?;
     let done = run_trials(
         out,
         plan.trials,
@@ -253,16 +251,16 @@ pub fn bench_nav(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, resu
         exec,
         progress,
         |i, mcap| {
-            let (k, (s, setup)) = at(i);
+            let (k, s, setup) = scenes.of(i);
             nav_record(s, &o, setup, seed, k, i, mcap)
         },
         |i, reason| {
-            let (k, (s, setup)) = at(i);
+            let (k, s, setup) = scenes.of(i);
             NavRecord { trial: NavTrial { scene: k, ..failed_trial(s, setup, i, trial_seed(seed, i), reason).trial }, path: vec![] }
         },
         |r| serde_json::to_string(&r.trial).expect("plain struct"),
     )?;
-    let setup = &scenes[0].1;
+    let setup = scenes.first();
     let traces: Vec<TrialTrace> = done
         .results
         .iter()

@@ -33,14 +33,46 @@ pub fn in_scene(s: &Scenario, scene: u64) -> Scenario {
     s
 }
 
-/// Every scene's scenario and what `setup` makes of it (map, targets), scene 0 first.
-pub fn per_scene_setups<T>(s: &Scenario, scenes: u64, setup: impl Fn(&Scenario) -> agrisim_error::Result<T>) -> agrisim_error::Result<Vec<(Scenario, T)>> {
-    (0..scenes.max(1))
-        .map(|k| {
-            let s = in_scene(s, k);
-            setup(&s).map(|t| (s, t))
-        })
-        .collect()
+/// The scenes a benchmark's trials run in: each scene's index, scenario and what the
+/// benchmark's setup makes of it (map, targets).
+pub struct Scenes<T> {
+    scenes: u64,
+    list: Vec<(u64, Scenario, T)>,
+}
+
+impl<T> Scenes<T> {
+    /// All `scenes` scenes, scene 0 first.
+    pub fn all(s: &Scenario, scenes: u64, setup: impl Fn(&Scenario) -> agrisim_error::Result<T>) -> agrisim_error::Result<Scenes<T>> {
+        Scenes::of_indices(s, scenes, 0..scenes.max(1), setup)
+    }
+
+    /// Only trial `trial`'s scene (a worker process runs one trial).
+    pub fn for_trial(s: &Scenario, scenes: u64, trial: u64, setup: impl Fn(&Scenario) -> agrisim_error::Result<T>) -> agrisim_error::Result<Scenes<T>> {
+        let k = scene_of(trial, scenes);
+        Scenes::of_indices(s, scenes, k..k + 1, setup)
+    }
+
+    fn of_indices(s: &Scenario, scenes: u64, ks: std::ops::Range<u64>, setup: impl Fn(&Scenario) -> agrisim_error::Result<T>) -> agrisim_error::Result<Scenes<T>> {
+        let list = ks
+            .map(|k| {
+                let s = in_scene(s, k);
+                setup(&s).map(|t| (k, s, t))
+            })
+            .collect::<agrisim_error::Result<_>>()?;
+        Ok(Scenes { scenes, list })
+    }
+
+    /// Trial `trial`'s scene index, scenario and setup (its scene must be held).
+    pub fn of(&self, trial: u64) -> (u64, &Scenario, &T) {
+        let k = scene_of(trial, self.scenes);
+        let (_, s, t) = self.list.iter().find(|e| e.0 == k).expect("the trial's scene was set up");
+        (k, s, t)
+    }
+
+    /// The first scene's setup (scene 0 for a whole benchmark).
+    pub fn first(&self) -> &T {
+        &self.list[0].2
+    }
 }
 
 /// One scene's share of a benchmark.

@@ -116,6 +116,7 @@ fn greedy_order(weight: &[Vec<u32>]) -> Vec<usize> {
 /// The plan in words, for `agrisim run --explain`.
 pub fn explain(system: &System, order: &Order) -> String {
     let name = |c: usize| system.components[c].name.as_str();
+    let labels = |routes: &[usize]| routes.iter().map(|&r| format!("  {}\n", system.routes[r].label)).collect::<String>();
     let mut out = String::new();
     let names: Vec<&str> = order.step.iter().map(|&c| name(c)).collect();
     out.push_str(&format!("Step order (Gauss-Seidel; each component reads the values its sources have after this step): {}\n", names.join(" -> ")));
@@ -123,18 +124,14 @@ pub fn explain(system: &System, order: &Order) -> String {
         out.push_str("Delayed connections: none (no loop)\n");
     } else {
         out.push_str("Delayed connections (read before their source steps, one step late; they close a loop):\n");
-        for &r in &order.delayed {
-            out.push_str(&format!("  {}\n", system.routes[r].label));
-        }
+        out.push_str(&labels(&order.delayed));
     }
     out.push_str("Initialization: one pass in the step order (every input of a component set before its outputs are read)");
     if order.init_loops.is_empty() {
         out.push_str("; no loop needs iteration\n");
     } else {
         out.push_str(", then fixed-point passes until nothing changes through:\n");
-        for &r in &order.init_loops {
-            out.push_str(&format!("  {}\n", system.routes[r].label));
-        }
+        out.push_str(&labels(&order.init_loops));
     }
     out.push_str("Exchange periods:\n");
     for r in &system.routes {

@@ -714,16 +714,36 @@ impl Instance {
             .collect()
     }
 
+    /// An optional FMU-state function, refused up front (not called) when a capability flag
+    /// it needs is not declared or the library does not export it.
     fn state_fn<T>(
         &self,
         function: &str,
         pick: impl FnOnce(&Functions) -> Option<T>,
     ) -> Result<T, FmiError> {
-        if !self.can_get_and_set_state {
+        self.optional_fn(function, &[(self.can_get_and_set_state, "canGetAndSetFMUState")], pick)
+    }
+
+    fn serial_fns<T>(
+        &self,
+        function: &str,
+        pick: impl FnOnce(&Functions) -> Option<T>,
+    ) -> Result<T, FmiError> {
+        let needs = [(self.can_serialize_state, "canSerializeFMUState"), (self.can_get_and_set_state, "canGetAndSetFMUState")];
+        self.optional_fn(function, &needs, pick)
+    }
+
+    fn optional_fn<T>(
+        &self,
+        function: &str,
+        needs: &[(bool, &str)],
+        pick: impl FnOnce(&Functions) -> Option<T>,
+    ) -> Result<T, FmiError> {
+        if let Some((_, flag)) = needs.iter().find(|(declared, _)| !declared) {
             return Err(self.refuse(
                 function,
                 &[],
-                "refused: not supported, the FMU declares canGetAndSetFMUState=\"false\" (not called; instance state unchanged)",
+                &format!("refused: not supported, the FMU declares {flag}=\"false\" (not called; instance state unchanged)"),
             ));
         }
         pick(&self.lib.f).ok_or_else(|| {
@@ -733,21 +753,6 @@ impl Instance {
                 "refused: the shared library does not export this function (not called; instance state unchanged)",
             )
         })
-    }
-
-    fn serial_fns<T>(
-        &self,
-        function: &str,
-        pick: impl FnOnce(&Functions) -> Option<T>,
-    ) -> Result<T, FmiError> {
-        if !self.can_serialize_state {
-            return Err(self.refuse(
-                function,
-                &[],
-                "refused: not supported, the FMU declares canSerializeFMUState=\"false\" (not called; instance state unchanged)",
-            ));
-        }
-        self.state_fn(function, pick)
     }
 
     fn own_state(
