@@ -8,6 +8,7 @@
 //! * [`cdr`]: [`CdrWriter`] / [`CdrReader`] (XCDR1, CDR_LE header; reader never panics).
 //! * [`message`]: the [`Message`] trait (`to_cdr` / `from_cdr`) and FMI mimeTypes.
 //! * one module per ROS package with plain structs ([`geometry_msgs::Twist`], ...).
+//! * [`dynamic`]: any known type by name at run time ([`dynamic::Value`] trees), for bindings and bridges.
 //! * [`schema`]: the .msg texts from models/msgs and [`ros2msg_schema`] for MCAP.
 //!
 //! ```
@@ -26,6 +27,7 @@
 pub mod cdr;
 mod check;
 pub mod message;
+pub mod dynamic;
 pub mod schema;
 
 pub mod agrisim;

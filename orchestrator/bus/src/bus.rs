@@ -29,7 +29,7 @@ pub struct Published {
     pub cdr: Vec<u8>,
 }
 
-#[derive(Default, Debug)]
+#[derive(Default, Debug, Clone)]
 pub struct Bus {
     latest: BTreeMap<String, Sample>,
     scalars: BTreeMap<String, f64>,
@@ -41,7 +41,7 @@ pub struct Bus {
 }
 
 /// Messages of one topic kept for its readers, and where each reader is.
-#[derive(Default, Debug)]
+#[derive(Default, Debug, Clone)]
 struct Queue {
     samples: VecDeque<Sample>,
     /// Per reader (index = reader id): the last sequence number it took.

@@ -26,6 +26,18 @@ pub enum Profile {
     None,
 }
 
+impl Profile {
+    /// The name `--record` and `[recording] profile` take.
+    pub fn name(self) -> &'static str {
+        match self {
+            Profile::Full => "full",
+            Profile::Standard => "standard",
+            Profile::Judge => "judge",
+            Profile::None => "none",
+        }
+    }
+}
+
 impl std::str::FromStr for Profile {
     type Err = String;
     fn from_str(s: &str) -> Result<Profile, String> {

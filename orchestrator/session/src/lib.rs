@@ -16,4 +16,4 @@ pub mod session;
 pub use run::{prepare, RunOptions, RunSummary};
 pub use agrisim_bus::{Profile, RecordPolicy};
 pub use scenario::{PriorMap, Scenario};
-pub use session::Session;
+pub use session::{Session, SessionSnapshot};

@@ -132,6 +132,40 @@ impl Session {
     }
 }
 
+/// A session's state at a communication point: the engine's (every FMU, the master's tick
+/// and route positions) and the message bus's (latest messages, queues, readers).
+pub struct SessionSnapshot {
+    engine: agrisim_cosim::Snapshot,
+    bus: Bus,
+    readers: BTreeMap<usize, Reader>,
+}
+
+impl Session {
+    /// Saves the session for [`Session::restore`]. Nodes keep their memory in themselves, so
+    /// only a session without nodes (driven from outside: Python, a gymnasium environment)
+    /// can be saved and restored exactly; one with nodes is refused. The recording goes on
+    /// (a restored run records its messages again, at their simulated times).
+    pub fn snapshot(&mut self) -> Result<SessionSnapshot> {
+        if let Some(n) = self.nodes.first() {
+            return Err(err!("cannot snapshot a session with nodes (node '{}' keeps state the snapshot would not hold)", n.name()));
+        }
+        Ok(SessionSnapshot { engine: self.master.snapshot()?, bus: self.bus.clone(), readers: self.readers.clone() })
+    }
+
+    /// Returns the session to `snapshot` (taken from this session).
+    pub fn restore(&mut self, snapshot: &SessionSnapshot) -> Result<()> {
+        self.master.restore(&snapshot.engine)?;
+        self.bus = snapshot.bus.clone();
+        self.readers = snapshot.readers.clone();
+        Ok(())
+    }
+
+    /// Frees a snapshot's FMU states now (otherwise they go with the instances).
+    pub fn free_snapshot(&mut self, snapshot: SessionSnapshot) -> Result<()> {
+        self.master.free_snapshot(snapshot.engine)
+    }
+}
+
 /// The session's side of the engine's [`Hooks`].
 struct Link<'a> {
     bus: &'a mut Bus,

@@ -1,0 +1,53 @@
+"""agrisim from Python: the greenhouse co-simulation, its messages, benchmarks and
+gymnasium environments.
+
+    import agrisim
+    with agrisim.Simulation("default", seed=1) as sim:
+        sim.publish("/cmd_vel", {"linear": {"x": 0.3}})
+        sim.step(50)                       # 1 s at 0.02 s
+        odom = sim.latest("/odom")         # a dict of the nav_msgs/Odometry fields
+
+Importing the package registers the environments ``agrisim/Navigate-v0`` and
+``agrisim/Reach-v0`` with gymnasium (when gymnasium is installed).
+"""
+
+from ._agrisim import (  # noqa: F401
+    AgrisimError,
+    ArmModel,
+    NavTask,
+    Simulation,
+    Snapshot,
+    decode,
+    encode,
+    message_types,
+    root,
+    scenario_path,
+)
+from . import bench, msg  # noqa: F401
+from .msg import image_to_array, pointcloud_to_array  # noqa: F401
+
+__all__ = [
+    "AgrisimError",
+    "ArmModel",
+    "NavTask",
+    "Simulation",
+    "Snapshot",
+    "bench",
+    "decode",
+    "encode",
+    "image_to_array",
+    "message_types",
+    "msg",
+    "pointcloud_to_array",
+    "root",
+    "scenario_path",
+]
+
+try:
+    import gymnasium  # noqa: F401
+except ImportError:  # the environments need gymnasium; the rest does not
+    pass
+else:
+    from . import envs  # noqa: F401
+
+    envs.register_all()
