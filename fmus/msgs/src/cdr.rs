@@ -282,6 +282,11 @@ impl<'a> CdrReader<'a> {
         Ok(s)
     }
 
+    /// `n` bytes at once (a `uint8[]` body: images, point clouds).
+    pub fn read_bytes(&mut self, n: usize) -> Result<&'a [u8], CdrError> {
+        self.take(n, "uint8 array")
+    }
+
     pub fn read_u8(&mut self) -> Result<u8, CdrError> {
         Ok(self.take(1, "uint8")?[0])
     }

@@ -223,11 +223,7 @@ fn read_struct(fields: &[Field], r: &mut CdrReader<'_>) -> Result<Value, DynErro
 
 fn read_many(base: &Base, n: usize, r: &mut CdrReader<'_>) -> Result<Value, DynError> {
     if *base == Base::Prim(Prim::U8) {
-        let mut v = Vec::with_capacity(n.min(r.remaining()));
-        for _ in 0..n {
-            v.push(r.read_u8()?);
-        }
-        return Ok(Value::Bytes(v));
+        return Ok(Value::Bytes(r.read_bytes(n)?.to_vec()));
     }
     let mut v = Vec::with_capacity(n.min(r.remaining()));
     for _ in 0..n {

@@ -49,13 +49,14 @@ def planar_scan(cloud: dict | None, beams: int, max_range: float, z_band: tuple[
     if cloud is None:
         return scan
     p = pointcloud_to_array(cloud)
-    x, y, z = p["x"].astype(np.float64), p["y"].astype(np.float64), p["z"].astype(np.float64)
+    z = p["z"]
+    band = (z >= z_band[0]) & (z <= z_band[1])
+    x, y = p["x"][band], p["y"][band]
     r = np.hypot(x, y)
-    keep = (z >= z_band[0]) & (z <= z_band[1]) & (r > 0.05) & np.isfinite(r)
-    if not keep.any():
-        return scan
-    sector = ((np.arctan2(y[keep], x[keep]) + math.pi) / (2.0 * math.pi) * beams).astype(np.int64) % beams
-    np.minimum.at(scan, sector, np.minimum(r[keep], max_range).astype(np.float32))
+    ok = (r > 0.05) & np.isfinite(r)
+    x, y, r = x[ok], y[ok], r[ok]
+    sector = ((np.arctan2(y, x) + np.float32(math.pi)) * np.float32(beams / (2.0 * math.pi))).astype(np.int64) % beams
+    np.minimum.at(scan, sector, np.minimum(r, np.float32(max_range)))
     return scan
 
 
