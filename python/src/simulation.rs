@@ -81,7 +81,7 @@ impl Simulation {
     /// `record`: an MCAP file to record to (None: nothing kept); `profile`: full, standard,
     /// judge or none. `nodes`: built-in nodes to run beside Python (odom_tf, script, inject).
     #[new]
-    #[pyo3(signature = (scenario="default".into(), seed=None, fmu=None, parameters=None, record=None, profile=None, nodes=None))]
+    #[pyo3(signature = (scenario="default".into(), seed=None, fmu=None, parameters=None, record=None, profile=None, nodes=None), text_signature = "(scenario='default', seed=None, fmu=None, parameters=None, record=None, profile=None, nodes=None)")]
     fn new(
         py: Python<'_>,
         scenario: PathBuf,
@@ -293,7 +293,9 @@ impl Simulation {
         slf
     }
 
-    fn __exit__(&mut self, _t: Option<Bound<'_, PyAny>>, _v: Option<Bound<'_, PyAny>>, _tb: Option<Bound<'_, PyAny>>) -> PyResult<bool> {
+    /// Closes the simulation; an exception in the `with` block goes on.
+    fn __exit__(&mut self, exc_type: Option<Bound<'_, PyAny>>, exc_value: Option<Bound<'_, PyAny>>, traceback: Option<Bound<'_, PyAny>>) -> PyResult<bool> {
+        let _ = (exc_type, exc_value, traceback);
         self.close()?;
         Ok(false)
     }

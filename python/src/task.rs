@@ -21,7 +21,7 @@ pub struct NavTask {
 #[pymethods]
 impl NavTask {
     #[new]
-    #[pyo3(signature = (scenario="default".into()))]
+    #[pyo3(signature = (scenario="default".into()), text_signature = "(scenario='default')")]
     fn new(py: Python<'_>, scenario: PathBuf) -> PyResult<NavTask> {
         let s = Scenario::load(&scenario_path(scenario)).map_err(py_err)?;
         let mut job = OnThisThread(s.clone());

@@ -17,6 +17,7 @@ reset is fast and deterministic: the same seed gives the same goal and the same 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -78,8 +79,8 @@ class NavigateEnv(gym.Env):
         self._task = _agrisim.NavTask(scenario)
         self._beams, self._max_range, self._time_limit = beams, max_range, time_limit
         self._parameters, self._fmu = parameters, fmu
-        self._sim = None
-        self._start = None
+        self._sim: Any = None
+        self._start: Any = None
         # Positions within 1 km of the map origin, speeds within 10 m/s or rad/s.
         pose = np.array([1e3, 1e3, math.pi, 10.0, 10.0, 10.0], np.float32)
         goal = np.array([2e3, 2e3, math.pi], np.float32)
@@ -179,7 +180,7 @@ class ReachEnv(gym.Env):
         self._names = self._arm.joint_names
         lo, hi = self._arm.limits
         self._lo, self._hi = np.array(lo), np.array(hi)
-        self._sim = None
+        self._sim: Any = None
         self.observation_space = spaces.Box(-10.0, 10.0, (20,), np.float32)
         self.action_space = spaces.Box(-1.0, 1.0, (7,), np.float32)
 
