@@ -3,7 +3,7 @@ which (normal dependencies, followed transitively through the workspace).
 
   fmus/ (environment, robot, sensors)  <-  orchestrator/cosim (engine)
   orchestrator/bus (messages)  <-  algorithm nodes (nodes, nav, manip, trajectory, harvest)
-  session (engine + bus)  <-  bench  <-  cli
+  session (engine + bus)  <-  bench  <-  cli, python (the pyo3 package; siblings on top)
 
 The engine and the message layer do not know each other; algorithms never link the engine,
 the FMU export layer or scene generation, so any of them can be swapped for a ROS 2 node.
@@ -22,7 +22,8 @@ SCENE = "agrisim-greenhouse"
 FMI_EXPORT = "agrisim-fmi"
 MESSAGES = "agrisim-msgs"
 BUS = "agrisim-bus"
-ABOVE = {"agrisim-session", "agrisim-bench", "agrisim"}
+PYTHON = "agrisim-python"
+ABOVE = {"agrisim-session", "agrisim-bench", "agrisim", PYTHON}
 
 # crate -> crates it must not reach (directly or through other workspace crates), and why.
 FORBIDDEN = {
@@ -30,8 +31,9 @@ FORBIDDEN = {
     ENGINE: ({MESSAGES, BUS, SCENE, FMI_EXPORT} | ALGORITHMS | ABOVE, "the engine knows no ROS, no greenhouse, no algorithm"),
     BUS: ({ENGINE, SCENE, FMI_EXPORT} | ALGORITHMS | ABOVE, "the message layer has no FMI inside"),
     SCENE: ({FMI_EXPORT, ENGINE, BUS} | ALGORITHMS | ABOVE, "scene generation is a plain library"),
-    "agrisim-session": ({"agrisim-bench", "agrisim", "agrisim-nav", "agrisim-harvest"}, "a session runs any nodes; it picks none"),
-    "agrisim-bench": ({"agrisim"}, "the CLI is on top"),
+    "agrisim-session": ({"agrisim-bench", "agrisim", PYTHON, "agrisim-nav", "agrisim-harvest"}, "a session runs any nodes; it picks none"),
+    "agrisim-bench": ({"agrisim", PYTHON}, "the CLI and the Python package are on top"),
+    PYTHON: ({"agrisim"}, "the Python package and the CLI are siblings: neither links the other"),
 }
 
 
@@ -85,7 +87,7 @@ def test_layers_hold(graph):
 
 
 def test_every_layer_crate_exists(graph):
-    for crate in ALGORITHMS | {ENGINE, BUS, SCENE, "agrisim-session", "agrisim-bench", "agrisim"}:
+    for crate in ALGORITHMS | {ENGINE, BUS, SCENE, "agrisim-session", "agrisim-bench", "agrisim", PYTHON}:
         assert crate in graph, crate
 
 

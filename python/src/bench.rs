@@ -54,7 +54,7 @@ fn job(kind: Kind, scenario: Option<PathBuf>, trials: u64, seed: u64, scenes: u6
     let scenario = Scenario::load(&path).map_err(py_err)?;
     let (fmu_dir, cache_dir) = fmu_dirs();
     let record = record.map(|r| r.parse::<Profile>().map_err(py_err)).transpose()?;
-    let options = RunOptions { fmu_dir, cache_dir, seed: None, duration: None, fmu_overrides: Default::default(), fmu_log: None, record };
+    let options = RunOptions { fmu_dir, cache_dir, seed: None, duration: None, fmu_overrides: Default::default(), fmu_log: None, record, nodes: Default::default() };
     Ok(Job { kind, scenario, options, plan: TrialPlan { trials, seed, scenes }, out })
 }
 

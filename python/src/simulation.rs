@@ -119,7 +119,7 @@ impl Simulation {
         };
         let nodes = nodes.unwrap_or_default().iter().map(|n| node_of(n, &s)).collect::<PyResult<Vec<_>>>()?;
         let (fmu_dir, cache_dir) = fmu_dirs();
-        let o = RunOptions { fmu_dir, cache_dir, seed, duration: None, fmu_overrides: fmu.unwrap_or_default(), fmu_log: None, record: profile };
+        let o = RunOptions { fmu_dir, cache_dir, seed, duration: None, fmu_overrides: fmu.unwrap_or_default(), fmu_log: None, record: profile, nodes: Default::default() };
         let mut task = OnThisThread((s.clone(), o, mcap.clone(), Some(nodes)));
         let session = py
             .detach(move || {

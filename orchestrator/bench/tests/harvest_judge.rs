@@ -64,7 +64,7 @@ impl Bench {
         let mut scenario = Scenario::load(&root().join("models/scenarios/harvest.toml")).unwrap();
         // The judge's checks need a harvest that succeeds: a fruit in plain view.
         scenario.harvest.visibility = vec!["free".into()];
-        let options = RunOptions { fmu_dir, cache_dir: dir.path().join("cache"), seed: None, duration: None, fmu_overrides: BTreeMap::new(), fmu_log: None, record: None };
+        let options = RunOptions { fmu_dir, cache_dir: dir.path().join("cache"), seed: None, duration: None, fmu_overrides: BTreeMap::new(), fmu_log: None, record: None, nodes: Default::default() };
         let setup = HarvestSetup::new(&scenario).unwrap();
         Bench { scenario, options, setup, dir }
     }

@@ -165,6 +165,17 @@ impl Bus {
         }
     }
 
+    /// Every topic with a message so far and its type, by name.
+    pub fn topics(&self) -> impl Iterator<Item = (&str, &str)> {
+        self.latest.iter().map(|(t, s)| (t.as_str(), s.type_name.as_str()))
+    }
+
+    /// Reports a message refused before it reached the bus (a bridge's inbound check); it
+    /// goes to the run's status log with the readers' skips.
+    pub fn reject(&mut self, reason: String) {
+        self.rejected.push(reason);
+    }
+
     /// Reports of messages readers skipped since the last call.
     pub fn take_rejected(&mut self) -> Vec<String> {
         std::mem::take(&mut self.rejected)

@@ -3,6 +3,7 @@
 
 mod pack;
 mod png;
+mod ros2;
 mod snapshot;
 
 use agrisim_error::Result;
@@ -42,6 +43,8 @@ enum Command {
         log: FmuLog,
         #[command(flatten)]
         record: Record,
+        #[command(flatten)]
+        ros2: ros2::Ros2Args,
         /// Print how the master orders the system (step order, delayed connections,
         /// initialization, exchange periods) and exit without running.
         #[arg(long)]
@@ -142,6 +145,8 @@ struct TrialArgs {
     log: FmuLog,
     #[command(flatten)]
     record: Record,
+    #[command(flatten)]
+    ros2: ros2::Ros2Args,
     /// Keep the trials already complete in DIR (an interrupted run) and run the others.
     #[arg(long)]
     resume: bool,
@@ -247,6 +252,7 @@ fn run_options(dirs: Dirs, target: &std::path::Path, seed: Option<u64>, duration
         fmu_overrides,
         fmu_log,
         record: None,
+        nodes: Default::default(),
     }
 }
 
@@ -299,21 +305,38 @@ fn exec<'a>(a: &TrialArgs, command: &'a dyn Fn(u64) -> std::process::Command) ->
 }
 
 /// The scenario (or the benchmark's default) and run options of a many-trial benchmark.
-fn trial_setup(a: &TrialArgs, default_scenario: &str, target: &Path) -> Result<(Scenario, RunOptions)> {
+fn trial_setup(a: &TrialArgs, default_scenario: &str, target: &Path, bridges: &Bridges) -> Result<(Scenario, RunOptions)> {
     let s = Scenario::load(a.scenario.as_deref().unwrap_or(Path::new(default_scenario)))?;
     let mut o = run_options(a.dirs.clone(), target, None, None, BTreeMap::new(), a.log.categories());
     o.record = a.record.profile;
+    if a.ros2.ros2 && a.jobs > 1 {
+        return Err(agrisim_error::err!("--ros2 runs one trial at a time (trials would share the DDS topics): use --jobs 1"));
+    }
+    o.nodes = a.ros2.plan(bridges)?;
     Ok((s, o))
 }
 
+/// The ROS 2 bridges' statistics of this process's runs.
+type Bridges = std::sync::Arc<std::sync::Mutex<Vec<std::sync::Arc<std::sync::Mutex<agrisim_ros2::Stats>>>>>;
+
 fn real_main() -> Result<()> {
     let cli = Cli::parse();
+    let bridges = Bridges::default();
+    let result = dispatch(cli, &bridges);
+    if let Some(line) = ros2::report(&bridges) {
+        eprintln!("{line}");
+    }
+    result
+}
+
+fn dispatch(cli: Cli, bridges: &Bridges) -> Result<()> {
     let (exe_dir, target) = build_dirs();
     match cli.command {
-        Command::Run { scenario, duration, seed, fmus, dirs, log, record, explain, out } => {
+        Command::Run { scenario, duration, seed, fmus, dirs, log, record, ros2, explain, out } => {
             let s = Scenario::load(&scenario)?;
             let mut opts = run_options(dirs, &target, seed, duration, fmus.into_iter().collect(), log.categories());
             opts.record = record.profile;
+            opts.nodes = ros2.plan(bridges)?;
             if explain {
                 print!("{}", agrisim_session::run::explain(&s, &opts)?);
                 return Ok(());
@@ -323,7 +346,7 @@ fn real_main() -> Result<()> {
             println!("{} steps ({} s simulated) -> {}", summary.steps, summary.simulated, summary.mcap.display());
         }
         Command::Bench { command: BenchCommand::Nav(a) } => {
-            let (s, opts) = trial_setup(&a, "models/scenarios/default.toml", &target)?;
+            let (s, opts) = trial_setup(&a, "models/scenarios/default.toml", &target, bridges)?;
             if let Some(i) = a.worker_trial {
                 return agrisim_bench::nav::nav_worker(&s, &opts, a.plan(), &a.out, i);
             }
@@ -332,7 +355,7 @@ fn real_main() -> Result<()> {
             println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
         }
         Command::Bench { command: BenchCommand::Harvest(a) } => {
-            let (s, opts) = trial_setup(&a, "models/scenarios/harvest.toml", &target)?;
+            let (s, opts) = trial_setup(&a, "models/scenarios/harvest.toml", &target, bridges)?;
             if let Some(i) = a.worker_trial {
                 return agrisim_bench::harvest::harvest_worker(&s, &opts, a.plan(), &a.out, i);
             }

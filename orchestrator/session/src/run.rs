@@ -8,8 +8,9 @@ use agrisim_cosim::system::ticks_of;
 use agrisim_cosim::{LoadOptions, Master, System};
 use agrisim_error::{err, Context, Result};
 use agrisim_nodes::{CommandScript, FaultInjector, OdomTf};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Everything `agrisim run` needs besides the scenario.
 #[derive(Clone, Debug)]
@@ -26,6 +27,46 @@ pub struct RunOptions {
     pub fmu_log: Option<Vec<String>>,
     /// Recording profile (CLI `--record`), replacing the scenario's `[recording] profile`.
     pub record: Option<agrisim_bus::Profile>,
+    /// Built-in nodes turned off and nodes added (CLI `--external`, `--ros2`).
+    pub nodes: NodePlan,
+}
+
+/// Makes the extra nodes of one run (each run gets its own: a ROS 2 bridge joins DDS anew),
+/// given the system's message inputs (topic, ROS 2 type): the commands it takes.
+pub type NodeFactory = Arc<dyn Fn(&[(String, String)]) -> Result<Vec<Box<dyn Node>>> + Send + Sync>;
+
+/// How a run's nodes differ from what its scenario or benchmark would run: built-in nodes
+/// named in `external` are left out (an external node takes their place, e.g. over ROS 2),
+/// and `extra` adds nodes after all others (a bridge must see the others' messages).
+#[derive(Clone, Default)]
+pub struct NodePlan {
+    /// Node names ([`Node::name`]): navigator, harvest, command_script, odom_tf, ...
+    pub external: BTreeSet<String>,
+    pub extra: Option<NodeFactory>,
+}
+
+impl std::fmt::Debug for NodePlan {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("NodePlan").field("external", &self.external).field("extra", &self.extra.is_some()).finish()
+    }
+}
+
+impl NodePlan {
+    /// `nodes` without the external ones, then the extra ones. Naming a node that is not
+    /// there is an error (a typo must not leave the built-in node running).
+    pub fn apply(&self, nodes: Vec<Box<dyn Node>>, inputs: &[(String, String)]) -> Result<Vec<Box<dyn Node>>> {
+        for name in &self.external {
+            if !nodes.iter().any(|n| n.name() == name) {
+                let names: Vec<&str> = nodes.iter().map(|n| n.name()).collect();
+                return Err(err!("--external {name}: this run has no node '{name}' (its nodes: {})", names.join(", ")));
+            }
+        }
+        let mut out: Vec<Box<dyn Node>> = nodes.into_iter().filter(|n| !self.external.contains(n.name())).collect();
+        if let Some(extra) = &self.extra {
+            out.extend(extra(inputs)?);
+        }
+        Ok(out)
+    }
 }
 
 impl RunOptions {
@@ -121,6 +162,19 @@ pub fn prepare(s: &Scenario, o: &RunOptions, mcap: &Path, nodes: Vec<Box<dyn Nod
         recorder.metadata(&format!("agrisim.parameters.{comp}"), params)?;
     }
     let master = Master::new(system, s.timing.step, lo.message_period)?;
+    let inputs: Vec<(String, String)> = master
+        .system
+        .routes
+        .iter()
+        .zip(&types)
+        .filter_map(|(r, ty)| match (&r.from, ty) {
+            (agrisim_cosim::Port::Bus { topic }, Some(ty)) => Some((topic.clone(), ty.clone())),
+            _ => None,
+        })
+        .collect::<BTreeSet<_>>()
+        .into_iter()
+        .collect();
+    let nodes = o.nodes.apply(nodes, &inputs)?;
     let mut session = Session::new(master, nodes, recorder, types);
     session.master.initialize()?;
     Ok(session)

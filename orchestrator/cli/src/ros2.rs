@@ -1,0 +1,156 @@
+//! `--ros2` and `--external`: the command line of the live ROS 2 link. Which built-in nodes
+//! an external node replaces, which topics the bridge takes from ROS 2 peers (the system's
+//! commands, the replaced nodes' outputs, `--ros2-subscribe`), and how it keeps time.
+
+use agrisim_error::{err, Result};
+use agrisim_ros2::names::Remap;
+use agrisim_ros2::{BridgeConfig, Mode, Ros2Bridge, Stats};
+use agrisim_session::run::NodePlan;
+use std::collections::BTreeSet;
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+#[derive(clap::Args, Clone, Debug)]
+pub struct Ros2Args {
+    /// Bridge the run to ROS 2 over DDS: every message of the bus is published (topics
+    /// `rt/<name>`, types `pkg::msg::dds_::Type_`, raw CDR) with /clock, and the system's
+    /// command topics (plus those of `--external` nodes) are taken from ROS 2 peers.
+    #[arg(long)]
+    pub ros2: bool,
+    /// DDS domain (ROS_DOMAIN_ID).
+    #[arg(long, value_name = "ID", default_value_t = 0, env = "ROS_DOMAIN_ID")]
+    pub ros2_domain: u16,
+    /// lockstep: at each message instant wait for the peers' answers (deterministic);
+    /// realtime: pace the simulation to the wall clock (as the paper ran).
+    #[arg(long, value_name = "MODE", default_value = "lockstep", value_parser = ["lockstep", "realtime"])]
+    pub ros2_mode: String,
+    /// Lockstep: how long to wait for the answers at one instant [s, wall time].
+    #[arg(long, value_name = "SECONDS", default_value_t = 1.0)]
+    pub ros2_timeout: f64,
+    /// Lockstep: how long to wait for the peers before the first instant [s, wall time].
+    #[arg(long, value_name = "SECONDS", default_value_t = 30.0)]
+    pub ros2_startup_timeout: f64,
+    /// Realtime: simulated seconds per wall second.
+    #[arg(long, value_name = "FACTOR", default_value_t = 1.0)]
+    pub ros2_rate: f64,
+    /// Rename a topic on the ROS 2 side: FROM:=TO (e.g. /cmd_vel:=/robot/cmd_vel).
+    #[arg(long = "ros2-remap", value_name = "FROM:=TO")]
+    pub remap: Vec<String>,
+    /// Also take TOPIC (of ROS 2 type pkg/msg/Type) from ROS 2 peers: TOPIC=TYPE.
+    #[arg(long = "ros2-subscribe", value_name = "TOPIC=TYPE")]
+    pub subscribe: Vec<String>,
+    /// Lockstep waits for these topics (default: the replaced nodes' command outputs).
+    #[arg(long = "ros2-lockstep", value_name = "TOPIC")]
+    pub lockstep: Vec<String>,
+    /// Talk on every network interface, not only loopback (exposes the run to the network).
+    #[arg(long)]
+    pub ros2_all_interfaces: bool,
+    /// Turn off a built-in node so an external one (over --ros2) takes its place: navigator,
+    /// harvest, command_script, odom_tf, robot_state_publisher, map_server, goal_publisher.
+    #[arg(long = "external", value_name = "NODE")]
+    pub external: Vec<String>,
+}
+
+/// What a replaced built-in node published (its topics now come from ROS 2), and those
+/// lockstep waits for: the external node answers each /clock tick with one message on each
+/// (the navigator: a command and its status, as Nav2's controller and navigator do).
+fn outputs_of(node: &str) -> Option<(&'static [(&'static str, &'static str)], &'static [&'static str])> {
+    Some(match node {
+        "navigator" => (
+            &[("/cmd_vel", "geometry_msgs/msg/Twist"), ("/navigate/status", "agrisim_msgs/msg/NavigationStatus"), ("/localization/pose", "geometry_msgs/msg/PoseStamped"), ("/plan", "nav_msgs/msg/Path")],
+            &["/cmd_vel", "/navigate/status"],
+        ),
+        "command_script" => (&[("/cmd_vel", "geometry_msgs/msg/Twist")], &["/cmd_vel"]),
+        "odom_tf" | "robot_state_publisher" => (&[("/tf", "tf2_msgs/msg/TFMessage")], &[]),
+        "map_server" => (&[("/map", "nav_msgs/msg/OccupancyGrid")], &[]),
+        "goal_publisher" => (&[("/goal_pose", "geometry_msgs/msg/PoseStamped")], &[]),
+        _ => return None,
+    })
+}
+
+impl Ros2Args {
+    /// The run's node plan; `stats` collects each run's bridge statistics.
+    pub fn plan(&self, stats: &Arc<Mutex<Vec<Arc<Mutex<Stats>>>>>) -> Result<NodePlan> {
+        let external: BTreeSet<String> = self.external.iter().cloned().collect();
+        if !self.ros2 {
+            if !external.is_empty() {
+                return Err(err!("--external needs --ros2 (the external node talks to the run over ROS 2)"));
+            }
+            return Ok(NodePlan::default());
+        }
+        let mut extra_inbound: Vec<(String, String)> = vec![];
+        let mut lockstep: Vec<String> = vec![];
+        for name in &external {
+            let (outs, answer) = outputs_of(name).ok_or_else(|| err!("--external {name}: not a node whose outputs the bridge knows (navigator, command_script, odom_tf, robot_state_publisher, map_server, goal_publisher)"))?;
+            extra_inbound.extend(outs.iter().map(|(t, ty)| (t.to_string(), ty.to_string())));
+            lockstep.extend(answer.iter().map(|t| t.to_string()));
+        }
+        for s in &self.subscribe {
+            let (t, ty) = s.split_once('=').ok_or_else(|| err!("--ros2-subscribe {s}: expected TOPIC=pkg/msg/Type"))?;
+            if !agrisim_msgs::dynamic::is_known(ty) {
+                return Err(err!("--ros2-subscribe {s}: unknown message type {ty}"));
+            }
+            extra_inbound.push((t.to_string(), ty.to_string()));
+        }
+        if !self.lockstep.is_empty() {
+            lockstep = self.lockstep.clone();
+        }
+        lockstep.sort();
+        lockstep.dedup();
+        let mode = match self.ros2_mode.as_str() {
+            "realtime" if self.ros2_rate > 0.0 && self.ros2_rate.is_finite() => Mode::Realtime { rate: self.ros2_rate },
+            "realtime" => return Err(err!("--ros2-rate {}: must be a positive number", self.ros2_rate)),
+            _ if self.ros2_timeout > 0.0 && self.ros2_timeout.is_finite() => Mode::Lockstep { timeout: Duration::from_secs_f64(self.ros2_timeout) },
+            _ => return Err(err!("--ros2-timeout {}: must be a positive number", self.ros2_timeout)),
+        };
+        let remap = Remap::parse(&self.remap).map_err(|e| err!("--ros2-remap: {e}"))?;
+        let (domain, loopback_only) = (self.ros2_domain, !self.ros2_all_interfaces);
+        if !(self.ros2_startup_timeout >= 0.0 && self.ros2_startup_timeout.is_finite()) {
+            return Err(err!("--ros2-startup-timeout {}: must be a number of seconds", self.ros2_startup_timeout));
+        }
+        let startup_timeout = Duration::from_secs_f64(self.ros2_startup_timeout);
+        let stats = stats.clone();
+        let factory = move |inputs: &[(String, String)]| -> Result<Vec<Box<dyn agrisim_bus::Node>>> {
+            let mut inbound: Vec<(String, String)> = inputs.to_vec();
+            for t in &extra_inbound {
+                if !inbound.iter().any(|(i, _)| i == &t.0) {
+                    inbound.push(t.clone());
+                }
+            }
+            let config = BridgeConfig { domain, mode, inbound, lockstep: lockstep.clone(), remap: remap.clone(), loopback_only, startup_timeout };
+            let (bridge, s) = Ros2Bridge::new(config)?;
+            stats.lock().expect("stats lock").push(s);
+            Ok(vec![Box::new(bridge)])
+        };
+        Ok(NodePlan { external, extra: Some(Arc::new(factory)) })
+    }
+}
+
+/// One line of bridge statistics for stderr.
+pub fn report(stats: &Arc<Mutex<Vec<Arc<Mutex<Stats>>>>>) -> Option<String> {
+    let all = stats.lock().expect("stats lock");
+    if all.is_empty() {
+        return None;
+    }
+    let mut t = Stats::default();
+    for s in all.iter() {
+        let s = s.lock().expect("stats lock");
+        t.published += s.published;
+        t.published_bytes += s.published_bytes;
+        t.received += s.received;
+        t.rejected += s.rejected;
+        t.instants += s.instants;
+        t.lockstep_timeouts += s.lockstep_timeouts;
+        t.waited += s.waited;
+    }
+    Some(format!(
+        "ros2 bridge: {} instants, {} messages ({:.1} MB) published, {} received, {} rejected, {} lockstep timeouts, {:.2} s waiting",
+        t.instants,
+        t.published,
+        t.published_bytes as f64 / 1e6,
+        t.received,
+        t.rejected,
+        t.lockstep_timeouts,
+        t.waited
+    ))
+}

@@ -1,0 +1,21 @@
+//! agrisim-ros2: the live ROS 2 link. A DDS bridge carries what the message bus carries to
+//! ROS 2 peers (rmw_cyclonedds, rmw_fastrtps: Humble, Jazzy) and their commands back, so an
+//! external navigation, perception or manipulation node replaces a built-in one and the
+//! benchmark harness still judges the run.
+//!
+//! Messages cross as raw CDR: the bytes on the bus are the bytes on the wire (no decode and
+//! re-encode), so what a peer receives equals what the MCAP records. Inbound messages are
+//! checked against their topic's type before they reach the bus; a bad one is rejected,
+//! counted and reported, and the run goes on.
+//!
+//! * [`names`]: ROS 2 topic and type names on DDS (`rt/...`, `pkg::msg::dds_::Type_`), remapping;
+//! * [`qos`]: the QoS ROS 2 users expect per topic;
+//! * [`raw`]: the raw-CDR sample type and its RustDDS adapters;
+//! * [`bridge`]: the bridge node (lockstep or real time) and its statistics.
+
+pub mod bridge;
+pub mod names;
+pub mod qos;
+pub mod raw;
+
+pub use bridge::{BridgeConfig, Mode, Ros2Bridge, Stats};
