@@ -116,4 +116,15 @@ class PointCloud2(IdlStruct, typename="sensor_msgs::msg::dds_::PointCloud2_"):
     is_dense: bool = False
 
 
-__all__ = ["Clock", "Header", "NavigationStatus", "Odometry", "PointCloud2", "PoseStamped", "Time", "Twist", "Vector3", "float32"]
+@dataclass
+class Image(IdlStruct, typename="sensor_msgs::msg::dds_::Image_"):
+    header: Header = field(default_factory=Header)
+    height: uint32 = 0
+    width: uint32 = 0
+    encoding: str = ""
+    is_bigendian: uint8 = 0
+    step: uint32 = 0
+    data: sequence[uint8] = field(default_factory=list)
+
+
+__all__ = ["Clock", "Header", "Image", "NavigationStatus", "Odometry", "PointCloud2", "PoseStamped", "Time", "Twist", "Vector3", "float32"]

@@ -4,6 +4,7 @@ which (normal dependencies, followed transitively through the workspace).
   fmus/ (environment, robot, sensors)  <-  orchestrator/cosim (engine)
   orchestrator/bus (messages)  <-  algorithm nodes (nodes, nav, manip, trajectory, harvest)
   session (engine + bus)  <-  bench  <-  cli, python (the pyo3 package; siblings on top)
+  bus  <-  bridges (ros2: DDS, foxglove: WebSocket): they carry messages, like a node
 
 The engine and the message layer do not know each other; algorithms never link the engine,
 the FMU export layer or scene generation, so any of them can be swapped for a ROS 2 node.
@@ -23,15 +24,17 @@ FMI_EXPORT = "agrisim-fmi"
 MESSAGES = "agrisim-msgs"
 BUS = "agrisim-bus"
 PYTHON = "agrisim-python"
+BRIDGES = {"agrisim-ros2", "agrisim-foxglove"}
 ABOVE = {"agrisim-session", "agrisim-bench", "agrisim", PYTHON}
 
 # crate -> crates it must not reach (directly or through other workspace crates), and why.
 FORBIDDEN = {
-    **{a: ({ENGINE, SCENE, FMI_EXPORT} | ABOVE, "an algorithm speaks only messages (node API)") for a in ALGORITHMS},
-    ENGINE: ({MESSAGES, BUS, SCENE, FMI_EXPORT} | ALGORITHMS | ABOVE, "the engine knows no ROS, no greenhouse, no algorithm"),
-    BUS: ({ENGINE, SCENE, FMI_EXPORT} | ALGORITHMS | ABOVE, "the message layer has no FMI inside"),
+    **{a: ({ENGINE, SCENE, FMI_EXPORT} | BRIDGES | ABOVE, "an algorithm speaks only messages (node API)") for a in ALGORITHMS},
+    **{b: ({ENGINE, SCENE, FMI_EXPORT} | ALGORITHMS | ABOVE, "a bridge carries messages: no FMI, no algorithm") for b in BRIDGES},
+    ENGINE: ({MESSAGES, BUS, SCENE, FMI_EXPORT} | ALGORITHMS | BRIDGES | ABOVE, "the engine knows no ROS, no greenhouse, no algorithm"),
+    BUS: ({ENGINE, SCENE, FMI_EXPORT} | ALGORITHMS | BRIDGES | ABOVE, "the message layer has no FMI inside"),
     SCENE: ({FMI_EXPORT, ENGINE, BUS} | ALGORITHMS | ABOVE, "scene generation is a plain library"),
-    "agrisim-session": ({"agrisim-bench", "agrisim", PYTHON, "agrisim-nav", "agrisim-harvest"}, "a session runs any nodes; it picks none"),
+    "agrisim-session": ({"agrisim-bench", "agrisim", PYTHON, "agrisim-nav", "agrisim-harvest"} | BRIDGES, "a session runs any nodes; it picks none"),
     "agrisim-bench": ({"agrisim", PYTHON}, "the CLI and the Python package are on top"),
     PYTHON: ({"agrisim"}, "the Python package and the CLI are siblings: neither links the other"),
 }
@@ -68,7 +71,7 @@ def violations(graph):
             if target in forbidden:
                 out.append(f"{crate} depends on {target} ({' -> '.join(path)}): {why}")
     fmu_side = {n for n in graph if n.startswith("agrisim-fmu-")} | {SCENE, FMI_EXPORT, MESSAGES}
-    orchestrator = {ENGINE, BUS} | ALGORITHMS | ABOVE
+    orchestrator = {ENGINE, BUS} | ALGORITHMS | BRIDGES | ABOVE
     for crate in sorted(fmu_side):
         for target, path in sorted(reach(graph, crate).items()):
             if target in orchestrator:
@@ -87,7 +90,7 @@ def test_layers_hold(graph):
 
 
 def test_every_layer_crate_exists(graph):
-    for crate in ALGORITHMS | {ENGINE, BUS, SCENE, "agrisim-session", "agrisim-bench", "agrisim", PYTHON}:
+    for crate in ALGORITHMS | BRIDGES | {ENGINE, BUS, SCENE, "agrisim-session", "agrisim-bench", "agrisim", PYTHON}:
         assert crate in graph, crate
 
 

@@ -3,7 +3,7 @@
 
 mod pack;
 mod png;
-mod ros2;
+mod live;
 mod snapshot;
 
 use agrisim_error::Result;
@@ -44,7 +44,7 @@ enum Command {
         #[command(flatten)]
         record: Record,
         #[command(flatten)]
-        ros2: ros2::Ros2Args,
+        live: live::LiveArgs,
         /// Print how the master orders the system (step order, delayed connections,
         /// initialization, exchange periods) and exit without running.
         #[arg(long)]
@@ -146,7 +146,7 @@ struct TrialArgs {
     #[command(flatten)]
     record: Record,
     #[command(flatten)]
-    ros2: ros2::Ros2Args,
+    live: live::LiveArgs,
     /// Keep the trials already complete in DIR (an interrupted run) and run the others.
     #[arg(long)]
     resume: bool,
@@ -309,10 +309,10 @@ fn trial_setup(a: &TrialArgs, default_scenario: &str, target: &Path, bridges: &B
     let s = Scenario::load(a.scenario.as_deref().unwrap_or(Path::new(default_scenario)))?;
     let mut o = run_options(a.dirs.clone(), target, None, None, BTreeMap::new(), a.log.categories());
     o.record = a.record.profile;
-    if a.ros2.ros2 && a.jobs > 1 {
-        return Err(agrisim_error::err!("--ros2 runs one trial at a time (trials would share the DDS topics): use --jobs 1"));
+    if (a.live.ros2 || a.live.foxglove.is_some()) && a.jobs > 1 {
+        return Err(agrisim_error::err!("--ros2 and --foxglove run one trial at a time (trials would share the DDS topics and the port): use --jobs 1"));
     }
-    o.nodes = a.ros2.plan(bridges)?;
+    o.nodes = a.live.plan(bridges)?;
     Ok((s, o))
 }
 
@@ -322,8 +322,13 @@ type Bridges = std::sync::Arc<std::sync::Mutex<Vec<std::sync::Arc<std::sync::Mut
 fn real_main() -> Result<()> {
     let cli = Cli::parse();
     let bridges = Bridges::default();
+    let stats_file = match &cli.command {
+        Command::Run { live, .. } => live.ros2_stats.clone(),
+        Command::Bench { command: BenchCommand::Nav(a) | BenchCommand::Harvest(a) } => a.live.ros2_stats.clone(),
+        _ => None,
+    };
     let result = dispatch(cli, &bridges);
-    if let Some(line) = ros2::report(&bridges) {
+    if let Some(line) = live::report(&bridges, stats_file.as_deref())? {
         eprintln!("{line}");
     }
     result
@@ -332,11 +337,11 @@ fn real_main() -> Result<()> {
 fn dispatch(cli: Cli, bridges: &Bridges) -> Result<()> {
     let (exe_dir, target) = build_dirs();
     match cli.command {
-        Command::Run { scenario, duration, seed, fmus, dirs, log, record, ros2, explain, out } => {
+        Command::Run { scenario, duration, seed, fmus, dirs, log, record, live, explain, out } => {
             let s = Scenario::load(&scenario)?;
             let mut opts = run_options(dirs, &target, seed, duration, fmus.into_iter().collect(), log.categories());
             opts.record = record.profile;
-            opts.nodes = ros2.plan(bridges)?;
+            opts.nodes = live.plan(bridges)?;
             if explain {
                 print!("{}", agrisim_session::run::explain(&s, &opts)?);
                 return Ok(());

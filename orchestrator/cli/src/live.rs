@@ -1,6 +1,7 @@
-//! `--ros2` and `--external`: the command line of the live ROS 2 link. Which built-in nodes
-//! an external node replaces, which topics the bridge takes from ROS 2 peers (the system's
-//! commands, the replaced nodes' outputs, `--ros2-subscribe`), and how it keeps time.
+//! `--ros2`, `--external` and `--foxglove`: the command line of the live links. Which built-in
+//! nodes an external node replaces, which topics the ROS 2 bridge takes from peers (the
+//! system's commands, the replaced nodes' outputs, `--ros2-subscribe`), how it keeps time,
+//! and where the Foxglove live view listens.
 
 use agrisim_error::{err, Result};
 use agrisim_ros2::names::Remap;
@@ -11,7 +12,7 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 #[derive(clap::Args, Clone, Debug)]
-pub struct Ros2Args {
+pub struct LiveArgs {
     /// Bridge the run to ROS 2 over DDS: every message of the bus is published (topics
     /// `rt/<name>`, types `pkg::msg::dds_::Type_`, raw CDR) with /clock, and the system's
     /// command topics (plus those of `--external` nodes) are taken from ROS 2 peers.
@@ -45,10 +46,18 @@ pub struct Ros2Args {
     /// Talk on every network interface, not only loopback (exposes the run to the network).
     #[arg(long)]
     pub ros2_all_interfaces: bool,
+    /// Write the bridge's statistics to FILE (JSON): messages and bytes per topic, received,
+    /// rejected, lockstep round trips [s].
+    #[arg(long, value_name = "FILE")]
+    pub ros2_stats: Option<std::path::PathBuf>,
     /// Turn off a built-in node so an external one (over --ros2) takes its place: navigator,
     /// harvest, command_script, odom_tf, robot_state_publisher, map_server, goal_publisher.
     #[arg(long = "external", value_name = "NODE")]
     pub external: Vec<String>,
+    /// Serve the bus live to Foxglove (WebSocket, foxglove.sdk.v1) on ADDR (default
+    /// 127.0.0.1:8765; give 0.0.0.0:PORT to expose it to the network).
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = agrisim_foxglove::DEFAULT_ADDR)]
+    pub foxglove: Option<String>,
 }
 
 /// What a replaced built-in node published (its topics now come from ROS 2), and those
@@ -68,15 +77,22 @@ fn outputs_of(node: &str) -> Option<(&'static [(&'static str, &'static str)], &'
     })
 }
 
-impl Ros2Args {
+impl LiveArgs {
     /// The run's node plan; `stats` collects each run's bridge statistics.
     pub fn plan(&self, stats: &Arc<Mutex<Vec<Arc<Mutex<Stats>>>>>) -> Result<NodePlan> {
         let external: BTreeSet<String> = self.external.iter().cloned().collect();
+        let foxglove: Option<std::net::SocketAddr> = match &self.foxglove {
+            Some(a) => Some(a.parse().map_err(|e| err!("--foxglove {a}: not an address IP:PORT ({e})"))?),
+            None => None,
+        };
         if !self.ros2 {
             if !external.is_empty() {
                 return Err(err!("--external needs --ros2 (the external node talks to the run over ROS 2)"));
             }
-            return Ok(NodePlan::default());
+            return Ok(match foxglove {
+                Some(addr) => NodePlan { external, extra: Some(Arc::new(move |_: &[(String, String)]| Ok(vec![foxglove_view(addr)?]))) },
+                None => NodePlan::default(),
+            });
         }
         let mut extra_inbound: Vec<(String, String)> = vec![];
         let mut lockstep: Vec<String> = vec![];
@@ -120,14 +136,25 @@ impl Ros2Args {
             let config = BridgeConfig { domain, mode, inbound, lockstep: lockstep.clone(), remap: remap.clone(), loopback_only, startup_timeout };
             let (bridge, s) = Ros2Bridge::new(config)?;
             stats.lock().expect("stats lock").push(s);
-            Ok(vec![Box::new(bridge)])
+            let mut nodes: Vec<Box<dyn agrisim_bus::Node>> = vec![Box::new(bridge)];
+            if let Some(addr) = foxglove {
+                nodes.push(foxglove_view(addr)?);
+            }
+            Ok(nodes)
         };
         Ok(NodePlan { external, extra: Some(Arc::new(factory)) })
     }
 }
 
-/// One line of bridge statistics for stderr.
-pub fn report(stats: &Arc<Mutex<Vec<Arc<Mutex<Stats>>>>>) -> Option<String> {
+/// The Foxglove live view on `addr`, announced on stderr.
+fn foxglove_view(addr: std::net::SocketAddr) -> Result<Box<dyn agrisim_bus::Node>> {
+    let (view, port) = agrisim_foxglove::FoxgloveView::start(addr)?;
+    eprintln!("foxglove: ws://{}:{port} (open it in Foxglove: Open connection, Foxglove WebSocket)", addr.ip());
+    Ok(Box::new(view))
+}
+
+/// All runs' bridge statistics summed (round trips concatenated).
+fn total(stats: &Arc<Mutex<Vec<Arc<Mutex<Stats>>>>>) -> Option<Stats> {
     let all = stats.lock().expect("stats lock");
     if all.is_empty() {
         return None;
@@ -142,8 +169,40 @@ pub fn report(stats: &Arc<Mutex<Vec<Arc<Mutex<Stats>>>>>) -> Option<String> {
         t.instants += s.instants;
         t.lockstep_timeouts += s.lockstep_timeouts;
         t.waited += s.waited;
+        t.round_trips.extend(&s.round_trips);
+        for (k, (n, b)) in &s.topics {
+            let e = t.topics.entry(k.clone()).or_default();
+            e.0 += n;
+            e.1 += b;
+        }
     }
-    Some(format!(
+    Some(t)
+}
+
+/// The q-quantile (nearest rank) of sorted `v` [ms].
+fn quantile_ms(v: &[f64], q: f64) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    1e3 * v[((q * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1]
+}
+
+/// One line of bridge statistics for stderr, and the JSON file if asked for.
+pub fn report(stats: &Arc<Mutex<Vec<Arc<Mutex<Stats>>>>>, file: Option<&std::path::Path>) -> Result<Option<String>> {
+    let Some(mut t) = total(stats) else { return Ok(None) };
+    t.round_trips.sort_by(f64::total_cmp);
+    let rt = &t.round_trips;
+    let (p50, p99, max) = (quantile_ms(rt, 0.5), quantile_ms(rt, 0.99), quantile_ms(rt, 1.0));
+    if let Some(f) = file {
+        let topics: serde_json::Map<String, serde_json::Value> = t.topics.iter().map(|(k, (n, b))| (k.clone(), serde_json::json!({"messages": n, "bytes": b}))).collect();
+        let v = serde_json::json!({
+            "instants": t.instants, "published": t.published, "published_bytes": t.published_bytes,
+            "received": t.received, "rejected": t.rejected, "lockstep_timeouts": t.lockstep_timeouts,
+            "waited_s": t.waited, "round_trip_ms": {"n": rt.len(), "p50": p50, "p99": p99, "max": max}, "topics": topics,
+        });
+        std::fs::write(f, serde_json::to_string_pretty(&v).expect("plain value")).map_err(|e| err!("cannot write {}: {e}", f.display()))?;
+    }
+    let mut line = format!(
         "ros2 bridge: {} instants, {} messages ({:.1} MB) published, {} received, {} rejected, {} lockstep timeouts, {:.2} s waiting",
         t.instants,
         t.published,
@@ -152,5 +211,9 @@ pub fn report(stats: &Arc<Mutex<Vec<Arc<Mutex<Stats>>>>>) -> Option<String> {
         t.rejected,
         t.lockstep_timeouts,
         t.waited
-    ))
+    );
+    if !rt.is_empty() {
+        line += &format!("; round trip p50 {p50:.2} ms, p99 {p99:.2} ms, max {max:.2} ms");
+    }
+    Ok(Some(line))
 }
