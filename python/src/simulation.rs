@@ -81,6 +81,7 @@ impl Simulation {
     /// `record`: an MCAP file to record to (None: nothing kept); `profile`: full, standard,
     /// judge or none. `nodes`: built-in nodes to run beside Python (odom_tf, script, inject).
     #[new]
+    #[allow(clippy::too_many_arguments)]
     #[pyo3(signature = (scenario="default".into(), seed=None, fmu=None, parameters=None, record=None, profile=None, nodes=None), text_signature = "(scenario='default', seed=None, fmu=None, parameters=None, record=None, profile=None, nodes=None)")]
     fn new(
         py: Python<'_>,
@@ -125,7 +126,7 @@ impl Simulation {
             .detach(move || {
                 let t = task.get();
                 let nodes = t.3.take().expect("once");
-                agrisim_session::prepare(&t.0, &t.1, &t.2, nodes).map(|s| OnThisThread(s))
+                agrisim_session::prepare(&t.0, &t.1, &t.2, nodes).map(OnThisThread)
             })
             .map_err(py_err)?
             .0;

@@ -60,10 +60,13 @@ pub struct LiveArgs {
     pub foxglove: Option<String>,
 }
 
+/// A topic and its ROS 2 type.
+type Topic = (&'static str, &'static str);
+
 /// What a replaced built-in node published (its topics now come from ROS 2), and those
 /// lockstep waits for: the external node answers each /clock tick with one message on each
 /// (the navigator: a command and its status, as Nav2's controller and navigator do).
-fn outputs_of(node: &str) -> Option<(&'static [(&'static str, &'static str)], &'static [&'static str])> {
+fn outputs_of(node: &str) -> Option<(&'static [Topic], &'static [&'static str])> {
     Some(match node {
         "navigator" => (
             &[("/cmd_vel", "geometry_msgs/msg/Twist"), ("/navigate/status", "agrisim_msgs/msg/NavigationStatus"), ("/localization/pose", "geometry_msgs/msg/PoseStamped"), ("/plan", "nav_msgs/msg/Path")],
