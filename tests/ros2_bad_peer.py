@@ -2,7 +2,9 @@
 agrisim command given after `--` (so both share this network namespace) and answers each
 /clock tick with one /cmd_vel: valid Twists (0.3 m/s), but at some ticks garbage bytes or a
 message of another type under the Twist type name, and once a Twist with a NaN; it also
-sends garbage on /left_arm/joint_trajectory. Prints what it sent as JSON."""
+sends garbage on /left_arm/joint_trajectory. It raises the lift through the scalar input
+/lift/setpoint (std_msgs/Float64), later sends it a NaN, and records /lift/position. Prints
+what it sent and saw as JSON."""
 
 import argparse
 import json
@@ -24,7 +26,7 @@ from cyclonedds.topic import Topic
 from cyclonedds.util import duration
 
 sys.path.insert(0, str(Path(__file__).parent))
-from ros2_idl import Clock, Twist, Vector3  # noqa: E402
+from ros2_idl import Clock, Float64, Twist, Vector3  # noqa: E402
 
 RELIABLE = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.History.KeepAll)
 
@@ -58,6 +60,9 @@ def main() -> int:
     garbage = DataWriter(dp, Topic(dp, "rt/cmd_vel", GarbageTwist), qos=RELIABLE)
     text = DataWriter(dp, Topic(dp, "rt/cmd_vel", TextAsTwist), qos=RELIABLE)
     traj = DataWriter(dp, Topic(dp, "rt/left_arm/joint_trajectory", GarbageTrajectory), qos=RELIABLE)
+    lift = DataWriter(dp, Topic(dp, "rt/lift/setpoint", Float64), qos=RELIABLE)
+    lift_position = DataReader(dp, Topic(dp, "rt/lift/position", Float64), qos=RELIABLE)
+    positions = []
     proc = subprocess.Popen([x for x in a.agrisim if x != "--"])
     ticks = good_sent = bad_sent = 0
     try:
@@ -84,11 +89,17 @@ def main() -> int:
                 if ticks == 12:
                     traj.write(GarbageTrajectory(junk=[1, 2, 3, 4, 5]))
                     bad_sent += 1
+                if ticks == 5:
+                    lift.write(Float64(data=0.4))  # a scalar input over ROS 2 (the lift starts at 0.2 m)
+                elif ticks == 30:
+                    lift.write(Float64(data=math.nan))  # refused by the bridge
+                    bad_sent += 1
+            positions += [m.data for m in lift_position.take(N=100) if not isinstance(m, InvalidSample)]
     finally:
         if proc.poll() is None:
             proc.kill()
         proc.wait()
-    print(json.dumps({"ticks": ticks, "good_sent": good_sent, "bad_sent": bad_sent, "returncode": proc.returncode}))
+    print(json.dumps({"ticks": ticks, "good_sent": good_sent, "bad_sent": bad_sent, "lift_positions": positions, "returncode": proc.returncode}))
     return 0
 
 

@@ -23,6 +23,11 @@ class Header(IdlStruct, typename="std_msgs::msg::dds_::Header_"):
 
 
 @dataclass
+class Float64(IdlStruct, typename="std_msgs::msg::dds_::Float64_"):
+    data: float64 = 0.0
+
+
+@dataclass
 class Vector3(IdlStruct, typename="geometry_msgs::msg::dds_::Vector3_"):
     x: float64 = 0.0
     y: float64 = 0.0
@@ -127,4 +132,4 @@ class Image(IdlStruct, typename="sensor_msgs::msg::dds_::Image_"):
     data: sequence[uint8] = field(default_factory=list)
 
 
-__all__ = ["Clock", "Header", "Image", "NavigationStatus", "Odometry", "PointCloud2", "PoseStamped", "Time", "Twist", "Vector3", "float32"]
+__all__ = ["Clock", "Float64", "Header", "Image", "NavigationStatus", "Odometry", "PointCloud2", "PoseStamped", "Time", "Twist", "Vector3", "float32"]

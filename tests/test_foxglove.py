@@ -1,7 +1,7 @@
 """The Foxglove live view (`--foxglove`) against a client no one here wrote: the `websockets`
 package speaking the Foxglove WebSocket protocol (subprotocol foxglove.sdk.v1), in a private
 network namespace with only loopback. The run is paced to the wall clock (`--ros2-mode
-realtime`, twice real time) so the client joins while it goes. The client gets serverInfo,
+realtime`, real time) so the client joins while it goes. The client gets serverInfo,
 every topic advertised with its ros2msg schema (the MCAP's own text), simulated time, and
 messages equal, byte for byte and stamp for stamp, to what the MCAP recorded."""
 
@@ -23,7 +23,7 @@ pytestmark = pytest.mark.skipif(netns.available() is not None, reason=str(netns.
 
 def test_foxglove_client_sees_the_recorded_messages(tmp_path):
     out, got = tmp_path / "run", tmp_path / "client.json"
-    cmd = [str(agrisim_bin()), "run", "--duration", "4", "--record", "full", "--ros2", "--ros2-mode", "realtime", "--ros2-rate", "2", "--foxglove", "127.0.0.1:0", "--out", str(out)]
+    cmd = [str(agrisim_bin()), "run", "--duration", "4", "--record", "full", "--ros2", "--ros2-mode", "realtime", "--ros2-rate", "1", "--foxglove", "127.0.0.1:0", "--out", str(out)]
     topics = ["/odom", "/points", "/tf", "/clock"]
     argv = [sys.executable, str(HERE / "foxglove_client.py"), "--out", str(got)] + [x for t in topics for x in ("--topic", t)] + ["--", *cmd]
     r = netns.run(argv, timeout=120, capture_output=True, text=True)

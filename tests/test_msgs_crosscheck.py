@@ -111,6 +111,7 @@ EXPECTED = {
     "time_negative": {"sec": -2, "nanosec": 300_000_000},
     "header": hdr(12, 500_000_000, "odom"),
     "header_empty_frame": hdr(0, 1, ""),
+    "float64": {"data": -0.125},
     "vector3": v3(1.5, -2.25, 1e-300),
     "point": v3(0.1, 0.2, 0.3),
     "quaternion": q(0.0, 0.0, H, H),
@@ -423,7 +424,7 @@ SAMPLE_NAMES = sorted(EXPECTED)
 def test_samples_cover_every_msg_file(samples):
     assert set(samples) == set(EXPECTED)
     assert {t for t, _, _ in samples.values()} == set(msg_files())
-    assert len(msg_files()) == 45
+    assert len(msg_files()) == 46
 
 
 @pytest.mark.parametrize("name", SAMPLE_NAMES)
@@ -521,7 +522,7 @@ def test_msg_texts_match_ros2_distro(rosbags_store, store_name):
             continue
         assert rosbags_store.fielddefs[name] == ref.fielddefs[name], name
         checked += 1
-    assert checked == 33
+    assert checked == 34
 
 
 @pytest.mark.parametrize("name", SAMPLE_NAMES)

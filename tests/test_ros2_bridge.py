@@ -6,8 +6,9 @@ namespace with only loopback (tests/netns.py), bounded in time.
   (`--external navigator`) and drives the robot to the nav benchmark's goal in lockstep; the
   harness scores it from messages and ground truth. The point clouds it received are
   byte-equal to the recorded ones, and a second run records the very same MCAP.
-* Garbage and wrongly typed messages on /cmd_vel and on an arm trajectory topic are
-  rejected and reported (topic, sender, reason); the run goes on.
+* Garbage and wrongly typed messages on /cmd_vel and on an arm trajectory topic, and a NaN
+  on the scalar lift set-point, are rejected and reported (topic, sender, reason); the run
+  goes on. Scalars cross as std_msgs/Float64 in both directions.
 """
 
 from __future__ import annotations
@@ -101,6 +102,12 @@ def test_malformed_messages_are_rejected_and_the_run_goes_on(tmp_path):
     # The valid commands before and after drove the base: the run went on to the end.
     cmds = decoded_messages(out / "run.mcap", "/cmd_vel")
     assert len(cmds) == peer["good_sent"]
+    # Scalars cross as std_msgs/Float64 both ways: the set-point raised the lift, whose
+    # position the peer saw rise from 0.2 m to 0.4 m; the NaN set-point was refused and the
+    # lift held 0.4 m.
+    assert "scalar /lift/setpoint from writer" in err and "not a finite number" in err, err
+    lift = peer["lift_positions"]
+    assert abs(lift[0] - 0.2) < 1e-9 and abs(lift[-1] - 0.4) < 1e-3 and len(set(lift)) > 5, lift
     odom = decoded_messages(out / "run.mcap", "/odom")
     assert odom[-1][1] >= 3.9e9
     assert odom[-1][2].pose.pose.position.x - odom[0][2].pose.pose.position.x > 0.3

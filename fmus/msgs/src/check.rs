@@ -34,6 +34,7 @@ pub fn check_cdr(type_name: &str, bytes: &[u8]) -> Option<Result<(), CdrError>> 
         "rosgraph_msgs/msg/Clock" => ok::<rosgraph_msgs::Clock>(bytes),
         "sensor_msgs/msg/JointState" => ok::<sensor_msgs::JointState>(bytes),
         "std_msgs/msg/Header" => ok::<std_msgs::Header>(bytes),
+        "std_msgs/msg/Float64" => ok::<std_msgs::Float64>(bytes),
         "tf2_msgs/msg/TFMessage" => ok::<tf2_msgs::TFMessage>(bytes),
         "sensor_msgs/msg/PointField" => ok::<sensor_msgs::PointField>(bytes),
         "sensor_msgs/msg/PointCloud2" => ok::<sensor_msgs::PointCloud2>(bytes),

@@ -33,6 +33,7 @@ macro_rules! msg_table {
 msg_table! {
     "builtin_interfaces" / "Time",
     "std_msgs" / "Header",
+    "std_msgs" / "Float64",
     "geometry_msgs" / "Vector3",
     "geometry_msgs" / "Point",
     "geometry_msgs" / "Quaternion",

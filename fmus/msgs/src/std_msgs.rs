@@ -1,4 +1,4 @@
-//! `std_msgs`: the common stamped-data header.
+//! `std_msgs`: the common stamped-data header, and Float64 for scalars on the bridge.
 
 use crate::builtin_interfaces::Time;
 use crate::message::ros_message;
@@ -9,6 +9,14 @@ ros_message! {
     pub struct Header = "std_msgs/msg/Header" {
         pub stamp: Time,
         pub frame_id: String,
+    }
+}
+
+ros_message! {
+    /// `std_msgs/msg/Float64`: one number (scalar connectors on the ROS 2 bridge).
+    #[derive(Debug, Default, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+    pub struct Float64 = "std_msgs/msg/Float64" {
+        pub data: f64,
     }
 }
 

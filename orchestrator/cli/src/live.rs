@@ -6,7 +6,7 @@
 use agrisim_error::{err, Result};
 use agrisim_ros2::names::Remap;
 use agrisim_ros2::{BridgeConfig, Mode, Ros2Bridge, Stats};
-use agrisim_session::run::NodePlan;
+use agrisim_session::run::{NodePlan, SystemInputs};
 use std::collections::BTreeSet;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -14,8 +14,9 @@ use std::time::Duration;
 #[derive(clap::Args, Clone, Debug)]
 pub struct LiveArgs {
     /// Bridge the run to ROS 2 over DDS: every message of the bus is published (topics
-    /// `rt/<name>`, types `pkg::msg::dds_::Type_`, raw CDR) with /clock, and the system's
-    /// command topics (plus those of `--external` nodes) are taken from ROS 2 peers.
+    /// `rt/<name>`, types `pkg::msg::dds_::Type_`, raw CDR) with /clock, scalars as
+    /// std_msgs/Float64, and the system's command topics and scalar inputs (plus the topics
+    /// of `--external` nodes) are taken from ROS 2 peers.
     #[arg(long)]
     pub ros2: bool,
     /// DDS domain (ROS_DOMAIN_ID).
@@ -93,7 +94,7 @@ impl LiveArgs {
                 return Err(err!("--external needs --ros2 (the external node talks to the run over ROS 2)"));
             }
             return Ok(match foxglove {
-                Some(addr) => NodePlan { external, extra: Some(Arc::new(move |_: &[(String, String)]| Ok(vec![foxglove_view(addr)?]))) },
+                Some(addr) => NodePlan { external, extra: Some(Arc::new(move |_: &SystemInputs| Ok(vec![foxglove_view(addr)?]))) },
                 None => NodePlan::default(),
             });
         }
@@ -129,14 +130,14 @@ impl LiveArgs {
         }
         let startup_timeout = Duration::from_secs_f64(self.ros2_startup_timeout);
         let stats = stats.clone();
-        let factory = move |inputs: &[(String, String)]| -> Result<Vec<Box<dyn agrisim_bus::Node>>> {
-            let mut inbound: Vec<(String, String)> = inputs.to_vec();
+        let factory = move |inputs: &SystemInputs| -> Result<Vec<Box<dyn agrisim_bus::Node>>> {
+            let mut inbound: Vec<(String, String)> = inputs.messages.clone();
             for t in &extra_inbound {
                 if !inbound.iter().any(|(i, _)| i == &t.0) {
                     inbound.push(t.clone());
                 }
             }
-            let config = BridgeConfig { domain, mode, inbound, lockstep: lockstep.clone(), remap: remap.clone(), loopback_only, startup_timeout };
+            let config = BridgeConfig { domain, mode, inbound, inbound_scalars: inputs.scalars.clone(), lockstep: lockstep.clone(), remap: remap.clone(), loopback_only, startup_timeout };
             let (bridge, s) = Ros2Bridge::new(config)?;
             stats.lock().expect("stats lock").push(s);
             let mut nodes: Vec<Box<dyn agrisim_bus::Node>> = vec![Box::new(bridge)];

@@ -12,6 +12,7 @@ use agrisim_bus::{Bus, Node, Reader};
 use agrisim_error::{err, Result};
 use agrisim_msgs::builtin_interfaces::Time;
 use agrisim_msgs::rosgraph_msgs::Clock;
+use agrisim_msgs::std_msgs::Float64;
 use agrisim_msgs::Message;
 use rustdds::no_key::{DataReader, DataWriter};
 use rustdds::{DomainParticipant, DomainParticipantBuilder, Publisher, Subscriber, TopicKind};
@@ -39,6 +40,9 @@ pub struct BridgeConfig {
     /// Topics taken from ROS 2 peers onto the bus, with their ROS 2 types (`pkg/msg/Type`).
     /// They are not published back.
     pub inbound: Vec<(String, String)>,
+    /// Scalar connectors taken from peers as `std_msgs/msg/Float64` (a lift set-point).
+    /// The bus's other scalars are published as Float64 at each instant.
+    pub inbound_scalars: Vec<String>,
     /// In lockstep: the inbound topics that must answer at each message instant.
     pub lockstep: Vec<String>,
     pub remap: Remap,
@@ -70,6 +74,8 @@ pub struct Stats {
 struct Inbound {
     topic: String,
     ros_type: String,
+    /// A scalar connector: its Float64 messages set the bus's scalar.
+    scalar: bool,
     reader: DataReader<RawCdr, RawAdapter>,
     /// Taken from DDS since the last delivery: sender and bytes.
     pending: Vec<(String, Vec<u8>)>,
@@ -112,14 +118,16 @@ impl Ros2Bridge {
             }
         }
         let mut inbound = vec![];
-        for (topic, ros_type) in &config.inbound {
+        let scalars = config.inbound_scalars.iter().map(|t| (t, Float64::TYPE_NAME));
+        for (topic, ros_type) in config.inbound.iter().map(|(t, ty)| (t, ty.as_str())).chain(scalars) {
             let ty = dds_type(ros_type).ok_or_else(|| err!("ROS 2 bridge: topic {topic}: '{ros_type}' is not a pkg/msg/Type name"))?;
             let name = dds_topic(config.remap.apply(topic));
             let t = participant.create_topic(name.clone(), ty, &qos::reader(), TopicKind::NoKey).map_err(|e| dds_err(&format!("topic {name}"), e))?;
             let reader = subscriber.create_datareader_no_key::<RawCdr, RawAdapter>(&t, Some(qos::reader())).map_err(|e| dds_err(&format!("reader of {name}"), e))?;
-            inbound.push(Inbound { topic: topic.clone(), ros_type: ros_type.clone(), reader, pending: vec![] });
+            let scalar = config.inbound_scalars.contains(topic);
+            inbound.push(Inbound { topic: topic.clone(), ros_type: ros_type.to_string(), scalar, pending: vec![] , reader });
         }
-        let inbound_topics = config.inbound.iter().map(|(t, _)| t.clone()).collect();
+        let inbound_topics = config.inbound.iter().map(|(t, _)| t.clone()).chain(config.inbound_scalars.iter().cloned()).collect();
         let stats = Arc::new(Mutex::new(Stats::default()));
         let bridge = Ros2Bridge {
             _participant: participant.clone(),
@@ -239,6 +247,10 @@ impl Node for Ros2Bridge {
                 self.write(&topic, &ty, s.cdr)?;
             }
         }
+        let scalars: Vec<(String, f64)> = bus.scalars().iter().filter(|(t, _)| !self.inbound_topics.contains(*t)).map(|(t, v)| (t.clone(), *v)).collect();
+        for (topic, data) in scalars {
+            self.write(&topic, Float64::TYPE_NAME, Float64 { data }.to_cdr())?;
+        }
         self.write("/clock", Clock::TYPE_NAME, Clock { clock: Time::from_nanos(t_ns) }.to_cdr())?;
         let published = Instant::now();
         match self.config.mode {
@@ -278,6 +290,16 @@ impl Node for Ros2Bridge {
         for i in &mut self.inbound {
             for (sender, cdr) in i.pending.drain(..) {
                 match agrisim_msgs::check_cdr(&i.ros_type, &cdr) {
+                    Some(Ok(())) if i.scalar => match Float64::from_cdr(&cdr) {
+                        Ok(Float64 { data }) if data.is_finite() => {
+                            received += 1;
+                            bus.set_scalar(&i.topic, data);
+                        }
+                        _ => {
+                            rejected += 1;
+                            bus.reject(format!("ROS 2 bridge: scalar {} from writer {sender}: not a finite number; rejected (the last valid value stays in force)", i.topic));
+                        }
+                    },
                     Some(Ok(())) => {
                         received += 1;
                         bus.publish_raw(&i.topic, &i.ros_type, t_ns, cdr);

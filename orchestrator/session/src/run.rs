@@ -31,9 +31,18 @@ pub struct RunOptions {
     pub nodes: NodePlan,
 }
 
+/// What the system takes from the algorithm layer: the commands.
+#[derive(Clone, Debug, Default)]
+pub struct SystemInputs {
+    /// Message inputs: topic and ROS 2 type.
+    pub messages: Vec<(String, String)>,
+    /// Scalar inputs (a lift set-point): their connector names on the bus.
+    pub scalars: Vec<String>,
+}
+
 /// Makes the extra nodes of one run (each run gets its own: a ROS 2 bridge joins DDS anew),
-/// given the system's message inputs (topic, ROS 2 type): the commands it takes.
-pub type NodeFactory = Arc<dyn Fn(&[(String, String)]) -> Result<Vec<Box<dyn Node>>> + Send + Sync>;
+/// given the system's inputs.
+pub type NodeFactory = Arc<dyn Fn(&SystemInputs) -> Result<Vec<Box<dyn Node>>> + Send + Sync>;
 
 /// How a run's nodes differ from what its scenario or benchmark would run: built-in nodes
 /// named in `external` are left out (an external node takes their place, e.g. over ROS 2),
@@ -54,7 +63,7 @@ impl std::fmt::Debug for NodePlan {
 impl NodePlan {
     /// `nodes` without the external ones, then the extra ones. Naming a node that is not
     /// there is an error (a typo must not leave the built-in node running).
-    pub fn apply(&self, nodes: Vec<Box<dyn Node>>, inputs: &[(String, String)]) -> Result<Vec<Box<dyn Node>>> {
+    pub fn apply(&self, nodes: Vec<Box<dyn Node>>, inputs: &SystemInputs) -> Result<Vec<Box<dyn Node>>> {
         for name in &self.external {
             if !nodes.iter().any(|n| n.name() == name) {
                 let names: Vec<&str> = nodes.iter().map(|n| n.name()).collect();
@@ -162,18 +171,17 @@ pub fn prepare(s: &Scenario, o: &RunOptions, mcap: &Path, nodes: Vec<Box<dyn Nod
         recorder.metadata(&format!("agrisim.parameters.{comp}"), params)?;
     }
     let master = Master::new(system, s.timing.step, lo.message_period)?;
-    let inputs: Vec<(String, String)> = master
-        .system
-        .routes
-        .iter()
-        .zip(&types)
-        .filter_map(|(r, ty)| match (&r.from, ty) {
-            (agrisim_cosim::Port::Bus { topic }, Some(ty)) => Some((topic.clone(), ty.clone())),
-            _ => None,
-        })
-        .collect::<BTreeSet<_>>()
-        .into_iter()
-        .collect();
+    let mut messages = BTreeSet::new();
+    let mut scalars = BTreeSet::new();
+    for (r, ty) in master.system.routes.iter().zip(&types) {
+        if let agrisim_cosim::Port::Bus { topic } = &r.from {
+            match ty {
+                Some(ty) => messages.insert((topic.clone(), ty.clone())),
+                None => scalars.insert(topic.clone()),
+            };
+        }
+    }
+    let inputs = SystemInputs { messages: messages.into_iter().collect(), scalars: scalars.into_iter().collect() };
     let nodes = o.nodes.apply(nodes, &inputs)?;
     let mut session = Session::new(master, nodes, recorder, types);
     session.master.initialize()?;

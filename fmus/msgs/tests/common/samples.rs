@@ -18,7 +18,7 @@ use agrisim_msgs::rosgraph_msgs::Clock;
 use agrisim_msgs::sensor_msgs::{
     CameraInfo, Image, Imu, JointState, PointCloud2, PointField, RegionOfInterest,
 };
-use agrisim_msgs::std_msgs::Header;
+use agrisim_msgs::std_msgs::{Float64, Header};
 use agrisim_msgs::tf2_msgs::TFMessage;
 use agrisim_msgs::{CdrError, Message};
 use std::fmt::Debug;
@@ -328,6 +328,7 @@ fn base_samples() -> Vec<Sample> {
         sample("time_negative", Time::new(-2, 300_000_000)),
         sample("header", hdr(12, 500_000_000, "odom")),
         sample("header_empty_frame", hdr(0, 1, "")),
+        sample("float64", Float64 { data: -0.125 }),
         sample("vector3", v3(1.5, -2.25, 1e-300)),
         sample(
             "point",
