@@ -6,6 +6,8 @@ namespace with only loopback (tests/netns.py), bounded in time.
   (`--external navigator`) and drives the robot to the nav benchmark's goal in lockstep; the
   harness scores it from messages and ground truth. The point clouds it received are
   byte-equal to the recorded ones, and a second run records the very same MCAP.
+* An external harvest node in Python (agrisim.Node("harvest") in its own process) replaces
+  the built-in one (`--external harvest`); the harvest harness scores the trial.
 * Garbage and wrongly typed messages on /cmd_vel and on an arm trajectory topic, and a NaN
   on the scalar lift set-point, are rejected and reported (topic, sender, reason); the run
   goes on. Scalars cross as std_msgs/Float64 in both directions.
@@ -111,3 +113,25 @@ def test_malformed_messages_are_rejected_and_the_run_goes_on(tmp_path):
     odom = decoded_messages(out / "run.mcap", "/odom")
     assert odom[-1][1] >= 3.9e9
     assert odom[-1][2].pose.pose.position.x - odom[0][2].pose.pose.position.x > 0.3
+
+
+def test_external_harvest_node_in_python(tmp_path):
+    """agrisim's harvest node run in a separate Python process (`agrisim.Node`) on the far
+    side of the link replaces the built-in one (`--external harvest`): it learns its fruit
+    from /harvest/task, gets joint states, statuses, the planning scene, the target and the
+    lift position over DDS, and sends trajectories, gripper commands and the lift set-point
+    back. The harvest harness scores the trial from messages and ground truth."""
+    scenario = write_variant(REPO / "models/scenarios/harvest.toml", tmp_path, '[harvest]\nvisibility = ["free"]\n')
+    out = tmp_path / "out"
+    cmd = [str(agrisim_bin()), "bench", "harvest", "--scenario", str(scenario), "--trials", "1", "--seed", "1", "--record", "judge", "--in-process", "--ros2", "--external", "harvest", "--out", str(out)]
+    r = netns.run([PY, str(HERE / "ros2_external_harvest.py"), "--", *cmd], timeout=300, capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout + r.stderr
+    peer = json.loads(r.stdout.strip().splitlines()[-1])
+    assert peer["task_received"] and peer["returncode"] == 0 and peer["sent"] > 20, peer
+    assert "0 rejected, 0 lockstep timeouts" in r.stderr, r.stderr
+    trial = json.loads((out / "trials.jsonl").read_text())
+    assert trial["outcome"] == "success", trial
+    assert trial["planning"] == "ok" and trial["plans"] >= 3 and trial["placed_count"] == 1
+    # The judge saw the node's messages only: its plans and statuses came over DDS.
+    statuses = decoded_messages(out / "trials/0000.mcap", "/harvest/status")
+    assert any(m.outcome == "success" for _, _, m in statuses)

@@ -7,6 +7,7 @@
 mod bench;
 mod convert;
 mod kinematics;
+mod node;
 mod paths;
 mod simulation;
 mod task;
@@ -40,6 +41,7 @@ fn _agrisim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<simulation::Snapshot>()?;
     m.add_class::<task::NavTask>()?;
     m.add_class::<kinematics::ArmModel>()?;
+    m.add_class::<node::Node>()?;
     m.add_function(wrap_pyfunction!(convert::decode, m)?)?;
     m.add_function(wrap_pyfunction!(convert::encode, m)?)?;
     m.add_function(wrap_pyfunction!(convert::message_types, m)?)?;

@@ -216,8 +216,10 @@ impl Reports {
     fn read(&mut self, m: &mut agrisim_session::Session, node: &str) -> Result<()> {
         let plans: Vec<PlanResult> = self.plans_reader.take(&mut m.bus)?;
         if !plans.is_empty() {
-            let wall = m.node_wall(node).unwrap_or(0.0) / plans.len() as f64;
-            self.planning_times.extend(std::iter::repeat_n(wall, plans.len()));
+            // An external node (over ROS 2) is not timed here: no planning times for it.
+            if let Some(wall) = m.node_wall(node) {
+                self.planning_times.extend(std::iter::repeat_n(wall / plans.len() as f64, plans.len()));
+            }
             self.plans.extend(plans);
         }
         for st in self.status_reader.take::<HarvestStatus>(&mut m.bus)? {
@@ -253,7 +255,7 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
     nav_cfg.embedded_localizer = false;
     let harvest = node(target.fruit_index, seed);
     let node_name = harvest.name().to_string();
-    let nodes: Vec<Box<dyn Node>> = vec![
+    let mut nodes: Vec<Box<dyn Node>> = vec![
         Box::new(MapServer::new(grid_message(&setup.map, 0))),
         Box::new(OdomTf::default()),
         Box::new(Localizer::new(&nav_cfg)),
@@ -261,6 +263,10 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
         harvest,
         Box::new(FaultInjector::new(&s.inject)),
     ];
+    if o.nodes.external.contains(&node_name) {
+        // An external node takes the harvest node's place: it is told the task the same way.
+        nodes.push(Box::new(crate::task_publisher::TaskPublisher::new(target.fruit_index)));
+    }
     let opts = RunOptions { seed: Some(seed), ..o.clone() };
     let mut m = prepare(&s, &opts, mcap, nodes)?;
     let (world, arm_l, arm_r) = (m.component("world", "harvest benchmark")?, m.component("arm_left", "harvest benchmark")?, m.component("arm_right", "harvest benchmark")?);

@@ -15,6 +15,7 @@ pub mod report;
 pub mod scenes;
 pub mod stats;
 pub mod targets;
+pub mod task_publisher;
 pub mod trials;
 
 pub use overhead::{overhead, OverheadReport};

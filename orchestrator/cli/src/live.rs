@@ -52,7 +52,8 @@ pub struct LiveArgs {
     #[arg(long, value_name = "FILE")]
     pub ros2_stats: Option<std::path::PathBuf>,
     /// Turn off a built-in node so an external one (over --ros2) takes its place: navigator,
-    /// harvest, command_script, odom_tf, robot_state_publisher, map_server, goal_publisher.
+    /// harvest (told its fruit on /harvest/task), command_script, odom_tf,
+    /// robot_state_publisher, map_server, goal_publisher.
     #[arg(long = "external", value_name = "NODE")]
     pub external: Vec<String>,
     /// Serve the bus live to Foxglove (WebSocket, foxglove.sdk.v1) on ADDR (default
@@ -74,6 +75,20 @@ fn outputs_of(node: &str) -> Option<(&'static [Topic], &'static [&'static str])>
             &["/cmd_vel", "/navigate/status"],
         ),
         "command_script" => (&[("/cmd_vel", "geometry_msgs/msg/Twist")], &["/cmd_vel"]),
+        // The harvest node's scalars (/lift/setpoint, /harvest/target_id) are system inputs,
+        // taken anyway; it reports its status every tick.
+        "harvest" => (
+            &[
+                ("/cmd_vel", "geometry_msgs/msg/Twist"),
+                ("/left_arm/joint_trajectory", "trajectory_msgs/msg/JointTrajectory"),
+                ("/right_arm/joint_trajectory", "trajectory_msgs/msg/JointTrajectory"),
+                ("/left_gripper/command", "control_msgs/msg/GripperCommand"),
+                ("/right_gripper/command", "control_msgs/msg/GripperCommand"),
+                ("/harvest/status", "agrisim_msgs/msg/HarvestStatus"),
+                ("/harvest/plans", "agrisim_msgs/msg/PlanResult"),
+            ],
+            &["/harvest/status"],
+        ),
         "odom_tf" | "robot_state_publisher" => (&[("/tf", "tf2_msgs/msg/TFMessage")], &[]),
         "map_server" => (&[("/map", "nav_msgs/msg/OccupancyGrid")], &[]),
         "goal_publisher" => (&[("/goal_pose", "geometry_msgs/msg/PoseStamped")], &[]),
@@ -101,7 +116,7 @@ impl LiveArgs {
         let mut extra_inbound: Vec<(String, String)> = vec![];
         let mut lockstep: Vec<String> = vec![];
         for name in &external {
-            let (outs, answer) = outputs_of(name).ok_or_else(|| err!("--external {name}: not a node whose outputs the bridge knows (navigator, command_script, odom_tf, robot_state_publisher, map_server, goal_publisher)"))?;
+            let (outs, answer) = outputs_of(name).ok_or_else(|| err!("--external {name}: not a node whose outputs the bridge knows (navigator, harvest, command_script, odom_tf, robot_state_publisher, map_server, goal_publisher)"))?;
             extra_inbound.extend(outs.iter().map(|(t, ty)| (t.to_string(), ty.to_string())));
             lockstep.extend(answer.iter().map(|t| t.to_string()));
         }

@@ -10,6 +10,7 @@ __all__ = [
     "AgrisimError",
     "ArmModel",
     "NavTask",
+    "Node",
     "Simulation",
     "Snapshot",
     "bench_harvest",
@@ -93,6 +94,15 @@ class ArmModel:
     @property
     def limits(self) -> tuple[list[float], list[float]]: ...
     def fk(self, q: list[float]) -> tuple[list[float], list[list[float]]]: ...
+
+@final
+class Node:
+    """A built-in algorithm node run from Python, fed and read as CDR messages and scalars."""
+
+    def __new__(cls, kind: str, fruit_index: int = 0, seed: int = 0) -> Self: ...
+    @property
+    def name(self) -> str: ...
+    def step(self, t_ns: int, messages: list[tuple[str, str, bytes]], scalars: dict[str, float]) -> tuple[list[tuple[str, str, bytes]], dict[str, float]]: ...
 
 def decode(type_name: str, data: bytes) -> dict[str, Any]: ...
 def encode(type_name: str, msg: dict[str, Any]) -> bytes: ...
