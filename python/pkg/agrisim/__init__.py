@@ -11,39 +11,12 @@ Importing the package registers the environments ``agrisim/Navigate-v0`` and
 ``agrisim/Reach-v0`` with gymnasium (when gymnasium is installed).
 """
 
-from ._agrisim import (  # noqa: F401
-    AgrisimError,
-    ArmModel,
-    NavTask,
-    Node,
-    Simulation,
-    Snapshot,
-    decode,
-    encode,
-    message_types,
-    root,
-    scenario_path,
-)
+from . import _agrisim
+from ._agrisim import *  # noqa: F401,F403  (Simulation, Snapshot, Node, NavTask, ArmModel, ...)
 from . import bench, msg  # noqa: F401
 from .msg import image_to_array, pointcloud_to_array  # noqa: F401
 
-__all__ = [
-    "AgrisimError",
-    "ArmModel",
-    "NavTask",
-    "Node",
-    "Simulation",
-    "Snapshot",
-    "bench",
-    "decode",
-    "encode",
-    "image_to_array",
-    "message_types",
-    "msg",
-    "pointcloud_to_array",
-    "root",
-    "scenario_path",
-]
+__all__ = [*_agrisim.__all__, "bench", "image_to_array", "msg", "pointcloud_to_array"]
 
 try:
     import gymnasium  # noqa: F401
