@@ -135,3 +135,10 @@ def test_external_harvest_node_in_python(tmp_path):
     # The judge saw the node's messages only: its plans and statuses came over DDS.
     statuses = decoded_messages(out / "trials/0000.mcap", "/harvest/status")
     assert any(m.outcome == "success" for _, _, m in statuses)
+    # Across the link, in lockstep, the node acts as it does inside: the same trial with the
+    # built-in node harvests at the same instant with the same plans.
+    inside = tmp_path / "inside"
+    subprocess.run([str(agrisim_bin()), "bench", "harvest", "--scenario", str(scenario), "--trials", "1", "--seed", "1", "--record", "judge", "--in-process", "--out", str(inside)], check=True, capture_output=True, timeout=300)
+    builtin = json.loads((inside / "trials.jsonl").read_text())
+    for key in ["outcome", "time_to_harvest", "plans", "placed_count", "fruit_index"]:
+        assert trial[key] == builtin[key], (key, trial[key], builtin[key])

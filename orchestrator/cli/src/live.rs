@@ -6,7 +6,7 @@
 use agrisim_error::{err, Result};
 use agrisim_ros2::names::Remap;
 use agrisim_ros2::{BridgeConfig, Mode, Ros2Bridge, Stats};
-use agrisim_session::run::{NodePlan, SystemInputs};
+use agrisim_session::run::{NodePlan, SystemIo};
 use std::collections::BTreeSet;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -109,7 +109,7 @@ impl LiveArgs {
                 return Err(err!("--external needs --ros2 (the external node talks to the run over ROS 2)"));
             }
             return Ok(match foxglove {
-                Some(addr) => NodePlan { external, extra: Some(Arc::new(move |_: &SystemInputs| Ok(vec![foxglove_view(addr)?]))) },
+                Some(addr) => NodePlan { external, extra: Some(Arc::new(move |_: &SystemIo| Ok(vec![foxglove_view(addr)?]))) },
                 None => NodePlan::default(),
             });
         }
@@ -145,14 +145,14 @@ impl LiveArgs {
         }
         let startup_timeout = Duration::from_secs_f64(self.ros2_startup_timeout);
         let stats = stats.clone();
-        let factory = move |inputs: &SystemInputs| -> Result<Vec<Box<dyn agrisim_bus::Node>>> {
+        let factory = move |inputs: &SystemIo| -> Result<Vec<Box<dyn agrisim_bus::Node>>> {
             let mut inbound: Vec<(String, String)> = inputs.messages.clone();
             for t in &extra_inbound {
                 if !inbound.iter().any(|(i, _)| i == &t.0) {
                     inbound.push(t.clone());
                 }
             }
-            let config = BridgeConfig { domain, mode, inbound, inbound_scalars: inputs.scalars.clone(), lockstep: lockstep.clone(), remap: remap.clone(), loopback_only, startup_timeout };
+            let config = BridgeConfig { domain, mode, inbound, inbound_scalars: inputs.scalars.clone(), outbound: inputs.outputs.clone(), lockstep: lockstep.clone(), remap: remap.clone(), loopback_only, startup_timeout };
             let (bridge, s) = Ros2Bridge::new(config)?;
             stats.lock().expect("stats lock").push(s);
             let mut nodes: Vec<Box<dyn agrisim_bus::Node>> = vec![Box::new(bridge)];

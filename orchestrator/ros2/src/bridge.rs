@@ -43,6 +43,10 @@ pub struct BridgeConfig {
     /// Scalar connectors taken from peers as `std_msgs/msg/Float64` (a lift set-point).
     /// The bus's other scalars are published as Float64 at each instant.
     pub inbound_scalars: Vec<String>,
+    /// Topics known to be published (the system's message outputs): their writers exist from
+    /// the start, so peers match them before the first message (a reliable, volatile writer
+    /// made on the fly loses what it sends before its readers have matched it).
+    pub outbound: Vec<(String, String)>,
     /// In lockstep: the inbound topics that must answer at each message instant.
     pub lockstep: Vec<String>,
     pub remap: Remap,
@@ -129,7 +133,7 @@ impl Ros2Bridge {
         }
         let inbound_topics = config.inbound.iter().map(|(t, _)| t.clone()).chain(config.inbound_scalars.iter().cloned()).collect();
         let stats = Arc::new(Mutex::new(Stats::default()));
-        let bridge = Ros2Bridge {
+        let mut bridge = Ros2Bridge {
             _participant: participant.clone(),
             publisher,
             config,
@@ -143,6 +147,10 @@ impl Ros2Bridge {
             warned_timeout: false,
             started: false,
         };
+        let outbound: Vec<(String, String)> = bridge.config.outbound.iter().filter(|(t, _)| !bridge.inbound_topics.contains(t)).cloned().collect();
+        for (t, ty) in outbound.iter().chain([&("/clock".to_string(), Clock::TYPE_NAME.to_string())]) {
+            bridge.writer(t, ty)?;
+        }
         Ok((bridge, stats))
     }
 
@@ -241,10 +249,23 @@ impl Node for Ros2Bridge {
         }
         // Everything new on the bus, topic by topic in name order, oldest first.
         let topics: Vec<(String, String)> = bus.topics().filter(|(t, _)| !self.inbound_topics.contains(*t)).map(|(t, ty)| (t.to_string(), ty.to_string())).collect();
+        let mut reliable_written = vec![];
         for (topic, ty) in topics {
             let samples = self.bus_readers.entry(topic.clone()).or_insert_with(|| Reader::new(&topic)).take_samples(bus);
+            if !samples.is_empty() && qos::kind_of(&topic, &ty) != qos::Kind::Sensor {
+                reliable_written.push(topic.clone());
+            }
             for s in samples {
                 self.write(&topic, &ty, s.cdr)?;
+            }
+        }
+        if let Mode::Lockstep { timeout } = self.config.mode {
+            // DDS orders messages per writer only: a peer could see this instant's /clock
+            // before the instant's messages on other topics. In lockstep, every reliable
+            // message is acknowledged by its readers before /clock goes out, so a peer that
+            // acts on /clock has them all (best-effort sensor streams carry no such promise).
+            for topic in &reliable_written {
+                let _ = self.writers[topic].wait_for_acknowledgments(timeout);
             }
         }
         let scalars: Vec<(String, f64)> = bus.scalars().iter().filter(|(t, _)| !self.inbound_topics.contains(*t)).map(|(t, v)| (t.clone(), *v)).collect();

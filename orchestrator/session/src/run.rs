@@ -31,18 +31,20 @@ pub struct RunOptions {
     pub nodes: NodePlan,
 }
 
-/// What the system takes from the algorithm layer: the commands.
+/// What the system exchanges with the algorithm layer.
 #[derive(Clone, Debug, Default)]
-pub struct SystemInputs {
-    /// Message inputs: topic and ROS 2 type.
+pub struct SystemIo {
+    /// Message inputs (the commands): topic and ROS 2 type.
     pub messages: Vec<(String, String)>,
     /// Scalar inputs (a lift set-point): their connector names on the bus.
     pub scalars: Vec<String>,
+    /// Message outputs (sensors, ground truth): topic and ROS 2 type.
+    pub outputs: Vec<(String, String)>,
 }
 
 /// Makes the extra nodes of one run (each run gets its own: a ROS 2 bridge joins DDS anew),
 /// given the system's inputs.
-pub type NodeFactory = Arc<dyn Fn(&SystemInputs) -> Result<Vec<Box<dyn Node>>> + Send + Sync>;
+pub type NodeFactory = Arc<dyn Fn(&SystemIo) -> Result<Vec<Box<dyn Node>>> + Send + Sync>;
 
 /// How a run's nodes differ from what its scenario or benchmark would run: built-in nodes
 /// named in `external` are left out (an external node takes their place, e.g. over ROS 2),
@@ -63,7 +65,7 @@ impl std::fmt::Debug for NodePlan {
 impl NodePlan {
     /// `nodes` without the external ones, then the extra ones. Naming a node that is not
     /// there is an error (a typo must not leave the built-in node running).
-    pub fn apply(&self, nodes: Vec<Box<dyn Node>>, inputs: &SystemInputs) -> Result<Vec<Box<dyn Node>>> {
+    pub fn apply(&self, nodes: Vec<Box<dyn Node>>, inputs: &SystemIo) -> Result<Vec<Box<dyn Node>>> {
         for name in &self.external {
             if !nodes.iter().any(|n| n.name() == name) {
                 let names: Vec<&str> = nodes.iter().map(|n| n.name()).collect();
@@ -171,17 +173,16 @@ pub fn prepare(s: &Scenario, o: &RunOptions, mcap: &Path, nodes: Vec<Box<dyn Nod
         recorder.metadata(&format!("agrisim.parameters.{comp}"), params)?;
     }
     let master = Master::new(system, s.timing.step, lo.message_period)?;
-    let mut messages = BTreeSet::new();
-    let mut scalars = BTreeSet::new();
+    let (mut messages, mut scalars, mut outputs) = (BTreeSet::new(), BTreeSet::new(), BTreeSet::new());
     for (r, ty) in master.system.routes.iter().zip(&types) {
-        if let agrisim_cosim::Port::Bus { topic } = &r.from {
-            match ty {
-                Some(ty) => messages.insert((topic.clone(), ty.clone())),
-                None => scalars.insert(topic.clone()),
-            };
-        }
+        match (&r.from, &r.to, ty) {
+            (agrisim_cosim::Port::Bus { topic }, _, Some(ty)) => messages.insert((topic.clone(), ty.clone())),
+            (agrisim_cosim::Port::Bus { topic }, _, None) => scalars.insert(topic.clone()),
+            (_, agrisim_cosim::Port::Bus { topic }, Some(ty)) => outputs.insert((topic.clone(), ty.clone())),
+            _ => false,
+        };
     }
-    let inputs = SystemInputs { messages: messages.into_iter().collect(), scalars: scalars.into_iter().collect() };
+    let inputs = SystemIo { messages: messages.into_iter().collect(), scalars: scalars.into_iter().collect(), outputs: outputs.into_iter().collect() };
     let nodes = o.nodes.apply(nodes, &inputs)?;
     let mut session = Session::new(master, nodes, recorder, types);
     session.master.initialize()?;
