@@ -122,6 +122,26 @@ impl Reader {
     }
 }
 
+/// Readers of every topic on the bus (joined as topics appear): what a bridge forwards.
+#[derive(Clone, Debug, Default)]
+pub struct Tap {
+    readers: BTreeMap<String, Reader>,
+}
+
+impl Tap {
+    /// Every message since the last call on every topic `keep` accepts, topic by topic in
+    /// name order, oldest first: (topic, type, sample).
+    pub fn take(&mut self, bus: &mut Bus, keep: impl Fn(&str) -> bool) -> Vec<(String, String, Sample)> {
+        let topics: Vec<(String, String)> = bus.topics().filter(|(t, _)| keep(t)).map(|(t, ty)| (t.to_string(), ty.to_string())).collect();
+        let mut out = vec![];
+        for (topic, ty) in topics {
+            let samples = self.readers.entry(topic.clone()).or_insert_with(|| Reader::new(&topic)).take_samples(bus);
+            out.extend(samples.into_iter().map(|s| (topic.clone(), ty.clone(), s)));
+        }
+        out
+    }
+}
+
 impl Bus {
     /// Publishes CDR bytes on `topic`.
     pub fn publish_raw(&mut self, topic: &str, type_name: &str, time_ns: i64, cdr: Vec<u8>) {
@@ -202,5 +222,28 @@ impl Bus {
     /// Messages published since the last drain, in publication order.
     pub fn drain(&mut self) -> Vec<Published> {
         std::mem::take(&mut self.outbox)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tap_takes_every_new_message_of_every_kept_topic_once() {
+        let mut bus = Bus::default();
+        let mut tap = Tap::default();
+        bus.publish_raw("/b", "x/msg/B", 1, vec![1]);
+        bus.publish_raw("/a", "x/msg/A", 1, vec![2]);
+        bus.publish_raw("/a", "x/msg/A", 2, vec![3]);
+        let got: Vec<(String, Vec<u8>)> = tap.take(&mut bus, |t| t != "/c").into_iter().map(|(t, _, s)| (t, s.cdr)).collect();
+        // A topic is joined at its newest message, then followed in full.
+        assert_eq!(got, [("/a".to_string(), vec![3]), ("/b".to_string(), vec![1])]);
+        bus.publish_raw("/a", "x/msg/A", 3, vec![4]);
+        bus.publish_raw("/a", "x/msg/A", 4, vec![5]);
+        bus.publish_raw("/c", "x/msg/C", 4, vec![6]);
+        let got: Vec<Vec<u8>> = tap.take(&mut bus, |t| t != "/c").into_iter().map(|(_, _, s)| s.cdr).collect();
+        assert_eq!(got, [vec![4], vec![5]]);
+        assert!(tap.take(&mut bus, |t| t != "/c").is_empty());
     }
 }

@@ -13,7 +13,7 @@ pub mod policy;
 pub mod recorder;
 
 pub use agrisim_error::{err, Context, Error, Result};
-pub use bus::{Bus, Published, Reader, Sample};
+pub use bus::{Bus, Published, Reader, Sample, Tap};
 pub use node::Node;
 pub use policy::{Profile, RecordPolicy};
 pub use recorder::{part_path, Channel, Recorder};

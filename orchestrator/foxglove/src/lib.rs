@@ -4,7 +4,7 @@
 //! server's clock follows simulated time, so Foxglove's panels show the run as it happens.
 //! Bound to 127.0.0.1 unless the user gives another address.
 
-use agrisim_bus::{Bus, Node, Reader};
+use agrisim_bus::{Bus, Node, Tap};
 use agrisim_error::{err, Result};
 use agrisim_msgs::builtin_interfaces::Time;
 use agrisim_msgs::rosgraph_msgs::Clock;
@@ -22,7 +22,7 @@ pub struct FoxgloveView {
     context: Arc<Context>,
     server: Option<WebSocketServerHandle>,
     channels: BTreeMap<String, Arc<RawChannel>>,
-    readers: BTreeMap<String, Reader>,
+    tap: Tap,
 }
 
 impl FoxgloveView {
@@ -38,7 +38,7 @@ impl FoxgloveView {
             .start_blocking()
             .map_err(|e| err!("Foxglove server on {addr}: {e}"))?;
         let port = server.port();
-        Ok((FoxgloveView { context, server: Some(server), channels: BTreeMap::new(), readers: BTreeMap::new() }, port))
+        Ok((FoxgloveView { context, server: Some(server), channels: BTreeMap::new(), tap: Tap::default() }, port))
     }
 
     fn log(&mut self, topic: &str, ros_type: &str, t_ns: i64, cdr: &[u8]) -> Result<()> {
@@ -63,12 +63,8 @@ impl Node for FoxgloveView {
     }
 
     fn step(&mut self, t_ns: i64, bus: &mut Bus) -> Result<()> {
-        let topics: Vec<(String, String)> = bus.topics().map(|(t, ty)| (t.to_string(), ty.to_string())).collect();
-        for (topic, ty) in topics {
-            let samples = self.readers.entry(topic.clone()).or_insert_with(|| Reader::new(&topic)).take_samples(bus);
-            for s in samples {
-                self.log(&topic, &ty, s.time_ns, &s.cdr)?;
-            }
+        for (topic, ty, s) in self.tap.take(bus, |_| true) {
+            self.log(&topic, &ty, s.time_ns, &s.cdr)?;
         }
         self.log("/clock", Clock::TYPE_NAME, t_ns, &Clock { clock: Time::from_nanos(t_ns) }.to_cdr())?;
         if let Some(s) = &self.server {

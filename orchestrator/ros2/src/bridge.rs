@@ -8,7 +8,7 @@
 use crate::names::{dds_topic, dds_type, Remap};
 use crate::qos;
 use crate::raw::{RawAdapter, RawCdr};
-use agrisim_bus::{Bus, Node, Reader};
+use agrisim_bus::{Bus, Node, Tap};
 use agrisim_error::{err, Result};
 use agrisim_msgs::builtin_interfaces::Time;
 use agrisim_msgs::rosgraph_msgs::Clock;
@@ -86,14 +86,13 @@ struct Inbound {
 }
 
 pub struct Ros2Bridge {
-    _participant: DomainParticipant,
     publisher: Publisher,
     config: BridgeConfig,
     participant: DomainParticipant,
     writers: BTreeMap<String, DataWriter<RawCdr, RawAdapter>>,
     inbound: Vec<Inbound>,
     inbound_topics: BTreeSet<String>,
-    bus_readers: BTreeMap<String, Reader>,
+    tap: Tap,
     /// Wall time and simulated time of the first instant (real-time pacing).
     start: Option<(Instant, i64)>,
     stats: Arc<Mutex<Stats>>,
@@ -134,14 +133,13 @@ impl Ros2Bridge {
         let inbound_topics = config.inbound.iter().map(|(t, _)| t.clone()).chain(config.inbound_scalars.iter().cloned()).collect();
         let stats = Arc::new(Mutex::new(Stats::default()));
         let mut bridge = Ros2Bridge {
-            _participant: participant.clone(),
             publisher,
             config,
             participant,
             writers: BTreeMap::new(),
             inbound,
             inbound_topics,
-            bus_readers: BTreeMap::new(),
+            tap: Tap::default(),
             start: None,
             stats: stats.clone(),
             warned_timeout: false,
@@ -248,16 +246,13 @@ impl Node for Ros2Bridge {
             }
         }
         // Everything new on the bus, topic by topic in name order, oldest first.
-        let topics: Vec<(String, String)> = bus.topics().filter(|(t, _)| !self.inbound_topics.contains(*t)).map(|(t, ty)| (t.to_string(), ty.to_string())).collect();
-        let mut reliable_written = vec![];
-        for (topic, ty) in topics {
-            let samples = self.bus_readers.entry(topic.clone()).or_insert_with(|| Reader::new(&topic)).take_samples(bus);
-            if !samples.is_empty() && qos::kind_of(&topic, &ty) != qos::Kind::Sensor {
-                reliable_written.push(topic.clone());
+        let inbound = &self.inbound_topics;
+        let mut reliable_written = BTreeSet::new();
+        for (topic, ty, s) in self.tap.take(bus, |t| !inbound.contains(t)) {
+            if qos::kind_of(&topic, &ty) != qos::Kind::Sensor {
+                reliable_written.insert(topic.clone());
             }
-            for s in samples {
-                self.write(&topic, &ty, s.cdr)?;
-            }
+            self.write(&topic, &ty, s.cdr)?;
         }
         if let Mode::Lockstep { timeout } = self.config.mode {
             // DDS orders messages per writer only: a peer could see this instant's /clock

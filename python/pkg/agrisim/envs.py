@@ -99,7 +99,6 @@ class NavigateEnv(gym.Env):
             return
         self._sim = _agrisim.Simulation(self._scenario, parameters=self._parameters, fmu=self._fmu)
         self._ticks = max(1, round(self._sim.message_period / self._sim.step_size))
-        self._chassis_x = lambda: (self._sim.get("chassis", "x"), self._sim.get("chassis", "y"))
         # One message period standing still: the first scan and odometry exist.
         self._sim.step(self._ticks)
         self._start = self._sim.snapshot()
@@ -121,7 +120,7 @@ class NavigateEnv(gym.Env):
     def _judge(self) -> tuple[float, bool]:
         """Ground truth, for the reward only: distance of the true base centre to the goal,
         and the world's collision flag."""
-        x, y = self._chassis_x()
+        x, y = self._sim.get("chassis", "x"), self._sim.get("chassis", "y")
         d = math.hypot(x - self._goal[0], y - self._goal[1])
         return d, self._sim.get("world", "collision") != 0
 
@@ -218,7 +217,7 @@ class ReachEnv(gym.Env):
         self._target = np.array(self._arm.fk(list(q_goal))[0])
         self._command, _ = self._joints()
         self._t0 = self._sim.time
-        return self._observe(), {"distance": self._distance(), "target_joints": q_goal}
+        return self._observe(), {"distance": self._distance()}
 
     def step(self, action):
         a = np.clip(np.asarray(action, dtype=np.float64), -1.0, 1.0)
