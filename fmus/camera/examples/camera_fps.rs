@@ -55,8 +55,9 @@ fn main() {
                 (w as usize * h as usize * frames) as f64 / s * 1e-6,
                 100.0 * io.i32(VALID_DEPTH) as f64 / (w * h) as f64
             );
+            let f = m.capture(x, y, yaw);
+            println!("    frame digest {:016x} (FNV-1a of RGB, depth and labels: equal digests = identical frames)", digest(&f));
             if w == 640 {
-                let f = m.capture(x, y, yaw);
                 let out = f
                     .true_depth
                     .iter()
@@ -66,4 +67,10 @@ fn main() {
             }
         }
     }
+}
+
+/// FNV-1a over a frame's RGB, depth and label bytes.
+fn digest(f: &agrisim_fmu_camera::render::Frame) -> u64 {
+    let bytes = f.rgb.iter().copied().chain(f.depth.iter().flat_map(|v| v.to_le_bytes())).chain(f.labels.iter().flat_map(|v| v.to_le_bytes()));
+    bytes.fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ b as u64).wrapping_mul(0x0100_0000_01b3))
 }

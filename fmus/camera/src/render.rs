@@ -7,7 +7,7 @@ use crate::lighting::{self, Lighting, Shadows};
 use crate::optics::{mat_vec, CameraPose, Intrinsics, Vec3};
 use crate::scene::Scene;
 use crate::shading::{self, Palette};
-use agrisim_greenhouse::{Hit, Object};
+use agrisim_greenhouse::{Hit, Object, RayCaster};
 use agrisim_math::Rng;
 
 /// Depth noise (issue 5 item 2).
@@ -95,7 +95,8 @@ pub fn render(
         labels: vec![0; n],
         valid: 0,
     };
-    let ctx = Ctx { scene, dynamic, k, pose, light, palette: Palette::default() };
+    let movers = RayCaster::new(dynamic);
+    let ctx = Ctx { scene, movers: &movers, k, pose, light, palette: Palette::default() };
     let threads = threads.clamp(1, h.div_ceil(CHUNK_ROWS).max(1));
     let chunks = f
         .rgb
@@ -130,7 +131,8 @@ pub fn render(
 /// What every pixel needs.
 struct Ctx<'a> {
     scene: &'a Scene,
-    dynamic: &'a [Object],
+    /// The frame's moving objects, prepared once.
+    movers: &'a RayCaster,
     k: &'a Intrinsics,
     pose: &'a CameraPose,
     light: &'a Lighting,
@@ -148,7 +150,7 @@ impl Ctx<'_> {
             let (u, v) = ((j % w) as f64, (v0 + j / w) as f64);
             let d_opt = self.k.ray(u, v);
             let d = mat_vec(&self.pose.rotation, d_opt);
-            let hit = self.scene.caster.cast(self.pose.origin, d, 0.0, FAR, self.dynamic);
+            let hit = self.scene.caster.cast_among(self.pose.origin, d, 0.0, FAR, self.movers);
             if let Some(hit) = &hit {
                 *zi = (hit.distance * d_opt[2]) as f32;
                 labels[j] = hit.object as i32 + 1;
@@ -157,7 +159,7 @@ impl Ctx<'_> {
                 let mut acc = [0.0; 3];
                 for (du, dv) in SUB {
                     let ds = mat_vec(&self.pose.rotation, self.k.ray(u + du, v + dv));
-                    let hs = self.scene.caster.cast(self.pose.origin, ds, 0.0, FAR, self.dynamic);
+                    let hs = self.scene.caster.cast_among(self.pose.origin, ds, 0.0, FAR, self.movers);
                     let c = self.radiance(ds, hs.as_ref());
                     (0..3).for_each(|i| acc[i] += 0.25 * c[i]);
                 }
@@ -165,7 +167,7 @@ impl Ctx<'_> {
             } else {
                 self.radiance(d, hit.as_ref())
             };
-            rgb[3 * j..3 * j + 3].copy_from_slice(&lin.map(shading::linear_to_srgb));
+            rgb[3 * j..3 * j + 3].copy_from_slice(&lin.map(shading::encode_srgb));
         }
     }
 
@@ -183,7 +185,7 @@ impl Ctx<'_> {
                     Some(h) if !shading::casts_shadow(self.scene.kind(h.object)) => {
                         through *= tau;
                         inside = inside.min(h.distance);
-                        hit = self.scene.caster.cast(self.pose.origin, d, h.distance + 1e-4, FAR, self.dynamic);
+                        hit = self.scene.caster.cast_among(self.pose.origin, d, h.distance + 1e-4, FAR, self.movers);
                     }
                     _ => break,
                 }
@@ -228,11 +230,11 @@ impl Ctx<'_> {
         let l = self.light;
         match l.shadows {
             Shadows::None => l.cover_tau,
-            Shadows::Hard => transmitted(self.scene, self.dynamic, p, l.sun, l.cover_tau),
+            Shadows::Hard => transmitted(self.scene, self.movers, p, l.sun, l.cover_tau),
             Shadows::Soft(n) => {
                 let n = n.max(1);
                 let sum: f64 = (0..n)
-                    .map(|i| transmitted(self.scene, self.dynamic, p, sun_disc_sample(l.sun, i, n), l.cover_tau))
+                    .map(|i| transmitted(self.scene, self.movers, p, sun_disc_sample(l.sun, i, n), l.cover_tau))
                     .sum();
                 sum / n as f64
             }
@@ -269,21 +271,12 @@ fn normalize(v: Vec3) -> Vec3 {
 }
 
 /// The shadow ray: 0 if something opaque lies between `p` and the sun, else `tau` per glass
-/// or film layer crossed.
-fn transmitted(scene: &Scene, dynamic: &[Object], mut p: Vec3, s: Vec3, tau: f64) -> f64 {
-    let mut t_all = 1.0;
-    for _ in 0..16 {
-        match scene.caster.cast(p, s, EPS, FAR, dynamic) {
-            None => return t_all,
-            Some(hit) if shading::casts_shadow(scene.kind(hit.object)) => return 0.0,
-            Some(hit) => {
-                t_all *= tau;
-                let t = hit.distance + 1e-4;
-                p = [p[0] + t * s[0], p[1] + t * s[1], p[2] + t * s[2]];
-            }
-        }
+/// or film surface crossed (16 or more: 0, as deep as anyone renders).
+fn transmitted(scene: &Scene, movers: &RayCaster, p: Vec3, s: Vec3, tau: f64) -> f64 {
+    match scene.caster.pass_through(p, s, EPS, FAR, movers, |id| shading::casts_shadow(scene.kind(id))) {
+        Some(n) if n < 16 => tau.powi(n as i32),
+        _ => 0.0,
     }
-    0.0
 }
 
 /// SplitMix64's finalizer: a bijective 64-bit mix.

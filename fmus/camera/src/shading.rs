@@ -67,6 +67,35 @@ pub fn linear_to_srgb(l: f64) -> u8 {
     (c * 255.0).round() as u8
 }
 
+/// [`linear_to_srgb`] by table: the 255 linear values where the code steps up, found once by
+/// bisecting `linear_to_srgb` itself, so the two agree exactly (the function is monotonic) and
+/// a pixel costs a binary search instead of a `powf`.
+pub fn encode_srgb(l: f64) -> u8 {
+    srgb_steps().partition_point(|&t| t <= l) as u8
+}
+
+/// The linear values where [`linear_to_srgb`] steps from code k to k + 1.
+fn srgb_steps() -> &'static [f64; 255] {
+    static STEPS: std::sync::LazyLock<[f64; 255]> = std::sync::LazyLock::new(|| {
+        let mut steps = [0.0; 255];
+        for (k, step) in steps.iter_mut().enumerate() {
+            // Smallest non-negative f64 (by bit pattern, which orders them) with code > k.
+            let (mut lo, mut hi) = (0u64, 1f64.to_bits());
+            while lo < hi {
+                let mid = lo + (hi - lo) / 2;
+                if linear_to_srgb(f64::from_bits(mid)) as usize > k {
+                    hi = mid;
+                } else {
+                    lo = mid + 1;
+                }
+            }
+            *step = f64::from_bits(lo);
+        }
+        steps
+    });
+    &STEPS
+}
+
 /// Linear albedo per kind, precomputed.
 #[derive(Clone, Debug)]
 pub struct Palette {
@@ -116,5 +145,30 @@ mod tests {
         assert!(r as f64 > 3.0 * g as f64 && r > b);
         let [r, g, _] = fruit_srgb(1);
         assert!(g > r);
+    }
+
+    #[test]
+    fn the_table_encoder_equals_the_curve() {
+        let mut rng = agrisim_math::Rng::new(5);
+        for _ in 0..200_000 {
+            let l = rng.range(-0.1, 1.1);
+            assert_eq!(encode_srgb(l), linear_to_srgb(l), "{l}");
+        }
+        // Around every step, to the last bit.
+        for c in 0..=255u8 {
+            let l = srgb_to_linear(c);
+            for b in [l.to_bits().saturating_sub(2), l.to_bits(), l.to_bits() + 2] {
+                let v = f64::from_bits(b);
+                assert_eq!(encode_srgb(v), linear_to_srgb(v), "{v}");
+            }
+        }
+        // Each step is exactly where the curve steps (with the curve monotonic, the table
+        // then equals it everywhere).
+        for (k, &t) in srgb_steps().iter().enumerate() {
+            assert_eq!(linear_to_srgb(t) as usize, k + 1, "step {k} at {t}");
+            assert_eq!(linear_to_srgb(t.next_down()) as usize, k, "below step {k}");
+        }
+        assert_eq!(encode_srgb(f64::NAN), linear_to_srgb(f64::NAN));
+        assert_eq!(encode_srgb(f64::INFINITY), 255);
     }
 }

@@ -31,5 +31,5 @@ pub mod weather;
 pub use config::{GreenhouseConfig, ObstacleConfig};
 pub use generate::{generate, Greenhouse};
 pub use layout::{Aisle, Layout, Row};
-pub use raycast::{Hit, RayCaster};
+pub use raycast::{Hit, RayCaster, RigidPose};
 pub use scene::{Kind, Object, Placement, Shape};

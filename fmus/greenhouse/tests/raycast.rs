@@ -204,3 +204,56 @@ fn random_solids_match_brute_force_and_geometry() {
     }
     assert!(hits > 3000, "{hits}");
 }
+
+/// The shadow query against its reference: a walk from hit to hit with `cast`, restarting
+/// 0.1 mm past each translucent surface, as the camera computed shadows before the query
+/// existed. Rays toward random sun directions from points in the canopy and on the floor of
+/// the default greenhouse, with the robot's base box as a mover.
+#[test]
+fn pass_through_equals_the_hit_to_hit_walk() {
+    let cfg = GreenhouseConfig::default();
+    let objs = generate(&cfg, cfg.seed).objects;
+    let rc = RayCaster::new(&objs);
+    let kind = |id: u32| objs.get(id as usize).map_or(Kind::Robot, |o| o.kind);
+    let opaque = |id: u32| !matches!(kind(id), Kind::Wall | Kind::Roof);
+    let base = Object {
+        id: objs.len() as u32,
+        name: "base".into(),
+        kind: Kind::Robot,
+        shape: Shape::Box { half: [0.6, 0.45, 0.3] },
+        placement: Placement::yawed([6.0, 3.0, 0.5], 0.3),
+    };
+    let movers = RayCaster::new(std::slice::from_ref(&base));
+    let walk = |mut p: [f64; 3], s: [f64; 3]| -> Option<u32> {
+        let mut n = 0;
+        for _ in 0..16 {
+            match rc.cast(p, s, 1e-6, 1000.0, std::slice::from_ref(&base)) {
+                None => return Some(n),
+                Some(h) if opaque(h.object) => return None,
+                Some(h) => {
+                    n += 1;
+                    let t = h.distance + 1e-4;
+                    p = [p[0] + t * s[0], p[1] + t * s[1], p[2] + t * s[2]];
+                }
+            }
+        }
+        None
+    };
+    let mut rng = Rng::scene(9);
+    let (mut lit, mut differ) = (0, 0);
+    let n = 50_000;
+    for k in 0..n {
+        let p = [rng.range(0.0, cfg.length), rng.range(0.0, cfg.width), rng.range(0.0, 3.0)];
+        let s = unit([rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(0.05, 1.0)]);
+        let a = rc.pass_through(p, s, 1e-6, 1000.0, &movers, opaque);
+        let b = walk(p, s);
+        lit += a.is_some() as usize;
+        if a != b {
+            differ += 1;
+            eprintln!("ray {k} from {p:?} toward {s:?}: query {a:?}, walk {b:?}");
+        }
+    }
+    eprintln!("{lit} of {n} rays reach the sky, {differ} differ from the walk");
+    assert!(lit > n / 10, "only {lit} lit");
+    assert_eq!(differ, 0);
+}

@@ -19,9 +19,9 @@ pub(crate) struct Bvh {
 }
 
 const BINS: usize = 16;
-const MAX_LEAF: usize = 4;
+const MAX_LEAF: usize = 1;
 /// Cost of visiting a node relative to one primitive test (SAH).
-const TRAVERSAL_COST: f64 = 1.0;
+const TRAVERSAL_COST: f64 = 0.3;
 
 #[derive(Clone, Copy)]
 struct Aabb {
@@ -108,7 +108,7 @@ impl Bvh {
                 None => {
                     // Splitting does not pay (or centroids coincide): keep a leaf if small
                     // enough, else split at the median along the widest axis.
-                    if count <= 4 * MAX_LEAF {
+                    if count <= 4 {
                         make_leaf(&mut nodes);
                         continue;
                     }
@@ -197,25 +197,4 @@ fn partition(v: &mut [u32], pred: impl Fn(u32) -> bool) -> usize {
         }
     }
     i
-}
-
-/// Entry distance of the ray into the box if it overlaps [tmin, tmax] (slab test). Plain
-/// comparisons (not `f64::min`) so it compiles to minsd/maxsd; a NaN from 0 * inf at an exact
-/// boundary cannot occur on the padded boxes except for rays starting exactly on a pad plane.
-#[inline(always)]
-pub(crate) fn slab(min: &[f64; 3], max: &[f64; 3], o: &[f64; 3], inv: &[f64; 3], tmin: f64, tmax: f64) -> Option<f64> {
-    let mut t0 = tmin;
-    let mut t1 = tmax;
-    for i in 0..3 {
-        let a = (min[i] - o[i]) * inv[i];
-        let b = (max[i] - o[i]) * inv[i];
-        let (lo, hi) = if a < b { (a, b) } else { (b, a) };
-        t0 = if lo > t0 { lo } else { t0 };
-        t1 = if hi < t1 { hi } else { t1 };
-    }
-    if t0 <= t1 {
-        Some(t0)
-    } else {
-        None
-    }
 }

@@ -5,10 +5,12 @@
 
 mod bvh;
 mod primitives;
+mod wide;
 
-use crate::scene::Object;
-use bvh::{slab, Bvh, Node};
+use crate::scene::{Object, Placement};
+use bvh::Bvh;
 use primitives::Prim;
+use wide::{far, traverse, Node4, Visit};
 
 /// A ray hit: distance along the (unit) direction, the object's id, outward surface normal.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -18,9 +20,11 @@ pub struct Hit {
     pub normal: [f64; 3],
 }
 
-/// Static scene prepared for ray casting.
+/// Objects prepared for ray casting: the static scene (built once), or a frame's moving
+/// objects (robot links, placed obstacles: build one per pose and pass it to
+/// [`RayCaster::cast_among`], so no ray re-derives their transforms).
 pub struct RayCaster {
-    nodes: Vec<Node>,
+    nodes: Vec<Node4>,
     /// Primitives in BVH leaf order, with their object ids.
     prims: Vec<Prim>,
     ids: Vec<u32>,
@@ -33,10 +37,10 @@ impl RayCaster {
         let bvh = Bvh::build(&boxes);
         let prims = bvh.order.iter().map(|&i| Prim::from_object(&objects[i as usize])).collect();
         let ids = bvh.order.iter().map(|&i| objects[i as usize].id).collect();
-        RayCaster { nodes: bvh.nodes, prims, ids }
+        RayCaster { nodes: wide::collapse(&bvh.nodes, objects.len()), prims, ids }
     }
 
-    /// Number of static objects.
+    /// Number of objects.
     pub fn len(&self) -> usize {
         self.prims.len()
     }
@@ -45,17 +49,18 @@ impl RayCaster {
         self.prims.is_empty()
     }
 
-    /// Number of BVH nodes (for diagnostics).
+    /// Number of (4-wide) BVH nodes (for diagnostics).
     pub fn node_count(&self) -> usize {
         self.nodes.len()
     }
 
     /// Nearest hit along origin + t*dir (dir unit), t in [min, max]. `dynamic` are extra
-    /// objects (moving robot links, placed obstacles) tested too. A ray starting inside a
-    /// solid reports where it leaves it.
+    /// objects (moving robot links, placed obstacles) tested too, each one per ray: for more
+    /// than a few, prepare them once with [`RayCaster::new`] and use [`RayCaster::cast_among`].
+    /// A ray starting inside a solid reports where it leaves it.
     pub fn cast(&self, origin: [f64; 3], dir: [f64; 3], min: f64, max: f64, dynamic: &[Object]) -> Option<Hit> {
         let mut best = Best { t: max, id: u32::MAX, normal: [0.0; 3] };
-        self.cast_static(origin, dir, min, &mut best, &mut ());
+        self.nearest(origin, dir, min, &mut best, &mut ());
         for o in dynamic {
             if let Some((t, n)) = Prim::from_object(o).intersect(origin, dir, min, best.t) {
                 best.offer(t, o.id, n);
@@ -64,99 +69,197 @@ impl RayCaster {
         best.hit()
     }
 
+    /// Nearest hit among this scene and `movers` (a prepared set of moving objects).
+    pub fn cast_among(&self, origin: [f64; 3], dir: [f64; 3], min: f64, max: f64, movers: &RayCaster) -> Option<Hit> {
+        let mut best = Best { t: max, id: u32::MAX, normal: [0.0; 3] };
+        self.nearest(origin, dir, min, &mut best, &mut ());
+        movers.nearest(origin, dir, min, &mut best, &mut ());
+        best.hit()
+    }
+
+    /// Nearest hit among this scene and `movers`, whose objects are given in a moving frame
+    /// that sits at `pose` (robot links in base_link, the base at its pose): the ray is taken
+    /// into that frame instead of the objects out of it, so a moving set is built once, not
+    /// at every pose. Distances are those of the map-frame ray; normals come back in the map.
+    pub fn cast_among_posed(&self, origin: [f64; 3], dir: [f64; 3], min: f64, max: f64, movers: &RayCaster, pose: &RigidPose) -> Option<Hit> {
+        let mut best = Best { t: max, id: u32::MAX, normal: [0.0; 3] };
+        self.nearest(origin, dir, min, &mut best, &mut ());
+        let before = (best.t, best.id);
+        let (o, d) = (pose.local_of(sub(origin, pose.translation)), pose.local_of(dir));
+        movers.nearest(o, d, min, &mut best, &mut ());
+        if (best.t, best.id) != before {
+            best.normal = pose.map_of(best.normal);
+        }
+        best.hit()
+    }
+
+    /// What a ray from `origin` along `dir` (t in [min, max]) passes through, over this scene
+    /// and `movers`: None if an object for which `opaque(id)` holds blocks it, else the number
+    /// of surfaces of other (translucent: glass, film) objects it crosses, counted as a walk
+    /// from hit to hit restarting 0.1 mm past each would count them. One traversal that stops
+    /// at the first opaque object found: a shadow ray.
+    pub fn pass_through(&self, origin: [f64; 3], dir: [f64; 3], min: f64, max: f64, movers: &RayCaster, opaque: impl Fn(u32) -> bool) -> Option<u32> {
+        let mut at = Crossings { t: [0.0; MAX_CROSSINGS], len: 0 };
+        for set in [self, movers] {
+            let mut v = Through { caster: set, o: origin, d: dir, tmin: min, tmax: max, far: far(max), opaque: &opaque, at: &mut at };
+            if traverse(&set.nodes, origin, dir, min, &mut v) {
+                return None;
+            }
+        }
+        // Count as the walk would: a surface within one restart step of the last one counted
+        // (a pane resting on another) is passed over with it.
+        let t = &mut at.t[..at.len];
+        t.sort_unstable_by(f64::total_cmp);
+        let mut n = 0;
+        let mut last = f64::NEG_INFINITY;
+        for &x in t.iter() {
+            if x >= last + RESTART + min {
+                n += 1;
+                last = x;
+            }
+        }
+        Some(n + (at.len == MAX_CROSSINGS) as u32 * MAX_CROSSINGS as u32)
+    }
+
     /// Work done for one ray: (BVH nodes visited, primitive tests). For tuning and reports.
     pub fn traversal_stats(&self, origin: [f64; 3], dir: [f64; 3], min: f64, max: f64) -> (usize, usize) {
         let mut best = Best { t: max, id: u32::MAX, normal: [0.0; 3] };
         let mut c = Counts(0, 0);
-        self.cast_static(origin, dir, min, &mut best, &mut c);
+        self.nearest(origin, dir, min, &mut best, &mut c);
         (c.0, c.1)
     }
 
-    fn cast_static<S: Stats>(&self, o: [f64; 3], d: [f64; 3], tmin: f64, best: &mut Best, stats: &mut S) {
-        if self.prims.is_empty() {
-            return;
-        }
-        let inv = [1.0 / d[0], 1.0 / d[1], 1.0 / d[2]];
-        let root = &self.nodes[0];
-        if slab(&root.min, &root.max, &o, &inv, tmin, best.t).is_none() {
-            return;
-        }
-        // Far children wait on the stack with their entry distance, so a pop can discard a
-        // node behind the current best hit without touching it again.
-        let mut stack = [(0u32, 0.0f64); 64];
-        let mut sp = 0usize;
-        let mut ni = 0usize;
-        loop {
-            let node = &self.nodes[ni];
-            stats.node();
-            if node.count > 0 {
-                let s = node.start as usize;
-                for k in s..s + node.count as usize {
-                    stats.prim();
-                    if let Some((t, n)) = self.prims[k].intersect(o, d, tmin, best.t) {
-                        best.offer(t, self.ids[k], n);
-                    }
-                }
-            } else {
-                let l = node.start as usize;
-                let (a, b) = (&self.nodes[l], &self.nodes[l + 1]);
-                let ta = slab(&a.min, &a.max, &o, &inv, tmin, best.t);
-                let tb = slab(&b.min, &b.max, &o, &inv, tmin, best.t);
-                match (ta, tb) {
-                    (Some(x), Some(y)) => {
-                        let (near, far, tfar) = if x <= y { (l, l + 1, y) } else { (l + 1, l, x) };
-                        if sp < stack.len() {
-                            stack[sp] = (far as u32, tfar);
-                            sp += 1;
-                        } else {
-                            // Pathologically deep tree: finish the far side recursively.
-                            self.cast_from(far, o, d, &inv, tmin, best);
-                        }
-                        ni = near;
-                        continue;
-                    }
-                    (Some(_), None) => {
-                        ni = l;
-                        continue;
-                    }
-                    (None, Some(_)) => {
-                        ni = l + 1;
-                        continue;
-                    }
-                    (None, None) => {}
-                }
-            }
-            // Pop the next node that can still hold a nearer (or equally near) hit.
-            loop {
-                if sp == 0 {
-                    return;
-                }
-                sp -= 1;
-                let (n, t) = stack[sp];
-                if t <= best.t {
-                    ni = n as usize;
-                    break;
-                }
-            }
-        }
+    fn nearest<S: Stats>(&self, o: [f64; 3], d: [f64; 3], tmin: f64, best: &mut Best, stats: &mut S) {
+        let far = far(best.t);
+        let mut v = Nearest { caster: self, o, d, tmin, best, far, stats };
+        traverse(&self.nodes, o, d, tmin, &mut v);
+    }
+}
+
+/// A rigid placement of a moving frame: local -> map rotation (row-major) and translation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RigidPose {
+    pub rotation: [[f64; 3]; 3],
+    pub translation: [f64; 3],
+}
+
+impl RigidPose {
+    pub fn of(p: &Placement) -> RigidPose {
+        RigidPose { rotation: p.matrix(), translation: p.translation }
     }
 
-    fn cast_from(&self, ni: usize, o: [f64; 3], d: [f64; 3], inv: &[f64; 3], tmin: f64, best: &mut Best) {
-        let node = &self.nodes[ni];
-        if slab(&node.min, &node.max, &o, inv, tmin, best.t).is_none() {
-            return;
+    /// A yaw about map z at (x, y, z), as a base pose is.
+    pub fn yawed(x: f64, y: f64, z: f64, yaw: f64) -> RigidPose {
+        let (s, c) = yaw.sin_cos();
+        RigidPose { rotation: [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]], translation: [x, y, z] }
+    }
+
+    /// R^T v: a map vector in the local frame.
+    #[inline(always)]
+    fn local_of(&self, v: [f64; 3]) -> [f64; 3] {
+        let m = &self.rotation;
+        [0, 1, 2].map(|j| m[0][j] * v[0] + m[1][j] * v[1] + m[2][j] * v[2])
+    }
+
+    /// R v: a local vector in the map.
+    #[inline(always)]
+    fn map_of(&self, v: [f64; 3]) -> [f64; 3] {
+        self.rotation.map(|r| r[0] * v[0] + r[1] * v[1] + r[2] * v[2])
+    }
+}
+
+#[inline(always)]
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// Nearest-hit traversal.
+struct Nearest<'a, S> {
+    caster: &'a RayCaster,
+    o: [f64; 3],
+    d: [f64; 3],
+    tmin: f64,
+    best: &'a mut Best,
+    /// `best.t` as the traversal's f32 limit.
+    far: f32,
+    stats: &'a mut S,
+}
+
+impl<S: Stats> Visit for Nearest<'_, S> {
+    #[inline(always)]
+    fn t_max(&self) -> f32 {
+        self.far
+    }
+
+    #[inline(always)]
+    fn leaf(&mut self, start: usize, count: usize) -> bool {
+        for k in start..start + count {
+            self.stats.prim();
+            if let Some((t, n)) = self.caster.prims[k].intersect(self.o, self.d, self.tmin, self.best.t) {
+                self.best.offer(t, self.caster.ids[k], n);
+                self.far = far(self.best.t);
+            }
         }
-        if node.count > 0 {
-            let s = node.start as usize;
-            for k in s..s + node.count as usize {
-                if let Some((t, n)) = self.prims[k].intersect(o, d, tmin, best.t) {
-                    best.offer(t, self.ids[k], n);
+        false
+    }
+
+    fn node(&mut self) {
+        self.stats.node();
+    }
+}
+
+/// Shadow traversal of [`RayCaster::pass_through`]: stops at an opaque hit, collects where the
+/// ray crosses the surfaces of translucent ones (at most two per convex object: in and out).
+struct Through<'a, F> {
+    caster: &'a RayCaster,
+    o: [f64; 3],
+    d: [f64; 3],
+    tmin: f64,
+    tmax: f64,
+    far: f32,
+    opaque: &'a F,
+    at: &'a mut Crossings,
+}
+
+/// Most translucent surface crossings a shadow ray records (beyond: treated as dark).
+const MAX_CROSSINGS: usize = 32;
+
+struct Crossings {
+    t: [f64; MAX_CROSSINGS],
+    len: usize,
+}
+
+impl Crossings {
+    fn push(&mut self, t: f64) {
+        if self.len < MAX_CROSSINGS {
+            self.t[self.len] = t;
+            self.len += 1;
+        }
+    }
+}
+
+/// Restart offset past a translucent surface [m].
+const RESTART: f64 = 1e-4;
+
+impl<F: Fn(u32) -> bool> Visit for Through<'_, F> {
+    fn t_max(&self) -> f32 {
+        self.far
+    }
+
+    fn leaf(&mut self, start: usize, count: usize) -> bool {
+        for k in start..start + count {
+            let p = &self.caster.prims[k];
+            if let Some((t, _)) = p.intersect(self.o, self.d, self.tmin, self.tmax) {
+                if (self.opaque)(self.caster.ids[k]) {
+                    return true;
+                }
+                self.at.push(t);
+                if let Some((t2, _)) = p.intersect(self.o, self.d, t + RESTART, self.tmax) {
+                    self.at.push(t2);
                 }
             }
-        } else {
-            self.cast_from(node.start as usize, o, d, inv, tmin, best);
-            self.cast_from(node.start as usize + 1, o, d, inv, tmin, best);
         }
+        false
     }
 }
 
