@@ -71,7 +71,24 @@ pub fn linear_to_srgb(l: f64) -> u8 {
 /// bisecting `linear_to_srgb` itself, so the two agree exactly (the function is monotonic) and
 /// a pixel costs a binary search instead of a `powf`.
 pub fn encode_srgb(l: f64) -> u8 {
-    srgb_steps().partition_point(|&t| t <= l) as u8
+    // A bucket of the linear range gives the code at its start; at most a few steps follow
+    // inside it (they are densest near black, 1 / (255 x 12.92) apart: > 1 / BUCKETS).
+    const BUCKETS: usize = 4096;
+    static START: std::sync::LazyLock<Vec<u8>> = std::sync::LazyLock::new(|| {
+        (0..BUCKETS).map(|b| srgb_steps().partition_point(|&t| t <= b as f64 / BUCKETS as f64) as u8).collect()
+    });
+    if !(l > 0.0) {
+        return 0; // black, and NaN as `linear_to_srgb` gives it
+    }
+    if l >= 1.0 {
+        return 255;
+    }
+    let steps = srgb_steps();
+    let mut c = START[(l * BUCKETS as f64) as usize] as usize;
+    while c < 255 && steps[c] <= l {
+        c += 1;
+    }
+    c as u8
 }
 
 /// The linear values where [`linear_to_srgb`] steps from code k to k + 1.

@@ -12,14 +12,15 @@
 
 use crate::cloud::{CloudBuilder, Point};
 use crate::frame::{yaw_rotate, Mount};
-use crate::pattern::ScanPattern;
+use crate::pattern::{Firing, ScanPattern};
 use crate::ports::*;
 use crate::reflectivity;
-use crate::scene::{BaseBox, Scene};
+use crate::scene::{robot_in_base_link, Scene};
 use crate::trajectory::Trajectory;
 use agrisim_fmi::{Log, Model, OutPort, Store, Var};
 use agrisim_fmu_util::{to_ns, Schedule};
 use agrisim_greenhouse::environment::Environment;
+use agrisim_greenhouse::{RayCaster, RigidPose};
 use agrisim_greenhouse::weather::Conditions;
 use agrisim_math::{Pose2, Rng};
 use agrisim_msgs::sensor_msgs::PointCloud2;
@@ -33,6 +34,8 @@ pub use crate::ports::MAX_POINTS_PER_FRAME;
 #[derive(Clone, Debug)]
 struct Config {
     scene: Arc<Scene>,
+    /// The robot's own geometry in base_link.
+    robot: RayCaster,
     pattern: ScanPattern,
     points_per_frame: usize,
     frame_period: f64,
@@ -58,7 +61,6 @@ pub struct Lidar {
     /// Derived from the parameters: rebuilt, not serialized.
     #[serde(skip)]
     config: Option<Config>,
-    base: Option<BaseBox>,
     trajectory: Trajectory,
     schedule: Schedule,
     rng: Rng,
@@ -98,8 +100,10 @@ impl Config {
                 (c.extinction, c.visibility)
             }
         };
+        let scene = SENSOR_PORTS.scene(io)?;
         Ok(Config {
-            scene: SENSOR_PORTS.scene(io)?,
+            robot: robot_in_base_link(scene.object_count() as u32, SENSOR_PORTS.base_box(io)?),
+            scene,
             pattern: ScanPattern::mid360(point_rate, el_min.to_radians(), el_max.to_radians()),
             points_per_frame: points_per_frame as usize,
             frame_period: 1.0 / frame_rate,
@@ -131,7 +135,6 @@ impl Lidar {
     /// `points_per_frame` before that instant).
     pub fn capture(&mut self, end_ns: i64) -> Frame {
         let c = self.config.as_ref().expect("initialized");
-        let base = self.base.as_mut().expect("initialized");
         let p = &c.pattern;
         let n_end = (end_ns as f64 * 1e-9 * p.point_rate).floor() as i64;
         let n0 = n_end - c.points_per_frame as i64;
@@ -141,25 +144,29 @@ impl Lidar {
         let end_pose = self.trajectory.at(end_s);
         let mut cloud = CloudBuilder::with_capacity(c.points_per_frame);
         let mut returns = 0;
-        let mut last: Option<(Pose2, f64, f64)> = None;
+        // What the beams of one firing share: its time, pattern state and base pose.
+        let mut firing: Option<(i64, Firing, RigidPose)> = None;
+        let beams = p.beams as i64;
         for n in n0..n_end {
-            let s = p.time(n);
-            let pose = if c.deskewed { end_pose } else { self.trajectory.at(s) };
-            let (sin, cos) = match last {
-                Some((q, sin, cos)) if q == pose => (sin, cos),
+            let f = n.div_euclid(beams);
+            let (fs, base) = match firing {
+                Some((g, fs, base)) if g == f => (fs, base),
                 _ => {
-                    let (sin, cos) = pose.yaw.sin_cos();
-                    base.place(pose.x, pose.y, pose.yaw);
-                    last = Some((pose, sin, cos));
-                    (sin, cos)
+                    let fs = p.firing(f);
+                    let pose = if c.deskewed { end_pose } else { self.trajectory.at(fs.time) };
+                    let base = RigidPose::yawed(pose.x, pose.y, 0.0, pose.yaw);
+                    firing = Some((f, fs, base));
+                    (fs, base)
                 }
             };
-            let d_sensor = p.direction(n);
+            let s = fs.time;
+            let (sin, cos) = (base.rotation[1][0], base.rotation[0][0]);
+            let d_sensor = p.beam_direction(&fs, p.beam(n));
             let d = yaw_rotate(sin, cos, c.mount.rotate(d_sensor));
             let m = yaw_rotate(sin, cos, c.mount.translation);
-            let origin = [pose.x + m[0], pose.y + m[1], m[2]];
+            let origin = [base.translation[0] + m[0], base.translation[1] + m[1], m[2]];
             let t = (s - stamp_s) as f32;
-            let hit = c.scene.caster.cast(origin, d, c.range.0, c.range.1, std::slice::from_ref(&base.object));
+            let hit = c.scene.caster.cast_among_posed(origin, d, c.range.0, c.range.1, &c.robot, &base);
             match hit.filter(|h| detected(h.distance, c.range.1, c.extinction)) {
                 Some(hit) => {
                     let rho = reflectivity::of_kind(c.scene.kind(hit.object));
@@ -201,8 +208,6 @@ impl Model for Lidar {
 
     fn initialize(&mut self, io: &mut Store, start_time: f64, _log: &mut dyn Log) -> Result<(), String> {
         let config = Config::from_params(io)?;
-        let [length, width, height, clearance] = SENSOR_PORTS.base_box(io)?;
-        self.base = Some(BaseBox::new(config.scene.object_count() as u32, length, width, height, clearance));
         self.trajectory = Trajectory::default();
         self.trajectory.push(start_time, pose(io)?, 2.0 * config.frame_period);
         self.schedule = Schedule::new(1.0 / config.frame_period, start_time)?;

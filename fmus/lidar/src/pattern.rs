@@ -67,14 +67,26 @@ impl ScanPattern {
     /// the fan offset.
     pub fn angles(&self, n: i64) -> (f64, f64) {
         let b = self.beams as i64;
-        let firing = n.div_euclid(b);
-        let head = (firing as f64 * self.azimuth_step).rem_euclid(TAU);
-        let u = (self.time(n) * self.sweep_frequency).rem_euclid(1.0);
+        self.beam_angles(&self.firing(n.div_euclid(b)), self.beam(n))
+    }
+
+    /// What the beams of firing `f` (points f * beams ..) share, computed once for all of them.
+    pub fn firing(&self, f: i64) -> Firing {
+        let b = self.beams as i64;
+        let time = (f * b) as f64 / self.point_rate;
+        let head = (f as f64 * self.azimuth_step).rem_euclid(TAU);
+        let u = (time * self.sweep_frequency).rem_euclid(1.0);
         let (lo, hi) = (self.elevation_min, self.elevation_max);
         let centre = lo + (hi - lo) * (1.0 - (2.0 * u - 1.0).abs());
-        let offset = (n.rem_euclid(b) as f64 - 0.5 * (b - 1) as f64) * self.beam_spacing;
-        let (s, c) = head.sin_cos();
-        let mut elevation = centre + offset * c;
+        let (sin, cos) = head.sin_cos();
+        Firing { time, head, sin, cos, centre }
+    }
+
+    /// (azimuth, elevation) of beam `beam` of a firing.
+    pub fn beam_angles(&self, f: &Firing, beam: usize) -> (f64, f64) {
+        let (lo, hi) = (self.elevation_min, self.elevation_max);
+        let offset = (beam as f64 - 0.5 * (self.beams - 1) as f64) * self.beam_spacing;
+        let mut elevation = f.centre + offset * f.cos;
         // Fold overshoot back into the field (the spacing is far below its height).
         if elevation > hi {
             elevation = (2.0 * hi - elevation).max(lo);
@@ -82,17 +94,34 @@ impl ScanPattern {
             elevation = (2.0 * lo - elevation).min(hi);
         }
         // The fan's sideways offset is an angle on the sphere: wider in azimuth when raised.
-        let azimuth = head + offset * s / elevation.cos().max(0.1);
+        let azimuth = f.head + offset * f.sin / elevation.cos().max(0.1);
         (azimuth, elevation)
     }
 
     /// Unit direction of point n in the sensor frame (x forward, z up).
     pub fn direction(&self, n: i64) -> [f64; 3] {
-        let (az, el) = self.angles(n);
+        let b = self.beams as i64;
+        self.beam_direction(&self.firing(n.div_euclid(b)), self.beam(n))
+    }
+
+    /// Unit direction of beam `beam` of a firing in the sensor frame.
+    pub fn beam_direction(&self, f: &Firing, beam: usize) -> [f64; 3] {
+        let (az, el) = self.beam_angles(f, beam);
         let (sa, ca) = az.sin_cos();
         let (se, ce) = el.sin_cos();
         [ce * ca, ce * sa, se]
     }
+}
+
+/// One firing of the head: its time [s], head azimuth [rad] with its sine and cosine, and the
+/// fan centre's elevation [rad].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Firing {
+    pub time: f64,
+    pub head: f64,
+    pub sin: f64,
+    pub cos: f64,
+    pub centre: f64,
 }
 
 #[cfg(test)]

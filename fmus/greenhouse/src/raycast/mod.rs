@@ -23,6 +23,7 @@ pub struct Hit {
 /// Objects prepared for ray casting: the static scene (built once), or a frame's moving
 /// objects (robot links, placed obstacles: build one per pose and pass it to
 /// [`RayCaster::cast_among`], so no ray re-derives their transforms).
+#[derive(Clone)]
 pub struct RayCaster {
     nodes: Vec<Node4>,
     /// Primitives in BVH leaf order, with their object ids.
@@ -100,8 +101,9 @@ impl RayCaster {
     /// at the first opaque object found: a shadow ray.
     pub fn pass_through(&self, origin: [f64; 3], dir: [f64; 3], min: f64, max: f64, movers: &RayCaster, opaque: impl Fn(u32) -> bool) -> Option<u32> {
         let mut at = Crossings { t: [0.0; MAX_CROSSINGS], len: 0 };
+        let at = &mut at;
         for set in [self, movers] {
-            let mut v = Through { caster: set, o: origin, d: dir, tmin: min, tmax: max, far: far(max), opaque: &opaque, at: &mut at };
+            let mut v = Through { caster: set, o: origin, d: dir, tmin: min, tmax: max, far: far(max), opaque: &opaque, at: &mut *at };
             if traverse(&set.nodes, origin, dir, min, &mut v) {
                 return None;
             }
@@ -133,6 +135,12 @@ impl RayCaster {
         let far = far(best.t);
         let mut v = Nearest { caster: self, o, d, tmin, best, far, stats };
         traverse(&self.nodes, o, d, tmin, &mut v);
+    }
+}
+
+impl std::fmt::Debug for RayCaster {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "RayCaster({} objects, {} nodes)", self.prims.len(), self.nodes.len())
     }
 }
 
@@ -222,7 +230,7 @@ struct Through<'a, F> {
 }
 
 /// Most translucent surface crossings a shadow ray records (beyond: treated as dark).
-const MAX_CROSSINGS: usize = 32;
+const MAX_CROSSINGS: usize = 16;
 
 struct Crossings {
     t: [f64; MAX_CROSSINGS],

@@ -10,6 +10,7 @@
 //! bounds the f32 slab arithmetic's own error.
 
 use super::bvh::Node;
+use std::mem::MaybeUninit;
 
 /// A child slot that holds nothing.
 pub(crate) const EMPTY: u32 = u32::MAX;
@@ -198,7 +199,9 @@ pub(crate) fn traverse<V: Visit>(nodes: &[Node4], o: [f64; 3], d: [f64; 3], tmin
 /// followed without touching the stack, two are ordered by one comparison, only three or four
 /// are sorted.
 fn walk<V: Visit>(nodes: &[Node4], root: u32, r: &Ray32, tmin: f32, v: &mut V) -> bool {
-    let stack = &mut [(0u32, 0f32); STACK];
+    // Uninitialised: zeroing it cost as much as a node visit per ray.
+    let mut stack = [const { MaybeUninit::<(u32, f32)>::uninit() }; STACK];
+    let stack = &mut stack;
     let mut sp = 0usize;
     let mut cur = root;
     'next: loop {
@@ -253,7 +256,8 @@ fn walk<V: Visit>(nodes: &[Node4], root: u32, r: &Ray32, tmin: f32, v: &mut V) -
                 return false;
             }
             sp -= 1;
-            let (c, tc) = stack[sp];
+            // SAFETY: every entry below `sp` was written by `push`.
+            let (c, tc) = unsafe { stack[sp].assume_init() };
             if tc <= v.t_max() {
                 cur = c;
                 continue 'next;
@@ -266,9 +270,9 @@ fn walk<V: Visit>(nodes: &[Node4], root: u32, r: &Ray32, tmin: f32, v: &mut V) -
 /// False when the traversal was stopped.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn push<V: Visit>(stack: &mut [(u32, f32); STACK], sp: &mut usize, c: u32, t: f32, nodes: &[Node4], r: &Ray32, tmin: f32, v: &mut V) -> bool {
+fn push<V: Visit>(stack: &mut [MaybeUninit<(u32, f32)>; STACK], sp: &mut usize, c: u32, t: f32, nodes: &[Node4], r: &Ray32, tmin: f32, v: &mut V) -> bool {
     if *sp < STACK {
-        stack[*sp] = (c, t);
+        stack[*sp].write((c, t));
         *sp += 1;
         true
     } else {
