@@ -7,6 +7,7 @@ use crate::lighting::{self, Lighting, Shadows};
 use crate::optics::{mat_vec, CameraPose, Intrinsics, Vec3};
 use crate::scene::Scene;
 use crate::shading::{self, Palette};
+use agrisim_greenhouse::raycast::MAX_PACKET;
 use agrisim_greenhouse::{Hit, Object, RayCaster};
 use agrisim_math::Rng;
 
@@ -70,6 +71,8 @@ const FAR: f64 = 1000.0;
 const EPS: f64 = 1e-6;
 /// Rows per work chunk; chunks are dealt to threads round-robin.
 const CHUNK_ROWS: usize = 8;
+/// Columns of a primary-ray packet (CHUNK_ROWS x TILE_COLS <= MAX_PACKET rays).
+const TILE_COLS: usize = 8;
 
 /// Renders one frame on `threads` threads (>= 1). `dynamic` are moving objects (the robot's
 /// base box); their ids must not collide with scene ids. `rng` gives the frame's noise key
@@ -143,32 +146,54 @@ struct Ctx<'a> {
 const SUB: [(f64, f64); 4] = [(-0.25, -0.25), (0.25, -0.25), (-0.25, 0.25), (0.25, 0.25)];
 
 impl Ctx<'_> {
-    /// Renders rows from `v0` into the row-major slices (as many rows as they hold).
+    /// Renders rows from `v0` into the row-major slices (as many rows as they hold, at most
+    /// [`CHUNK_ROWS`]). Primary rays go as packets: tiles of [`TILE_COLS`] columns by the
+    /// chunk's rows, one origin, exact per-ray hits.
     fn rows(&self, v0: usize, rgb: &mut [u8], z: &mut [f32], labels: &mut [i32]) {
         let w = self.k.width as usize;
-        for (j, zi) in z.iter_mut().enumerate() {
-            let (u, v) = ((j % w) as f64, (v0 + j / w) as f64);
-            let d_opt = self.k.ray(u, v);
-            let d = mat_vec(&self.pose.rotation, d_opt);
-            let hit = self.scene.caster.cast_among(self.pose.origin, d, 0.0, FAR, self.movers);
-            if let Some(hit) = &hit {
-                *zi = (hit.distance * d_opt[2]) as f32;
-                labels[j] = hit.object as i32 + 1;
+        let rows = z.len() / w;
+        let mut d_opt = [[0.0; 3]; MAX_PACKET];
+        let mut dirs = [[0.0; 3]; MAX_PACKET];
+        let mut hits = [None; MAX_PACKET];
+        for u0 in (0..w).step_by(TILE_COLS) {
+            let cols = TILE_COLS.min(w - u0);
+            let n = rows * cols;
+            for i in 0..n {
+                let (u, v) = ((u0 + i % cols) as f64, (v0 + i / cols) as f64);
+                d_opt[i] = self.k.ray(u, v);
+                dirs[i] = mat_vec(&self.pose.rotation, d_opt[i]);
             }
-            let lin = if self.light.supersample {
-                let mut acc = [0.0; 3];
-                for (du, dv) in SUB {
-                    let ds = mat_vec(&self.pose.rotation, self.k.ray(u + du, v + dv));
-                    let hs = self.scene.caster.cast_among(self.pose.origin, ds, 0.0, FAR, self.movers);
-                    let c = self.radiance(ds, hs.as_ref());
-                    (0..3).for_each(|i| acc[i] += 0.25 * c[i]);
-                }
-                acc
-            } else {
-                self.radiance(d, hit.as_ref())
-            };
-            rgb[3 * j..3 * j + 3].copy_from_slice(&lin.map(shading::encode_srgb));
+            self.scene.caster.cast_packet(self.pose.origin, &dirs[..n], 0.0, FAR, self.movers, &mut hits[..n]);
+            for i in 0..n {
+                let j = (i / cols) * w + u0 + i % cols;
+                self.pixel(j, v0, d_opt[i], dirs[i], hits[i].as_ref(), &mut rgb[3 * j..3 * j + 3], &mut z[j], &mut labels[j]);
+            }
         }
+    }
+
+    /// Depth, label and colour of pixel `j` of the chunk starting at row `v0`, given its
+    /// primary ray (optical and map frame) and first hit.
+    #[allow(clippy::too_many_arguments)]
+    fn pixel(&self, j: usize, v0: usize, d_opt: Vec3, d: Vec3, hit: Option<&Hit>, rgb: &mut [u8], zi: &mut f32, label: &mut i32) {
+        let w = self.k.width as usize;
+        let (u, v) = ((j % w) as f64, (v0 + j / w) as f64);
+        if let Some(hit) = hit {
+            *zi = (hit.distance * d_opt[2]) as f32;
+            *label = hit.object as i32 + 1;
+        }
+        let lin = if self.light.supersample {
+            let mut acc = [0.0; 3];
+            for (du, dv) in SUB {
+                let ds = mat_vec(&self.pose.rotation, self.k.ray(u + du, v + dv));
+                let hs = self.scene.caster.cast_among(self.pose.origin, ds, 0.0, FAR, self.movers);
+                let c = self.radiance(ds, hs.as_ref());
+                (0..3).for_each(|i| acc[i] += 0.25 * c[i]);
+            }
+            acc
+        } else {
+            self.radiance(d, hit)
+        };
+        rgb.copy_from_slice(&lin.map(shading::encode_srgb));
     }
 
     /// Linear RGB seen along `d` (map frame) given its first hit.

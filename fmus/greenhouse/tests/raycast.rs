@@ -257,3 +257,52 @@ fn pass_through_equals_the_hit_to_hit_walk() {
     assert!(lit > n / 10, "only {lit} lit");
     assert_eq!(differ, 0);
 }
+
+/// Packets (camera tiles of up to 64 rays from one origin) give exactly the single-ray
+/// answers: on the default greenhouse from aisle points looking every way (tiles straddling
+/// an axis fall back to single rays), and on random tilted solids.
+#[test]
+fn packets_equal_single_rays() {
+    use agrisim_greenhouse::raycast::MAX_PACKET;
+    let cfg = GreenhouseConfig::default();
+    let gh = generate(&cfg, cfg.seed);
+    let mut rng = Rng::scene(4);
+    let solids = random_solids(&mut rng, 300);
+    let base = Object {
+        id: 1_000_000,
+        name: "base".into(),
+        kind: Kind::Robot,
+        shape: Shape::Box { half: [0.6, 0.45, 0.3] },
+        placement: Placement::yawed([6.0, 3.0, 0.5], 0.3),
+    };
+    let movers = RayCaster::new(std::slice::from_ref(&base));
+    let (mut packets, mut hits) = (0, 0);
+    for (objs, origins) in [(&gh.objects, 0), (&solids, 1)] {
+        let rc = RayCaster::new(objs);
+        for k in 0..300 {
+            let o = if origins == 0 {
+                let a = &gh.layout.aisles[k % gh.layout.aisles.len()];
+                [rng.range(a.x_start, a.x_end), a.y + rng.range(-0.5, 0.5), rng.range(0.3, 2.5)]
+            } else {
+                [rng.range(-1.0, 11.0), rng.range(-1.0, 11.0), rng.range(-1.0, 11.0)]
+            };
+            // A tile: a random central direction and a spread from a pixel's width to wide.
+            let c = random_dir(&mut rng);
+            let spread = [0.0005, 0.005, 0.05][k % 3];
+            let n = 1 + k % MAX_PACKET;
+            let dirs: Vec<[f64; 3]> = (0..n)
+                .map(|_| unit([c[0] + spread * rng.range(-1.0, 1.0), c[1] + spread * rng.range(-1.0, 1.0), c[2] + spread * rng.range(-1.0, 1.0)]))
+                .collect();
+            let (tmin, tmax) = (rng.range(0.0, 0.2), rng.range(0.5, 60.0));
+            let mut out = vec![None; n];
+            rc.cast_packet(o, &dirs, tmin, tmax, &movers, &mut out);
+            packets += 1;
+            for (i, d) in dirs.iter().enumerate() {
+                let single = rc.cast_among(o, *d, tmin, tmax, &movers);
+                assert_eq!(out[i], single, "packet {k} ray {i} from {o:?} along {d:?}");
+                hits += single.is_some() as usize;
+            }
+        }
+    }
+    assert!(packets == 600 && hits > 5_000, "{hits} hits");
+}

@@ -127,8 +127,8 @@ fn area(n: &Node) -> f64 {
 
 /// A ray in the form the slab test wants.
 pub(crate) struct Ray32 {
-    o: [f32; 3],
-    inv: [f32; 3],
+    pub o: [f32; 3],
+    pub inv: [f32; 3],
 }
 
 impl Ray32 {

@@ -1,0 +1,197 @@
+//! Ray packets: up to [`MAX_PACKET`] rays from one origin (a camera tile) traverse the 4-wide
+//! tree together. A node is entered when the interval of the packet's inverse directions
+//! says some ray may meet it (a conservative test: culling by it never loses a hit of any
+//! ray); at a leaf every ray is tested against the leaf's box in SIMD lanes, and only rays
+//! that pass get the exact f64 primitive test. Each ray keeps its own nearest hit, so the
+//! answers are exactly those of single-ray casts; the node work is shared by the packet.
+//!
+//! The interval bound (same origin, inverse direction per axis within [lo, hi] of one sign):
+//! a slab's entry distance min(a inv, b inv) is concave in inv and its exit max(a inv, b inv)
+//! convex, so their extremes over the packet lie at the interval's ends; rounding is
+//! monotonic, so the same holds for the f32 products each ray computes alone.
+
+use super::wide::{as_leaf, down, far, Node4, Ray32};
+use std::mem::MaybeUninit;
+
+/// Most rays in a packet.
+pub const MAX_PACKET: usize = 64;
+
+/// The rays of a packet, lane-wise (structure of arrays) for the leaf tests.
+pub(crate) struct Packet {
+    o: [f32; 3],
+    inv: [[f32; MAX_PACKET]; 3],
+    /// Per-ray far limit (f32, robust slack included); unused lanes hold -inf.
+    pub far: [f32; MAX_PACKET],
+    /// Inverse-direction interval per axis.
+    lo: [f32; 3],
+    hi: [f32; 3],
+}
+
+impl Packet {
+    /// None when some axis has directions of both signs: the interval test would cull nothing.
+    pub(crate) fn new(o: [f64; 3], dirs: &[[f64; 3]], tmax: f64) -> Option<Packet> {
+        debug_assert!(dirs.len() <= MAX_PACKET);
+        let mut p = Packet {
+            o: o.map(|v| v as f32),
+            inv: [[0.0; MAX_PACKET]; 3],
+            far: [f32::NEG_INFINITY; MAX_PACKET],
+            lo: [f32::INFINITY; 3],
+            hi: [f32::NEG_INFINITY; 3],
+        };
+        for (i, d) in dirs.iter().enumerate() {
+            let r = Ray32::new(o, *d);
+            for a in 0..3 {
+                let v = r.inv[a];
+                p.inv[a][i] = v;
+                p.lo[a] = p.lo[a].min(v);
+                p.hi[a] = p.hi[a].max(v);
+            }
+            p.far[i] = far(tmax);
+        }
+        (0..3).all(|a| p.lo[a] > 0.0 || p.hi[a] < 0.0).then_some(p)
+    }
+
+    fn far_max(&self) -> f32 {
+        self.far.iter().fold(f32::NEG_INFINITY, |m, &f| if f > m { f } else { m })
+    }
+
+    /// Flags the rays that may meet the box in lane `lane` of node `n` (each ray's own robust
+    /// slab test, lane-wise over rays); true if any may.
+    #[inline(always)]
+    fn rays_meeting(&self, n: &Node4, lane: usize, tmin: f32, hit: &mut [bool; MAX_PACKET]) -> bool {
+        let bmin = [n.min[0][lane], n.min[1][lane], n.min[2][lane]];
+        let bmax = [n.max[0][lane], n.max[1][lane], n.max[2][lane]];
+        let a = [bmin[0] - self.o[0], bmin[1] - self.o[1], bmin[2] - self.o[2]];
+        let b = [bmax[0] - self.o[0], bmax[1] - self.o[1], bmax[2] - self.o[2]];
+        let mut any = false;
+        for i in 0..MAX_PACKET {
+            let mut t0 = tmin;
+            let mut t1 = self.far[i];
+            for k in 0..3 {
+                let x = a[k] * self.inv[k][i];
+                let y = b[k] * self.inv[k][i];
+                let (l, h) = if x < y { (x, y) } else { (y, x) };
+                t0 = if l > t0 { l } else { t0 };
+                t1 = if h < t1 { h } else { t1 };
+            }
+            hit[i] = t0 <= t1;
+            any |= hit[i];
+        }
+        any
+    }
+
+    /// Packet slab test of a node's four boxes: entry bound and mask of possibly met boxes.
+    #[inline(always)]
+    fn slab4(&self, n: &Node4, tmin: f32, tmax: f32) -> ([f32; 4], u32) {
+        let mut t0 = [tmin; 4];
+        let mut t1 = [tmax; 4];
+        for k in 0..3 {
+            for i in 0..4 {
+                let a = n.min[k][i] - self.o[k];
+                let b = n.max[k][i] - self.o[k];
+                let (p, q, r, s) = (a * self.lo[k], a * self.hi[k], b * self.lo[k], b * self.hi[k]);
+                // Every ray's slab entry is at least the smallest corner product and its exit
+                // at most the largest.
+                let entry = p.min(q).min(r.min(s));
+                let exit = p.max(q).max(r.max(s));
+                t0[i] = if entry > t0[i] { entry } else { t0[i] };
+                t1[i] = if exit < t1[i] { exit } else { t1[i] };
+            }
+        }
+        let mut mask = 0;
+        for i in 0..4 {
+            mask |= ((t0[i] <= t1[i]) as u32) << i;
+        }
+        (t0, mask)
+    }
+}
+
+/// What a packet traversal does at leaves.
+pub(crate) trait PacketVisit {
+    /// Tests primitives `start .. start + count` for the rays flagged in `rays`, lowering
+    /// `packet.far` of the rays whose nearest hit moved closer.
+    fn leaf(&mut self, packet: &mut Packet, start: usize, count: usize, rays: &[bool; MAX_PACKET]);
+}
+
+const STACK: usize = 96;
+
+/// Visits, for each ray, every leaf whose box it may meet before its current far limit.
+pub(crate) fn traverse_packet<V: PacketVisit>(nodes: &[Node4], p: &mut Packet, tmin: f64, v: &mut V) {
+    if nodes.is_empty() {
+        return;
+    }
+    let tmin = down(tmin);
+    let mut stack = [const { MaybeUninit::<(u32, f32)>::uninit() }; STACK];
+    let mut sp = 0usize;
+    let mut cur = 0u32;
+    let mut far_max = p.far_max();
+    let mut rays = [false; MAX_PACKET];
+    // `cur` is always an interior node: leaves are tested where their parent's lane (their
+    // box) is at hand.
+    'next: loop {
+        let n = &nodes[cur as usize];
+        let (t, mut mask) = p.slab4(n, tmin, far_max);
+        // Leaves now (their rays tested lane-wise), interior children ordered near to far.
+        let mut kids = [(0u32, 0f32); 4];
+        let mut k = 0;
+        while mask != 0 {
+            let i = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            match as_leaf(n.child[i]) {
+                Some((s, count)) => {
+                    if p.rays_meeting(n, i, tmin, &mut rays) {
+                        v.leaf(p, s, count, &rays);
+                        far_max = p.far_max();
+                    }
+                }
+                None => {
+                    kids[k] = (n.child[i], t[i]);
+                    k += 1;
+                }
+            }
+        }
+        kids[..k].sort_unstable_by(|x, y| y.1.total_cmp(&x.1));
+        for &(c, tc) in &kids[..k] {
+            if sp < STACK {
+                stack[sp].write((c, tc));
+                sp += 1;
+            } else {
+                // A pathologically deep tree: finish this child recursively.
+                traverse_from(nodes, c, p, tmin, v);
+                far_max = p.far_max();
+            }
+        }
+        loop {
+            if sp == 0 {
+                return;
+            }
+            sp -= 1;
+            // SAFETY: every entry below `sp` was written above.
+            let (c, tc) = unsafe { stack[sp].assume_init() };
+            if tc <= far_max {
+                cur = c;
+                continue 'next;
+            }
+        }
+    }
+}
+
+/// [`traverse_packet`] from an interior node other than the root (stack overflow fallback).
+fn traverse_from<V: PacketVisit>(nodes: &[Node4], root: u32, p: &mut Packet, tmin: f32, v: &mut V) {
+    let n = &nodes[root as usize];
+    let (_, mask) = p.slab4(n, tmin, p.far_max());
+    let mut rays = [false; MAX_PACKET];
+    for i in 0..4 {
+        if mask & (1 << i) == 0 {
+            continue;
+        }
+        match as_leaf(n.child[i]) {
+            Some((s, count)) => {
+                if p.rays_meeting(n, i, tmin, &mut rays) {
+                    v.leaf(p, s, count, &rays);
+                }
+            }
+            None => traverse_from(nodes, n.child[i], p, tmin, v),
+        }
+    }
+}
