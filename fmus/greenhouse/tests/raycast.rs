@@ -1,7 +1,7 @@
 //! The BVH caster must agree exactly with a brute-force scan over all objects.
 
 use agrisim_greenhouse::raycast::cast_brute_force;
-use agrisim_greenhouse::{generate, GreenhouseConfig, Kind, Object, Placement, RayCaster, Shape};
+use agrisim_greenhouse::{generate, GreenhouseConfig, Kind, Object, Placement, RayCaster, RigidPose, Shape};
 use agrisim_math::Rng;
 
 fn unit(v: [f64; 3]) -> [f64; 3] {
@@ -276,7 +276,9 @@ fn packets_equal_single_rays() {
         placement: Placement::yawed([6.0, 3.0, 0.5], 0.3),
     };
     let movers = RayCaster::new(std::slice::from_ref(&base));
-    let (mut packets, mut hits) = (0, 0);
+    // A robot in its own frame, placed per ray by a pose.
+    let local = RayCaster::new(&[Object { id: 1_000_001, placement: Placement::at(0.0, 0.0, 0.5), ..base.clone() }]);
+    let (mut packets, mut hits, mut posed_hits) = (0, 0, 0);
     for (objs, origins) in [(&gh.objects, 0), (&solids, 1)] {
         let rc = RayCaster::new(objs);
         for k in 0..300 {
@@ -302,7 +304,16 @@ fn packets_equal_single_rays() {
                 assert_eq!(out[i], single, "packet {k} ray {i} from {o:?} along {d:?}");
                 hits += single.is_some() as usize;
             }
+            // Own origins (a moving LiDAR: up to 5 cm apart) and own mover poses.
+            let origins: Vec<[f64; 3]> = (0..n).map(|_| [0, 1, 2].map(|a| o[a] + rng.range(-0.05, 0.05))).collect();
+            let poses: Vec<RigidPose> = (0..n).map(|_| RigidPose::yawed(o[0] + rng.range(-1.0, 1.0), o[1] + rng.range(-1.0, 1.0), 0.0, rng.range(-3.0, 3.0))).collect();
+            rc.cast_packet_posed(&origins, &dirs, tmin, tmax, &local, &poses, &mut out);
+            for i in 0..n {
+                let single = rc.cast_among_posed(origins[i], dirs[i], tmin, tmax, &local, &poses[i]);
+                assert_eq!(out[i], single, "posed packet {k} ray {i}");
+                posed_hits += single.map_or(false, |h| h.object == 1_000_001) as usize;
+            }
         }
     }
-    assert!(packets == 600 && hits > 5_000, "{hits} hits");
+    assert!(packets == 600 && hits > 5_000 && posed_hits > 50, "{hits} hits, {posed_hits} on the posed robot");
 }

@@ -130,6 +130,35 @@ pub fn detected(r: f64, range_max: f64, beta: f64) -> bool {
     beta == 0.0 || (-2.0 * beta * r).exp() * (range_max / r).powi(2) >= 1.0
 }
 
+/// Points per ray packet (a few firings).
+const LIDAR_PACKET: usize = 64;
+
+/// One packet's rays and results.
+struct Batch {
+    len: usize,
+    sensor: [[f64; 3]; LIDAR_PACKET],
+    dirs: [[f64; 3]; LIDAR_PACKET],
+    origins: [[f64; 3]; LIDAR_PACKET],
+    poses: [RigidPose; LIDAR_PACKET],
+    times: [f32; LIDAR_PACKET],
+    hits: [Option<agrisim_greenhouse::Hit>; LIDAR_PACKET],
+}
+
+impl Default for Batch {
+    fn default() -> Batch {
+        let pose = RigidPose::yawed(0.0, 0.0, 0.0, 0.0);
+        Batch {
+            len: 0,
+            sensor: [[0.0; 3]; LIDAR_PACKET],
+            dirs: [[0.0; 3]; LIDAR_PACKET],
+            origins: [[0.0; 3]; LIDAR_PACKET],
+            poses: [pose; LIDAR_PACKET],
+            times: [0.0; LIDAR_PACKET],
+            hits: [None; LIDAR_PACKET],
+        }
+    }
+}
+
 impl Lidar {
     /// Casts the frame that ends at `end_ns` (its points are the pattern's last
     /// `points_per_frame` before that instant).
@@ -147,37 +176,52 @@ impl Lidar {
         // What the beams of one firing share: its time, pattern state and base pose.
         let mut firing: Option<(i64, Firing, RigidPose)> = None;
         let beams = p.beams as i64;
-        for n in n0..n_end {
-            let f = n.div_euclid(beams);
-            let (fs, base) = match firing {
-                Some((g, fs, base)) if g == f => (fs, base),
-                _ => {
-                    let fs = p.firing(f);
-                    let pose = if c.deskewed { end_pose } else { self.trajectory.at(fs.time) };
-                    let base = RigidPose::yawed(pose.x, pose.y, 0.0, pose.yaw);
-                    firing = Some((f, fs, base));
-                    (fs, base)
+        // Rays go as packets of consecutive points (successive firings look close together);
+        // each ray's hit is exactly its single-ray hit, so the cloud does not depend on it.
+        let mut batch = Batch::default();
+        let mut n = n0;
+        while n < n_end {
+            batch.len = 0;
+            while batch.len < LIDAR_PACKET && n < n_end {
+                let f = n.div_euclid(beams);
+                let (fs, base) = match firing {
+                    Some((g, fs, base)) if g == f => (fs, base),
+                    _ => {
+                        let fs = p.firing(f);
+                        let pose = if c.deskewed { end_pose } else { self.trajectory.at(fs.time) };
+                        let base = RigidPose::yawed(pose.x, pose.y, 0.0, pose.yaw);
+                        firing = Some((f, fs, base));
+                        (fs, base)
+                    }
+                };
+                let (sin, cos) = (base.rotation[1][0], base.rotation[0][0]);
+                let d_sensor = p.beam_direction(&fs, p.beam(n));
+                let m = yaw_rotate(sin, cos, c.mount.translation);
+                let i = batch.len;
+                batch.sensor[i] = d_sensor;
+                batch.dirs[i] = yaw_rotate(sin, cos, c.mount.rotate(d_sensor));
+                batch.origins[i] = [base.translation[0] + m[0], base.translation[1] + m[1], m[2]];
+                batch.poses[i] = base;
+                batch.times[i] = (fs.time - stamp_s) as f32;
+                batch.len += 1;
+                n += 1;
+            }
+            let k = batch.len;
+            c.scene.caster.cast_packet_posed(&batch.origins[..k], &batch.dirs[..k], c.range.0, c.range.1, &c.robot, &batch.poses[..k], &mut batch.hits[..k]);
+            for i in 0..k {
+                let (d, d_sensor, t) = (batch.dirs[i], batch.sensor[i], batch.times[i]);
+                match batch.hits[i].filter(|h| detected(h.distance, c.range.1, c.extinction)) {
+                    Some(hit) => {
+                        let rho = reflectivity::of_kind(c.scene.kind(hit.object));
+                        let cos_incidence = -(hit.normal[0] * d[0] + hit.normal[1] * d[1] + hit.normal[2] * d[2]);
+                        let r = hit.distance + self.rng.gauss(c.noise);
+                        let xyz = [(d_sensor[0] * r) as f32, (d_sensor[1] * r) as f32, (d_sensor[2] * r) as f32];
+                        cloud.push(&Point { xyz, intensity: reflectivity::intensity(rho, cos_incidence), t });
+                        returns += 1;
+                    }
+                    None if c.drop_no_return => {}
+                    None => cloud.push(&Point { t, ..Point::default() }),
                 }
-            };
-            let s = fs.time;
-            let (sin, cos) = (base.rotation[1][0], base.rotation[0][0]);
-            let d_sensor = p.beam_direction(&fs, p.beam(n));
-            let d = yaw_rotate(sin, cos, c.mount.rotate(d_sensor));
-            let m = yaw_rotate(sin, cos, c.mount.translation);
-            let origin = [base.translation[0] + m[0], base.translation[1] + m[1], m[2]];
-            let t = (s - stamp_s) as f32;
-            let hit = c.scene.caster.cast_among_posed(origin, d, c.range.0, c.range.1, &c.robot, &base);
-            match hit.filter(|h| detected(h.distance, c.range.1, c.extinction)) {
-                Some(hit) => {
-                    let rho = reflectivity::of_kind(c.scene.kind(hit.object));
-                    let cos_incidence = -(hit.normal[0] * d[0] + hit.normal[1] * d[1] + hit.normal[2] * d[2]);
-                    let r = hit.distance + self.rng.gauss(c.noise);
-                    let xyz = [(d_sensor[0] * r) as f32, (d_sensor[1] * r) as f32, (d_sensor[2] * r) as f32];
-                    cloud.push(&Point { xyz, intensity: reflectivity::intensity(rho, cos_incidence), t });
-                    returns += 1;
-                }
-                None if c.drop_no_return => {}
-                None => cloud.push(&Point { t, ..Point::default() }),
             }
         }
         Frame { cloud: cloud.finish(stamp_ns, &c.frame_id), returns }

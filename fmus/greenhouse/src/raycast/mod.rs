@@ -85,21 +85,50 @@ impl RayCaster {
     /// tile), traversing together: `out[i]` is exactly what `cast_among` gives for `dirs[i]`,
     /// at a fraction of the node work when the rays are coherent.
     pub fn cast_packet(&self, origin: [f64; 3], dirs: &[[f64; 3]], min: f64, max: f64, movers: &RayCaster, out: &mut [Option<Hit>]) {
-        assert!(dirs.len() <= MAX_PACKET && out.len() == dirs.len(), "cast_packet: {} rays, {} results", dirs.len(), out.len());
-        let Some(mut packet) = Packet::new(origin, dirs, max) else {
-            // Directions of both signs on an axis: the packet bound would cull nothing.
-            for (d, o) in dirs.iter().zip(out.iter_mut()) {
-                *o = self.cast_among(origin, *d, min, max, movers);
-            }
-            return;
-        };
-        let mut best = [Best { t: max, id: u32::MAX, normal: [0.0; 3] }; MAX_PACKET];
-        let mut v = PacketNearest { caster: self, o: origin, dirs, tmin: min, best: &mut best };
-        traverse_packet(&self.nodes, &mut packet, min, &mut v);
+        let mut best = self.packet_static(&[origin], dirs, min, max);
         for (i, (d, o)) in dirs.iter().zip(out.iter_mut()).enumerate() {
             movers.nearest(origin, *d, min, &mut best[i], &mut ());
             *o = best[i].hit();
         }
+    }
+
+    /// [`RayCaster::cast_among_posed`] for up to [`MAX_PACKET`] coherent rays with their own
+    /// origins and mover poses (a run of LiDAR firings while the base moves): `out[i]` is
+    /// exactly the single-ray answer for ray i.
+    #[allow(clippy::too_many_arguments)]
+    pub fn cast_packet_posed(&self, origins: &[[f64; 3]], dirs: &[[f64; 3]], min: f64, max: f64, movers: &RayCaster, poses: &[RigidPose], out: &mut [Option<Hit>]) {
+        assert!(origins.len() == dirs.len() && poses.len() == dirs.len(), "cast_packet_posed: {} origins, {} rays, {} poses", origins.len(), dirs.len(), poses.len());
+        let mut best = self.packet_static(origins, dirs, min, max);
+        for i in 0..dirs.len() {
+            let pose = &poses[i];
+            let before = (best[i].t, best[i].id);
+            let (o, d) = (pose.local_of(sub(origins[i], pose.translation)), pose.local_of(dirs[i]));
+            movers.nearest(o, d, min, &mut best[i], &mut ());
+            if (best[i].t, best[i].id) != before {
+                best[i].normal = pose.map_of(best[i].normal);
+            }
+            out[i] = best[i].hit();
+        }
+    }
+
+    /// Nearest static hits of a packet (one origin for all rays, or one per ray).
+    fn packet_static(&self, origins: &[[f64; 3]], dirs: &[[f64; 3]], min: f64, max: f64) -> [Best; MAX_PACKET] {
+        assert!(dirs.len() <= MAX_PACKET, "a packet of {} rays (at most {MAX_PACKET})", dirs.len());
+        let mut best = [Best { t: max, id: u32::MAX, normal: [0.0; 3] }; MAX_PACKET];
+        let origin = |i: usize| origins[i.min(origins.len() - 1)];
+        match Packet::new(origins, dirs, max) {
+            Some(mut packet) => {
+                let mut v = PacketNearest { caster: self, origins, dirs, tmin: min, best: &mut best };
+                traverse_packet(&self.nodes, &mut packet, min, &mut v);
+            }
+            None => {
+                // Directions of both signs on an axis: the packet bound would cull nothing.
+                for (i, d) in dirs.iter().enumerate() {
+                    self.nearest(origin(i), *d, min, &mut best[i], &mut ());
+                }
+            }
+        }
+        best
     }
 
     /// Nearest hit among this scene and `movers`, whose objects are given in a moving frame
@@ -243,7 +272,8 @@ impl<S: Stats> Visit for Nearest<'_, S> {
 /// Nearest-hit traversal of a packet: each ray keeps its own best hit.
 struct PacketNearest<'a> {
     caster: &'a RayCaster,
-    o: [f64; 3],
+    /// One origin for all rays, or one per ray.
+    origins: &'a [[f64; 3]],
     dirs: &'a [[f64; 3]],
     tmin: f64,
     best: &'a mut [Best; MAX_PACKET],
@@ -257,8 +287,9 @@ impl PacketVisit for PacketNearest<'_> {
             }
             let best = &mut self.best[i];
             let before = best.t;
+            let o = self.origins[i.min(self.origins.len() - 1)];
             for k in start..start + count {
-                if let Some((t, n)) = self.caster.prims[k].intersect(self.o, *d, self.tmin, best.t) {
+                if let Some((t, n)) = self.caster.prims[k].intersect(o, *d, self.tmin, best.t) {
                     best.offer(t, self.caster.ids[k], n);
                 }
             }

@@ -1,14 +1,15 @@
-//! Ray packets: up to [`MAX_PACKET`] rays from one origin (a camera tile) traverse the 4-wide
+//! Ray packets: up to [`MAX_PACKET`] coherent rays (a camera tile from one origin, a run of
+//! LiDAR firings from nearby origins) traverse the 4-wide
 //! tree together. A node is entered when the interval of the packet's inverse directions
 //! says some ray may meet it (a conservative test: culling by it never loses a hit of any
 //! ray); at a leaf every ray is tested against the leaf's box in SIMD lanes, and only rays
 //! that pass get the exact f64 primitive test. Each ray keeps its own nearest hit, so the
 //! answers are exactly those of single-ray casts; the node work is shared by the packet.
 //!
-//! The interval bound (same origin, inverse direction per axis within [lo, hi] of one sign):
-//! a slab's entry distance min(a inv, b inv) is concave in inv and its exit max(a inv, b inv)
-//! convex, so their extremes over the packet lie at the interval's ends; rounding is
-//! monotonic, so the same holds for the f32 products each ray computes alone.
+//! The interval bound: per axis the origins lie in [o_lo, o_hi] and the inverse directions in
+//! [lo, hi] of one sign; a slab plane's distance (p - o) inv is bilinear in (o, inv), so over
+//! the packet it lies between the smallest and largest of its four corner values, and since
+//! rounding is monotonic the same holds for the f32 values each ray computes alone.
 
 use super::wide::{as_leaf, down, far, Node4, Ray32};
 use std::mem::MaybeUninit;
@@ -18,7 +19,10 @@ pub const MAX_PACKET: usize = 64;
 
 /// The rays of a packet, lane-wise (structure of arrays) for the leaf tests.
 pub(crate) struct Packet {
-    o: [f32; 3],
+    o: [[f32; MAX_PACKET]; 3],
+    /// Origin interval per axis.
+    o_lo: [f32; 3],
+    o_hi: [f32; 3],
     inv: [[f32; MAX_PACKET]; 3],
     /// Per-ray far limit (f32, robust slack included); unused lanes hold -inf.
     pub far: [f32; MAX_PACKET],
@@ -29,22 +33,27 @@ pub(crate) struct Packet {
 
 impl Packet {
     /// None when some axis has directions of both signs: the interval test would cull nothing.
-    pub(crate) fn new(o: [f64; 3], dirs: &[[f64; 3]], tmax: f64) -> Option<Packet> {
-        debug_assert!(dirs.len() <= MAX_PACKET);
+    /// `origins` holds one origin for all rays or one per ray.
+    pub(crate) fn new(origins: &[[f64; 3]], dirs: &[[f64; 3]], tmax: f64) -> Option<Packet> {
+        debug_assert!(dirs.len() <= MAX_PACKET && (origins.len() == 1 || origins.len() == dirs.len()));
         let mut p = Packet {
-            o: o.map(|v| v as f32),
+            o: [[0.0; MAX_PACKET]; 3],
+            o_lo: [f32::INFINITY; 3],
+            o_hi: [f32::NEG_INFINITY; 3],
             inv: [[0.0; MAX_PACKET]; 3],
             far: [f32::NEG_INFINITY; MAX_PACKET],
             lo: [f32::INFINITY; 3],
             hi: [f32::NEG_INFINITY; 3],
         };
         for (i, d) in dirs.iter().enumerate() {
-            let r = Ray32::new(o, *d);
+            let r = Ray32::new(origins[i.min(origins.len() - 1)], *d);
             for a in 0..3 {
-                let v = r.inv[a];
-                p.inv[a][i] = v;
-                p.lo[a] = p.lo[a].min(v);
-                p.hi[a] = p.hi[a].max(v);
+                p.o[a][i] = r.o[a];
+                p.o_lo[a] = p.o_lo[a].min(r.o[a]);
+                p.o_hi[a] = p.o_hi[a].max(r.o[a]);
+                p.inv[a][i] = r.inv[a];
+                p.lo[a] = p.lo[a].min(r.inv[a]);
+                p.hi[a] = p.hi[a].max(r.inv[a]);
             }
             p.far[i] = far(tmax);
         }
@@ -61,15 +70,13 @@ impl Packet {
     fn rays_meeting(&self, n: &Node4, lane: usize, tmin: f32, hit: &mut [bool; MAX_PACKET]) -> bool {
         let bmin = [n.min[0][lane], n.min[1][lane], n.min[2][lane]];
         let bmax = [n.max[0][lane], n.max[1][lane], n.max[2][lane]];
-        let a = [bmin[0] - self.o[0], bmin[1] - self.o[1], bmin[2] - self.o[2]];
-        let b = [bmax[0] - self.o[0], bmax[1] - self.o[1], bmax[2] - self.o[2]];
         let mut any = false;
         for i in 0..MAX_PACKET {
             let mut t0 = tmin;
             let mut t1 = self.far[i];
             for k in 0..3 {
-                let x = a[k] * self.inv[k][i];
-                let y = b[k] * self.inv[k][i];
+                let x = (bmin[k] - self.o[k][i]) * self.inv[k][i];
+                let y = (bmax[k] - self.o[k][i]) * self.inv[k][i];
                 let (l, h) = if x < y { (x, y) } else { (y, x) };
                 t0 = if l > t0 { l } else { t0 };
                 t1 = if h < t1 { h } else { t1 };
@@ -87,13 +94,18 @@ impl Packet {
         let mut t1 = [tmax; 4];
         for k in 0..3 {
             for i in 0..4 {
-                let a = n.min[k][i] - self.o[k];
-                let b = n.max[k][i] - self.o[k];
-                let (p, q, r, s) = (a * self.lo[k], a * self.hi[k], b * self.lo[k], b * self.hi[k]);
-                // Every ray's slab entry is at least the smallest corner product and its exit
-                // at most the largest.
-                let entry = p.min(q).min(r.min(s));
-                let exit = p.max(q).max(r.max(s));
+                // Each plane's distance over the packet's (origin, inverse direction) box: its
+                // corner values bound every ray's (the nearer plane's distance is the entry).
+                let (a0, a1) = (n.min[k][i] - self.o_hi[k], n.min[k][i] - self.o_lo[k]);
+                let (b0, b1) = (n.max[k][i] - self.o_hi[k], n.max[k][i] - self.o_lo[k]);
+                let (lo, hi) = (self.lo[k], self.hi[k]);
+                let c = [a0 * lo, a0 * hi, a1 * lo, a1 * hi, b0 * lo, b0 * hi, b1 * lo, b1 * hi];
+                let mut entry = c[0];
+                let mut exit = c[0];
+                for &x in &c[1..] {
+                    entry = if x < entry { x } else { entry };
+                    exit = if x > exit { x } else { exit };
+                }
                 t0[i] = if entry > t0[i] { entry } else { t0[i] };
                 t1[i] = if exit < t1[i] { exit } else { t1[i] };
             }
