@@ -13,6 +13,8 @@ Needs numpy, pygltflib and open3d (Open3D 0.20 also needs Debian's libusb-1.0-0)
     python3 -m venv .venv-bench && .venv-bench/bin/pip install open3d numpy pygltflib
     .venv-bench/bin/python python/bench_raycast.py [--rays N] [--config FILE] [--out DIR] [--no-run]
 
+With --lidar-pattern the rays are the LiDAR's own (the MID-360 pattern from the Rust example
+`pattern_rays` of agrisim-fmu-lidar, cast in packets of 64 as the FMU casts them).
 With --camera the rays are the RGB-D camera's depth rays instead (one per pixel centre of
 1280x720 D435i frames in the middle aisle, from the Rust example `depth_rays` of
 agrisim-fmu-camera; --rays is then ignored, --poses sets the number of frames).
@@ -92,9 +94,15 @@ def main():
     ap.add_argument("--no-run", action="store_true", help="reuse the files of a previous Rust run")
     ap.add_argument("--camera", action="store_true", help="the camera's depth rays (1280x720 frames) instead of LiDAR rays")
     ap.add_argument("--poses", type=int, default=2, help="with --camera: frames of rays")
+    ap.add_argument("--lidar-pattern", action="store_true",
+                    help="the LiDAR's own scan pattern (MID-360, 12 frames from each of 8 spots) instead of random LiDAR-like rays")
     args = ap.parse_args()
 
-    if not args.no_run and args.camera:
+    if not args.no_run and args.lidar_pattern:
+        cmd = ["cargo", "run", "--release", "-q", "-p", "agrisim-fmu-lidar", "--example", "pattern_rays", "--", "--out", args.out]
+        print("$", " ".join(cmd), flush=True)
+        subprocess.run(cmd, cwd=ROOT, check=True)
+    elif not args.no_run and args.camera:
         cmd = ["cargo", "run", "--release", "-q", "-p", "agrisim-fmu-camera", "--example", "depth_rays", "--",
                "--poses", str(args.poses), "--out", args.out]
         print("$", " ".join(cmd), flush=True)
@@ -148,7 +156,7 @@ def main():
     print(f"Open3D (Embree)    {o3d_1:.3e} rays/s, 1 thread;  {o3d_all:.3e} rays/s, {os.cpu_count()} threads")
     print(f"ratio agrisim / Open3D, 1 thread: {rust['rays_per_s'] / o3d_1:.2f}")
     if "single_ray_rays_per_s" in rust:
-        print(f"  (camera rays go in 8x8 packets as the camera casts them; as single rays agrisim casts "
+        print(f"  (rays go in packets as the sensor casts them; as single rays agrisim casts "
               f"{rust['single_ray_rays_per_s']:.3e} rays/s: ratio {rust['single_ray_rays_per_s'] / o3d_1:.2f})")
     print(f"hit/miss agreement {100 * same_hit_miss:.3f} % of rays")
     print(f"|distance diff| where both hit ({both.sum()} rays): median {np.median(d) * 1e3:.3f} mm, "

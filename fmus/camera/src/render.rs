@@ -142,6 +142,16 @@ struct Ctx<'a> {
     palette: Palette,
 }
 
+/// What a primary ray shows, before the sun's beam is known.
+#[derive(Clone, Copy, Debug)]
+enum Surface {
+    /// Sky (or nothing), final linear RGB.
+    Sky([f64; 3]),
+    /// A surface: the shadow ray's start `p` (just off it), the normal's z, cos(incidence) of
+    /// the sun, transmittance of the layers seen through, fog path length, the object.
+    Lit { p: Vec3, n_z: f64, cos_sun: f64, through: f64, fog_path: f64, object: u32 },
+}
+
 /// Sub-pixel offsets of 2x2 supersampling.
 const SUB: [(f64, f64); 4] = [(-0.25, -0.25), (0.25, -0.25), (-0.25, 0.25), (0.25, 0.25)];
 
@@ -166,43 +176,99 @@ impl Ctx<'_> {
             self.scene.caster.cast_packet(self.pose.origin, &dirs[..n], 0.0, FAR, self.movers, &mut hits[..n]);
             for i in 0..n {
                 let j = (i / cols) * w + u0 + i % cols;
-                self.pixel(j, v0, d_opt[i], dirs[i], hits[i].as_ref(), &mut rgb[3 * j..3 * j + 3], &mut z[j], &mut labels[j]);
+                if let Some(hit) = &hits[i] {
+                    z[j] = (hit.distance * d_opt[i][2]) as f32;
+                    labels[j] = hit.object as i32 + 1;
+                }
+            }
+            if self.light.supersample {
+                for i in 0..n {
+                    let j = (i / cols) * w + u0 + i % cols;
+                    let lin = self.supersampled(((j % w) as f64, (v0 + j / w) as f64));
+                    rgb[3 * j..3 * j + 3].copy_from_slice(&lin.map(shading::encode_srgb));
+                }
+                continue;
+            }
+            // Surfaces, then their shadow rays toward the sun as one packet, then colours.
+            let mut surfaces = [Surface::Sky([0.0; 3]); MAX_PACKET];
+            for i in 0..n {
+                surfaces[i] = self.surface(dirs[i], hits[i].as_ref());
+            }
+            let beams = self.beams(&surfaces[..n]);
+            for i in 0..n {
+                let j = (i / cols) * w + u0 + i % cols;
+                let lin = self.shade(&surfaces[i], beams[i]);
+                rgb[3 * j..3 * j + 3].copy_from_slice(&lin.map(shading::encode_srgb));
             }
         }
     }
 
-    /// Depth, label and colour of pixel `j` of the chunk starting at row `v0`, given its
-    /// primary ray (optical and map frame) and first hit.
-    #[allow(clippy::too_many_arguments)]
-    fn pixel(&self, j: usize, v0: usize, d_opt: Vec3, d: Vec3, hit: Option<&Hit>, rgb: &mut [u8], zi: &mut f32, label: &mut i32) {
-        let w = self.k.width as usize;
-        let (u, v) = ((j % w) as f64, (v0 + j / w) as f64);
-        if let Some(hit) = hit {
-            *zi = (hit.distance * d_opt[2]) as f32;
-            *label = hit.object as i32 + 1;
+    /// 2x2 supersampled colour of pixel (u, v): four rays, each shaded alone.
+    fn supersampled(&self, (u, v): (f64, f64)) -> [f64; 3] {
+        let mut acc = [0.0; 3];
+        for (du, dv) in SUB {
+            let ds = mat_vec(&self.pose.rotation, self.k.ray(u + du, v + dv));
+            let hs = self.scene.caster.cast_among(self.pose.origin, ds, 0.0, FAR, self.movers);
+            let c = self.radiance(ds, hs.as_ref());
+            (0..3).for_each(|i| acc[i] += 0.25 * c[i]);
         }
-        let lin = if self.light.supersample {
-            let mut acc = [0.0; 3];
-            for (du, dv) in SUB {
-                let ds = mat_vec(&self.pose.rotation, self.k.ray(u + du, v + dv));
-                let hs = self.scene.caster.cast_among(self.pose.origin, ds, 0.0, FAR, self.movers);
-                let c = self.radiance(ds, hs.as_ref());
-                (0..3).for_each(|i| acc[i] += 0.25 * c[i]);
+        acc
+    }
+
+    /// Unblocked fraction of the sun's beam at each lit surface of a tile (0 elsewhere): the
+    /// shadow rays of each sun sample go as one packet.
+    fn beams(&self, surfaces: &[Surface]) -> [f64; MAX_PACKET] {
+        let l = self.light;
+        let mut beams = [0.0; MAX_PACKET];
+        let mut points = [[0.0; 3]; MAX_PACKET];
+        let mut which = [0usize; MAX_PACKET];
+        let mut m = 0;
+        for (i, s) in surfaces.iter().enumerate() {
+            if let Surface::Lit { p, cos_sun, .. } = s {
+                if l.sun_up && *cos_sun > 0.0 {
+                    points[m] = *p;
+                    which[m] = i;
+                    m += 1;
+                }
             }
-            acc
-        } else {
-            self.radiance(d, hit)
+        }
+        let samples = match l.shadows {
+            Shadows::None => {
+                which[..m].iter().for_each(|&i| beams[i] = l.cover_tau);
+                return beams;
+            }
+            Shadows::Hard => 1,
+            Shadows::Soft(n) => n.max(1),
         };
-        rgb.copy_from_slice(&lin.map(shading::encode_srgb));
+        let mut out = [None; MAX_PACKET];
+        for k in 0..samples {
+            let s = if samples == 1 { l.sun } else { sun_disc_sample(l.sun, k, samples) };
+            self.scene.caster.pass_through_packet(&points[..m], s, EPS, FAR, self.movers, |id| shading::casts_shadow(self.scene.kind(id)), &mut out[..m]);
+            for (q, &i) in which[..m].iter().enumerate() {
+                beams[i] += transmittance(out[q], l.cover_tau);
+            }
+        }
+        which[..m].iter().for_each(|&i| beams[i] /= samples as f64);
+        beams
     }
 
-    /// Linear RGB seen along `d` (map frame) given its first hit.
+    /// Linear RGB seen along `d` (map frame) given its first hit (one ray alone).
     fn radiance(&self, d: Vec3, hit: Option<&Hit>) -> [f64; 3] {
+        let s = self.surface(d, hit);
+        let beam = match s {
+            Surface::Lit { p, cos_sun, .. } if self.light.sun_up && cos_sun > 0.0 => self.beam(p),
+            _ => 0.0,
+        };
+        self.shade(&s, beam)
+    }
+
+    /// What the ray along `d` shows: through up to 4 layers of glass or film (colour only),
+    /// the sky or a surface. Fog and haze fill the greenhouse up to its cover (the air outside
+    /// is not modelled).
+    fn surface(&self, d: Vec3, hit: Option<&Hit>) -> Surface {
         let l = self.light;
         let mut hit = hit.cloned();
         let mut through = 1.0;
-        // Through up to 4 layers of glass or film (colour only); fog and haze fill the
-        // greenhouse up to its cover (the air outside is not modelled).
         let mut inside = f64::INFINITY;
         if let Some(tau) = l.cover_see_through {
             for _ in 0..4 {
@@ -218,13 +284,13 @@ impl Ctx<'_> {
         }
         let Some(hit) = hit else {
             let sky = l.sky.map(|v| v * through);
-            return match l.fog {
+            return Surface::Sky(match l.fog {
                 Some(f) => {
                     let t = (-f.beta * inside).exp();
                     [0, 1, 2].map(|i| sky[i] * t + f.colour[i] * (1.0 - t))
                 }
                 None => sky,
-            };
+            });
         };
         let mut nrm = hit.normal;
         if nrm[0] * d[0] + nrm[1] * d[1] + nrm[2] * d[2] > 0.0 {
@@ -237,13 +303,22 @@ impl Ctx<'_> {
             o[1] + hit.distance * d[1] + EPS * nrm[1],
             o[2] + hit.distance * d[2] + EPS * nrm[2],
         ];
-        let beam = if l.sun_up && cos_sun > 0.0 { self.beam(p) } else { 0.0 };
-        let e = lighting::irradiance(l, cos_sun, beam, nrm[2]) * through;
-        let a = self.palette.albedo(self.scene.kind(hit.object));
+        Surface::Lit { p, n_z: nrm[2], cos_sun, through, fog_path: hit.distance.min(inside), object: hit.object }
+    }
+
+    /// Linear RGB of a surface given the unblocked fraction of the sun's beam on it.
+    fn shade(&self, s: &Surface, beam: f64) -> [f64; 3] {
+        let l = self.light;
+        let (n_z, cos_sun, through, fog_path, object) = match *s {
+            Surface::Sky(c) => return c,
+            Surface::Lit { n_z, cos_sun, through, fog_path, object, .. } => (n_z, cos_sun, through, fog_path, object),
+        };
+        let e = lighting::irradiance(l, cos_sun, beam, n_z) * through;
+        let a = self.palette.albedo(self.scene.kind(object));
         let c = [a[0] * e, a[1] * e, a[2] * e];
         match l.fog {
             Some(f) => {
-                let t = (-f.beta * hit.distance.min(inside)).exp();
+                let t = (-f.beta * fog_path).exp();
                 [0, 1, 2].map(|i| c[i] * t + f.colour[i] * (1.0 - t))
             }
             None => c,
@@ -298,7 +373,12 @@ fn normalize(v: Vec3) -> Vec3 {
 /// The shadow ray: 0 if something opaque lies between `p` and the sun, else `tau` per glass
 /// or film surface crossed (16 or more: 0, as deep as anyone renders).
 fn transmitted(scene: &Scene, movers: &RayCaster, p: Vec3, s: Vec3, tau: f64) -> f64 {
-    match scene.caster.pass_through(p, s, EPS, FAR, movers, |id| shading::casts_shadow(scene.kind(id))) {
+    transmittance(scene.caster.pass_through(p, s, EPS, FAR, movers, |id| shading::casts_shadow(scene.kind(id))), tau)
+}
+
+/// A shadow ray's answer as the beam's transmittance.
+fn transmittance(pass: Option<u32>, tau: f64) -> f64 {
+    match pass {
         Some(n) if n < 16 => tau.powi(n as i32),
         _ => 0.0,
     }

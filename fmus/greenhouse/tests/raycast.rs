@@ -256,6 +256,25 @@ fn pass_through_equals_the_hit_to_hit_walk() {
     eprintln!("{lit} of {n} rays reach the sky, {differ} differ from the walk");
     assert!(lit > n / 10, "only {lit} lit");
     assert_eq!(differ, 0);
+
+    // Packets: one sun direction, origins spread over a patch of canopy (a camera tile's
+    // surface points), every answer equal to the single-ray query.
+    let (mut blocked, mut through) = (0, 0);
+    for k in 0..400 {
+        let s = unit([rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(0.05, 1.0)]);
+        let c = [rng.range(0.0, cfg.length), rng.range(0.0, cfg.width), rng.range(0.0, 3.0)];
+        let size = [0.05, 0.5, 3.0][k % 3];
+        let m = 1 + k % 64;
+        let origins: Vec<[f64; 3]> = (0..m).map(|_| [0, 1, 2].map(|a| c[a] + rng.range(-size, size))).collect();
+        let mut out = vec![None; m];
+        rc.pass_through_packet(&origins, s, 1e-6, 1000.0, &movers, opaque, &mut out);
+        for (i, o) in origins.iter().enumerate() {
+            assert_eq!(out[i], rc.pass_through(*o, s, 1e-6, 1000.0, &movers, opaque), "packet {k} ray {i}");
+            blocked += out[i].is_none() as usize;
+            through += out[i].is_some_and(|n| n > 0) as usize;
+        }
+    }
+    assert!(blocked > 100 && through > 1000, "{blocked} blocked, {through} through glass");
 }
 
 /// Packets (camera tiles of up to 64 rays from one origin) give exactly the single-ray

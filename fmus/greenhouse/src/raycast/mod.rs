@@ -161,19 +161,40 @@ impl RayCaster {
                 return None;
             }
         }
-        // Count as the walk would: a surface within one restart step of the last one counted
-        // (a pane resting on another) is passed over with it.
-        let t = &mut at.t[..at.len];
-        t.sort_unstable_by(f64::total_cmp);
-        let mut n = 0;
-        let mut last = f64::NEG_INFINITY;
-        for &x in t.iter() {
-            if x >= last + RESTART + min {
-                n += 1;
-                last = x;
+        Some(at.count(min))
+    }
+
+    /// [`RayCaster::pass_through`] for up to [`MAX_PACKET`] rays with their own origins and a
+    /// common direction (shadow rays toward the sun from a camera tile's surface points):
+    /// `out[i]` is exactly the single-ray answer for origin i.
+    #[allow(clippy::too_many_arguments)]
+    pub fn pass_through_packet(&self, origins: &[[f64; 3]], dir: [f64; 3], min: f64, max: f64, movers: &RayCaster, opaque: impl Fn(u32) -> bool, out: &mut [Option<u32>]) {
+        let n = origins.len();
+        assert!(n <= MAX_PACKET && out.len() == n, "pass_through_packet: {n} rays, {} results", out.len());
+        let dirs = [dir; MAX_PACKET];
+        let Some(mut packet) = Packet::new(origins, &dirs[..n], max) else {
+            for (o, r) in origins.iter().zip(out.iter_mut()) {
+                *r = self.pass_through(*o, dir, min, max, movers, &opaque);
             }
+            return;
+        };
+        let mut at = [Crossings { t: [0.0; MAX_CROSSINGS], len: 0 }; MAX_PACKET];
+        let mut blocked = [false; MAX_PACKET];
+        let mut v = PacketThrough { caster: self, origins, d: dir, tmin: min, tmax: max, opaque: &opaque, at: &mut at, blocked: &mut blocked };
+        traverse_packet(&self.nodes, &mut packet, min, &mut v);
+        for i in 0..n {
+            out[i] = if blocked[i] {
+                None
+            } else {
+                // The movers (a handful) per ray, continuing the same crossing list.
+                let mut w = Through { caster: movers, o: origins[i], d: dir, tmin: min, tmax: max, far: far(max), opaque: &opaque, at: &mut at[i] };
+                if traverse(&movers.nodes, origins[i], dir, min, &mut w) {
+                    None
+                } else {
+                    Some(at[i].count(min))
+                }
+            };
         }
-        Some(n + (at.len == MAX_CROSSINGS) as u32 * MAX_CROSSINGS as u32)
     }
 
     /// Work done for one ray: (BVH nodes visited, primitive tests). For tuning and reports.
@@ -300,6 +321,43 @@ impl PacketVisit for PacketNearest<'_> {
     }
 }
 
+/// Shadow traversal of a packet ([`RayCaster::pass_through_packet`]): a blocked ray leaves
+/// the packet (its far limit drops below every box).
+struct PacketThrough<'a, F> {
+    caster: &'a RayCaster,
+    origins: &'a [[f64; 3]],
+    d: [f64; 3],
+    tmin: f64,
+    tmax: f64,
+    opaque: &'a F,
+    at: &'a mut [Crossings; MAX_PACKET],
+    blocked: &'a mut [bool; MAX_PACKET],
+}
+
+impl<F: Fn(u32) -> bool> PacketVisit for PacketThrough<'_, F> {
+    fn leaf(&mut self, packet: &mut Packet, start: usize, count: usize, rays: &[bool; MAX_PACKET]) {
+        for (i, o) in self.origins.iter().enumerate() {
+            if !rays[i] {
+                continue;
+            }
+            for k in start..start + count {
+                let p = &self.caster.prims[k];
+                if let Some((t, _)) = p.intersect(*o, self.d, self.tmin, self.tmax) {
+                    if (self.opaque)(self.caster.ids[k]) {
+                        self.blocked[i] = true;
+                        packet.far[i] = f32::NEG_INFINITY;
+                        break;
+                    }
+                    self.at[i].push(t);
+                    if let Some((t2, _)) = p.intersect(*o, self.d, t + RESTART, self.tmax) {
+                        self.at[i].push(t2);
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// Shadow traversal of [`RayCaster::pass_through`]: stops at an opaque hit, collects where the
 /// ray crosses the surfaces of translucent ones (at most two per convex object: in and out).
 struct Through<'a, F> {
@@ -316,12 +374,30 @@ struct Through<'a, F> {
 /// Most translucent surface crossings a shadow ray records (beyond: treated as dark).
 const MAX_CROSSINGS: usize = 16;
 
+#[derive(Clone, Copy)]
 struct Crossings {
     t: [f64; MAX_CROSSINGS],
     len: usize,
 }
 
 impl Crossings {
+    /// Counts as the walk would: a surface within one restart step of the last one counted
+    /// (a pane resting on another) is passed over with it. A full list counts as at least
+    /// [`MAX_CROSSINGS`].
+    fn count(&mut self, tmin: f64) -> u32 {
+        let t = &mut self.t[..self.len];
+        t.sort_unstable_by(f64::total_cmp);
+        let mut n = 0;
+        let mut last = f64::NEG_INFINITY;
+        for &x in t.iter() {
+            if x >= last + RESTART + tmin {
+                n += 1;
+                last = x;
+            }
+        }
+        n + (self.len == MAX_CROSSINGS) as u32 * MAX_CROSSINGS as u32
+    }
+
     fn push(&mut self, t: f64) {
         if self.len < MAX_CROSSINGS {
             self.t[self.len] = t;
