@@ -69,7 +69,7 @@ def test_scene_export_is_a_glb(tmp_path):
 
 def test_snapshot_writes_pictures_of_the_scene(tmp_path):
     p = run_agrisim("snapshot", "--scenario", str(SCENARIO), "--out", str(tmp_path))
-    for name, (w, h) in {"rgb.png": (1280, 720), "depth.png": (1280, 720), "lidar_top.png": (800, 800)}.items():
+    for name, (w, h) in {"rgb.png": (1280, 720), "depth.png": (1280, 720), "lidar_top.png": (800, 800), "lidar_near.png": (800, 800)}.items():
         data = (tmp_path / name).read_bytes()
         assert data[:8] == b"\x89PNG\r\n\x1a\n", name
         assert struct.unpack(">II", data[16:24]) == (w, h), name

@@ -2,8 +2,9 @@
 //! CameraInfo) on the default greenhouse, the robot in the middle of aisle 0 looking along
 //! the aisle and then at a row, at 1280x720 and 640x480, on 1 and 2 render threads (frames
 //! are identical either way), fixed sun, no environment.
-//! `cargo run --release -p agrisim-fmu-camera --example camera_fps [FRAMES] [ENVIRONMENT] [THREADS]`
-//! (with THREADS: 1280x720 on that many threads only, e.g. to compare CPU and wall time).
+//! `cargo run --release -p agrisim-fmu-camera --example camera_fps [FRAMES] [ENVIRONMENT] [THREADS] [ROBOT_LINKS]`
+//! (with THREADS: 1280x720 on that many threads only, e.g. to compare CPU and wall time;
+//! ROBOT_LINKS `false`: the base box only, as before the links were seen).
 
 use agrisim_fmi::{Model, Quiet, Store, Value};
 use agrisim_fmu_camera::ports::*;
@@ -17,11 +18,12 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(5);
     let environment = std::env::args().nth(2).unwrap_or_default();
+    let robot_links = std::env::args().nth(4).is_none_or(|s| s != "false");
     let cfg = GreenhouseConfig::from_toml_str("").expect("scene");
     let gh = generate(&cfg, cfg.seed);
     let a = &gh.layout.aisles[0];
     let (x, y) = (0.5 * (a.x_start + a.x_end), a.y);
-    let configs: Vec<(i32, i32, i32)> = match std::env::args().nth(3).and_then(|s| s.parse().ok()) {
+    let configs: Vec<(i32, i32, i32)> = match std::env::args().nth(3).and_then(|s| s.parse().ok()).filter(|&t: &i32| t > 0) {
         Some(t) => vec![(1280, 720, t)],
         None => vec![(1280, 720, 1), (1280, 720, 2), (640, 480, 2)],
     };
@@ -35,6 +37,7 @@ fn main() {
             *io.value_mut(HEIGHT) = Value::Int32(h);
             *io.value_mut(RENDER_THREADS) = Value::Int32(threads);
             *io.value_mut(ENVIRONMENT) = Value::String(environment.clone());
+            *io.value_mut(ROBOT_LINKS) = Value::Boolean(robot_links);
             io.set_f64(BASE_X, x);
             io.set_f64(BASE_Y, y);
             io.set_f64(BASE_YAW, yaw);

@@ -11,7 +11,8 @@ use crate::lighting::Lighting;
 use crate::optics::{CameraPose, Intrinsics, Mount};
 use crate::ports::*;
 use crate::render::{self, DepthModel, DepthNoise, Frame};
-use crate::scene::{self, Scene};
+use crate::scene::Scene;
+use agrisim_sensor_ports::robot::{Coords, RobotBody};
 use agrisim_fmi::{Log, Model, OutPort, Store, Var};
 use agrisim_fmu_util::{to_ns, Schedule};
 use agrisim_greenhouse::environment::Environment;
@@ -35,8 +36,9 @@ pub struct Config {
     pub conditions: Option<Conditions>,
     pub threads: usize,
     pub frame_id: String,
-    /// Base box (length, width, height, clearance).
-    pub base: [f64; 4],
+    /// The robot's own body (base box and, with `robot_links`, its URDF links).
+    pub robot: RobotBody,
+    pub robot_links: bool,
 }
 
 #[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
@@ -128,9 +130,11 @@ impl Config {
             t @ 1..=64 => t as usize,
             t => return Err(format!("parameter render_threads must be in [1, 64], got {t}")),
         };
-        let base = SENSOR_PORTS.base_box(io)?;
+        let scene = SENSOR_PORTS.scene(io)?;
         Ok(Config {
-            scene: SENSOR_PORTS.scene(io)?,
+            robot: SENSOR_PORTS.robot_body(io, scene.object_count() as u32)?,
+            robot_links: io.bool(ROBOT_LINKS),
+            scene,
             intrinsics: Intrinsics::from_fov(width, height, fov_h, fov_v),
             period: 1.0 / rate,
             mount,
@@ -146,27 +150,35 @@ impl Config {
             conditions,
             threads,
             frame_id: io.string(FRAME_ID).to_string(),
-            base,
         })
     }
 }
 
 impl Camera {
-    /// Renders a frame with base_link at (x, y, yaw) (advances the noise generator).
+    /// Renders a frame with base_link at (x, y, yaw) (advances the noise generator); the
+    /// arms, if seen, in their default (ready) pose.
     pub fn capture(&mut self, x: f64, y: f64, yaw: f64) -> Frame {
         self.capture_on_lift(x, y, yaw, 0.0)
     }
 
-    /// As [`Camera::capture`] with the camera raised by `lift` metres.
+    /// As [`Camera::capture`] with the lift (and the camera on it) raised by `lift` metres.
     pub fn capture_on_lift(&mut self, x: f64, y: f64, yaw: f64, lift: f64) -> Frame {
+        let links = self.config.as_ref().is_some_and(|c| c.robot_links);
+        let coords = links.then(|| Coords { lift, ..Coords::default() });
+        self.capture_posed(x, y, yaw, lift, coords.as_ref())
+    }
+
+    /// A frame with the camera raised by `lift` and the robot's links at `coords` (None: the
+    /// base box only).
+    pub fn capture_posed(&mut self, x: f64, y: f64, yaw: f64, lift: f64, coords: Option<&Coords>) -> Frame {
         let c = self.config.as_ref().expect("initialized");
-        let robot = scene::base_box(c.scene.object_count() as u32, c.base, x, y, yaw);
+        let robot = c.robot.objects(coords, x, y, yaw);
         let mut mount = c.mount;
         mount.translation[2] += lift;
         let pose = CameraPose::new(&mount, x, y, yaw);
         render::render(
             &c.scene,
-            std::slice::from_ref(&robot),
+            &robot,
             &c.intrinsics,
             &pose,
             &c.light,
@@ -235,7 +247,8 @@ impl Model for Camera {
             return Err(format!("input lift_position = {lift} is not finite or beyond 100 m"));
         }
         if let Some(stamp) = self.schedule.due(t + h) {
-            self.capture_and_publish(io, stamp, x, y, yaw, lift);
+            let coords = SENSOR_PORTS.coords(io)?;
+            self.capture_and_publish(io, stamp, x, y, yaw, lift, coords.as_ref());
         }
         self.sync(io, to_ns(t + h));
         Ok(())
@@ -250,8 +263,9 @@ impl Camera {
         }
     }
 
-    fn capture_and_publish(&mut self, io: &mut Store, stamp: i64, x: f64, y: f64, yaw: f64, lift: f64) {
-        let frame = self.capture_on_lift(x, y, yaw, lift);
+    #[allow(clippy::too_many_arguments)]
+    fn capture_and_publish(&mut self, io: &mut Store, stamp: i64, x: f64, y: f64, yaw: f64, lift: f64, coords: Option<&Coords>) {
+        let frame = self.capture_posed(x, y, yaw, lift, coords);
         let c = self.config.as_ref().expect("initialized");
         let (w, hh, id) = (c.intrinsics.width, c.intrinsics.height, c.frame_id.as_str());
         let info = c.intrinsics.camera_info(stamp, id).to_cdr();

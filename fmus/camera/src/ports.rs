@@ -69,9 +69,6 @@ agrisim_sensor_ports::sensor_variables! { pub VARIABLES {
     PORT_WINDOW = agrisim_fmi::port_window(),
   },
   ports: {
-    // --- inputs (and base_x, base_y, base_yaw) ---
-    LIFT_POSITION = Var::input("lift_position", 0.0).unit("m")
-        .desc("Lift joint position, added to mount_z (connect it when the camera rides on the lift, as on the robot: camera_link at (0.32, 0, 0.60 + lift) on base_link)"),
     // --- outputs ---
     // Frames come with the steps; initialization only sets the sun and visibility outputs.
     IMAGE = Var::output_discrete("image", Start::Binary(&[])).mime(IMAGE_MIME).max_size(agrisim_fmi::port::frames_max_size(image_max_size(3), 2)).init_depends_on(&[])

@@ -516,3 +516,55 @@ fn keyed_pixel_noise_is_uncorrelated_and_new_every_frame() {
         assert!(c.abs() < 0.01, "{c}");
     }
 }
+
+/// Pixels per robot label (scene ids end at `first`; labels are id + 1) of a frame from the
+/// camera where the robot carries it (camera_link on the lift, agrisim_robot.urdf).
+fn robot_pixels(links: bool, setup: impl FnOnce(&mut Store)) -> std::collections::BTreeMap<i32, usize> {
+    let mut io = store(320, 240, 0);
+    *io.value_mut(ROBOT_LINKS) = Value::Boolean(links);
+    io.set_f64(MOUNT_X, 0.32);
+    io.set_f64(MOUNT_Z, 0.60);
+    setup(&mut io);
+    let m = run(&mut io, 1);
+    let first = m.config().unwrap().scene.object_count() as i32;
+    let labels = image::read_32sc1(&Image::from_cdr(agrisim_fmi::port::latest(&io, LABELS_IMAGE)).unwrap()).unwrap();
+    let mut out = std::collections::BTreeMap::new();
+    for &l in labels.iter().filter(|&&l| l > first) {
+        *out.entry(l).or_insert(0) += 1;
+    }
+    out
+}
+
+/// Both arms reaching forward and down (hands 0.9 m ahead, 0.76 m high, 0.25 m to each side):
+/// in the view of the camera on the lift.
+const WORKING: [f64; 7] = [0.0, 0.6, 0.0, -1.6, 0.0, 2.2, 0.785];
+
+fn set_arms(io: &mut Store, q: [f64; 7], q1: [f64; 2]) {
+    for (i, v) in q.into_iter().enumerate() {
+        io.set_f64(LEFT_Q1 + i, if i == 0 { q1[0] } else { v });
+        io.set_f64(RIGHT_Q1 + i, if i == 0 { q1[1] } else { v });
+    }
+}
+
+#[test]
+fn the_camera_sees_the_arms_where_the_joints_put_them() {
+    // Without links the camera on the lift at lift 0 is inside the base box parameters (the
+    // navigation envelope, up to 0.65 m): it sees nothing but the box.
+    assert_eq!(robot_pixels(false, |_| {}).values().sum::<usize>(), 320 * 240);
+    // With links: the chassis (0.42 m high) is below the view, the ready arms above it
+    // (folded over the lift); arms reaching forward are in it, and both are seen.
+    assert!(robot_pixels(true, |_| {}).is_empty());
+    let working = robot_pixels(true, |io| set_arms(io, WORKING, [0.0, 0.0]));
+    let seen: usize = working.values().sum();
+    assert!(working.len() >= 6 && seen > 320 * 240 / 50, "{working:?}");
+    // Swinging them out to the sides (joint 1) takes them out of the view; raising the lift
+    // (camera and arms together) keeps them where they were in the image.
+    let out = robot_pixels(true, |io| set_arms(io, WORKING, [1.6, -1.6]));
+    assert!(out.values().sum::<usize>() < seen / 4, "{out:?} vs {working:?}");
+    let raised = robot_pixels(true, |io| {
+        set_arms(io, WORKING, [0.0, 0.0]);
+        io.set_f64(LIFT_POSITION, 0.3);
+    });
+    let diff: usize = working.keys().chain(raised.keys()).map(|k| working.get(k).unwrap_or(&0).abs_diff(*raised.get(k).unwrap_or(&0))).sum();
+    assert!(diff < seen / 20, "{raised:?} vs {working:?}");
+}

@@ -15,12 +15,12 @@ use crate::frame::{yaw_rotate, Mount};
 use crate::pattern::{Firing, ScanPattern};
 use crate::ports::*;
 use crate::reflectivity;
-use crate::scene::{robot_in_base_link, Scene};
+use crate::scene::{RobotInBaseLink, Scene};
 use crate::trajectory::Trajectory;
 use agrisim_fmi::{Log, Model, OutPort, Store, Var};
 use agrisim_fmu_util::{to_ns, Schedule};
 use agrisim_greenhouse::environment::Environment;
-use agrisim_greenhouse::{RayCaster, RigidPose};
+use agrisim_greenhouse::RigidPose;
 use agrisim_greenhouse::weather::Conditions;
 use agrisim_math::{Pose2, Rng};
 use agrisim_msgs::sensor_msgs::PointCloud2;
@@ -34,8 +34,6 @@ pub use crate::ports::MAX_POINTS_PER_FRAME;
 #[derive(Clone, Debug)]
 struct Config {
     scene: Arc<Scene>,
-    /// The robot's own geometry in base_link.
-    robot: RayCaster,
     pattern: ScanPattern,
     points_per_frame: usize,
     frame_period: f64,
@@ -66,6 +64,10 @@ pub struct Lidar {
     rng: Rng,
     port: Option<OutPort>,
     window_ns: i64,
+    /// The robot's body in base_link, re-posed from the inputs before each frame (derived
+    /// from parameters and inputs: rebuilt, not serialized).
+    #[serde(skip)]
+    robot: Option<RobotInBaseLink>,
 }
 
 fn param(io: &Store, i: usize, ok: impl Fn(f64) -> bool, what: &str) -> Result<f64, String> {
@@ -102,7 +104,6 @@ impl Config {
         };
         let scene = SENSOR_PORTS.scene(io)?;
         Ok(Config {
-            robot: robot_in_base_link(scene.object_count() as u32, SENSOR_PORTS.base_box(io)?),
             scene,
             pattern: ScanPattern::mid360(point_rate, el_min.to_radians(), el_max.to_radians()),
             points_per_frame: points_per_frame as usize,
@@ -162,8 +163,11 @@ impl Default for Batch {
 impl Lidar {
     /// Casts the frame that ends at `end_ns` (its points are the pattern's last
     /// `points_per_frame` before that instant).
+    /// The robot's links are where the inputs last put them (set by [`Lidar::pose_robot`]
+    /// before the frame; arms move little in one frame).
     pub fn capture(&mut self, end_ns: i64) -> Frame {
         let c = self.config.as_ref().expect("initialized");
+        let robot = &self.robot.as_ref().expect("initialized").caster;
         let p = &c.pattern;
         let n_end = (end_ns as f64 * 1e-9 * p.point_rate).floor() as i64;
         let n0 = n_end - c.points_per_frame as i64;
@@ -207,7 +211,7 @@ impl Lidar {
                 n += 1;
             }
             let k = batch.len;
-            c.scene.caster.cast_packet_posed(&batch.origins[..k], &batch.dirs[..k], c.range.0, c.range.1, &c.robot, &batch.poses[..k], &mut batch.hits[..k]);
+            c.scene.caster.cast_packet_posed(&batch.origins[..k], &batch.dirs[..k], c.range.0, c.range.1, robot, &batch.poses[..k], &mut batch.hits[..k]);
             for i in 0..k {
                 let (d, d_sensor, t) = (batch.dirs[i], batch.sensor[i], batch.times[i]);
                 match batch.hits[i].filter(|h| detected(h.distance, c.range.1, c.extinction)) {
@@ -227,6 +231,13 @@ impl Lidar {
         Frame { cloud: cloud.finish(stamp_ns, &c.frame_id), returns }
     }
 
+    /// Poses the robot's links for `coords` (None: the base box only).
+    pub fn pose_robot(&mut self, coords: Option<agrisim_sensor_ports::robot::Coords>) {
+        if let Some(r) = self.robot.as_mut() {
+            r.update(coords);
+        }
+    }
+
     /// The scene the rays are cast at (after initialization).
     pub fn scene(&self) -> Option<&Scene> {
         self.config.as_ref().map(|c| &*c.scene)
@@ -243,7 +254,10 @@ impl Model for Lidar {
     }
 
     fn load_state(&mut self, bytes: &[u8]) -> Result<(), agrisim_fmi::ModelError> {
-        agrisim_fmi::serial::load_keeping(self, bytes, |new, old| new.config = old.config.take())
+        agrisim_fmi::serial::load_keeping(self, bytes, |new, old| {
+            new.config = old.config.take();
+            new.robot = old.robot.take();
+        })
     }
 
     fn new() -> Self {
@@ -262,6 +276,8 @@ impl Model for Lidar {
         self.port = Some(OutPort::new(POINTS, POINTS_SEQ));
         self.port.as_mut().expect("set above").sync(io, to_ns(start_time), self.window_ns);
         io.set_f64(VISIBILITY, config.visibility);
+        let body = SENSOR_PORTS.robot_body(io, config.scene.object_count() as u32)?;
+        self.robot = Some(RobotInBaseLink::new(body, SENSOR_PORTS.coords(io)?));
         self.config = Some(config);
         Ok(())
     }
@@ -270,6 +286,7 @@ impl Model for Lidar {
         let period = self.config.as_ref().map_or(0.1, |c| c.frame_period);
         self.trajectory.push(t, pose(io)?, 2.0 * period + h);
         if let Some(end_ns) = self.schedule.due(t + h) {
+            self.pose_robot(SENSOR_PORTS.coords(io)?);
             let frame = self.capture(end_ns);
             io.set_i32(POINTS_IN_FRAME, frame.cloud.width as i32);
             io.set_i32(RETURNS_IN_FRAME, frame.returns as i32);

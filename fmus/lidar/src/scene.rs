@@ -1,14 +1,32 @@
 //! The geometry rays are cast at: the shared sensor scene of the greenhouse crate (exactly
-//! what the world FMU builds) plus the robot, prepared once in base_link: rays are taken into
-//! base_link at each pose of the scan instead of the robot being re-placed.
+//! what the world FMU builds) plus the robot's own body (base box and URDF links, see
+//! `agrisim_sensor_ports::robot`), prepared in base_link: rays are taken into base_link at
+//! each pose of the scan instead of the robot being re-placed, and the body is rebuilt only
+//! when the lift, arm or finger inputs change.
 
-use agrisim_greenhouse::cast_scene::base_box;
 use agrisim_greenhouse::RayCaster;
+use agrisim_sensor_ports::robot::{Coords, RobotBody};
 
 pub use agrisim_greenhouse::cast_scene::{load_cached as load, CastScene as Scene};
 
-/// The robot base box in base_link (`dims` = [length, width, height, clearance]), with ids
-/// from `first_id` (use the scene's object count so they do not collide with scene ids).
-pub fn robot_in_base_link(first_id: u32, dims: [f64; 4]) -> RayCaster {
-    RayCaster::new(&[base_box(first_id, dims, 0.0, 0.0, 0.0)])
+/// The robot in base_link for the configuration it was last built for.
+#[derive(Clone, Debug)]
+pub struct RobotInBaseLink {
+    body: RobotBody,
+    coords: Option<Coords>,
+    pub caster: RayCaster,
+}
+
+impl RobotInBaseLink {
+    pub fn new(body: RobotBody, coords: Option<Coords>) -> RobotInBaseLink {
+        let caster = RayCaster::new(&body.objects(coords.as_ref(), 0.0, 0.0, 0.0));
+        RobotInBaseLink { body, coords, caster }
+    }
+
+    /// Re-poses the links for `coords` (nothing to do when they are unchanged).
+    pub fn update(&mut self, coords: Option<Coords>) {
+        if coords != self.coords {
+            *self = RobotInBaseLink::new(self.body.clone(), coords);
+        }
+    }
 }

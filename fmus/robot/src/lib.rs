@@ -8,6 +8,7 @@
 //! collision primitives of every link. Meshes are rejected for collision: the project's
 //! collision checking (sphere approximations, parry) works on primitives.
 
+pub mod model;
 mod pose;
 
 pub use pose::Pose;

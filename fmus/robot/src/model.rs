@@ -1,4 +1,4 @@
-//! The robot as the world sees it: the project URDF (models/robot/agrisim_robot.urdf, compiled
+//! The robot as the world and the sensors see it: the project URDF (models/robot/agrisim_robot.urdf, compiled
 //! in so the FMU carries exactly the geometry every other consumer reads), forward kinematics
 //! driven by the world's scalar inputs (lift, 2 x 7 arm joints, 2 finger gaps), and the two
 //! pieces of geometry harvest physics derives from it: the finger pads and the harvest box
@@ -7,7 +7,7 @@
 //! FK runs over a table built once (joint -> input coordinate, parent/child link indices), so a
 //! step costs one pass of ~50 joint transforms and allocates nothing.
 
-use agrisim_robot::{JointKind, Pose as RPose, Robot, Shape};
+use crate::{JointKind, Pose as RPose, Robot, Shape};
 use std::collections::HashMap;
 
 /// The URDF the world is built from.
@@ -61,6 +61,13 @@ impl Default for Coords {
     }
 }
 
+/// Links the base box stands for, left out of the world's colliders and the sensors' robot:
+/// base_link (the box is the chassis: navigation's height band, contacts on `base_link`) and
+/// the wheel units (inside or below it; their steering is not an input of either).
+pub fn chassis_link(name: &str) -> bool {
+    name == "base_link" || name.ends_with("_steer_link") || name.ends_with("_wheel_link")
+}
+
 /// Which input drives a joint.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Source {
@@ -76,7 +83,7 @@ enum Source {
 struct FkJoint {
     parent: usize,
     child: usize,
-    joint: agrisim_robot::Joint,
+    joint: crate::Joint,
     source: Source,
 }
 

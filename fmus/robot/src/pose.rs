@@ -103,6 +103,28 @@ impl Pose {
         [self.rot[0][i], self.rot[1][i], self.rot[2][i]]
     }
 
+    /// The rotation as a unit quaternion (x, y, z, w), by Shepperd's method (the largest of
+    /// the four candidates first, for accuracy near 180-degree turns).
+    pub fn quaternion(&self) -> [f64; 4] {
+        let m = &self.rot;
+        let tr = m[0][0] + m[1][1] + m[2][2];
+        let q = if tr > 0.0 {
+            let s = (tr + 1.0).sqrt() * 2.0;
+            [(m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s, 0.25 * s]
+        } else if m[0][0] > m[1][1] && m[0][0] > m[2][2] {
+            let s = (1.0 + m[0][0] - m[1][1] - m[2][2]).sqrt() * 2.0;
+            [0.25 * s, (m[0][1] + m[1][0]) / s, (m[0][2] + m[2][0]) / s, (m[2][1] - m[1][2]) / s]
+        } else if m[1][1] > m[2][2] {
+            let s = (1.0 + m[1][1] - m[0][0] - m[2][2]).sqrt() * 2.0;
+            [(m[0][1] + m[1][0]) / s, 0.25 * s, (m[1][2] + m[2][1]) / s, (m[0][2] - m[2][0]) / s]
+        } else {
+            let s = (1.0 + m[2][2] - m[0][0] - m[1][1]).sqrt() * 2.0;
+            [(m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, 0.25 * s, (m[1][0] - m[0][1]) / s]
+        };
+        let n = q.iter().map(|v| v * v).sum::<f64>().sqrt();
+        q.map(|v| v / n)
+    }
+
     /// Largest absolute element difference (rotation and translation), for tests and checks.
     pub fn max_abs_diff(&self, other: &Pose) -> f64 {
         let mut m: f64 = 0.0;

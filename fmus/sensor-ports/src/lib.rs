@@ -9,7 +9,10 @@
 //! depend on the export layer. The world FMU declares the scene and base ports from the same
 //! constants.
 
+pub mod robot;
+
 use agrisim_fmi::{checked_f64, Start, Store, Var};
+use agrisim_robot::model::Coords;
 use agrisim_greenhouse::cast_scene::{load_cached, CastScene};
 use std::sync::Arc;
 
@@ -19,7 +22,9 @@ pub use agrisim_fmi as __fmi;
 /// A sensor's `variables!` table with the shared ports spliced in, in this order: `scene`,
 /// `scene_seed`; the sensor's own `params`; `mount_x/y/z`, `mount_roll/pitch/yaw` (of
 /// `$link`, default position `($x, $y, $z)`); `base_length/width/height/clearance`;
-/// the inputs `base_x`, `base_y`, `base_yaw`; the sensor's own `ports`. Also defines
+/// the inputs `base_x`, `base_y`, `base_yaw`; the sensor's own `ports`; the robot body's
+/// parameter `robot_links` and inputs `lift_position`, `left_q1..7`, `left_finger_width`,
+/// `right_q1..7`, `right_finger_width` (as the world FMU's, see [`robot`]). Also defines
 /// `SENSOR_PORTS` ([`SensorPorts`]) for reading them. Each own entry ends with a comma.
 #[macro_export]
 macro_rules! sensor_variables {
@@ -47,6 +52,24 @@ macro_rules! sensor_variables {
             BASE_Y = $crate::BASE_POSE[1],
             BASE_YAW = $crate::BASE_POSE[2],
             $($ports)*
+            ROBOT_LINKS = $crate::robot::ROBOT_LINKS,
+            LIFT_POSITION = $crate::robot::LIFT_POSITION,
+            LEFT_Q1 = $crate::robot::ARM_JOINTS[0][0],
+            LEFT_Q2 = $crate::robot::ARM_JOINTS[0][1],
+            LEFT_Q3 = $crate::robot::ARM_JOINTS[0][2],
+            LEFT_Q4 = $crate::robot::ARM_JOINTS[0][3],
+            LEFT_Q5 = $crate::robot::ARM_JOINTS[0][4],
+            LEFT_Q6 = $crate::robot::ARM_JOINTS[0][5],
+            LEFT_Q7 = $crate::robot::ARM_JOINTS[0][6],
+            LEFT_FINGER_WIDTH = $crate::robot::FINGER_WIDTHS[0],
+            RIGHT_Q1 = $crate::robot::ARM_JOINTS[1][0],
+            RIGHT_Q2 = $crate::robot::ARM_JOINTS[1][1],
+            RIGHT_Q3 = $crate::robot::ARM_JOINTS[1][2],
+            RIGHT_Q4 = $crate::robot::ARM_JOINTS[1][3],
+            RIGHT_Q5 = $crate::robot::ARM_JOINTS[1][4],
+            RIGHT_Q6 = $crate::robot::ARM_JOINTS[1][5],
+            RIGHT_Q7 = $crate::robot::ARM_JOINTS[1][6],
+            RIGHT_FINGER_WIDTH = $crate::robot::FINGER_WIDTHS[1],
         }}
 
         /// Readers of the shared sensor ports of this table.
@@ -58,6 +81,14 @@ macro_rules! sensor_variables {
             mount: [MOUNT_X, MOUNT_Y, MOUNT_Z, MOUNT_ROLL, MOUNT_PITCH, MOUNT_YAW],
             base_box: [BASE_LENGTH, BASE_WIDTH, BASE_HEIGHT, BASE_CLEARANCE],
             base_pose: [BASE_X, BASE_Y, BASE_YAW],
+            link: $link,
+            robot_links: ROBOT_LINKS,
+            lift: LIFT_POSITION,
+            arms: [
+                [LEFT_Q1, LEFT_Q2, LEFT_Q3, LEFT_Q4, LEFT_Q5, LEFT_Q6, LEFT_Q7],
+                [RIGHT_Q1, RIGHT_Q2, RIGHT_Q3, RIGHT_Q4, RIGHT_Q5, RIGHT_Q6, RIGHT_Q7],
+            ],
+            widths: [LEFT_FINGER_WIDTH, RIGHT_FINGER_WIDTH],
         };
     };
 }
@@ -109,6 +140,14 @@ pub struct SensorPorts {
     pub base_box: [usize; 4],
     /// base_x, base_y, base_yaw.
     pub base_pose: [usize; 3],
+    /// The sensor's own URDF link (its housing, which its rays start inside).
+    pub link: &'static str,
+    pub robot_links: usize,
+    pub lift: usize,
+    /// `<side>_q1..7`, left then right.
+    pub arms: [[usize; 7]; 2],
+    /// `<side>_finger_width`, left then right.
+    pub widths: [usize; 2],
 }
 
 impl SensorPorts {
@@ -129,6 +168,35 @@ impl SensorPorts {
         let [l, w, h, c] = self.base_box;
         let positive = |i| checked_f64(io, self.vars, i, |v| v > 0.0, "positive");
         Ok([positive(l)?, positive(w)?, positive(h)?, checked_f64(io, self.vars, c, |v| v >= 0.0, ">= 0")?])
+    }
+
+    /// The robot's configuration inputs when `robot_links` is on (None: the base box only).
+    /// Values must be finite; joints beyond their limits are clamped by the FK.
+    pub fn coords(&self, io: &Store) -> Result<Option<Coords>, String> {
+        if !io.bool(self.robot_links) {
+            return Ok(None);
+        }
+        let get = |i: usize| {
+            let v = io.f64(i);
+            if v.is_finite() && v.abs() < 1e3 {
+                Ok(v)
+            } else {
+                Err(format!("input {} = {v} is not finite or beyond 1e3", self.vars[i].name))
+            }
+        };
+        let mut c = Coords { lift: get(self.lift)?, ..Coords::default() };
+        for side in 0..2 {
+            for (q, &i) in c.arms[side].iter_mut().zip(&self.arms[side]) {
+                *q = get(i)?;
+            }
+            c.widths[side] = get(self.widths[side])?;
+        }
+        Ok(Some(c))
+    }
+
+    /// The robot body for this sensor (ids from `first_id`, the scene's object count).
+    pub fn robot_body(&self, io: &Store, first_id: u32) -> Result<robot::RobotBody, String> {
+        robot::RobotBody::new(first_id, self.base_box(io)?, self.link)
     }
 
     /// The base pose inputs (x, y, yaw); refused when not finite or beyond 1e6.

@@ -4,7 +4,6 @@
 //! (`agrisim_sensor_ports`), so every FMU reads the same scene and base box from
 //! the same scenario keys with the same defaults and ranges; only descriptions are the world's.
 
-use crate::robot_model::{OPEN_WIDTH, READY_POSE};
 use agrisim_fmi::{Start, Var};
 use agrisim_sensor_ports as sensor_ports;
 
@@ -36,8 +35,7 @@ agrisim_fmi::variables! { pub VARIABLES {
     BASE_X = sensor_ports::BASE_POSE[0],
     BASE_Y = sensor_ports::BASE_POSE[1],
     BASE_YAW = sensor_ports::BASE_POSE[2],
-    LIFT_POSITION = Var::input("lift_position", 0.0).unit("m")
-        .desc("Lift extension (URDF lift_joint, clamped to its limits): raises the lift carriage and both arms"),
+    LIFT_POSITION = sensor_ports::robot::LIFT_POSITION,
     TARGET_FRUIT = Var::input_discrete("target_fruit", Start::Int32(-1))
         .desc("Index into the fruit list (order of fruit_poses) whose pose is the target; -1 = none"),
     // --- outputs: contacts and clearance (at initialization: of the robot as the inputs
@@ -69,24 +67,22 @@ agrisim_fmi::variables! { pub VARIABLES {
         .desc("geometry_msgs/PoseStamped of the target fruit (frame map), at fruit_rate and when target_fruit changes"),
     TARGET_SEQ = Var::output_discrete("target_seq", Start::Int64(0)).init_depends_on(TARGET_CHOICE).desc("Sequence number of the newest message in target"),
     // --- harvest physics (appended: earlier value references stay as they were) ---
-    LEFT_Q1 = Var::input("left_q1", READY_POSE[0]).unit("rad").desc("left_joint1 angle (default: Franka ready pose; clamped to the URDF limits)"),
-    LEFT_Q2 = Var::input("left_q2", READY_POSE[1]).unit("rad").desc("left_joint2 angle"),
-    LEFT_Q3 = Var::input("left_q3", READY_POSE[2]).unit("rad").desc("left_joint3 angle"),
-    LEFT_Q4 = Var::input("left_q4", READY_POSE[3]).unit("rad").desc("left_joint4 angle"),
-    LEFT_Q5 = Var::input("left_q5", READY_POSE[4]).unit("rad").desc("left_joint5 angle"),
-    LEFT_Q6 = Var::input("left_q6", READY_POSE[5]).unit("rad").desc("left_joint6 angle"),
-    LEFT_Q7 = Var::input("left_q7", READY_POSE[6]).unit("rad").desc("left_joint7 angle"),
-    RIGHT_Q1 = Var::input("right_q1", READY_POSE[0]).unit("rad").desc("right_joint1 angle (default: Franka ready pose; clamped to the URDF limits)"),
-    RIGHT_Q2 = Var::input("right_q2", READY_POSE[1]).unit("rad").desc("right_joint2 angle"),
-    RIGHT_Q3 = Var::input("right_q3", READY_POSE[2]).unit("rad").desc("right_joint3 angle"),
-    RIGHT_Q4 = Var::input("right_q4", READY_POSE[3]).unit("rad").desc("right_joint4 angle"),
-    RIGHT_Q5 = Var::input("right_q5", READY_POSE[4]).unit("rad").desc("right_joint5 angle"),
-    RIGHT_Q6 = Var::input("right_q6", READY_POSE[5]).unit("rad").desc("right_joint6 angle"),
-    RIGHT_Q7 = Var::input("right_q7", READY_POSE[6]).unit("rad").desc("right_joint7 angle"),
-    LEFT_FINGER_WIDTH = Var::input("left_finger_width", OPEN_WIDTH).unit("m")
-        .desc("Gap between the left gripper's finger pads (each finger joint = width / 2; clamped to 0..0.08)"),
-    RIGHT_FINGER_WIDTH = Var::input("right_finger_width", OPEN_WIDTH).unit("m")
-        .desc("Gap between the right gripper's finger pads"),
+    LEFT_Q1 = sensor_ports::robot::ARM_JOINTS[0][0],
+    LEFT_Q2 = sensor_ports::robot::ARM_JOINTS[0][1],
+    LEFT_Q3 = sensor_ports::robot::ARM_JOINTS[0][2],
+    LEFT_Q4 = sensor_ports::robot::ARM_JOINTS[0][3],
+    LEFT_Q5 = sensor_ports::robot::ARM_JOINTS[0][4],
+    LEFT_Q6 = sensor_ports::robot::ARM_JOINTS[0][5],
+    LEFT_Q7 = sensor_ports::robot::ARM_JOINTS[0][6],
+    RIGHT_Q1 = sensor_ports::robot::ARM_JOINTS[1][0],
+    RIGHT_Q2 = sensor_ports::robot::ARM_JOINTS[1][1],
+    RIGHT_Q3 = sensor_ports::robot::ARM_JOINTS[1][2],
+    RIGHT_Q4 = sensor_ports::robot::ARM_JOINTS[1][3],
+    RIGHT_Q5 = sensor_ports::robot::ARM_JOINTS[1][4],
+    RIGHT_Q6 = sensor_ports::robot::ARM_JOINTS[1][5],
+    RIGHT_Q7 = sensor_ports::robot::ARM_JOINTS[1][6],
+    LEFT_FINGER_WIDTH = sensor_ports::robot::FINGER_WIDTHS[0],
+    RIGHT_FINGER_WIDTH = sensor_ports::robot::FINGER_WIDTHS[1],
     GRASP_TOLERANCE = Var::param("grasp_tolerance", Start::Float64(0.003)).unit("m").range(0.0, 0.05)
         .desc("Attach: gap <= fruit diameter + this, and the fruit centre within the finger pads widened by this"),
     RELEASE_MARGIN = Var::param("release_margin", Start::Float64(0.005)).unit("m").range(0.0, 0.05)

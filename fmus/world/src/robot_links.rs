@@ -5,7 +5,7 @@
 //! the contacts reported on `base_link`), so base_link's own box and the wheel and steering
 //! links are left out: they lie inside or below it, and wheels touch the floor by design.
 
-use crate::robot_model::{RobotModel, Side};
+use crate::robot_model::{chassis_link, RobotModel, Side};
 use crate::robot_parts::{Group, LinkBody, RobotPart};
 use crate::scene_world::SceneWorld;
 use agrisim_robot::{Pose as RPose, Shape};
@@ -14,11 +14,6 @@ use rapier3d::prelude::*;
 /// `user_data` of link colliders: this plus the part index (scene objects carry their index,
 /// far below; the base box carries [`crate::scene_world::ROBOT_TAG`]).
 pub const PART_TAG: u128 = 1 << 64;
-
-/// Links without world colliders: base_link (the base box stands for it) and the wheel units.
-pub fn skipped_link(name: &str) -> bool {
-    name == "base_link" || name.ends_with("_steer_link") || name.ends_with("_wheel_link")
-}
 
 pub fn group_of(name: &str) -> Group {
     if name.starts_with("left_") {
@@ -35,29 +30,13 @@ pub fn base_pose(x: f64, y: f64, yaw: f64) -> RPose {
     RPose::from_xyz_rpy([x, y, 0.0], [0.0, 0.0, yaw])
 }
 
-/// rapier (f32) pose of an f64 transform: rotation matrix -> quaternion (Shepperd's method,
-/// largest diagonal term first for accuracy).
+/// rapier (f32) pose of an f64 transform.
 pub fn to_rapier(p: &RPose) -> Pose {
-    let m = &p.rot;
-    let tr = m[0][0] + m[1][1] + m[2][2];
-    let (x, y, z, w) = if tr > 0.0 {
-        let s = (tr + 1.0).sqrt() * 2.0;
-        ((m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s, 0.25 * s)
-    } else if m[0][0] > m[1][1] && m[0][0] > m[2][2] {
-        let s = (1.0 + m[0][0] - m[1][1] - m[2][2]).sqrt() * 2.0;
-        (0.25 * s, (m[0][1] + m[1][0]) / s, (m[0][2] + m[2][0]) / s, (m[2][1] - m[1][2]) / s)
-    } else if m[1][1] > m[2][2] {
-        let s = (1.0 + m[1][1] - m[0][0] - m[2][2]).sqrt() * 2.0;
-        ((m[0][1] + m[1][0]) / s, 0.25 * s, (m[1][2] + m[2][1]) / s, (m[0][2] - m[2][0]) / s)
-    } else {
-        let s = (1.0 + m[2][2] - m[0][0] - m[1][1]).sqrt() * 2.0;
-        ((m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, 0.25 * s, (m[1][0] - m[0][1]) / s)
-    };
-    let n = (x * x + y * y + z * z + w * w).sqrt();
+    let [x, y, z, w] = p.quaternion();
     let t = p.trans;
     Pose::from_parts(
         Vector::new(t[0] as f32, t[1] as f32, t[2] as f32),
-        Rotation::from_xyzw((x / n) as f32, (y / n) as f32, (z / n) as f32, (w / n) as f32),
+        Rotation::from_xyzw(x as f32, y as f32, z as f32, w as f32),
     )
 }
 
@@ -106,7 +85,7 @@ impl SceneWorld {
             floor_counts: false,
         });
         for (i, link) in model.robot.links().iter().enumerate() {
-            if link.colliders.is_empty() || skipped_link(&link.name) {
+            if link.colliders.is_empty() || chassis_link(&link.name) {
                 continue;
             }
             let pose = to_rapier(&base.mul(&link_in_base[i]));

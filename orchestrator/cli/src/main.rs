@@ -58,7 +58,7 @@ enum Command {
         #[command(subcommand)]
         command: BenchCommand,
     },
-    /// Pictures of the default view: DIR/rgb.png, DIR/depth.png, DIR/lidar_top.png.
+    /// Pictures of the default view: DIR/rgb.png, DIR/depth.png, DIR/lidar_top.png, DIR/lidar_near.png.
     Snapshot {
         #[arg(long, default_value = "models/scenarios/default.toml")]
         scenario: PathBuf,

@@ -2,7 +2,8 @@
 //! importer would, places the robot in an aisle of the scenario's greenhouse, and writes the
 //! RGB image, a colour-mapped depth image and a top-down view of one second of LiDAR points.
 //! The scenario's `[environment]` (sun, weather) and `[parameters.camera]` / `[parameters.lidar]`
-//! apply as in a run.
+//! apply as in a run. The robot poses as at work: lift raised, both arms reaching forward
+//! and down (the sensors see its links); the scenario's parameters can set those inputs too.
 
 use agrisim_cosim::archive::FmuArchive;
 use agrisim_error::{Context, Result};
@@ -17,8 +18,14 @@ use std::path::{Path, PathBuf};
 
 const STEP: f64 = 0.02;
 
-/// Instantiates `file` as component `name`: the scenario's scene and environment, then its
-/// `[parameters.<name>]` overrides (e.g. the camera's resolution), then the robot's pose.
+/// The robot's pose in the pictures: lift extension and both arms' joints (hands 0.9 m ahead
+/// of base_link, 0.25 m to each side, 0.76 m above the lift's lowest position).
+const LIFT: f64 = 0.3;
+const ARMS: [f64; 7] = [0.0, 0.6, 0.0, -1.6, 0.0, 2.2, 0.785];
+
+/// Instantiates `file` as component `name`: the scenario's scene and environment, the robot's
+/// working pose (and the camera on the lift) where the scenario does not set them, its
+/// `[parameters.<name>]` overrides (e.g. the camera's resolution), then the base pose.
 fn open(s: &Scenario, o: &RunOptions, file: &str, name: &str, pose: [f64; 3]) -> Result<(FmuArchive, Instance)> {
     let a = FmuArchive::open(&o.fmu_dir.join(file), &o.cache_dir)?;
     let mut inst = Instance::instantiate(&a, name, false)?;
@@ -28,7 +35,21 @@ fn open(s: &Scenario, o: &RunOptions, file: &str, name: &str, pose: [f64; 3]) ->
     if !environment.is_empty() {
         value::set(&mut inst, &var("environment")?, &Value::Str(environment))?;
     }
-    for (n, v) in s.parameters.get(name).into_iter().flatten() {
+    let given = s.parameters.get(name);
+    let mut robot = vec![("lift_position".to_string(), LIFT)];
+    if name == "camera" {
+        // On the lift carriage, as on the robot (camera_link at (0.32, 0, 0.60 + lift), agrisim_robot.urdf).
+        robot.extend([("mount_x".to_string(), 0.32), ("mount_z".to_string(), 0.60)]);
+    }
+    for side in ["left", "right"] {
+        robot.extend(ARMS.iter().enumerate().map(|(i, &q)| (format!("{side}_q{}", i + 1), q)));
+    }
+    for (n, v) in robot {
+        if let (Some(var), false) = (a.md.variable(&n), given.is_some_and(|p| p.contains_key(&n))) {
+            value::set(&mut inst, &var.clone(), &Value::F64(v))?;
+        }
+    }
+    for (n, v) in given.into_iter().flatten() {
         let var = var(n)?;
         let val = value::from_toml(&var, v).map_err(|e| agrisim_error::err!("scenario parameter {name}.{n}: {e}"))?;
         value::set(&mut inst, &var, &val)?;
@@ -67,7 +88,7 @@ fn write(path: PathBuf, w: u32, h: u32, rgb: &[u8], written: &mut Vec<PathBuf>) 
     Ok(())
 }
 
-/// Writes rgb.png, depth.png and lidar_top.png into `out`; returns their paths.
+/// Writes rgb.png, depth.png, lidar_top.png and lidar_near.png into `out`; returns their paths.
 pub fn snapshot(s: &Scenario, o: &RunOptions, out: &Path) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(out).context(|| format!("cannot create {}", out.display()))?;
     let g = agrisim_session::scene::generate_scene(s)?;
@@ -91,12 +112,12 @@ pub fn snapshot(s: &Scenario, o: &RunOptions, out: &Path) -> Result<Vec<PathBuf>
     }
     write(out.join("depth.png"), depth.width, depth.height, &rgb, &mut written)?;
 
-    // One second of LiDAR frames, top-down, 20 m x 20 m around the robot, coloured by height
-    // (points above 2.5 m left out).
+    // One second of LiDAR frames, top-down, coloured by height (points above 2.5 m left
+    // out): 20 m x 20 m around the robot, and 4 m x 4 m (the robot's own links).
     let (la, mut lidar) = open(s, o, "Lidar.fmu", "lidar", pose)?;
     let mount_z = la.md.variable("mount_z").and_then(|v| v.start.as_deref()?.parse::<f64>().ok()).unwrap_or(1.0);
-    let (size, px) = (20.0, 800usize);
-    let mut top = vec![245u8; px * px * 3];
+    let px = 800usize;
+    let mut views = [(20.0, vec![245u8; px * px * 3]), (4.0, vec![245u8; px * px * 3])];
     let mut seen = 0;
     let mut t = 0.0;
     for _ in 0..50 {
@@ -114,13 +135,17 @@ pub fn snapshot(s: &Scenario, o: &RunOptions, out: &Path) -> Result<Vec<PathBuf>
             if (f(0) == 0.0 && f(1) == 0.0 && f(2) == 0.0) || z > 2.5 {
                 continue; // no return, or roof and gutters (they would hide the rows)
             }
-            let (i, j) = (((x + size / 2.0) / size * px as f64) as i64, ((size / 2.0 - y) / size * px as f64) as i64);
-            if (0..px as i64).contains(&i) && (0..px as i64).contains(&j) {
-                let k = (j as usize * px + i as usize) * 3;
-                top[k..k + 3].copy_from_slice(&colormap(z / 2.5));
+            for (size, top) in views.iter_mut() {
+                let (i, j) = (((x + *size / 2.0) / *size * px as f64) as i64, ((*size / 2.0 - y) / *size * px as f64) as i64);
+                if (0..px as i64).contains(&i) && (0..px as i64).contains(&j) {
+                    let k = (j as usize * px + i as usize) * 3;
+                    top[k..k + 3].copy_from_slice(&colormap(z / 2.5));
+                }
             }
         }
     }
+    let [(_, top), (_, near)] = views;
     write(out.join("lidar_top.png"), px as u32, px as u32, &top, &mut written)?;
+    write(out.join("lidar_near.png"), px as u32, px as u32, &near, &mut written)?;
     Ok(written)
 }
