@@ -1,6 +1,7 @@
 //! Rays per second of whole frames: the default greenhouse, the robot at the layout's start
-//! pose and in the middle of aisle 0, default sensor. `cargo run --release -p
-//! agrisim-fmu-lidar --example frame_rate [SCENE.toml-keys-file]`.
+//! pose and in the middle of aisle 0, default sensor, the robot's links in their default pose.
+//! `cargo run --release -p agrisim-fmu-lidar --example frame_rate [SCENE.toml-keys-file|-] [ROBOT_LINKS]`
+//! (ROBOT_LINKS `false`: the base box only, as before the links were seen).
 
 use agrisim_fmi::{Model, Quiet, Store, Value};
 use agrisim_fmu_lidar::ports::*;
@@ -9,7 +10,8 @@ use agrisim_greenhouse::{generate, GreenhouseConfig};
 use std::time::Instant;
 
 fn main() {
-    let scene = std::env::args().nth(1).map(|p| std::fs::read_to_string(p).expect("scene file")).unwrap_or_default();
+    let scene = std::env::args().nth(1).filter(|p| p != "-").map(|p| std::fs::read_to_string(p).expect("scene file")).unwrap_or_default();
+    let robot_links = std::env::args().nth(2).is_none_or(|s| s != "false");
     let cfg = GreenhouseConfig::from_toml_str(&scene).expect("scene");
     let t = Instant::now();
     let gh = generate(&cfg, cfg.seed);
@@ -17,6 +19,7 @@ fn main() {
     let poses = [("start pose", gh.layout.start_pose), ("aisle 0 middle", [0.5 * (aisle.x_start + aisle.x_end), aisle.y, 0.0])];
     let mut io = Store::new(Lidar::VARIABLES);
     *io.value_mut(SCENE) = Value::String(scene.clone());
+    *io.value_mut(ROBOT_LINKS) = Value::Boolean(robot_links);
     let mut m = Lidar::new();
     m.initialize(&mut io, 0.0, &mut Quiet).expect("initialize");
     println!("scene: {} objects, generated and prepared in {:.2} s", m.scene().unwrap().object_count(), t.elapsed().as_secs_f64());
