@@ -10,35 +10,13 @@
 
 use agrisim_fmu_camera::optics::{mat_vec, CameraPose, Intrinsics, Mount};
 use agrisim_greenhouse::{generate, gltf, GreenhouseConfig, RayCaster};
-use std::time::Instant;
+#[path = "../../greenhouse/examples/common/mod.rs"]
+mod common;
 
 const FAR: f64 = 1000.0;
 
-fn arg(name: &str) -> Option<String> {
-    let a: Vec<String> = std::env::args().collect();
-    a.iter().position(|x| x == name).and_then(|i| a.get(i + 1).cloned())
-}
-
-/// A version 1.0 .npy file: header padded to 64 bytes, then the raw little-endian data.
-fn write_npy(path: &std::path::Path, descr: &str, shape: &[usize], data: &[u8]) {
-    let shape = match shape {
-        [n] => format!("({n},)"),
-        s => format!("({})", s.iter().map(|v| v.to_string()).collect::<Vec<_>>().join(", ")),
-    };
-    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
-    while (10 + header.len() + 1) % 64 != 0 {
-        header.push(' ');
-    }
-    header.push('\n');
-    let mut out = b"\x93NUMPY\x01\x00".to_vec();
-    out.extend_from_slice(&(header.len() as u16).to_le_bytes());
-    out.extend_from_slice(header.as_bytes());
-    out.extend_from_slice(data);
-    std::fs::write(path, out).expect("write npy");
-}
-
 fn main() {
-    let poses: usize = arg("--poses").map_or(2, |s| s.parse().expect("--poses N"));
+    let poses: usize = common::arg("--poses").map_or(2, |s| s.parse().expect("--poses N"));
     let cfg = GreenhouseConfig::default();
     let gh = generate(&cfg, cfg.seed);
     let rc = RayCaster::new(&gh.objects);
@@ -98,31 +76,19 @@ fn main() {
         }
         dist
     };
-    // Best of three passes each (the machine is shared).
-    let time = |f: &dyn Fn(&[[f32; 6]]) -> Vec<f64>| {
-        let mut out = (Vec::new(), f64::INFINITY);
-        for _ in 0..3 {
-            let t = Instant::now();
-            let d = f(&rays);
-            out = (d, out.1.min(t.elapsed().as_secs_f64()));
-        }
-        out
-    };
-    let (dist_single, secs_single) = time(&single);
-    let (dist, secs) = time(&packets);
-    assert!(dist.iter().zip(&dist_single).all(|(a, b)| a == b), "packets and single rays disagree");
+    let (dist, secs, secs_single) = common::time_packets_and_single(&|| single(&rays), &|| packets(&rays));
     let n = rays.len();
     let hits = dist.iter().filter(|d| d.is_finite()).count();
     println!("camera depth rays  {n} ({poses} frames of 1280x720), hits {:.1} %", 100.0 * hits as f64 / n as f64);
     println!("rays/s             {:.3e} in 8x8 packets, {:.3e} as single rays (single thread, best of 3; identical hits)", n as f64 / secs, n as f64 / secs_single);
-    if let Some(dir) = arg("--out") {
+    if let Some(dir) = common::arg("--out") {
         let dir = std::path::PathBuf::from(dir);
         std::fs::create_dir_all(&dir).expect("out dir");
         gltf::write_glb(&gh.objects, &dir.join("scene.glb")).expect("glb");
         let rb: Vec<u8> = rays.iter().flat_map(|r| r.iter().flat_map(|v| v.to_le_bytes())).collect();
-        write_npy(&dir.join("rays.npy"), "<f4", &[n, 6], &rb);
+        common::write_npy(&dir.join("rays.npy"), "<f4", &[n, 6], &rb).expect("npy");
         let db: Vec<u8> = dist.iter().flat_map(|v| v.to_le_bytes()).collect();
-        write_npy(&dir.join("dist.npy"), "<f8", &[n], &db);
+        common::write_npy(&dir.join("dist.npy"), "<f8", &[n], &db).expect("npy");
         std::fs::write(
             dir.join("rust.json"),
             format!("{{\"rays\": {n}, \"seconds\": {secs}, \"rays_per_s\": {}, \"single_ray_rays_per_s\": {}, \"objects\": {}, \"min_range\": 0.0, \"max_range\": {FAR}}}\n", n as f64 / secs, n as f64 / secs_single, gh.objects.len()),

@@ -14,7 +14,6 @@ use agrisim_fmu_lidar::datasheet as ds;
 use agrisim_fmu_lidar::pattern::ScanPattern;
 use agrisim_greenhouse::raycast::MAX_PACKET;
 use agrisim_greenhouse::{generate, gltf, GreenhouseConfig, RayCaster};
-use std::time::Instant;
 
 fn main() {
     let frames: usize = common::arg("--frames").map_or(12, |s| s.parse().expect("--frames N"));
@@ -60,18 +59,7 @@ fn main() {
         }
         dist
     };
-    let time = |f: &dyn Fn() -> Vec<f64>| {
-        let mut out = (Vec::new(), f64::INFINITY);
-        for _ in 0..3 {
-            let t = Instant::now();
-            let d = f();
-            out = (d, out.1.min(t.elapsed().as_secs_f64()));
-        }
-        out
-    };
-    let (dist_single, secs_single) = time(&single);
-    let (dist, secs) = time(&packets);
-    assert!(dist.iter().zip(&dist_single).all(|(a, b)| a == b), "packets and single rays disagree");
+    let (dist, secs, secs_single) = common::time_packets_and_single(&single, &packets);
     let n = rays.len();
     let hits = dist.iter().filter(|d| d.is_finite()).count();
     println!("LiDAR pattern rays {n} ({frames} frames x {} spots), hits {:.1} %", spots.len(), 100.0 * hits as f64 / n as f64);

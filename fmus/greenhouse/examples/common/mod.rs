@@ -71,3 +71,22 @@ pub fn arg(key: &str) -> Option<String> {
     let args: Vec<String> = std::env::args().collect();
     args.iter().position(|a| a == key).and_then(|i| args.get(i + 1).cloned())
 }
+
+/// Times `single` and `packets` (best of three passes each: the machine is shared), checks
+/// they give the same distances, and returns (distances, seconds per pass of packets, of
+/// single rays).
+pub fn time_packets_and_single(single: &dyn Fn() -> Vec<f64>, packets: &dyn Fn() -> Vec<f64>) -> (Vec<f64>, f64, f64) {
+    let time = |f: &dyn Fn() -> Vec<f64>| {
+        let mut out = (Vec::new(), f64::INFINITY);
+        for _ in 0..3 {
+            let t = std::time::Instant::now();
+            let d = f();
+            out = (d, out.1.min(t.elapsed().as_secs_f64()));
+        }
+        out
+    };
+    let (dist_single, secs_single) = time(single);
+    let (dist, secs) = time(packets);
+    assert!(dist.iter().zip(&dist_single).all(|(a, b)| a == b), "packets and single rays disagree");
+    (dist, secs, secs_single)
+}
