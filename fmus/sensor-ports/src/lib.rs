@@ -227,11 +227,31 @@ mod tests {
             names,
             [
                 "scene", "scene_seed", "own", "mount_x", "mount_y", "mount_z", "mount_roll", "mount_pitch", "mount_yaw", "base_length",
-                "base_width", "base_height", "base_clearance", "base_x", "base_y", "base_yaw", "out"
+                "base_width", "base_height", "base_clearance", "base_x", "base_y", "base_yaw", "out", "robot_links", "lift_position",
+                "left_q1", "left_q2", "left_q3", "left_q4", "left_q5", "left_q6", "left_q7", "left_finger_width", "right_q1", "right_q2",
+                "right_q3", "right_q4", "right_q5", "right_q6", "right_q7", "right_finger_width"
             ]
         );
         assert_eq!((OWN, OUT, SENSOR_PORTS.base_pose), (2, 16, [13, 14, 15]));
+        assert_eq!((SENSOR_PORTS.robot_links, SENSOR_PORTS.lift, SENSOR_PORTS.arms[1][6], SENSOR_PORTS.widths), (17, 18, 33, [26, 34]));
+        assert_eq!(SENSOR_PORTS.link, "test_link");
         assert_eq!(VARIABLES[MOUNT_X].description, "test_link position on base_link");
+    }
+
+    #[test]
+    fn robot_inputs_read_as_coords_unless_links_are_off() {
+        let mut io = Store::new(VARIABLES);
+        let c = SENSOR_PORTS.coords(&io).unwrap().unwrap();
+        assert_eq!(c, crate::robot::Coords::default());
+        io.set_f64(LEFT_Q3, 0.4);
+        io.set_f64(RIGHT_FINGER_WIDTH, 0.02);
+        io.set_f64(LIFT_POSITION, 0.3);
+        let c = SENSOR_PORTS.coords(&io).unwrap().unwrap();
+        assert_eq!((c.arms[0][2], c.widths[1], c.lift), (0.4, 0.02, 0.3));
+        io.set_f64(RIGHT_Q5, f64::NAN);
+        assert!(SENSOR_PORTS.coords(&io).unwrap_err().contains("right_q5"));
+        *io.value_mut(ROBOT_LINKS) = agrisim_fmi::Value::Boolean(false);
+        assert_eq!(SENSOR_PORTS.coords(&io).unwrap(), None);
     }
 
     #[test]
