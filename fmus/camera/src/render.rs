@@ -232,17 +232,13 @@ impl Ctx<'_> {
                 }
             }
         }
-        let samples = match l.shadows {
-            Shadows::None => {
-                which[..m].iter().for_each(|&i| beams[i] = l.cover_tau);
-                return beams;
-            }
-            Shadows::Hard => 1,
-            Shadows::Soft(n) => n.max(1),
+        let Some(samples) = self.sun_samples() else {
+            which[..m].iter().for_each(|&i| beams[i] = l.cover_tau);
+            return beams;
         };
         let mut out = [None; MAX_PACKET];
         for k in 0..samples {
-            let s = if samples == 1 { l.sun } else { sun_disc_sample(l.sun, k, samples) };
+            let s = sun_disc_sample(l.sun, k, samples);
             self.scene.caster.pass_through_packet(&points[..m], s, EPS, FAR, self.movers, |id| shading::casts_shadow(self.scene.kind(id)), &mut out[..m]);
             for (q, &i) in which[..m].iter().enumerate() {
                 beams[i] += transmittance(out[q], l.cover_tau);
@@ -328,16 +324,17 @@ impl Ctx<'_> {
     /// Fraction of the sun's beam reaching `p` (0 = shadow; cover layers attenuate).
     fn beam(&self, p: Vec3) -> f64 {
         let l = self.light;
-        match l.shadows {
-            Shadows::None => l.cover_tau,
-            Shadows::Hard => transmitted(self.scene, self.movers, p, l.sun, l.cover_tau),
-            Shadows::Soft(n) => {
-                let n = n.max(1);
-                let sum: f64 = (0..n)
-                    .map(|i| transmitted(self.scene, self.movers, p, sun_disc_sample(l.sun, i, n), l.cover_tau))
-                    .sum();
-                sum / n as f64
-            }
+        let Some(n) = self.sun_samples() else { return l.cover_tau };
+        let sum: f64 = (0..n).map(|k| transmitted(self.scene, self.movers, p, sun_disc_sample(l.sun, k, n), l.cover_tau)).sum();
+        sum / n as f64
+    }
+
+    /// Shadow rays per lit point (directions by [`sun_disc_sample`]); None: no shadows.
+    fn sun_samples(&self) -> Option<u32> {
+        match self.light.shadows {
+            Shadows::None => None,
+            Shadows::Hard => Some(1),
+            Shadows::Soft(n) => Some(n.max(1)),
         }
     }
 }

@@ -26,7 +26,8 @@ impl RobotInBaseLink {
     /// Re-poses the links for `coords` (nothing to do when they are unchanged).
     pub fn update(&mut self, coords: Option<Coords>) {
         if coords != self.coords {
-            *self = RobotInBaseLink::new(self.body.clone(), coords);
+            self.caster = RayCaster::new(&self.body.objects(coords.as_ref(), 0.0, 0.0, 0.0));
+            self.coords = coords;
         }
     }
 }

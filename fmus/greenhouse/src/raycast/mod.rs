@@ -340,19 +340,9 @@ impl<F: Fn(u32) -> bool> PacketVisit for PacketThrough<'_, F> {
             if !rays[i] {
                 continue;
             }
-            for k in start..start + count {
-                let p = &self.caster.prims[k];
-                if let Some((t, _)) = p.intersect(*o, self.d, self.tmin, self.tmax) {
-                    if (self.opaque)(self.caster.ids[k]) {
-                        self.blocked[i] = true;
-                        packet.far[i] = f32::NEG_INFINITY;
-                        break;
-                    }
-                    self.at[i].push(t);
-                    if let Some((t2, _)) = p.intersect(*o, self.d, t + RESTART, self.tmax) {
-                        self.at[i].push(t2);
-                    }
-                }
+            if cross_leaf(self.caster, start, count, *o, self.d, self.tmin, self.tmax, self.opaque, &mut self.at[i]) {
+                self.blocked[i] = true;
+                packet.far[i] = f32::NEG_INFINITY;
             }
         }
     }
@@ -415,20 +405,27 @@ impl<F: Fn(u32) -> bool> Visit for Through<'_, F> {
     }
 
     fn leaf(&mut self, start: usize, count: usize) -> bool {
-        for k in start..start + count {
-            let p = &self.caster.prims[k];
-            if let Some((t, _)) = p.intersect(self.o, self.d, self.tmin, self.tmax) {
-                if (self.opaque)(self.caster.ids[k]) {
-                    return true;
-                }
-                self.at.push(t);
-                if let Some((t2, _)) = p.intersect(self.o, self.d, t + RESTART, self.tmax) {
-                    self.at.push(t2);
-                }
+        cross_leaf(self.caster, start, count, self.o, self.d, self.tmin, self.tmax, self.opaque, self.at)
+    }
+}
+
+/// One shadow ray through the primitives `start..start + count` of a leaf: true at an opaque
+/// hit, else the translucent ones' surface crossings (in and out) go to `at`.
+#[allow(clippy::too_many_arguments)]
+fn cross_leaf(caster: &RayCaster, start: usize, count: usize, o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, opaque: &impl Fn(u32) -> bool, at: &mut Crossings) -> bool {
+    for k in start..start + count {
+        let p = &caster.prims[k];
+        if let Some((t, _)) = p.intersect(o, d, tmin, tmax) {
+            if opaque(caster.ids[k]) {
+                return true;
+            }
+            at.push(t);
+            if let Some((t2, _)) = p.intersect(o, d, t + RESTART, tmax) {
+                at.push(t2);
             }
         }
-        false
     }
+    false
 }
 
 /// Counters for [`RayCaster::traversal_stats`]; `()` counts nothing and compiles away.
