@@ -73,6 +73,7 @@ def test_successful_harvests_place_the_fruit_by_ground_truth(bench):
     for t in ok:
         assert t["placed_count"] == 1
         assert t["contacts"]["contact_robot_structure"] == 0 and t["contacts"]["contact_arm_arm"] == 0
+        assert t["contacts"]["contact_carried_structure"] == 0
         assert 0 < t["tracking_rms"][0] < 0.05 and 0 < t["tracking_rms"][1] < 0.05
     for t in ts:
         if t["outcome"] != "success":
@@ -102,6 +103,27 @@ def test_trial_mcap_decodes_and_reports_every_stage(bench):
             "agrisim_msgs/msg/TrajectoryStatus"} <= types
     if t["outcome"] == "success":
         assert [s for s in STAGES if s in stages] == STAGES, stages
+
+
+def test_planning_time_is_charged_in_simulated_time(bench):
+    # Every plan reports the simulated time it took; each trajectory starts no earlier than
+    # the step that planned it plus that time (header.stamp after the publication time).
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+
+    t = trials(bench)[0]
+    charged, delays = [], []
+    with open(bench / t["mcap"], "rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        for _, channel, message, d in reader.iter_decoded_messages(topics=["/harvest/plans", "/left_arm/joint_trajectory", "/right_arm/joint_trajectory"]):
+            if channel.topic == "/harvest/plans":
+                charged.append(d.planning_time)
+            else:
+                delays.append(d.header.stamp.sec + 1e-9 * d.header.stamp.nanosec - message.publish_time * 1e-9)
+    assert charged and all(c > 0 for c in charged), charged
+    assert abs(sum(charged) - t["thinking_time"]) < 1e-9
+    assert delays and all(d > 0 for d in delays), delays
+    assert max(delays) <= sum(charged) + 1e-6
 
 
 def test_same_seed_gives_byte_identical_trial(bench, free_scenario, tmp_path):

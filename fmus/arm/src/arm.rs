@@ -7,7 +7,7 @@ use crate::gripper::Gripper;
 use crate::inertia::joint_inertia;
 use crate::ports::*;
 use crate::reference::{Reference, Setpoint};
-use crate::validate::validate;
+use crate::validate::{check, decode};
 use agrisim_fmi::{InPort, Log, Model, OutPort, Store, Var};
 use agrisim_fmu_util::{to_ns, Schedule};
 use agrisim_math::Rng;
@@ -184,20 +184,27 @@ impl Arm {
         Ok(())
     }
 
+    /// Takes one trajectory message received at `t_ns`. It starts at its `header.stamp` when
+    /// that lies ahead (a planner's result that becomes valid later), else at once; the
+    /// trajectory it replaces runs until then.
     fn take_trajectory(&mut self, bytes: &[u8], t_ns: i64, log: &mut dyn Log) {
-        let from: Setpoint = self.reference.sample(t_ns);
-        match validate(bytes, self.description(), &from.q) {
+        let msg = decode(bytes);
+        let start_ns = msg.as_ref().map_or(t_ns, |m| m.header.stamp.to_nanos().max(t_ns));
+        let from: Setpoint = self.reference.sample(start_ns);
+        match msg.and_then(|m| check(&m, self.description(), &from.q)) {
             Ok(points) => {
-                self.reference = Reference::new(t_ns, &from, &points);
+                let old = std::mem::replace(&mut self.reference, Reference::hold(from.q));
+                self.reference = Reference::new(start_ns, &from, &points).after(old, t_ns);
                 self.accepted += 1;
                 self.rejected_last = false;
                 self.exec = Exec::Executing;
                 self.errors = ErrorStats::default();
                 log.info(format_args!(
-                    "{} arm: trajectory {} accepted at t={} s ({} points, {} s)",
+                    "{} arm: trajectory {} accepted at t={} s, starting at {} s ({} points, {} s)",
                     self.description().side,
                     self.accepted,
                     t_ns as f64 * 1e-9,
+                    start_ns as f64 * 1e-9,
                     points.len(),
                     points.last().map_or(0, |p| p.t_ns) as f64 * 1e-9
                 ));
@@ -264,6 +271,7 @@ impl Arm {
             }
         }
         self.arm = Some(d);
+        self.reference.prune(to_ns);
     }
 
     fn joint_state_message(&mut self, s: &Snapshot) -> JointState {

@@ -67,18 +67,21 @@ fn eval(c: &[f64; 6], s: f64) -> (f64, f64, f64) {
     (q, qd, qdd)
 }
 
-/// A trajectory being executed: starts at `start_ns` (absolute simulation time).
+/// A trajectory being executed: starts at `start_ns` (absolute simulation time). Before
+/// that (a trajectory stamped to start later, as ros2_control's joint_trajectory_controller
+/// allows) the one it replaced goes on: `before`.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Reference {
     start_ns: i64,
     segments: Vec<Segment>,
     last: [f64; N],
+    before: Option<Box<Reference>>,
 }
 
 impl Reference {
     /// Holds `q` forever.
     pub fn hold(q: [f64; N]) -> Reference {
-        Reference { start_ns: 0, segments: vec![], last: q }
+        Reference { start_ns: 0, segments: vec![], last: q, before: None }
     }
 
     /// Builds the segments of `points` (validated, times strictly increasing), starting at
@@ -103,7 +106,24 @@ impl Reference {
             prev = end;
         }
         let last = points.last().map_or(from.q, |w| w.q);
-        Reference { start_ns, segments, last }
+        Reference { start_ns, segments, last, before: None }
+    }
+
+    /// This trajectory, with `old` running until it starts (dropped when it starts now).
+    pub fn after(mut self, old: Reference, now_ns: i64) -> Reference {
+        if self.start_ns > now_ns {
+            self.before = Some(Box::new(old));
+        }
+        self
+    }
+
+    /// Forgets what ran before `now_ns` (keeps the chain short).
+    pub fn prune(&mut self, now_ns: i64) {
+        if self.start_ns <= now_ns {
+            self.before = None;
+        } else if let Some(b) = &mut self.before {
+            b.prune(now_ns);
+        }
     }
 
     /// Absolute end time [ns] (the start for a hold).
@@ -113,6 +133,9 @@ impl Reference {
 
     /// Desired state at absolute time `t_ns`.
     pub fn sample(&self, t_ns: i64) -> Setpoint {
+        if let Some(b) = self.before.as_ref().filter(|_| t_ns < self.start_ns) {
+            return b.sample(t_ns);
+        }
         let rel = t_ns - self.start_ns;
         // Segments are sorted and contiguous: the first one ending after `rel`.
         let Some(seg) = self.segments.get(self.segments.partition_point(|s| s.t1_ns <= rel)) else {
@@ -159,6 +182,27 @@ mod tests {
             // Past the end: hold.
             assert_eq!(r.sample(r.end_ns() + 5), Setpoint::hold([1.0; N]));
         }
+    }
+
+    /// A trajectory that starts later leaves the running one in charge until then, and the
+    /// old one is forgotten once the new one has started.
+    #[test]
+    fn a_later_start_keeps_the_old_trajectory_until_then() {
+        let old = Reference::new(0, &Setpoint::hold([0.0; N]), &[wp(1_000_000_000, 1.0, Some(0.0), Some(0.0))]);
+        let at = old.sample(1_500_000_000);
+        let mut new = Reference::new(2_000_000_000, &at, &[wp(1_000_000_000, 2.0, Some(0.0), Some(0.0))]).after(old.clone(), 500_000_000);
+        assert_eq!(new.sample(600_000_000), old.sample(600_000_000), "the old one still runs");
+        assert_eq!(new.sample(1_900_000_000), Setpoint::hold([1.0; N]), "then holds its end");
+        assert!((new.sample(2_000_000_000).q[0] - 1.0).abs() < 1e-12);
+        assert!((new.sample(3_000_000_000).q[0] - 2.0).abs() < 1e-9);
+        assert_eq!(new.end_ns(), 3_000_000_000);
+        new.prune(1_000_000_000);
+        assert!(new.before.is_some(), "not started yet");
+        new.prune(2_000_000_000);
+        assert!(new.before.is_none());
+        // Starting now: nothing kept.
+        let now = Reference::new(500, &at, &[wp(10, 1.0, None, None)]).after(old, 500);
+        assert!(now.before.is_none());
     }
 
     /// Velocity is the derivative of position (central differences), for a 3-point quintic.

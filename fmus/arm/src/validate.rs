@@ -40,9 +40,12 @@ fn fmt_t(ns: i64) -> String {
 
 /// Decodes and validates `bytes`; `q_cmd` is the commanded position at arrival.
 pub fn validate(bytes: &[u8], arm: &ArmDescription, q_cmd: &[f64; N]) -> Result<Vec<Waypoint>, String> {
-    let msg = JointTrajectory::from_cdr(bytes)
-        .map_err(|e| format!("not a valid trajectory_msgs/msg/JointTrajectory CDR message ({} bytes): {e}", bytes.len()))?;
-    check(&msg, arm, q_cmd)
+    check(&decode(bytes)?, arm, q_cmd)
+}
+
+/// The trajectory message in `bytes`.
+pub fn decode(bytes: &[u8]) -> Result<JointTrajectory, String> {
+    JointTrajectory::from_cdr(bytes).map_err(|e| format!("not a valid trajectory_msgs/msg/JointTrajectory CDR message ({} bytes): {e}", bytes.len()))
 }
 
 /// Validates a decoded trajectory.

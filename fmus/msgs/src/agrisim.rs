@@ -144,6 +144,8 @@ ros_message! {
 ros_message! {
     /// `agrisim_msgs/msg/PlanResult`: one motion plan a task node asked for and its result;
     /// `optional` plans have a fallback, so their failure does not fail the task.
+    /// `planning_time`: the simulated time the plan took [s] (the node's own account; a
+    /// trajectory it produced starts no earlier than that after the request).
     #[derive(Debug, Default, Clone, PartialEq)]
     pub struct PlanResult = "agrisim_msgs/msg/PlanResult" {
         pub header: Header,
@@ -153,5 +155,6 @@ ros_message! {
         pub ok: bool,
         pub optional: bool,
         pub detail: String,
+        pub planning_time: f64,
     }
 }

@@ -3,10 +3,11 @@
 //!
 //! Arm-arm contacts use the same fields: `robot_link` is the left-arm link, `object_name` the
 //! right-arm link, `object_kind` is [`ARM_KIND`] and `object_id` is [`ARM_OBJECT_ID`] (no
-//! scene object has it). The category of a contact follows from `object_kind` alone (see
-//! [`crate::contacts`]).
+//! scene object has it). A fruit a gripper holds that touches the structure has `robot_link`
+//! [`CARRIED_LINK`] and the object's fields as usual. The category of a contact follows from
+//! `object_kind` and `robot_link` (see [`crate::contacts`]).
 
-use crate::contacts::{Other, RobotContact};
+use crate::contacts::{Other, RobotContact, Toucher};
 use crate::geometry::{point_msg, vector_msg};
 use crate::scene_world::SceneWorld;
 use agrisim_greenhouse::scene::Kind;
@@ -18,6 +19,8 @@ use agrisim_msgs::std_msgs::Header;
 pub const ARM_KIND: &str = "robot_arm";
 /// `object_id` of an arm-arm contact.
 pub const ARM_OBJECT_ID: u32 = u32::MAX;
+/// `robot_link` of a contact of a carried fruit (no URDF link has this name).
+pub const CARRIED_LINK: &str = "carried_fruit";
 
 /// Stable lower-case label of a kind (the `object_kind` field).
 pub fn kind_label(kind: Kind) -> &'static str {
@@ -57,7 +60,10 @@ pub fn collision_state(world: &SceneWorld, contacts: &[RobotContact], stamp_ns: 
                     object_id,
                     object_name,
                     object_kind,
-                    robot_link: world.parts[c.part].link.clone(),
+                    robot_link: match c.toucher {
+                        Toucher::Part(p) => world.parts[p].link.clone(),
+                        Toucher::Carried(_) => CARRIED_LINK.to_string(),
+                    },
                     position: point_msg(c.point),
                     normal: vector_msg(c.normal),
                     depth: c.depth as f64,

@@ -119,6 +119,12 @@ impl Harvest {
         matches!(self.state(fruit), FruitState::OnPlant | FruitState::Dropped)
     }
 
+    /// Fruit-list indices of the fruit the grippers hold, each once (both hold it in a handover).
+    pub fn carried(&self) -> impl Iterator<Item = usize> {
+        let [left, right] = self.grippers.map(|g| g.held);
+        left.into_iter().chain(right.filter(|&f| Some(f) != left))
+    }
+
     pub fn any_falling(&self) -> bool {
         self.fruit.values().any(|s| matches!(s, FruitState::Falling { .. }))
     }
@@ -309,5 +315,22 @@ impl Harvest {
         b.enable_ccd(false);
         self.fruit.insert(f, FruitState::Dropped);
         self.dropped += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_fruit_held_by_both_grippers_is_carried_once() {
+        let mut h = Harvest::new(HarvestParams { grasp_tolerance: 0.0, release_margin: 0.0 }, [0.08; 2], [RPose::IDENTITY; 2]);
+        assert_eq!(h.carried().count(), 0);
+        h.grippers[1].held = Some(4);
+        assert_eq!(h.carried().collect::<Vec<_>>(), [4]);
+        h.grippers[0].held = Some(4);
+        assert_eq!(h.carried().collect::<Vec<_>>(), [4], "a handover");
+        h.grippers[0].held = Some(2);
+        assert_eq!(h.carried().collect::<Vec<_>>(), [2, 4]);
     }
 }

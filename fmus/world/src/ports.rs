@@ -42,9 +42,9 @@ agrisim_fmi::variables! { pub VARIABLES {
     // place it; every message is published once, so the *_seq counters start at 1 except
     // target's, which needs a valid target_fruit; nothing is held, picked or placed yet) ---
     COLLISION = Var::output_discrete("collision", Start::Boolean(false)).init_depends_on(&CONTACTS)
-        .desc("Any robot contact now: a scene object (floor excluded for the base box; carried, falling and placed fruit excluded) or arm vs arm"),
+        .desc("Any robot contact now: a scene object (floor excluded for the base box; carried, falling and placed fruit excluded), arm vs arm, or a carried fruit vs the structure"),
     COLLISION_COUNT = Var::output_discrete("collision_count", Start::Int32(0)).init_depends_on(&CONTACTS)
-        .desc("Cumulative contact onsets, all categories (sum of contact_robot_plant, contact_robot_structure, contact_arm_arm)"),
+        .desc("Cumulative contact onsets, all categories (sum of contact_robot_plant, contact_robot_structure, contact_arm_arm, contact_carried_structure)"),
     MIN_CLEARANCE = Var::output("min_clearance").unit("m").init_depends_on(&[SCENE, SEED, BASE_LENGTH, BASE_WIDTH, BASE_HEIGHT, BASE_CLEARANCE, BASE_X, BASE_Y, BASE_YAW, CLEARANCE_CAP])
         .desc("Distance from the base box to the nearest scene object within the base's height band, capped at clearance_cap"),
     COLLISION_STATE = Var::output_discrete("collision_state", Start::Binary(&[])).mime(COLLISION_STATE_MIME).init_depends_on(&COLLISION_REPORT)
@@ -119,6 +119,9 @@ agrisim_fmi::variables! { pub VARIABLES {
         .desc("agrisim_msgs/PlanningScene: scene objects near the robot as primitives (frame map; ids = scene object ids), at planning_scene_rate"),
     PLANNING_SCENE_SEQ = Var::output_discrete("planning_scene_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence number of the newest message in planning_scene"),
     PORT_WINDOW = agrisim_fmi::port_window(),
+    // --- appended: earlier value references stay as they were ---
+    CONTACT_CARRIED_STRUCTURE = Var::output_discrete("contact_carried_structure", Start::Int32(0)).init_depends_on(&CONTACTS)
+        .desc("Cumulative onsets of a fruit held by a gripper touching posts, pipes, gutters, walls, obstacles, floor (the load swung into the structure)"),
 }}
 
 /// The robot's configuration inputs: base pose, lift, arm joints, finger gaps.

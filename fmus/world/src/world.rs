@@ -6,7 +6,7 @@
 use crate::base_box::BaseBox;
 use crate::clearance::min_clearance;
 use crate::collision_report::collision_state;
-use crate::contacts::{robot_contacts, Category, ContactTracker};
+use crate::contacts::{robot_contacts, Category, ContactTracker, Toucher};
 use crate::ground_truth::{fruit_poses, Target};
 use crate::harvest::{Harvest, HarvestParams};
 use crate::planning_scene::planning_scene;
@@ -247,9 +247,11 @@ impl Running {
         io.set_i32(CONTACT_ROBOT_PLANT, count(self.tracker.onsets_in(Category::Plant)));
         io.set_i32(CONTACT_ROBOT_STRUCTURE, count(self.tracker.onsets_in(Category::Structure)));
         io.set_i32(CONTACT_ARM_ARM, count(self.tracker.onsets_in(Category::ArmArm)));
+        io.set_i32(CONTACT_CARRIED_STRUCTURE, count(self.tracker.onsets_in(Category::CarriedStructure)));
         // Anything touching the box lies in its band: clearance 0, whatever f32 rounding in
-        // the distance query says (it can differ from the contact query by ~1e-5 m).
-        let base_touches = contacts.iter().any(|c| c.part == 0);
+        // the distance query says (it can differ from the contact query by ~1e-5 m). Only
+        // part 0, the base box: what a carried fruit touches says nothing of the band.
+        let base_touches = contacts.iter().any(|c| c.toucher == Toucher::Part(0));
         let clearance = if !base_touches { min_clearance(&self.world, self.band, self.clearance_cap) } else { 0.0 };
         io.set_f64(MIN_CLEARANCE, clearance);
         let due = self.collision_schedule.due(t);

@@ -1,7 +1,7 @@
 //! Harvest physics through the Model trait: grasp, carry, place, drop, free fall, handover,
-//! arm-arm and arm-wall contacts, planning scene, determinism. Joint values come from a small numeric IK
-//! (damped least squares on the world's own FK, written here) so the hands really reach the
-//! fruit and the box the way an arm FMU would put them there.
+//! arm-arm, arm-wall and carried-fruit-wall contacts, planning scene, determinism. Joint
+//! values come from a small numeric IK (damped least squares on the world's own FK, written
+//! here) so the hands really reach the fruit and the box the way an arm FMU would put them there.
 
 #![allow(clippy::needless_range_loop)] // small dense linear algebra reads best with indices
 
@@ -519,6 +519,79 @@ fn a_hand_pushed_into_the_wall_is_a_structure_contact() {
         assert!(c.position.x.abs() < 0.02 && c.normal.x > 0.99, "contact on the wall face x = 0: {c:?}");
     }
     assert_eq!((sim.io.i32(CONTACT_ARM_ARM), sim.io.i32(CONTACT_ROBOT_PLANT)), (0, 0));
+}
+
+/// The first fruit past x = 8 m of row 1 hanging on the aisle side (y 7.0-7.2), and the base
+/// pose (in the aisle, facing +x) and inputs putting the left TCP on its centre, the hand
+/// approaching horizontally from the aisle (+y): the robot clear of the rows.
+fn aisle_grasp_setup() -> (usize, [f64; 3], Coords) {
+    let model = RobotModel::load().unwrap();
+    let (f, (p, _)) = fruit_list().into_iter().enumerate().find(|(_, (p, _))| p[0] > 8.0 && p[1] > 7.0 && p[1] < 7.2).expect("a fruit on the aisle side");
+    let planar = [p[0] - 0.3, 6.2, 0.0];
+    // The left shoulder 0.1 m below the fruit.
+    let shoulder = link_in_base(&model, &Coords::default(), "left_link1").trans[2];
+    let mut c = Coords { lift: p[2] - shoulder - 0.1, ..Coords::default() };
+    c.arms[0] = ik(&model, &c, Side::Left, [0.3, p[1] - planar[1], p[2]], [0.0, 1.0, 0.0]);
+    (f, planar, c)
+}
+
+#[test]
+fn a_carried_fruit_pushed_into_the_wall_is_a_carried_structure_contact() {
+    let (f, planar, c0) = aisle_grasp_setup();
+    let mut sim = Sim::start(planar, &c0);
+    assert!(dist(sim.link_in_map(&c0, "left_hand_tcp").trans, sim.fruit_centre(f)) < 1e-6);
+    let mut c = c0;
+    close(&mut sim, &mut c, Side::Left).expect("held");
+    assert_eq!(sim.io.i32(LEFT_HELD_ID), sim.fruit_id(f));
+    let touched = |sim: &Sim| [CONTACT_ROBOT_STRUCTURE, CONTACT_ARM_ARM, CONTACT_CARRIED_STRUCTURE].map(|v| sim.io.i32(v));
+    assert_eq!(touched(&sim), [0, 0, 0], "picked from among its truss: no carried contact");
+    // Out of the row, the hand pointing ahead (base +x): carried through free air, nothing
+    // counts (the counters are cumulative: their end values tell).
+    let model = RobotModel::load().unwrap();
+    let r = sim.diameter(f) / 2.0;
+    let mut near = c;
+    near.lift = 0.2;
+    let (y, z) = (0.0, 1.3);
+    near.arms[0] = ik(&model, &near, Side::Left, [0.6, y, z], [1.0, 0.0, 0.0]);
+    glide(&mut sim, planar, &c, &near, 30, |_, _| {});
+    assert_eq!(touched(&sim), [0, 0, 0], "{:?}", sim.collision_state());
+    // To the headland, 0.85 m from the front wall (its face at x = 0), facing it: the fruit
+    // sticks out past the fingertips toward it.
+    let wall = [0.85, 6.0, std::f64::consts::PI];
+    sim.set(wall, &near);
+    sim.step();
+    assert!(sim.fruit_centre(f)[0] - r > 0.2, "the fruit in free air: {:?}", sim.fruit_centre(f));
+    assert!(!sim.io.bool(COLLISION), "{:?}", sim.collision_state());
+    // Push 1 cm into the wall (about 0.23 m in 60 steps): the fingertips, 5 mm past the
+    // fruit centre, stay clear of it.
+    let mut far = near;
+    far.arms[0] = ik(&model, &near, Side::Left, [0.85 - r + 0.01, y, z], [1.0, 0.0, 0.0]);
+    let mut first = None;
+    glide(&mut sim, wall, &near, &far, 60, |sim, _| {
+        if first.is_none() && sim.io.i32(CONTACT_CARRIED_STRUCTURE) > 0 {
+            first = Some(sim.fruit_centre(f)[0] - r);
+        }
+    });
+    let front = first.expect("the carried fruit hits the wall");
+    assert!(front <= 1e-4 && front > -0.01, "first contact with the fruit's front at x = {front} (wall face at 0)");
+    // Held still for 0.1 s: a periodic collision_state (10 Hz) has the final depth.
+    for _ in 0..5 {
+        sim.step();
+    }
+    assert_eq!(touched(&sim), [0, 0, 1], "one onset while pressed, the robot itself touches nothing");
+    assert_eq!(sim.io.i32(COLLISION_COUNT), sim.io.i32(CONTACT_ROBOT_PLANT) + 1);
+    let s = sim.collision_state();
+    assert!(s.in_collision && sim.io.bool(COLLISION));
+    let [hit] = s.contacts.as_slice() else { panic!("one contact: {s:?}") };
+    assert_eq!((hit.robot_link.as_str(), hit.object_name.as_str(), hit.object_kind.as_str()), ("carried_fruit", "wall_xmin", "wall"));
+    assert!(hit.position.x.abs() < 0.002 && hit.normal.x > 0.99 && (hit.depth - 0.01).abs() < 0.002, "{hit:?}");
+    // Back into free air: no onset; pushed in again: a second one.
+    glide(&mut sim, wall, &far, &near, 20, |_, _| {});
+    assert!(!sim.io.bool(COLLISION), "{:?}", sim.collision_state());
+    assert_eq!(touched(&sim), [0, 0, 1]);
+    glide(&mut sim, wall, &near, &far, 20, |_, _| {});
+    assert_eq!(touched(&sim), [0, 0, 2]);
+    assert_eq!(sim.io.i32(LEFT_HELD_ID), sim.fruit_id(f));
 }
 
 #[test]

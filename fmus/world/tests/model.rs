@@ -34,7 +34,7 @@ fn layout(scene: &str) -> Layout {
 }
 
 fn collision_state(io: &Store) -> CollisionState {
-    CollisionState::from_cdr(agrisim_fmi::port::latest(&io, COLLISION_STATE)).unwrap()
+    CollisionState::from_cdr(agrisim_fmi::port::latest(io, COLLISION_STATE)).unwrap()
 }
 
 /// Steps the base from `from` toward `to` in `n` equal moves (one per step) until it collides;

@@ -63,6 +63,10 @@ pub struct HarvestTrial {
     /// Wall time of each plan [s]: the harvest node's step that asked for it (IK + RRT-Connect
     /// + shortcut + time parameterization), shared among the plans of that step.
     pub planning_times: Vec<f64>,
+    /// Simulated planning time the node charged, summed over its plans (`planning_time` of
+    /// /harvest/plans) [s]: part of the time to harvest.
+    #[serde(default)]
+    pub thinking_time: f64,
     pub time_to_harvest: Option<f64>,
     pub placed_count: i64,
     pub contacts: BTreeMap<String, i64>,
@@ -108,6 +112,11 @@ pub struct HarvestSummary {
     pub planning_time_p50: Option<f64>,
     pub planning_time_p95: Option<f64>,
     pub planning_time_max: Option<f64>,
+    /// Mean simulated planning time per trial [s] (the node's cost model).
+    pub thinking_time_mean: f64,
+    /// Simulated planning time over measured planning wall time, all timed plans: how well the
+    /// node's cost model matches this machine (1 = exactly).
+    pub thinking_over_wall: Option<f64>,
     pub tracking_rms_mean: f64,
     /// Mean per trial of the scene objects the robot began to touch, by kind.
     pub touches_per_trial: BTreeMap<String, f64>,
@@ -138,7 +147,8 @@ impl Touches {
     fn update(&mut self, cs: &CollisionState, target: u32) {
         let mut next = std::collections::BTreeSet::new();
         for c in &cs.contacts {
-            if c.object_id == target || c.object_kind == "robot_arm" || !next.insert(c.object_id) {
+            // Arm-arm and carried-fruit contacts are failures, judged from the world's counters.
+            if c.object_id == target || c.object_kind == "robot_arm" || c.robot_link == "carried_fruit" || !next.insert(c.object_id) {
                 continue;
             }
             if !self.now.contains(&c.object_id) {
@@ -149,8 +159,10 @@ impl Touches {
     }
 }
 
-/// Contact counters of the world FMU that end a trial as a collision.
-pub const COLLISION_COUNTERS: [&str; 2] = ["contact_robot_structure", "contact_arm_arm"];
+/// Contact counters of the world FMU that end a trial as a collision (judged after every
+/// exchange from counters the world updates every step): the robot or a fruit it carries
+/// against the structure, arm against arm.
+pub const COLLISION_COUNTERS: [&str; 3] = ["contact_robot_structure", "contact_arm_arm", "contact_carried_structure"];
 /// Counted but expected: leaves and trusses brush the arm.
 pub const SOFT_COUNTERS: [&str; 1] = ["contact_robot_plant"];
 
@@ -244,31 +256,11 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
     let wall = Instant::now();
     let mut rng = Rng::new(seed);
     let target = draw(&setup.candidates, &setup.layout, &mut rng).expect("candidates checked non-empty");
-    let mut s = s.clone();
-    let chassis = s.parameters.entry("chassis".into()).or_default();
-    for (k, v) in ["x0", "y0", "yaw0"].iter().zip(target.start) {
-        chassis.insert(k.to_string(), toml::Value::Float(v));
-    }
-    // The localizer starts from an operator's estimate of the start pose, never the true one.
-    let (estimate, _) = initial_estimate(target.start, s.nav.initial_pose_std, seed);
-    let mut nav_cfg = NavConfig::for_estimate(estimate, s.nav.initial_pose_std);
-    nav_cfg.embedded_localizer = false;
     let harvest = node(target.fruit_index, seed);
     let node_name = harvest.name().to_string();
-    let mut nodes: Vec<Box<dyn Node>> = vec![
-        Box::new(MapServer::new(grid_message(&setup.map, 0))),
-        Box::new(OdomTf::default()),
-        Box::new(Localizer::new(&nav_cfg)),
-        Box::new(RobotStatePublisher::agrisim()),
-        harvest,
-        Box::new(FaultInjector::new(&s.inject)),
-    ];
-    if o.nodes.external.contains(&node_name) {
-        // An external node takes the harvest node's place: it is told the task the same way.
-        nodes.push(Box::new(crate::task_publisher::TaskPublisher::new(target.fruit_index)));
-    }
-    let opts = RunOptions { seed: Some(seed), ..o.clone() };
-    let mut m = prepare(&s, &opts, mcap, nodes)?;
+    // An external node takes the harvest node's place: it is told the task the same way.
+    let task = o.nodes.external.contains(&node_name).then(|| crate::task_publisher::TaskPublisher::new(target.fruit_index));
+    let mut m = harvest_session(s, o, setup, target.start, seed, mcap, harvest, task)?;
     let (world, arm_l, arm_r) = (m.component("world", "harvest benchmark")?, m.component("arm_left", "harvest benchmark")?, m.component("arm_right", "harvest benchmark")?);
     let max_ticks = (timeout / s.timing.step).round() as u64;
     let mut reports = Reports::subscribe(&mut m.bus);
@@ -358,6 +350,7 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
         planning_ok: planning == "ok",
         plans: reports.plans.len(),
         planning_times: reports.planning_times,
+        thinking_time: reports.plans.iter().map(|p| p.planning_time).sum(),
         time_to_harvest,
         placed_count: placed,
         contacts,
@@ -368,6 +361,34 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
         mcap: mcap.file_name().map(|f| format!("trials/{}", f.to_string_lossy())).unwrap_or_default(),
         ..HarvestTrial::of_target(index, seed, &target)
     })
+}
+
+/// A harvest system ready to run from `start` (x, y, yaw of base_link): the map server,
+/// odometry TF, the localizer started from a seeded estimate of the start pose (never the
+/// true one), the robot state publisher, `harvest` (the node under test), the fault
+/// injector, and `task` (what tells an external node its task), recording into `mcap`.
+#[allow(clippy::too_many_arguments)]
+pub fn harvest_session(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, start: [f64; 3], seed: u64, mcap: &Path, harvest: Box<dyn Node>, task: Option<crate::task_publisher::TaskPublisher>) -> Result<agrisim_session::Session> {
+    let mut s = s.clone();
+    let chassis = s.parameters.entry("chassis".into()).or_default();
+    for (k, v) in ["x0", "y0", "yaw0"].iter().zip(start) {
+        chassis.insert(k.to_string(), toml::Value::Float(v));
+    }
+    let (estimate, _) = initial_estimate(start, s.nav.initial_pose_std, seed);
+    let mut nav_cfg = NavConfig::for_estimate(estimate, s.nav.initial_pose_std);
+    nav_cfg.embedded_localizer = false;
+    let mut nodes: Vec<Box<dyn Node>> = vec![
+        Box::new(MapServer::new(grid_message(&setup.map, 0))),
+        Box::new(OdomTf::default()),
+        Box::new(Localizer::new(&nav_cfg)),
+        Box::new(RobotStatePublisher::agrisim()),
+        harvest,
+        Box::new(FaultInjector::new(&s.inject)),
+    ];
+    if let Some(t) = task {
+        nodes.push(Box::new(t));
+    }
+    prepare(&s, &RunOptions { seed: Some(seed), ..o.clone() }, mcap, nodes)
 }
 
 /// Runs `trials` trials and writes trials.jsonl, summary.json and trials/*.mcap.
@@ -432,6 +453,7 @@ impl HarvestTrial {
             planning_ok: false,
             plans: 0,
             planning_times: vec![],
+            thinking_time: 0.0,
             time_to_harvest: None,
             placed_count: 0,
             contacts: BTreeMap::new(),
@@ -500,6 +522,12 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, results: &[HarvestTrial]) -> Har
         planning_time_p50: percentile(&times, 0.5),
         planning_time_p95: percentile(&times, 0.95),
         planning_time_max: times.last().copied(),
+        thinking_time_mean: results.iter().map(|t| t.thinking_time).sum::<f64>() / n.max(1) as f64,
+        thinking_over_wall: {
+            let timed: Vec<&HarvestTrial> = results.iter().filter(|t| !t.planning_times.is_empty()).collect();
+            let wall: f64 = timed.iter().flat_map(|t| t.planning_times.iter()).sum();
+            (wall > 0.0).then(|| timed.iter().map(|t| t.thinking_time).sum::<f64>() / wall)
+        },
         touches_per_trial: {
             let mut m: BTreeMap<String, f64> = BTreeMap::new();
             for (k, v) in results.iter().flat_map(|t| t.touches.iter()) {
@@ -531,12 +559,13 @@ mod tests {
     }
 
     /// An object counts once per onset, however many links touch it and however long; the
-    /// target fruit and arm-arm contacts do not count; letting go and touching again does.
+    /// target fruit, arm-arm and carried-fruit contacts (failures, not touches) do not
+    /// count; letting go and touching again does.
     #[test]
     fn touches_count_onsets_by_kind() {
         let mut t = Touches::default();
         t.update(&state(&[(5, "leaf", "left_link5"), (5, "leaf", "left_link6"), (9, "fruit", "left_hand")]), 9);
-        t.update(&state(&[(5, "leaf", "left_link5"), (7, "stem", "left_link4"), (0, "robot_arm", "left_link7")]), 9);
+        t.update(&state(&[(5, "leaf", "left_link5"), (7, "stem", "left_link4"), (0, "robot_arm", "left_link7"), (13, "post", "carried_fruit")]), 9);
         t.update(&state(&[]), 9);
         t.update(&state(&[(5, "leaf", "left_link5"), (11, "fruit", "right_hand")]), 9);
         assert_eq!(t.by_kind, BTreeMap::from([("leaf".to_string(), 2), ("stem".to_string(), 1), ("fruit".to_string(), 1)]));

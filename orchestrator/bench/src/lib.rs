@@ -1,4 +1,5 @@
-//! agrisim-bench: the evaluations. Many-trial benchmarks (navigation, dual-arm harvest) with
+//! agrisim-bench: the evaluations. Many-trial benchmarks (navigation, dual-arm harvest, whole-row
+//! harvest) with
 //! honest statistics and every trial recorded, and the master's overhead.
 //!
 //! A judge reads only what was published on the bus (the messages every trial records) and
@@ -12,6 +13,7 @@ pub mod map;
 pub mod nav;
 pub mod overhead;
 pub mod report;
+pub mod row;
 pub mod scenes;
 pub mod stats;
 pub mod targets;

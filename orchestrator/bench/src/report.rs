@@ -32,6 +32,37 @@ fn escape(s: &str) -> String {
 
 /// Writes the report. `summary` rows are (label, value) pairs shown in a table.
 pub fn render(title: &str, summary: &[(String, String)], objects: &[Object], bounds: [f64; 4], trials: &[TrialTrace]) -> String {
+    render_with(title, summary, objects, bounds, trials, &[])
+}
+
+/// A histogram of `values` in bins `bin` wide, as an inline SVG bar chart labelled `label`.
+pub fn bar_chart(values: &[f64], bin: f64, label: &str) -> String {
+    if values.is_empty() {
+        return "<p>no values</p>".into();
+    }
+    let max = values.iter().copied().fold(0.0, f64::max);
+    let bins = ((max / bin).floor() as usize + 1).min(200);
+    let mut counts = vec![0u64; bins];
+    for v in values {
+        counts[((v / bin).floor().max(0.0) as usize).min(bins - 1)] += 1;
+    }
+    let top = counts.iter().copied().max().unwrap_or(1).max(1) as f64;
+    let (w, h, bw) = (60.0 + bins as f64 * 24.0, 200.0, 20.0);
+    let mut svg = format!(r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w:.0}" height="{:.0}">"#, h + 40.0);
+    for (i, &c) in counts.iter().enumerate() {
+        let bh = c as f64 / top * h;
+        let x = 40.0 + i as f64 * 24.0;
+        let _ = write!(svg, r##"<rect x="{x:.1}" y="{:.1}" width="{bw}" height="{bh:.1}" fill="#4a7ab5"><title>{:.0}-{:.0}: {c}</title></rect>"##, h - bh, i as f64 * bin, (i + 1) as f64 * bin);
+        if i % 2 == 0 {
+            let _ = write!(svg, r#"<text x="{x:.1}" y="{:.0}" font-size="10">{:.0}</text>"#, h + 14.0, i as f64 * bin);
+        }
+    }
+    let _ = write!(svg, r#"<text x="0" y="12" font-size="10">{}</text><text x="40" y="{:.0}" font-size="11">{}</text></svg>"#, top as u64, h + 34.0, escape(label));
+    svg
+}
+
+/// [`render`] with extra sections (heading, HTML) after the map.
+pub fn render_with(title: &str, summary: &[(String, String)], objects: &[Object], bounds: [f64; 4], trials: &[TrialTrace], sections: &[(String, String)]) -> String {
     let [x0, y0, x1, y1] = bounds;
     let scale = 900.0 / (x1 - x0).max(y1 - y0).max(1e-6);
     let (w, h) = ((x1 - x0) * scale, (y1 - y0) * scale);
@@ -68,7 +99,8 @@ pub fn render(title: &str, summary: &[(String, String)], objects: &[Object], bou
     let rows: String = summary.iter().map(|(k, v)| format!("<tr><th>{}</th><td>{}</td></tr>", escape(k), escape(v))).collect();
     let failures: String = trials.iter().filter(|t| !t.success).map(|t| format!("<li>trial {:04}: {}</li>", t.index, escape(&t.reason))).collect();
     format!(
-        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{t}</title><style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse}}th,td{{border:1px solid #ccc;padding:4px 10px;text-align:left}}</style></head>\n<body><h1>{t}</h1><table>{rows}</table><h2>Top-down map and trial paths</h2><p>Green: success, red: failure; circles: targets. Map frame x to the right, y up.</p>{svg}<h2>Failures</h2><ul>{failures}</ul></body></html>\n",
-        t = escape(title)
+        "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{t}</title><style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse}}th,td{{border:1px solid #ccc;padding:4px 10px;text-align:left}}</style></head>\n<body><h1>{t}</h1><table>{rows}</table><h2>Top-down map and trial paths</h2><p>Green: success, red: failure; circles: targets. Map frame x to the right, y up.</p>{svg}{extra}<h2>Failures</h2><ul>{failures}</ul></body></html>\n",
+        t = escape(title),
+        extra = sections.iter().map(|(h, body)| format!("<h2>{}</h2>{body}", escape(h))).collect::<String>()
     )
 }

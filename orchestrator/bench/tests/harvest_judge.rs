@@ -86,7 +86,7 @@ fn status(t_ns: i64, stage: &str, outcome: &str, category: &str, detail: &str) -
 }
 
 fn plan(t_ns: i64, ok: bool, optional: bool) -> (i64, Said) {
-    let m = PlanResult { header: header(t_ns), stage: "pre_grasp".into(), arm: "left".into(), kind: "free".into(), ok, optional, detail: if ok { String::new() } else { "no path".into() } };
+    let m = PlanResult { header: header(t_ns), stage: "pre_grasp".into(), arm: "left".into(), kind: "free".into(), ok, optional, detail: if ok { String::new() } else { "no path".into() }, planning_time: 0.004 };
     (t_ns, Said::Plan(m))
 }
 

@@ -107,6 +107,16 @@ enum BenchCommand {
     /// The dual-arm harvesting experiment: N trials on seeded ripe fruit; DIR/summary.json,
     /// trials.jsonl, trials/<NNNN>.mcap (default scenario: models/scenarios/harvest.toml).
     Harvest(TrialArgs),
+    /// The whole-row harvest: N aisle segments (both sides), every reachable ripe fruit in
+    /// them harvested in turn; DIR/summary.json, trials.jsonl, trials/<NNNN>.mcap, report.html
+    /// (default scenario: models/scenarios/harvest.toml; --trials is the number of segments).
+    Row {
+        #[command(flatten)]
+        trials: TrialArgs,
+        /// Segment length along the aisle [m].
+        #[arg(long, default_value_t = 10.0)]
+        length: f64,
+    },
     /// Orchestrator cost per FMU and step, beside the bare fmi3DoStep cost (JSON on stdout).
     Overhead {
         #[arg(long, default_value = "models/scenarios/default.toml")]
@@ -324,7 +334,7 @@ fn real_main() -> Result<()> {
     let bridges = Bridges::default();
     let stats_file = match &cli.command {
         Command::Run { live, .. } => live.ros2_stats.clone(),
-        Command::Bench { command: BenchCommand::Nav(a) | BenchCommand::Harvest(a) } => a.live.ros2_stats.clone(),
+        Command::Bench { command: BenchCommand::Nav(a) | BenchCommand::Harvest(a) | BenchCommand::Row { trials: a, .. } } => a.live.ros2_stats.clone(),
         _ => None,
     };
     let result = dispatch(cli, &bridges);
@@ -366,6 +376,15 @@ fn dispatch(cli: Cli, bridges: &Bridges) -> Result<()> {
             }
             let command = worker_command;
             let summary = agrisim_bench::harvest::bench_harvest(&s, &opts, a.plan(), &a.out, a.resume, exec(&a, &command), progress_printer())?;
+            println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
+        }
+        Command::Bench { command: BenchCommand::Row { trials: a, length } } => {
+            let (s, opts) = trial_setup(&a, "models/scenarios/harvest.toml", &target, bridges)?;
+            if let Some(i) = a.worker_trial {
+                return agrisim_bench::row::row_worker(&s, &opts, a.plan(), length, &a.out, i);
+            }
+            let command = worker_command;
+            let summary = agrisim_bench::row::bench_row(&s, &opts, a.plan(), length, &a.out, a.resume, exec(&a, &command), progress_printer())?;
             println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
         }
         Command::Bench { command: BenchCommand::Overhead { scenario, steps, dirs, log, record, out } } => {

@@ -1,9 +1,20 @@
 //! Fine positioning of the omnidirectional base next to a plant: a proportional controller
 //! on the localized pose that crabs sideways and creeps forward in one motion (the 4WS base
 //! is holonomic), speed-limited and slowed near the goal so it stops without overshoot.
+//! A mostly sideways move is made as a pure crab (no forward component, no turning) until
+//! the lateral error is gone, then forward and heading are closed: with the wheels at their
+//! 90 degree steering limit, a tiny forward or yaw command that changes sign swings wheels
+//! between +90 and -90 degrees and the base hardly moves (seen in row harvests, where the
+//! next fruit is often straight across the aisle).
 
 use agrisim_math::pose2::wrap_angle;
 use agrisim_math::Pose2;
+
+/// Forward error [m] below which a move with a lateral error is a pure crab.
+const CRAB_BAND: f64 = 0.05;
+/// Slowest commanded speed while out of place [m/s] (2 mm per 0.1 s exchange: no overshoot
+/// of the 10 mm tolerance).
+const MIN_SPEED: f64 = 0.02;
 
 #[derive(Debug, Clone, Copy)]
 pub struct BaseController {
@@ -28,12 +39,22 @@ impl BaseController {
         let (s, c) = pose.yaw.sin_cos();
         // Error in base_link.
         let (ex, ey) = (c * dx + s * dy, -s * dx + c * dy);
-        let mut v = [self.gain * ex, self.gain * ey];
+        // Crab while the lateral error is out of tolerance and the forward one small; else
+        // drive forward, sideways only while out of tolerance (no diagonal creep that keeps
+        // the wheels between the two steering states).
+        let crab = ey.abs() > self.tolerance.0 && ex.abs() < CRAB_BAND;
+        let lateral = if ey.abs() > self.tolerance.0 { self.gain * ey } else { 0.0 };
+        let mut v = if crab { [0.0, lateral] } else { [self.gain * ex, lateral] };
+        // Not slower than MIN_SPEED while out of place: a creeping base never arrives.
+        let n = v[0].hypot(v[1]);
+        if n > 0.0 && n < MIN_SPEED && ex.hypot(ey) > self.tolerance.0 {
+            v = [v[0] * MIN_SPEED / n, v[1] * MIN_SPEED / n];
+        }
         let n = v[0].hypot(v[1]);
         if n > self.max_speed {
             v = [v[0] * self.max_speed / n, v[1] * self.max_speed / n];
         }
-        let wz = (self.yaw_gain * wrap_angle(goal[2] - pose.yaw)).clamp(-self.max_yaw_rate, self.max_yaw_rate);
+        let wz = if crab { 0.0 } else { (self.yaw_gain * wrap_angle(goal[2] - pose.yaw)).clamp(-self.max_yaw_rate, self.max_yaw_rate) };
         [v[0], v[1], wz]
     }
 
@@ -61,5 +82,24 @@ mod tests {
             assert!(steps < 400, "no convergence: {p:?}");
         }
         assert!(steps > 10);
+    }
+
+    /// Nearly straight across: no forward component (whose sign would flip the steering)
+    /// until the lateral error is within tolerance, then the forward error is closed.
+    #[test]
+    fn crabs_purely_sideways_when_the_goal_is_across() {
+        let ctl = BaseController::default();
+        let goal = [1.02, -0.6, 0.0];
+        let mut p = Pose2::new(1.0, 0.0, 0.005);
+        let mut steps = 0;
+        while !ctl.in_place(p, goal) {
+            let [vx, vy, wz] = ctl.command(p, goal);
+            if (goal[1] - p.y).abs() > ctl.tolerance.0 {
+                assert_eq!((vx, wz), (0.0, 0.0), "at {p:?}");
+            }
+            p = Pose2::new(p.x + 0.1 * vx, p.y + 0.1 * vy, p.yaw + 0.1 * wz);
+            steps += 1;
+            assert!(steps < 400, "no convergence: {p:?}");
+        }
     }
 }

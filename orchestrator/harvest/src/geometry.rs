@@ -119,6 +119,9 @@ pub fn handover_goals(point: [f64; 3], giver_side: f64) -> (TcpGoal, TcpGoal) {
     (giver, taker)
 }
 
+/// Spots over the box a fruit is dropped from (each at two heights).
+pub const DROP_SPOTS: usize = 5;
+
 /// Drop poses above the harvest box, pointing down, roll free, in order of preference: the
 /// centre of the opening first, then toward its corners and higher up.
 pub fn drop_goals() -> Vec<TcpGoal> {

@@ -7,13 +7,16 @@
 //! * [`motion`]: goal -> IK goal set -> path -> time-parameterized, limit-checked
 //!   trajectory_msgs/JointTrajectory;
 //! * [`base`]: fine positioning of the holonomic base;
-//! * [`stage`]: stages and failure categories; [`node`]: the state machine.
+//! * [`stage`]: stages and failure categories; [`node`]: the state machine;
+//! * [`row`]: the whole-row harvest, the node taken through a list of fruit.
 
 pub mod base;
 pub mod geometry;
 pub mod motion;
 pub mod node;
+pub mod row;
 pub mod stage;
 
 pub use node::{topics, HarvestNode};
+pub use row::RowNode;
 pub use stage::{Failure, Stage};

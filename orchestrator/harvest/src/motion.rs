@@ -12,7 +12,7 @@
 use super::geometry::TcpGoal;
 use agrisim_math::Pose2;
 use agrisim_manip::cartesian::cartesian_path;
-use agrisim_manip::{exact_check, ArmModel, Checker, Context, Ik, Obstacle, ObstacleKind, Planner, Rng, Scene, Shape, Side, Target, DOF};
+use agrisim_manip::{exact_check, ArmModel, Checker, Context, Ik, Meter, Obstacle, ObstacleKind, Planner, Rng, Scene, Shape, Side, Target, Work, DOF};
 use agrisim_msgs::agrisim::PlanningScene;
 use agrisim_msgs::builtin_interfaces::Duration;
 use agrisim_msgs::shape_msgs::SolidPrimitive;
@@ -106,6 +106,8 @@ pub struct Motion {
     padding: f64,
     /// The straight approach (joint path, pre-grasp first) checked by the last pre-grasp plan.
     approach: Option<(Arm, Vec<[f64; DOF]>)>,
+    /// Every check, IK iteration and time parameterization of every plan, counted.
+    meter: Meter,
 }
 
 impl Motion {
@@ -123,7 +125,17 @@ impl Motion {
             held: [None, None],
             padding: agrisim_manip::checker::DEFAULT_PADDING,
             approach: None,
+            meter: Meter::default(),
         }
+    }
+
+    /// The planning work done so far (differences give one plan's work).
+    pub fn work(&self) -> Work {
+        self.meter.work()
+    }
+
+    fn ik(&self, arm: Arm, lift: f64) -> Ik<'_> {
+        Ik::new(self.model(arm), lift).metered(Some(&self.meter))
     }
 
     pub fn model(&self, arm: Arm) -> &ArmModel {
@@ -223,6 +235,7 @@ impl Motion {
         let o = self.model(arm.other());
         let mut ctx = Context::new(self.model(arm), lift, &self.scene).with_other(o, other_q, o.finger_limits.upper);
         ctx.padding = self.padding;
+        ctx.meter = Some(&self.meter);
         if let Some(r) = self.held[arm.index()] {
             ctx = ctx.holding(r);
         }
@@ -248,7 +261,7 @@ impl Motion {
         let goals = {
             let ctx = self.context(arm, lift, other);
             let checker = Checker::new(ctx);
-            let ik = Ik::new(self.model(arm), lift);
+            let ik = self.ik(arm, lift);
             let mut rng = self.rng.clone();
             let g = ik.goal_set(&target, &start, &mut rng, GOAL_SET.0, GOAL_SET.1, IK_BUDGET.0, |q| checker.is_valid(q));
             self.rng = rng;
@@ -268,10 +281,9 @@ impl Motion {
     pub fn plan_pregrasp(&mut self, arm: Arm, lift: f64, start: [f64; DOF], grasp: &TcpGoal, standoff: f64, other: [f64; DOF]) -> Result<Planned, String> {
         let mut rng = std::mem::replace(&mut self.rng, Rng::new(0));
         let goals = {
-            let model = &self.arms[arm.index()];
             let ctx = self.context(arm, lift, other);
             let checker = Checker::new(ctx);
-            let ik = Ik::new(model, lift);
+            let ik = self.ik(arm, lift);
             let z = super::geometry::normalize(grasp.approach);
             let up = if z[2].abs() < 0.9 { [0.0, 0.0, 1.0] } else { [1.0, 0.0, 0.0] };
             let x0 = super::geometry::normalize(super::geometry::cross(super::geometry::cross(z, up), z));
@@ -384,6 +396,7 @@ impl Motion {
         let samples = if wps.len() < 2 || plan.waypoints[0] == plan.waypoints[wps.len() - 1] {
             hold(&start)
         } else {
+            self.meter.add_timing();
             time_waypoints(&wps, &self.timing).map_err(|e| format!("time parameterization: {e}"))?
         };
         Ok(self.to_msg(arm, &samples, *plan.waypoints.last().expect("start at least")))
@@ -415,7 +428,8 @@ impl Motion {
             Err(e) => {
                 // Name what the blocked configuration touches.
                 let last = *e.partial.last().unwrap_or(&start);
-                let what = Ik::new(model, lift)
+                let what = self
+                    .ik(arm, lift)
                     .solve(&target_of(&TcpGoal { x_axis: Some(current_x(model, lift, &start)), ..*goal }), &last, &mut Rng::new(7), IK_BUDGET.1)
                     .and_then(|q| checker.contact(&q))
                     .map(|c| format!(" (at the goal: {})", c.describe(&ctx)))
@@ -442,12 +456,14 @@ impl Motion {
             }
             Ok(path)
         };
+        self.meter.add_timing();
         let jerk_limited = time_state_to_state(&JointState::at_rest(start.to_vec()), &JointState::at_rest(end.to_vec()), &self.timing).map_err(|e| format!("jerk-limited motion: {e}"))?;
         let (samples, path) = match on_line(&jerk_limited) {
             Ok(path) => (jerk_limited, path),
             Err(_) => {
                 // A spline through the dense waypoints is smooth; where it overshoots a limit,
                 // the polyline with small corner blends follows the checked segments.
+                self.meter.add_timing();
                 let wv: Vec<Vec<f64>> = wps.iter().map(|q| q.to_vec()).collect();
                 let spline = TimingConfig { shape: PathShape::Spline(PathParam::ChordLength), ..self.timing.clone() };
                 let blended = TimingConfig { shape: PathShape::Blended { radius: 0.01 }, ..self.timing.clone() };
@@ -480,6 +496,11 @@ impl Motion {
         let msg = JointTrajectory { joint_names: arm.joint_names().to_vec(), points, ..Default::default() };
         Planned { msg, duration: s.t.last().copied().unwrap_or(0.0), goal_q }
     }
+}
+
+/// Largest joint difference between `a` and `b` [rad].
+pub fn joint_distance(a: &[f64; DOF], b: &[f64; DOF]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
 }
 
 /// A one-point "stay here" trajectory.

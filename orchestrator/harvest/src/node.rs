@@ -14,15 +14,19 @@
 //! it learns from its messages. Whoever runs it judges it by those messages alone.
 //!
 //! The arm on the row's side grasps, hands the fruit over in front of the robot, and the
-//! other arm places it in the box at the rear. Planning happens inside one exchange step:
-//! it costs no simulated time (the harness may time the node's steps; the node never reads a
-//! clock).
+//! other arm places it in the box at the rear. Planning happens inside one exchange step
+//! but is charged in simulated time: the node prices the work each plan did (configuration
+//! checks, IK iterations, exact checks, time parameterizations) with a calibrated
+//! [`CostModel`], reports it as `planning_time` on `/harvest/plans`, and stamps the
+//! trajectory to start only after the step's plans so far would have been computed. The node
+//! never reads a clock, so results stay deterministic.
 
 use super::geometry::{self as geo, TcpGoal};
 use super::motion::{Arm, Motion, Planned};
 use super::stage::{Failure, Stage};
 use agrisim_bus::Bus;
 use agrisim_error::Result;
+use agrisim_manip::{CostModel, Work};
 use agrisim_math::Pose2;
 use agrisim_bus::Node;
 use agrisim_msgs::agrisim::{GripperState, HarvestStatus, PlanResult, PlanningScene, TrajectoryStatus};
@@ -59,6 +63,11 @@ const HANDOVER_OFFSETS: [f64; 2] = [0.015, -0.015];
 const HANDOVER_PADDING: f64 = 0.002;
 /// How far the giver backs off along its approach after letting go [m].
 const GIVER_BACKOFF: f64 = 0.06;
+/// How far an arm backs off along its approach axis when it cannot plan home from where it
+/// is (a row harvest's recovery) [m].
+const RECOVERY_BACKOFF: f64 = 0.12;
+/// Motions the recovery may send before it gives up (two per arm: back-off and home).
+const RECOVERY_MOTIONS: u32 = 4;
 
 /// What the node knows of one arm, from its messages.
 #[derive(Debug, Clone, Default)]
@@ -85,6 +94,8 @@ pub struct HarvestNode {
     arms: [ArmView; 2],
     target_map: Option<[f64; 3]>,
     target_stamp_ns: i64,
+    /// Target messages stamped at or before this are of an earlier fruit.
+    target_after_ns: i64,
     target_seen: u64,
     pose: Option<Pose2>,
     pose_seen: u64,
@@ -111,6 +122,15 @@ pub struct HarvestNode {
     target_name: String,
     /// Motions planned so far (reported in the status).
     plans: u32,
+    /// Fruit this node has put in the box (a row harvest's earlier fruit included).
+    boxed: u32,
+    /// Prices planning work in simulated seconds.
+    cost: CostModel,
+    /// Planning work counted up to the last plan reported.
+    work_mark: Work,
+    /// Simulated planning time of this exchange step so far [s]: a trajectory planned now
+    /// starts this long after the step.
+    step_thinking: f64,
 }
 
 impl HarvestNode {
@@ -128,6 +148,7 @@ impl HarvestNode {
             arms: [ArmView::default(), ArmView::default()],
             target_map: None,
             target_stamp_ns: i64::MIN,
+            target_after_ns: i64::MIN,
             target_seen: 0,
             pose: None,
             pose_seen: 0,
@@ -149,11 +170,46 @@ impl HarvestNode {
             release_ns: 0,
             target_name: String::new(),
             plans: 0,
+            boxed: 0,
+            cost: CostModel::CALIBRATED,
+            work_mark: Work::default(),
+            step_thinking: 0.0,
         }
+    }
+
+    /// Charges planning with `cost` instead of [`CostModel::CALIBRATED`] (e.g. a slower
+    /// computer, or [`CostModel::FREE`]).
+    pub fn with_cost(mut self, cost: CostModel) -> HarvestNode {
+        self.cost = cost;
+        self
     }
 
     pub fn stage(&self) -> Stage {
         self.stage
+    }
+
+    /// Goes on to fruit `fruit_index` (a row harvest): what the node knows of the robot, its
+    /// planner's random stream and its work count carry over; the task starts afresh with
+    /// [`Stage::Recover`] (let go, arms home), then selects the new target. Target messages
+    /// sent before `t_ns` are of the old fruit.
+    pub fn next_target(&mut self, fruit_index: usize, t_ns: i64, bus: &mut Bus) {
+        let mut fresh = HarvestNode::new(fruit_index, 0).with_cost(self.cost);
+        std::mem::swap(&mut fresh.motion, &mut self.motion);
+        fresh.motion.set_held(Arm::Left, None);
+        fresh.motion.set_held(Arm::Right, None);
+        fresh.motion.ignore_target(false);
+        fresh.arms = std::mem::take(&mut self.arms);
+        fresh.arms.iter_mut().for_each(|a| a.pending = None);
+        (fresh.pose, fresh.pose_seen) = (self.pose, self.pose_seen);
+        (fresh.scene, fresh.scene_seen, fresh.scene_at_ns) = (self.scene.take(), self.scene_seen, self.scene_at_ns);
+        (fresh.lift, fresh.lift_target, fresh.target_seen) = (self.lift, self.lift, self.target_seen);
+        fresh.target_after_ns = t_ns;
+        (fresh.work_mark, fresh.boxed) = (self.work_mark, self.boxed);
+        fresh.target_name = format!("fruit[{fruit_index}]");
+        *self = fresh;
+        // The world answers with the new fruit's pose from the next exchange on.
+        bus.set_scalar(topics::TARGET_ID, fruit_index as f64);
+        self.enter(Stage::Recover, t_ns, bus, &format!("next: fruit {fruit_index} of the world's list"));
     }
 
     fn giver(&self) -> Arm {
@@ -179,8 +235,10 @@ impl HarvestNode {
 
     fn read(&mut self, bus: &mut Bus) -> Result<()> {
         if let Some(p) = bus.take_new::<PoseStamped>(topics::TARGET, &mut self.target_seen)? {
-            self.target_map = Some([p.pose.position.x, p.pose.position.y, p.pose.position.z]);
-            self.target_stamp_ns = p.header.stamp.to_nanos();
+            if p.header.stamp.to_nanos() > self.target_after_ns {
+                self.target_map = Some([p.pose.position.x, p.pose.position.y, p.pose.position.z]);
+                self.target_stamp_ns = p.header.stamp.to_nanos();
+            }
         }
         if let Some(p) = bus.take_new::<PoseStamped>(topics::POSE, &mut self.pose_seen)? {
             self.pose = Some(Pose2::from_msg(&p.pose));
@@ -255,6 +313,7 @@ impl HarvestNode {
 
     fn succeed(&mut self, t_ns: i64, bus: &mut Bus) {
         self.stage = Stage::Done;
+        self.boxed += 1;
         self.publish_status(t_ns, bus, "success", "", "fruit in the box");
     }
 
@@ -274,6 +333,10 @@ impl HarvestNode {
     /// not fail the harvest).
     fn record<T>(&mut self, arm: Arm, kind: &str, r: &std::result::Result<T, String>, optional: bool, t_ns: i64, bus: &mut Bus) {
         self.plans += 1;
+        let work = self.motion.work();
+        let planning_time = self.cost.seconds(&(work - self.work_mark));
+        self.work_mark = work;
+        self.step_thinking += planning_time;
         let msg = PlanResult {
             header: Header { stamp: Time::from_nanos(t_ns), frame_id: "map".into() },
             stage: self.stage.name().into(),
@@ -282,6 +345,7 @@ impl HarvestNode {
             ok: r.is_ok(),
             optional,
             detail: r.as_ref().err().cloned().unwrap_or_default(),
+            planning_time,
         };
         bus.publish(topics::PLANS, t_ns, &msg);
     }
@@ -330,13 +394,15 @@ impl HarvestNode {
         self.plan_and_send(arm, "home", t_ns, bus, |m, lift, start, other| m.plan_home(arm, lift, start, other).map(|p| (0, p))).is_some()
     }
 
+    /// Sends a planned trajectory, stamped to start once this step's planning is done.
     fn send(&mut self, arm: Arm, p: Planned, t_ns: i64, bus: &mut Bus) {
         let mut msg = p.msg;
-        msg.header.stamp = Time::from_nanos(t_ns);
+        let start_ns = t_ns + (self.step_thinking * 1e9).ceil() as i64;
+        msg.header.stamp = Time::from_nanos(start_ns);
         bus.publish(&arm.topic("joint_trajectory"), t_ns, &msg);
         let v = &mut self.arms[arm.index()];
         let expect = v.status.trajectory_count + 1;
-        v.pending = Some((expect, t_ns + (p.duration * 1e9) as i64, p.goal_q));
+        v.pending = Some((expect, start_ns + (p.duration * 1e9) as i64, p.goal_q));
         v.commanded = Some(p.goal_q);
     }
 
@@ -387,6 +453,35 @@ impl HarvestNode {
         }
     }
 
+    /// Plans `arm` home; from a cramped spot (the plan fails) first straight back along the
+    /// hand's approach axis. Both plans are optional: a failure is reported, and only when
+    /// neither works does the recovery fail. Returns whether a motion was sent.
+    fn go_home(&mut self, arm: Arm, t_ns: i64, bus: &mut Bus) -> bool {
+        let (start, other) = (self.q(arm), self.q(arm.other()));
+        let r = self.motion.plan_home(arm, self.lift, start, other);
+        self.record(arm, "home", &r, true, t_ns, bus);
+        if let Ok(p) = r {
+            self.send(arm, p, t_ns, bus);
+            return true;
+        }
+        let tcp = self.motion.model(arm).fk(self.lift, &start);
+        let z = [tcp.rot[0][2], tcp.rot[1][2], tcp.rot[2][2]];
+        let x = [tcp.rot[0][0], tcp.rot[1][0], tcp.rot[2][0]];
+        let back = TcpGoal { position: [tcp.trans[0] - RECOVERY_BACKOFF * z[0], tcp.trans[1] - RECOVERY_BACKOFF * z[1], tcp.trans[2] - RECOVERY_BACKOFF * z[2]], approach: z, x_axis: Some(x) };
+        let r = self.motion.plan_linear(arm, self.lift, start, &back, other);
+        self.record(arm, "linear", &r, false, t_ns, bus);
+        match r {
+            Ok(p) => {
+                self.send(arm, p, t_ns, bus);
+                true
+            }
+            Err(e) => {
+                self.fail(Failure::Planning, t_ns, bus, format!("{} arm, recover: no way home ({e})", arm.name()));
+                false
+            }
+        }
+    }
+
     fn run_stage(&mut self, t_ns: i64, bus: &mut Bus) {
         let first = self.step_in_stage == 0;
         self.step_in_stage += 1;
@@ -397,6 +492,32 @@ impl HarvestNode {
         }
         let (giver, taker) = (self.giver(), self.taker());
         match self.stage {
+            Stage::Recover => match self.phase_now() {
+                0 => {
+                    for arm in [Arm::Left, Arm::Right] {
+                        self.gripper(arm, geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
+                    }
+                    self.stop_base(t_ns, bus);
+                    self.phase = 1;
+                }
+                // The grippers open (half a second), then each arm that is not home goes
+                // home, the one that reached furthest first (it may stand in the other's way).
+                1 if self.step_in_stage > 5 => {
+                    let far = |a: Arm| super::motion::joint_distance(&self.q(a), &super::motion::HOME);
+                    let arm = if far(Arm::Left) >= far(Arm::Right) { Arm::Left } else { Arm::Right };
+                    if far(arm) < 1e-3 {
+                        self.attempts = 0;
+                        self.enter(Stage::SelectTarget, t_ns, bus, "both arms home");
+                    } else if self.attempts >= RECOVERY_MOTIONS {
+                        self.fail(Failure::Planning, t_ns, bus, format!("recover: the arms are not home after {RECOVERY_MOTIONS} motions"));
+                    } else if self.go_home(arm, t_ns, bus) {
+                        self.attempts += 1;
+                        self.phase = 2;
+                    }
+                }
+                2 if [Arm::Left, Arm::Right].iter().all(|&a| self.arm_done(a, t_ns, bus) == Some(true)) => self.phase = 1,
+                _ => {}
+            },
             Stage::SelectTarget => {
                 bus.set_scalar(topics::TARGET_ID, self.fruit_index as f64);
                 if self.target_map.is_some() && self.pose.is_some() && self.arms.iter().all(|a| a.q.is_some()) {
@@ -632,7 +753,11 @@ impl HarvestNode {
                     }
                 }
                 1 if self.arm_done(giver, t_ns, bus) == Some(true) => {
-                    if self.move_any(taker, &geo::drop_goals(), t_ns, bus) {
+                    // Successive fruit of a row go to successive spots over the box, so they
+                    // spread instead of heaping up under one.
+                    let mut goals = geo::drop_goals();
+                    goals.rotate_left(self.boxed as usize % geo::DROP_SPOTS);
+                    if self.move_any(taker, &goals, t_ns, bus) {
                         self.phase = 2;
                     }
                 }
@@ -674,6 +799,9 @@ impl Node for HarvestNode {
 
     fn step(&mut self, t_ns: i64, bus: &mut Bus) -> Result<()> {
         self.read(bus)?;
+        // Work outside a reported plan (e.g. the lift's sweep check) is not charged.
+        self.work_mark = self.motion.work();
+        self.step_thinking = 0.0;
         if self.target_name.is_empty() {
             // First exchange: report the first stage like every later one.
             self.target_name = format!("fruit[{}]", self.fruit_index);

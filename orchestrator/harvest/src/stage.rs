@@ -3,6 +3,8 @@
 /// Stages in order; each is reported on `/harvest/status` when entered.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Stage {
+    /// Between two fruit of a row: let go of anything held, both arms home.
+    Recover,
     SelectTarget,
     PositionBase,
     PreGrasp,
@@ -22,6 +24,7 @@ pub enum Stage {
 impl Stage {
     pub fn name(self) -> &'static str {
         match self {
+            Stage::Recover => "recover",
             Stage::SelectTarget => "select_target",
             Stage::PositionBase => "position_base",
             Stage::PreGrasp => "pre_grasp",

@@ -46,7 +46,7 @@ pub fn cartesian_path(
     resolution: f64,
 ) -> Result<Vec<[f64; DOF]>, CartesianError> {
     let ctx = &checker.ctx;
-    let ik = Ik::new(ctx.arm, ctx.lift);
+    let ik = Ik::new(ctx.arm, ctx.lift).metered(ctx.meter);
     let p0 = ctx.arm.fk_iso(ctx.lift, start);
     let n = ((offset.norm() / step).ceil() as usize).max(1);
     let mut path = vec![*start];

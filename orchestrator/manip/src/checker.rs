@@ -53,6 +53,8 @@ pub struct Context<'a> {
     /// body and the other arm (not against itself). It also covers the motion between
     /// discretised edge samples, so the exact check of the final path rarely fails.
     pub padding: f64,
+    /// Where checks are counted (planning work charged in simulated time), if anywhere.
+    pub meter: Option<&'a crate::Meter>,
 }
 
 /// Default padding (m).
@@ -69,6 +71,7 @@ impl<'a> Context<'a> {
             other: None,
             scene,
             padding: DEFAULT_PADDING,
+            meter: None,
         }
     }
     pub fn with_other(mut self, arm: &'a ArmModel, q: [f64; DOF], finger: f64) -> Context<'a> {
@@ -206,6 +209,9 @@ impl<'a> Checker<'a> {
     #[allow(clippy::needless_range_loop)]
     pub fn contact(&self, q: &[f64; DOF]) -> Option<Contact> {
         self.checks.set(self.checks.get() + 1);
+        if let Some(m) = self.ctx.meter {
+            m.add_check();
+        }
         let ctx = &self.ctx;
         let arm = ctx.arm;
         let pad = ctx.padding;

@@ -201,6 +201,9 @@ impl<'a> Exact<'a> {
     #[allow(clippy::needless_range_loop)]
     fn contact(&self, q: &[f64; DOF]) -> Option<Contact> {
         let ctx = self.ctx;
+        if let Some(m) = ctx.meter {
+            m.add_exact_check();
+        }
         let a = ctx.arm;
         let fr = a.frames_x(&join(ctx.lift, q), ctx.finger);
         let pose = &fr.bodies;

@@ -41,6 +41,8 @@ pub struct Ik<'a> {
     pub lift: f64,
     /// Let the lift move within its limits as an 8th joint.
     pub free_lift: bool,
+    /// Where iterations are counted (planning work), if anywhere.
+    pub meter: Option<&'a crate::Meter>,
 }
 
 struct Problem<'a> {
@@ -58,7 +60,13 @@ impl<'a> Ik<'a> {
             arm,
             lift,
             free_lift: false,
+            meter: None,
         }
+    }
+
+    /// Counts this solver's iterations in `meter`.
+    pub fn metered(self, meter: Option<&'a crate::Meter>) -> Ik<'a> {
+        Ik { meter, ..self }
     }
 
     /// Same, with the lift as an 8th joint ([`Ik::solve_lift`] returns its value).
@@ -67,6 +75,7 @@ impl<'a> Ik<'a> {
             arm,
             lift,
             free_lift: true,
+            meter: None,
         }
     }
 
@@ -102,6 +111,14 @@ impl<'a> Ik<'a> {
         rng: &mut Rng,
         budget: usize,
     ) -> (Option<(f64, [f64; DOF])>, usize) {
+        let (r, used) = self.search(target, seed, rng, budget);
+        if let Some(m) = self.meter {
+            m.add_ik_iterations(used);
+        }
+        (r, used)
+    }
+
+    fn search(&self, target: &Target, seed: &[f64; DOF], rng: &mut Rng, budget: usize) -> (Option<(f64, [f64; DOF])>, usize) {
         let pb = self.problem(target);
         let mut left = budget;
         let mut attempt = 0usize;

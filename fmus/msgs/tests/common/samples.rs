@@ -310,6 +310,7 @@ fn manipulation_samples() -> Vec<Sample> {
                 ok: false,
                 optional: false,
                 detail: "no IK solution for any of 6 grasps".into(),
+                planning_time: 0.0123,
             },
         ),
     ]
