@@ -339,6 +339,7 @@ EXPECTED.update({
         "ok": False,
         "optional": False,
         "detail": "no IK solution for any of 6 grasps",
+        "planning_time": 0.0123,
     },
 })
 
