@@ -136,19 +136,20 @@ pub struct ClassResult {
 
 /// Onsets of contact with scene objects, by kind, from /collision messages.
 #[derive(Default)]
-struct Touches {
+pub(crate) struct Touches {
     /// Objects in contact in the last message.
     now: std::collections::BTreeSet<u32>,
-    by_kind: BTreeMap<String, u64>,
+    pub(crate) by_kind: BTreeMap<String, u64>,
 }
 
 impl Touches {
-    /// Counts every object in `cs` not touched in the previous message, except the target.
-    fn update(&mut self, cs: &CollisionState, target: u32) {
+    /// Counts every object in `cs` not touched in the previous message, except the task's
+    /// own fruit (`picked`).
+    pub(crate) fn update(&mut self, cs: &CollisionState, picked: impl Fn(u32) -> bool) {
         let mut next = std::collections::BTreeSet::new();
         for c in &cs.contacts {
             // Arm-arm and carried-fruit contacts are failures, judged from the world's counters.
-            if c.object_id == target || c.object_kind == "robot_arm" || c.robot_link == "carried_fruit" || !next.insert(c.object_id) {
+            if picked(c.object_id) || c.object_kind == "robot_arm" || c.robot_link == "carried_fruit" || !next.insert(c.object_id) {
                 continue;
             }
             if !self.now.contains(&c.object_id) {
@@ -157,6 +158,11 @@ impl Touches {
         }
         self.now = next;
     }
+}
+
+/// The failure a base contact in `cs` is, if any: the base must touch nothing.
+pub(crate) fn base_contact(cs: &CollisionState) -> Option<String> {
+    cs.contacts.iter().find(|c| c.robot_link == "base_link").map(|c| format!("the base touched {} ({})", c.object_name, c.object_kind))
 }
 
 /// Contact counters of the world FMU that end a trial as a collision (judged after every
@@ -275,9 +281,9 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
             // The base must touch nothing; the arms may brush plants (counted, not failures).
             // Every collision state counts, however short the contact.
             for cs in collisions.take::<CollisionState>(&mut m.bus)? {
-                touches.update(&cs, target.object_id);
-                if let Some(c) = cs.contacts.iter().find(|c| c.robot_link == "base_link") {
-                    judged = Some((Some("collision".into()), format!("the base touched {} ({})", c.object_name, c.object_kind)));
+                touches.update(&cs, |id| id == target.object_id);
+                if let Some(why) = base_contact(&cs) {
+                    judged = Some((Some("collision".into()), why));
                     return Ok(());
                 }
             }
@@ -564,10 +570,10 @@ mod tests {
     #[test]
     fn touches_count_onsets_by_kind() {
         let mut t = Touches::default();
-        t.update(&state(&[(5, "leaf", "left_link5"), (5, "leaf", "left_link6"), (9, "fruit", "left_hand")]), 9);
-        t.update(&state(&[(5, "leaf", "left_link5"), (7, "stem", "left_link4"), (0, "robot_arm", "left_link7"), (13, "post", "carried_fruit")]), 9);
-        t.update(&state(&[]), 9);
-        t.update(&state(&[(5, "leaf", "left_link5"), (11, "fruit", "right_hand")]), 9);
+        t.update(&state(&[(5, "leaf", "left_link5"), (5, "leaf", "left_link6"), (9, "fruit", "left_hand")]), |id| id == 9);
+        t.update(&state(&[(5, "leaf", "left_link5"), (7, "stem", "left_link4"), (0, "robot_arm", "left_link7"), (13, "post", "carried_fruit")]), |id| id == 9);
+        t.update(&state(&[]), |id| id == 9);
+        t.update(&state(&[(5, "leaf", "left_link5"), (11, "fruit", "right_hand")]), |id| id == 9);
         assert_eq!(t.by_kind, BTreeMap::from([("leaf".to_string(), 2), ("stem".to_string(), 1), ("fruit".to_string(), 1)]));
     }
 }

@@ -11,7 +11,7 @@
 //! (plant touches, counted). Figures: fraction harvested (by visibility class), fruit per
 //! hour, cycle time per fruit, plant touches per fruit, dropped fruit.
 
-use super::harvest::{harvest_session, HarvestSetup, COLLISION_COUNTERS};
+use super::harvest::{base_contact, harvest_session, HarvestSetup, Touches, COLLISION_COUNTERS};
 use super::harvest_targets::HarvestTarget;
 use super::nav::trial_seed;
 use super::report::{bar_chart, render_with, TrialTrace};
@@ -54,7 +54,7 @@ pub struct RowFruit {
     pub placed_at: Option<f64>,
 }
 
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
 pub struct RowTrial {
     pub trial: u64,
     pub scene: u64,
@@ -136,12 +136,10 @@ pub struct Segment {
 /// a uniformly placed stretch of it within the reachable fruit's extent; its fruit (both
 /// sides) in order along +x, the robot on the centre line before the first, facing +x.
 pub fn draw_segment(setup: &HarvestSetup, length: f64, rng: &mut Rng) -> Option<Segment> {
-    let aisles: Vec<f64> = setup.candidates.iter().map(|t| t.start[1]).fold(Vec::new(), |mut v, y| {
-        if !v.iter().any(|&a: &f64| (a - y).abs() < 1e-9) {
-            v.push(y);
-        }
-        v
-    });
+    // Aisle centre lines, in order (every candidate of an aisle starts on the same one).
+    let mut aisles: Vec<f64> = setup.candidates.iter().map(|t| t.start[1]).collect();
+    aisles.sort_by(f64::total_cmp);
+    aisles.dedup();
     if aisles.is_empty() {
         return None;
     }
@@ -174,8 +172,7 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, length: f64
     let mut outcomes: BTreeMap<i32, HarvestStatus> = BTreeMap::new();
     let mut placed: BTreeMap<u32, f64> = BTreeMap::new();
     let mut placed_count = 0.0;
-    let mut touches: BTreeMap<String, u64> = BTreeMap::new();
-    let mut touching: BTreeSet<u32> = BTreeSet::new();
+    let mut touches = Touches::default();
     let mut thinking = 0.0;
     let mut path = vec![];
     let mut ended = String::from("timeout");
@@ -192,23 +189,13 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, length: f64
                 }
             }
             thinking += plans.take::<PlanResult>(&mut m.bus)?.iter().map(|p| p.planning_time).sum::<f64>();
-            // Plant touches: onsets of contact with plant objects other than the fruit being
-            // picked or carried (failures are judged from the counters below).
+            // Plant touches (onsets, the segment's own fruit left out); the base touches nothing.
             for cs in collisions.take::<CollisionState>(&mut m.bus)? {
-                let mut now = BTreeSet::new();
-                if let Some(c) = cs.contacts.iter().find(|c| c.robot_link == "base_link") {
-                    ended = format!("collision: the base touched {} ({})", c.object_name, c.object_kind);
+                touches.update(&cs, |id| ids.contains(&id));
+                if let Some(why) = base_contact(&cs) {
+                    ended = format!("collision: {why}");
                     return Ok(());
                 }
-                for c in &cs.contacts {
-                    if ids.contains(&c.object_id) || c.object_kind == "robot_arm" || c.robot_link == "carried_fruit" || !now.insert(c.object_id) {
-                        continue;
-                    }
-                    if !touching.contains(&c.object_id) {
-                        *touches.entry(c.object_kind.clone()).or_insert(0) += 1;
-                    }
-                }
-                touching = now;
             }
             for c in COLLISION_COUNTERS {
                 if m.number(world, c)? > 0.0 {
@@ -301,7 +288,7 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, length: f64
         ended,
         cycle_times,
         fruit_per_hour: if sim_time > 0.0 { harvested as f64 * 3600.0 / sim_time } else { 0.0 },
-        touches,
+        touches: touches.by_kind,
         dropped: dropped.unwrap_or(0),
         thinking_time: thinking,
         fruit,
@@ -318,26 +305,15 @@ fn failed_trial(setup: &HarvestSetup, length: f64, index: u64, seed: u64, reason
     let targets = seg.as_ref().map_or(0, |s| s.targets.len() as u64);
     RowTrial {
         trial: index,
-        scene: 0,
         seed,
         aisle_y: seg.as_ref().map_or(0.0, |s| s.aisle_y),
         x_range: seg.as_ref().map_or([0.0; 2], |s| s.x_range),
         start: seg.as_ref().map_or([0.0; 3], |s| s.start),
         targets,
-        harvested: 0,
-        per_class: BTreeMap::new(),
         failures: BTreeMap::from([("error".to_string(), targets)]),
         ended: format!("error: {reason}"),
-        cycle_times: vec![],
-        fruit_per_hour: 0.0,
-        touches: BTreeMap::new(),
-        dropped: 0,
-        thinking_time: 0.0,
-        fruit: vec![],
-        path: vec![],
-        sim_time: 0.0,
-        wall_time: 0.0,
         mcap: format!("trials/{index:04}.mcap"),
+        ..RowTrial::default()
     }
 }
 

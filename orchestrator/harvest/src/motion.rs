@@ -498,11 +498,6 @@ impl Motion {
     }
 }
 
-/// Largest joint difference between `a` and `b` [rad].
-pub fn joint_distance(a: &[f64; DOF], b: &[f64; DOF]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
-}
-
 /// A one-point "stay here" trajectory.
 fn hold(q: &[f64; DOF]) -> Sampled {
     Sampled { t: vec![0.0], q: vec![q.to_vec()], qd: vec![vec![0.0; DOF]], qdd: vec![vec![0.0; DOF]] }

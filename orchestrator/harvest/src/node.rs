@@ -465,9 +465,8 @@ impl HarvestNode {
             return true;
         }
         let tcp = self.motion.model(arm).fk(self.lift, &start);
-        let z = [tcp.rot[0][2], tcp.rot[1][2], tcp.rot[2][2]];
-        let x = [tcp.rot[0][0], tcp.rot[1][0], tcp.rot[2][0]];
-        let back = TcpGoal { position: [tcp.trans[0] - RECOVERY_BACKOFF * z[0], tcp.trans[1] - RECOVERY_BACKOFF * z[1], tcp.trans[2] - RECOVERY_BACKOFF * z[2]], approach: z, x_axis: Some(x) };
+        let column = |k: usize| [tcp.rot[0][k], tcp.rot[1][k], tcp.rot[2][k]];
+        let back = TcpGoal { position: tcp.trans, approach: column(2), x_axis: Some(column(0)) }.along(-RECOVERY_BACKOFF);
         let r = self.motion.plan_linear(arm, self.lift, start, &back, other);
         self.record(arm, "linear", &r, false, t_ns, bus);
         match r {
@@ -503,7 +502,7 @@ impl HarvestNode {
                 // The grippers open (half a second), then each arm that is not home goes
                 // home, the one that reached furthest first (it may stand in the other's way).
                 1 if self.step_in_stage > 5 => {
-                    let far = |a: Arm| super::motion::joint_distance(&self.q(a), &super::motion::HOME);
+                    let far = |a: Arm| agrisim_manip::ik::dist(&self.q(a), &super::motion::HOME);
                     let arm = if far(Arm::Left) >= far(Arm::Right) { Arm::Left } else { Arm::Right };
                     if far(arm) < 1e-3 {
                         self.attempts = 0;

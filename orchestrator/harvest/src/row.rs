@@ -25,11 +25,6 @@ impl RowNode {
         let first = targets.first().copied().unwrap_or(0);
         RowNode { targets, current: 0, inner: HarvestNode::new(first, seed) }
     }
-
-    /// Whether every fruit has its outcome.
-    pub fn finished(&self) -> bool {
-        self.targets.is_empty() || (self.current + 1 >= self.targets.len() && matches!(self.inner.stage(), Stage::Done | Stage::Failed))
-    }
 }
 
 impl Node for RowNode {
