@@ -1,11 +1,12 @@
 """`agrisim bench harvest` end to end on the default greenhouse with a few trials: the files
-it promises, the statistics recomputed independently, the stages reported on
-/harvest/status, and every trial's MCAP decoding with mcap-ros2-support (JointTrajectory,
-JointState, GripperCommand, PlanningScene, HarvestStatus)."""
+it promises, the statistics recomputed independently, report.html against them, the stages
+reported on /harvest/status, and every trial's MCAP decoding with mcap-ros2-support
+(JointTrajectory, JointState, GripperCommand, PlanningScene, HarvestStatus)."""
 
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -62,6 +63,57 @@ def test_files_and_summary(bench):
     if times:
         assert s["planning_time_max"] == times[-1]
         assert times[0] <= s["planning_time_p50"] <= s["planning_time_p95"] <= times[-1]
+
+
+# A rate table's row in report.html: key, count, successes, fraction, Wilson interval.
+RATE_ROW = re.compile(r"<tr><td>([^<]*)</td><td>(\d+)</td><td>(\d+)</td><td>([\d.]+)</td><td>\[([\d.]+), ([\d.]+)\]</td></tr>")
+
+
+def rate_rows(html: str) -> dict[str, tuple[int, int, float, float, float]]:
+    return {k: (int(n), int(ok), float(f), float(lo), float(hi)) for k, n, ok, f, lo, hi in RATE_ROW.findall(html)}
+
+
+def test_report_shows_the_summary_classes_failures_times_and_paths(bench):
+    ts = trials(bench)
+    s = json.loads((bench / "summary.json").read_text())
+    html = (bench / "report.html").read_text()
+    summary = dict(re.findall(r"<tr><th>([^<]*)</th><td>([^<]*)</td></tr>", html))
+    assert summary["harvested"] == f"{s['successes']} / {TRIALS} = {s['success_rate']:.3f}"
+    assert summary["planning (of decided trials)"].startswith(f"{s['planning_successes']} / {s['planning_decided']} = ")
+    for key, label in (("wilson95", "harvest Wilson 95 %"), ("planning_wilson95", "planning Wilson 95 %"),
+                       ("cluster_bootstrap95", "harvest cluster bootstrap 95 % (over scenes)")):
+        lo, hi = map(float, summary[label].strip("[]").split(", "))
+        assert abs(lo - s[key][0]) < 6e-4 and abs(hi - s[key][1]) < 6e-4, label
+    # Figures the seed determines only: no wall-clock figure on the page.
+    assert "real-time" not in html
+    # One row per visibility class, as the summary has it.
+    rows = rate_rows(html)
+    for k, c in s["per_visibility"].items():
+        n, ok, frac, lo, hi = rows[k]
+        assert (n, ok) == (c["trials"], c["successes"]) and abs(frac - ok / n) < 6e-4, k
+        assert abs(lo - c["wilson95"][0]) < 6e-4 and abs(hi - c["wilson95"][1]) < 6e-4, k
+    assert sum(rows[k][0] for k in s["per_visibility"]) == TRIALS
+    # The failure taxonomy: every category of the summary with its count, and no other.
+    taxonomy = html.split("<h2>Failure taxonomy (trials not harvested)</h2>")[1].split("</table>")[0]
+    assert dict(re.findall(r"<tr><td>([^<]*)</td><td>(\d+)</td></tr>", taxonomy)) == {k: str(v) for k, v in s["failures"].items()}
+    # The histogram of the time to harvest holds every success, each in its bin.
+    bins = [(int(a), int(b), int(c)) for a, b, c in re.findall(r"<title>(\d+)-(\d+): (\d+)</title>", html)]
+    times = [t["time_to_harvest"] for t in ts if t["outcome"] == "success"]
+    assert sum(c for _, _, c in bins) == len(times)
+    for a, b, c in bins:
+        assert c == sum(a <= x < b for x in times), (a, b, times)
+    # One ground-truth base path per trial, from its start pose, coloured by its outcome,
+    # and its target fruit; the failures listed with their category.
+    paths = re.findall(r'<polyline points="([^"]*)" fill="none" stroke="([^"]*)"[^>]*><title>trial (\d+) ([^<]*)</title>', html)
+    assert [int(i) for _, _, i, _ in paths] == list(range(TRIALS))
+    for (points, colour, _, _), t in zip(paths, ts):
+        path = json.loads((bench / "trials" / f"{t['trial']:04}.json").read_text())["path"]
+        assert "path" not in t and len(path) >= 2 and len(points.split()) == len(path)
+        assert abs(path[0][0] - t["start"][0]) < 1e-9 and abs(path[0][1] - t["start"][1]) < 1e-9
+        assert colour == ("#1a7f37" if t["outcome"] == "success" else "#cf222e")
+        assert f"<title>target of trial {t['trial']}</title>" in html
+        if t["failure"]:
+            assert f"<li>trial {t['trial']:04}: {t['failure']} (stage " in html
 
 
 def test_successful_harvests_place_the_fruit_by_ground_truth(bench):
@@ -157,6 +209,10 @@ def test_scenes_spread_the_trials_and_every_fmu_grows_the_trial_scene(tmp_path):
             pose = next(d.pose.position for _, _, _, d in reader.iter_decoded_messages(topics=["/target_fruit"]))
         assert max(abs(a - b) for a, b in zip((pose.x, pose.y, pose.z), t["fruit"])) < 1e-6, (t["scene"], pose, t["fruit"])
     assert ts[0]["fruit"] != ts[1]["fruit"]
+    # report.html: a row per scene, as the summary counts them.
+    rows = rate_rows((out / "report.html").read_text())
+    for p in s["per_scene"]:
+        assert rows[f"{p['scene']} (greenhouse seed {p['scene_seed']})"][:2] == (p["trials"], p["successes"])
 
 
 def test_an_unknown_visibility_class_is_refused_by_name(tmp_path):

@@ -8,12 +8,13 @@
 //! (robot against structure, arm against arm, base against anything), within the time
 //! limit. Planning success means every motion the trial asked for was planned.
 
-use crate::trials::{run_one, run_trials, write_summary, Exec, TrialPlan};
+use crate::trials::{line_without, run_one, run_trials, write_summary, Exec, TrialPlan};
 use super::harvest_targets::{draw, eligible, HarvestTarget, Visibility};
 use crate::initial_pose::initial_estimate;
 use crate::scenes::{by_scene, SceneResult, Scenes};
 use super::map::{grid_message, prior_map};
-use super::nav::trial_seed;
+use super::nav::{decimate, trial_seed};
+use super::report::{self, bar_chart, count_table, interval, opt, per_kind, rate_table, render_with, view_bounds, TrialTrace};
 use super::stats::{percentile, wilson, Z95};
 use agrisim_bus::{Node, Reader};
 use agrisim_error::{err, Result};
@@ -80,6 +81,10 @@ pub struct HarvestTrial {
     pub sim_time: f64,
     pub wall_time: f64,
     pub mcap: String,
+    /// Ground-truth base path (chassis x, y: every 10th exchange and the last); in
+    /// trials/NNNN.json, not in trials.jsonl.
+    #[serde(default)]
+    pub path: Vec<[f64; 2]>,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -268,7 +273,9 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
     let task = o.nodes.external.contains(&node_name).then(|| crate::task_publisher::TaskPublisher::new(target.fruit_index));
     let mut m = harvest_session(s, o, setup, target.start, seed, mcap, harvest, task)?;
     let (world, arm_l, arm_r) = (m.component("world", "harvest benchmark")?, m.component("arm_left", "harvest benchmark")?, m.component("arm_right", "harvest benchmark")?);
+    let chassis = m.component("chassis", "harvest benchmark")?;
     let max_ticks = (timeout / s.timing.step).round() as u64;
+    let mut path = vec![[m.number(chassis, "x")?, m.number(chassis, "y")?]];
     let mut reports = Reports::subscribe(&mut m.bus);
     let mut collisions = Reader::subscribe(&mut m.bus, "/collision");
     let mut judged: Option<(Option<String>, String)> = None;
@@ -277,6 +284,7 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
     let result: Result<()> = (|| {
         for k in 1..=max_ticks {
             m.advance()?;
+            path.push([m.number(chassis, "x")?, m.number(chassis, "y")?]);
             reports.read(&mut m, &node_name)?;
             // The base must touch nothing; the arms may brush plants (counted, not failures).
             // Every collision state counts, however short the contact.
@@ -365,6 +373,7 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
         sim_time,
         wall_time: wall.elapsed().as_secs_f64(),
         mcap: mcap.file_name().map(|f| format!("trials/{}", f.to_string_lossy())).unwrap_or_default(),
+        path: decimate(&path, 10),
         ..HarvestTrial::of_target(index, seed, &target)
     })
 }
@@ -397,7 +406,7 @@ pub fn harvest_session(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, start
     prepare(&s, &RunOptions { seed: Some(seed), ..o.clone() }, mcap, nodes)
 }
 
-/// Runs `trials` trials and writes trials.jsonl, summary.json and trials/*.mcap.
+/// Runs `trials` trials and writes trials.jsonl, summary.json, report.html and trials/*.mcap.
 pub fn bench_harvest(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, resume: bool, exec: Exec, progress: impl FnMut(u64, u64)) -> Result<HarvestSummary> {
     let o = o.record_default(s, agrisim_session::Profile::Standard);
     let seed = plan.seed;
@@ -416,10 +425,12 @@ pub fn bench_harvest(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, 
             let (k, _, setup) = scenes.of(i);
             HarvestTrial { scene: k, ..failed_trial(setup, i, trial_seed(seed, i), reason) }
         },
-        |t| serde_json::to_string(t).expect("plain struct"),
+        // trials.jsonl without the path (it is in trials/NNNN.json).
+        |t| line_without(t, "path"),
     )?;
     let summary = summarize(s, plan, &done.results);
     write_summary(out, &summary, done.interrupted)?;
+    write_report(s, &summary, &done.results, out)?;
     Ok(summary)
 }
 
@@ -468,6 +479,7 @@ impl HarvestTrial {
             sim_time: 0.0,
             wall_time: 0.0,
             mcap: format!("trials/{index:04}.mcap"),
+            path: vec![],
         }
     }
 }
@@ -549,6 +561,63 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, results: &[HarvestTrial]) -> Har
     }
 }
 
+/// report.html: the rates (harvest, planning, conditional) with their intervals, results per
+/// scene and per visibility class, the failure taxonomy, a histogram of the time to harvest,
+/// and the map of scene 0 with every trial's ground-truth base path and target fruit (green
+/// harvested, red not). Only figures the seed determines: the same seed gives the same page
+/// (the wall-clock figures are in summary.json).
+fn write_report(s: &Scenario, sum: &HarvestSummary, results: &[HarvestTrial], out: &Path) -> Result<()> {
+    let g = agrisim_session::scene::generate_scene(s)?;
+    report::write(out, &report_html(&g, sum, results))
+}
+
+/// The page [`write_report`] writes, on the map of `g`.
+fn report_html(g: &agrisim_greenhouse::Greenhouse, sum: &HarvestSummary, results: &[HarvestTrial]) -> String {
+    let rows = vec![
+        ("scenario".to_string(), sum.scenario.clone()),
+        ("seed".to_string(), sum.seed.to_string()),
+        ("trials x scenes".to_string(), format!("{} in {} scene(s), {} distinct targets", sum.trials, sum.scenes, sum.distinct_targets)),
+        ("harvested".to_string(), format!("{} / {} = {:.3}", sum.successes, sum.trials, sum.success_rate)),
+        ("harvest Wilson 95 %".to_string(), interval(sum.wilson95)),
+        ("harvest cluster bootstrap 95 % (over scenes)".to_string(), interval(sum.cluster_bootstrap95)),
+        ("planning (of decided trials)".to_string(), format!("{} / {} = {:.3}", sum.planning_successes, sum.planning_decided, sum.planning_success_rate)),
+        ("planning Wilson 95 %".to_string(), interval(sum.planning_wilson95)),
+        ("harvested given planning".to_string(), format!("{:.3}, Wilson 95 % {}", sum.conditional_success_rate, interval(sum.conditional_wilson95))),
+        ("mean time to harvest [s]".to_string(), opt(sum.time_to_harvest_mean)),
+        ("plans; planning time charged per trial [s]".to_string(), format!("{}; {:.3}", sum.plans, sum.thinking_time_mean)),
+        ("plant touches per trial".to_string(), per_kind(&sum.touches_per_trial)),
+        ("joint tracking RMS mean [rad]".to_string(), format!("{:.2e}", sum.tracking_rms_mean)),
+        ("wall-clock figures".to_string(), "in summary.json (rtf, planning_time_p50/p95/max, thinking_over_wall)".to_string()),
+    ];
+    let classes = sum.per_visibility.iter().map(|(k, c)| (k.clone(), c.trials, c.successes, c.wilson95));
+    let times: Vec<f64> = results.iter().filter_map(|t| t.time_to_harvest).collect();
+    let mut sections = vec![];
+    if sum.scenes > 1 {
+        let scenes = sum.per_scene.iter().map(|r| (format!("{} (greenhouse seed {})", r.scene, r.scene_seed), r.trials, r.successes, wilson(r.successes, r.trials, Z95)));
+        let note = "<p>The map above is scene 0's; the trials of the other scenes are drawn on it.</p>";
+        sections.push(("Harvested per scene".to_string(), rate_table(["scene", "trials", "harvested"], scenes) + note));
+    }
+    sections.extend([
+        ("Harvested by visibility class".to_string(), rate_table(["class", "trials", "harvested"], classes)),
+        ("Failure taxonomy (trials not harvested)".to_string(), count_table(["category", "trials"], &sum.failures)),
+        ("Time to harvest (successful trials, simulated)".to_string(), bar_chart(&times, 5.0, "time to harvest [s]")),
+    ]);
+    let traces: Vec<TrialTrace> = results
+        .iter()
+        .map(|t| TrialTrace {
+            index: t.trial,
+            success: t.outcome == "success",
+            reason: match &t.failure {
+                None => format!("harvested in {} s", opt(t.time_to_harvest)),
+                Some(f) => format!("{f} (stage {}, {}): {}", t.failed_stage.as_deref().unwrap_or("-"), t.visibility, t.detail),
+            },
+            target: t.fruit,
+            path: t.path.clone(),
+        })
+        .collect();
+    render_with(&format!("agrisim harvest benchmark: {}", sum.scenario), &rows, &g.objects, view_bounds(&g.layout, &traces), &traces, &sections)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -575,5 +644,44 @@ mod tests {
         t.update(&state(&[]), |id| id == 9);
         t.update(&state(&[(5, "leaf", "left_link5"), (11, "fruit", "right_hand")]), |id| id == 9);
         assert_eq!(t.by_kind, BTreeMap::from([("leaf".to_string(), 2), ("stem".to_string(), 1), ("fruit".to_string(), 1)]));
+    }
+
+    /// report.html holds only what the seed determines: trials that differ in their
+    /// wall-clock figures alone give the same page. One path per trial, a row per visibility
+    /// class and per failure category, the time to harvest in the histogram.
+    #[test]
+    fn report_is_the_same_whatever_the_wall_clock() {
+        let s = Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/scenarios/harvest.toml")).unwrap();
+        let g = agrisim_session::scene::generate_scene(&s).unwrap();
+        let targets = eligible(&g.objects, &g.layout);
+        let trials = |wall: f64| -> Vec<HarvestTrial> {
+            let picked = targets.iter().step_by(97).take(3).enumerate();
+            picked
+                .map(|(i, t)| {
+                    let mut r = HarvestTrial { sim_time: 30.0, wall_time: wall * (i + 1) as f64, plans: 2, planning_times: vec![wall * 1e-3; 2], ..HarvestTrial::of_target(i as u64, 1, t) };
+                    r.path = vec![[t.start[0], t.start[1]], [t.start[0] + 0.5, t.start[1]]];
+                    let (failure, stage, planning) = [(None, None, "ok"), (Some("grasp"), Some("grasp"), "not_reached"), (Some("planning"), Some("pre_grasp"), "failed")][i];
+                    (r.failure, r.failed_stage, r.planning, r.planning_ok) = (failure.map(String::from), stage.map(String::from), planning.into(), planning == "ok");
+                    if failure.is_none() {
+                        (r.outcome, r.time_to_harvest) = ("success".into(), Some(27.3));
+                    }
+                    r
+                })
+                .collect()
+        };
+        let plan = TrialPlan { trials: 3, seed: 1, scenes: 1 };
+        let (a, b) = (trials(5.0), trials(9.0));
+        let (sa, sb) = (summarize(&s, plan, &a), summarize(&s, plan, &b));
+        assert_ne!(sa.rtf, sb.rtf);
+        let html = report_html(&g, &sa, &a);
+        assert_eq!(html, report_html(&g, &sb, &b));
+        assert!(!html.contains("real-time"));
+        assert_eq!(html.matches("<polyline").count(), 3);
+        assert!(html.contains("<tr><td>grasp</td><td>1</td></tr>") && html.contains("<tr><td>planning</td><td>1</td></tr>"));
+        assert!(html.contains("<th>planning (of decided trials)</th><td>1 / 2 = 0.500</td>"));
+        for (k, c) in &sa.per_visibility {
+            assert!(html.contains(&format!("<tr><td>{k}</td><td>{}</td><td>{}</td>", c.trials, c.successes)), "{k}");
+        }
+        assert!(html.contains("<title>25-30: 1</title>"), "the one time to harvest in the histogram");
     }
 }

@@ -7,10 +7,10 @@
 //! Ground truth is read here only to judge; the navigation stack never sees it.
 
 use crate::trials::{run_one, run_trials, write_summary, Exec, TrialPlan};
-use super::report::{render, TrialTrace};
+use super::report::{self, interval, opt, render, view_bounds, TrialTrace};
 use super::stats::{wilson, Z95};
 use super::targets::draw_target;
-use agrisim_error::{Context, Result};
+use agrisim_error::Result;
 use crate::initial_pose::initial_estimate;
 use crate::scenes::{by_scene, SceneResult, Scenes};
 use crate::map::{grid_message, prior_map, MAP_BAND, MAP_RESOLUTION};
@@ -274,39 +274,19 @@ pub fn bench_nav(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, resu
         ("trials".to_string(), summary.trials.to_string()),
         ("successes".to_string(), summary.successes.to_string()),
         ("success rate".to_string(), format!("{:.3}", summary.success_rate)),
-        ("Wilson 95 %".to_string(), format!("[{:.3}, {:.3}]", summary.wilson95[0], summary.wilson95[1])),
+        ("Wilson 95 %".to_string(), interval(summary.wilson95)),
         ("failures".to_string(), format!("{:?}", summary.failures)),
         ("real-time factor".to_string(), format!("{:.2}", summary.rtf)),
-        ("mean time to goal [s]".to_string(), summary.time_to_goal_mean.map_or("-".into(), |t| format!("{t:.1}"))),
+        ("mean time to goal [s]".to_string(), opt(summary.time_to_goal_mean)),
         ("min clearance [m]".to_string(), format!("{:.3}", summary.min_clearance_min)),
     ];
     let html = render(&format!("agrisim nav benchmark: {}", s.name), &rows, &setup.objects, view_bounds(&setup.layout, &traces), &traces);
-    let rp = out.join("report.html");
-    std::fs::write(&rp, html).context(|| rp.display().to_string())?;
+    report::write(out, &html)?;
     Ok(summary)
 }
 
-/// What the report's map shows: the rows, the headland and every path, with a margin (the
-/// hall around them is mostly empty floor).
-fn view_bounds(layout: &agrisim_greenhouse::Layout, traces: &[TrialTrace]) -> [f64; 4] {
-    let [hx0, hy0, hx1, hy1] = layout.headland;
-    let mut b = [hx0, hy0, hx1, hy1];
-    let mut grow = |x: f64, y: f64| {
-        b = [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)];
-    };
-    for r in layout.rows.iter().filter(|r| r.active) {
-        grow(r.x_start, r.y);
-        grow(r.x_end, r.y);
-    }
-    for p in traces.iter().flat_map(|t| t.path.iter()) {
-        grow(p[0], p[1]);
-    }
-    let m = 1.5;
-    let [x0, y0, x1, y1] = layout.bounds;
-    [(b[0] - m).max(x0), (b[1] - m).max(y0), (b[2] + m).min(x1), (b[3] + m).min(y1)]
-}
-
-fn decimate(path: &[[f64; 2]], every: usize) -> Vec<[f64; 2]> {
+/// Every `every`-th point of `path`, and its last.
+pub(crate) fn decimate(path: &[[f64; 2]], every: usize) -> Vec<[f64; 2]> {
     let mut v: Vec<[f64; 2]> = path.iter().step_by(every).copied().collect();
     if let Some(last) = path.last() {
         v.push(*last);

@@ -1,8 +1,12 @@
 //! report.html: a self-contained page (inline SVG, no scripts, no network) with the summary
-//! table, a top-down map of the greenhouse and every trial's ground-truth path.
+//! table, a top-down map of the greenhouse and every trial's ground-truth path, and the
+//! tables and charts the benchmarks share (rates by class, counts by category, histograms).
 
-use agrisim_greenhouse::{Kind, Object, Shape};
+use agrisim_error::{Context, Result};
+use agrisim_greenhouse::{Kind, Layout, Object, Shape};
+use std::collections::BTreeMap;
 use std::fmt::Write;
+use std::path::Path;
 
 /// One trial as drawn: its path, target and outcome.
 pub struct TrialTrace {
@@ -59,6 +63,68 @@ pub fn bar_chart(values: &[f64], bin: f64, label: &str) -> String {
     }
     let _ = write!(svg, r#"<text x="0" y="12" font-size="10">{}</text><text x="40" y="{:.0}" font-size="11">{}</text></svg>"#, top as u64, h + 34.0, escape(label));
     svg
+}
+
+/// A table of success rates: one row per (key, count, successes, Wilson 95 % interval), with
+/// the fraction. `head` names the key, count and successes columns.
+pub fn rate_table(head: [&str; 3], rows: impl IntoIterator<Item = (String, u64, u64, [f64; 2])>) -> String {
+    let body: String = rows
+        .into_iter()
+        .map(|(k, n, ok, w)| format!("<tr><td>{}</td><td>{n}</td><td>{ok}</td><td>{:.3}</td><td>{}</td></tr>", escape(&k), ok as f64 / n.max(1) as f64, interval(w)))
+        .collect();
+    let [k, n, ok] = head.map(escape);
+    format!("<table><tr><th>{k}</th><th>{n}</th><th>{ok}</th><th>fraction</th><th>Wilson 95 %</th></tr>{body}</table>")
+}
+
+/// A table of counts by category (a failure taxonomy); `head` names the two columns.
+pub fn count_table(head: [&str; 2], counts: &BTreeMap<String, u64>) -> String {
+    let body: String = counts.iter().map(|(k, v)| format!("<tr><td>{}</td><td>{v}</td></tr>", escape(k))).collect();
+    let [k, v] = head.map(escape);
+    format!("<table><tr><th>{k}</th><th>{v}</th></tr>{body}</table>")
+}
+
+/// Means by kind as "kind 0.12, kind 0.03" ("none" when empty).
+pub fn per_kind(means: &BTreeMap<String, f64>) -> String {
+    if means.is_empty() {
+        return "none".into();
+    }
+    means.iter().map(|(k, v)| format!("{k} {v:.2}")).collect::<Vec<_>>().join(", ")
+}
+
+/// A 95 % interval as "[lo, hi]", three decimals.
+pub fn interval(w: [f64; 2]) -> String {
+    format!("[{:.3}, {:.3}]", w[0], w[1])
+}
+
+/// An optional figure with one decimal, "-" when absent.
+pub fn opt(v: Option<f64>) -> String {
+    v.map_or("-".into(), |t| format!("{t:.1}"))
+}
+
+/// What the report's map shows: the rows, the headland and every path, with a margin (the
+/// hall around them is mostly empty floor).
+pub fn view_bounds(layout: &Layout, traces: &[TrialTrace]) -> [f64; 4] {
+    let [hx0, hy0, hx1, hy1] = layout.headland;
+    let mut b = [hx0, hy0, hx1, hy1];
+    let mut grow = |x: f64, y: f64| {
+        b = [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)];
+    };
+    for r in layout.rows.iter().filter(|r| r.active) {
+        grow(r.x_start, r.y);
+        grow(r.x_end, r.y);
+    }
+    for p in traces.iter().flat_map(|t| t.path.iter()) {
+        grow(p[0], p[1]);
+    }
+    let m = 1.5;
+    let [x0, y0, x1, y1] = layout.bounds;
+    [(b[0] - m).max(x0), (b[1] - m).max(y0), (b[2] + m).min(x1), (b[3] + m).min(y1)]
+}
+
+/// Writes `html` to out/report.html.
+pub fn write(out: &Path, html: &str) -> Result<()> {
+    let rp = out.join("report.html");
+    std::fs::write(&rp, html).context(|| rp.display().to_string())
 }
 
 /// [`render`] with extra sections (heading, HTML) after the map.

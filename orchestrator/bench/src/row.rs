@@ -14,12 +14,12 @@
 use super::harvest::{base_contact, harvest_session, HarvestSetup, Touches, COLLISION_COUNTERS};
 use super::harvest_targets::HarvestTarget;
 use super::nav::trial_seed;
-use super::report::{bar_chart, render_with, TrialTrace};
+use super::report::{self, bar_chart, count_table, interval, opt, per_kind, rate_table, render_with, TrialTrace};
 use super::stats::{cluster_bootstrap95, percentile, wilson, Z95};
 use crate::scenes::Scenes;
-use crate::trials::{run_one, run_trials, write_summary, Exec, TrialPlan};
+use crate::trials::{line_without, run_one, run_trials, write_summary, Exec, TrialPlan};
 use agrisim_bus::Reader;
-use agrisim_error::{err, Context, Result};
+use agrisim_error::{err, Result};
 use agrisim_harvest::{topics, RowNode};
 use agrisim_math::Rng;
 use agrisim_msgs::agrisim::{CollisionState, HarvestStatus, PlanResult};
@@ -339,14 +339,8 @@ pub fn bench_row(s: &Scenario, o: &RunOptions, plan: TrialPlan, length: f64, out
             let (k, _, setup) = scenes.of(i);
             RowTrial { scene: k, ..failed_trial(setup, length, i, trial_seed(seed, i), reason) }
         },
-        |t| {
-            // trials.jsonl without the path (it is in trials/NNNN.json).
-            let mut v = serde_json::to_value(t).expect("plain struct");
-            if let Some(m) = v.as_object_mut() {
-                m.remove("path");
-            }
-            v.to_string()
-        },
+        // trials.jsonl without the path (it is in trials/NNNN.json).
+        |t| line_without(t, "path"),
     )?;
     let summary = summarize(s, plan, length, &done.results);
     write_summary(out, &summary, done.interrupted)?;
@@ -434,20 +428,19 @@ fn write_report(s: &Scenario, sum: &RowSummary, results: &[RowTrial], out: &Path
         ("scenario".to_string(), sum.scenario.clone()),
         ("segments x length".to_string(), format!("{} x {} m", sum.segments, sum.segment_length)),
         ("ripe fruit reachable / harvested".to_string(), format!("{} / {}", sum.targets, sum.harvested)),
-        ("harvested fraction".to_string(), format!("{:.3} (cluster bootstrap 95 % [{:.3}, {:.3}])", sum.harvested_fraction, sum.cluster_bootstrap95[0], sum.cluster_bootstrap95[1])),
+        ("harvested fraction".to_string(), format!("{:.3} (cluster bootstrap 95 % {})", sum.harvested_fraction, interval(sum.cluster_bootstrap95))),
         ("fruit per hour".to_string(), format!("{:.1}", sum.fruit_per_hour)),
         ("cycle time mean / p50 / p95 [s]".to_string(), format!("{} / {} / {}", opt(sum.cycle_time_mean), opt(sum.cycle_time_p50), opt(sum.cycle_time_p95))),
-        ("plant touches per fruit".to_string(), format!("{:?}", sum.touches_per_fruit)),
+        ("plant touches per fruit".to_string(), per_kind(&sum.touches_per_fruit)),
         ("dropped fruit".to_string(), sum.dropped.to_string()),
         ("segments ended".to_string(), format!("{:?}", sum.segments_ended)),
         ("real-time factor".to_string(), format!("{:.2}", sum.rtf)),
     ];
-    let classes: String = sum.per_class.iter().map(|(k, c)| format!("<tr><td>{k}</td><td>{}</td><td>{}</td><td>{:.3}</td><td>[{:.3}, {:.3}]</td></tr>", c.targets, c.harvested, c.harvested as f64 / c.targets.max(1) as f64, c.wilson95[0], c.wilson95[1])).collect();
-    let taxonomy: String = sum.failures.iter().map(|(k, v)| format!("<tr><td>{k}</td><td>{v}</td></tr>")).collect();
+    let classes = sum.per_class.iter().map(|(k, c)| (k.clone(), c.targets, c.harvested, c.wilson95));
     let cycles: Vec<f64> = results.iter().flat_map(|t| t.cycle_times.iter().copied()).collect();
     let sections = vec![
-        ("Harvested by visibility class".to_string(), format!("<table><tr><th>class</th><th>fruit</th><th>harvested</th><th>fraction</th><th>Wilson 95 %</th></tr>{classes}</table>")),
-        ("Failure taxonomy (fruit not harvested)".to_string(), format!("<table><tr><th>category</th><th>fruit</th></tr>{taxonomy}</table>")),
+        ("Harvested by visibility class".to_string(), rate_table(["class", "fruit", "harvested"], classes)),
+        ("Failure taxonomy (fruit not harvested)".to_string(), count_table(["category", "fruit"], &sum.failures)),
         ("Cycle times (placement to placement)".to_string(), bar_chart(&cycles, 5.0, "cycle time [s]")),
     ];
     let traces: Vec<TrialTrace> = results
@@ -460,10 +453,5 @@ fn write_report(s: &Scenario, sum: &RowSummary, results: &[RowTrial], out: &Path
         .collect();
     let [x0, y0, x1, y1] = g.layout.bounds;
     let html = render_with(&format!("agrisim row harvest benchmark: {}", s.name), &rows, &g.objects, [x0, y0, x1, y1], &traces, &sections);
-    let rp = out.join("report.html");
-    std::fs::write(&rp, html).context(|| rp.display().to_string())
-}
-
-fn opt(v: Option<f64>) -> String {
-    v.map_or("-".into(), |t| format!("{t:.1}"))
+    report::write(out, &html)
 }

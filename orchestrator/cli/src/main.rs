@@ -105,7 +105,8 @@ enum BenchCommand {
     /// trials/<NNNN>.mcap, report.html (default scenario: models/scenarios/default.toml).
     Nav(TrialArgs),
     /// The dual-arm harvesting experiment: N trials on seeded ripe fruit; DIR/summary.json,
-    /// trials.jsonl, trials/<NNNN>.mcap (default scenario: models/scenarios/harvest.toml).
+    /// trials.jsonl, trials/<NNNN>.mcap, report.html (default scenario:
+    /// models/scenarios/harvest.toml).
     Harvest(TrialArgs),
     /// The whole-row harvest: N aisle segments (both sides), every reachable ripe fruit in
     /// them harvested in turn; DIR/summary.json, trials.jsonl, trials/<NNNN>.mcap, report.html
