@@ -6,6 +6,7 @@ use super::costmap::InflationConfig;
 use super::dwa::ControllerConfig;
 use super::footprint::Footprint;
 use super::astar::PlannerConfig;
+use super::lidar_odometry::LidarOdometryConfig;
 use super::local_costmap::LocalCostmapConfig;
 use super::scan_match::ScanMatchConfig;
 use serde::{Deserialize, Serialize};
@@ -124,6 +125,8 @@ pub struct LocalizationConfig {
     pub max_rejections: usize,
     /// Largest factor by which one inconsistent scan match inflates the covariance.
     pub max_inflation: f64,
+    /// Motion from the slices registered against each other (fused with the wheels').
+    pub lidar_odometry: LidarOdometryConfig,
 }
 
 impl Default for LocalizationConfig {
@@ -145,6 +148,7 @@ impl Default for LocalizationConfig {
             trusted_inliers: 0.6,
             max_rejections: 5,
             max_inflation: 25.0,
+            lidar_odometry: LidarOdometryConfig::default(),
         }
     }
 }

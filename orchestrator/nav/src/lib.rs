@@ -13,8 +13,9 @@
 //! Inside, one concept per file: [`map`] (the OccupancyGrid), [`distance`] (exact distance
 //! transform), [`costmap`] (global costmap, inflation), [`local_costmap`] (rolling window from
 //! the LiDAR), [`footprint`], [`astar`] (global planner), [`tracking`] (progress along the
-//! plan), [`dwa`] (local planner), [`scan_match`] + [`localization`], [`executor`] (the
-//! goal's state machine), [`config`] (all parameters) and [`cloud`] (PointCloud2 codec).
+//! plan), [`dwa`] (local planner), [`scan_match`] + [`lidar_odometry`] + [`localization`],
+//! [`executor`] (the goal's state machine), [`config`] (all parameters) and [`cloud`]
+//! (PointCloud2 codec).
 //! Deterministic: no clocks, no hash maps, no threads.
 
 pub mod astar;
@@ -25,6 +26,7 @@ pub mod distance;
 pub mod dwa;
 pub mod executor;
 pub mod footprint;
+pub mod lidar_odometry;
 pub mod local_costmap;
 pub mod localization;
 pub mod map;

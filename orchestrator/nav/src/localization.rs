@@ -1,6 +1,9 @@
 //! Localization without ground truth: an extended Kalman filter over the map pose
 //! (x, y, yaw) of base_link. Prediction from wheel odometry increments (translation) and the
-//! IMU yaw rate (heading: wheel slip corrupts the odometry's heading most); correction by
+//! IMU yaw rate (heading: wheel slip corrupts the odometry's heading most), replaced at every
+//! scan by that increment fused with the LiDAR odometry's
+//! ([`lidar_odometry`](super::lidar_odometry): the slice registered against the robot's own
+//! recent slices, which sees the wheels slip where the map has no feature); correction by
 //! matching a horizontal slice of the LiDAR cloud against the static map
 //! ([`scan_match`](super::scan_match)) a few times a second, weighted by the match's own
 //! covariance. Publishes what a ROS localization node does: map -> odom on `/tf` and the pose
@@ -11,6 +14,7 @@
 
 use super::config::{LocalizationConfig, NavConfig, RobotConfig};
 use agrisim_math::pose2::{wrap_angle, Pose2};
+use super::lidar_odometry::{Increment, LidarOdometry};
 use super::scan_match::{correlative_match, LikelihoodField, Match};
 use super::{cloud, map::StaticMap, topics};
 use agrisim_bus::{Bus, Reader};
@@ -66,6 +70,18 @@ fn diag(a: f64, b: f64, c: f64) -> Matrix3<f64> {
     Matrix3::from_diagonal(&Vector3::new(a, b, c))
 }
 
+/// The information-weighted mean of two measurements of one increment, the wheels' and the
+/// LiDAR odometry's (yaw taken relative to the wheels', so no wrap sits between them), and
+/// its covariance. `None` when a covariance is singular.
+fn fuse(wheel: &Pose2, q_wheel: &Matrix3<f64>, lidar: &Increment) -> Option<(Pose2, Matrix3<f64>)> {
+    let (a, b) = (inverse(q_wheel)?, inverse(&lidar.cov)?);
+    let p = inverse(&(a + b))?;
+    let dw = Vector3::new(wheel.x, wheel.y, wheel.yaw);
+    let dl = Vector3::new(lidar.delta.x, lidar.delta.y, wheel.yaw + wrap_angle(lidar.delta.yaw - wheel.yaw));
+    let d = p * (a * dw + b * dl);
+    Some((Pose2::new(d[0], d[1], wrap_angle(d[2])), p))
+}
+
 /// Counters for tests and logs.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct LocalizerStats {
@@ -75,6 +91,8 @@ pub struct LocalizerStats {
     pub failed: u64,
     /// Updates that inflated the covariance (odometry inconsistent with the scans).
     pub inflations: u64,
+    /// Predictions from a LiDAR odometry increment (fused with the wheels').
+    pub lidar_odometry: u64,
 }
 
 pub struct Localizer {
@@ -94,6 +112,11 @@ pub struct Localizer {
     gyro_bias: f64,
     last_match_ns: Option<i64>,
     rejections: usize,
+    lidar_odometry: Option<LidarOdometry>,
+    /// The filter's state just after the last scan, and the wheel (+ gyro) increment since:
+    /// the prediction the next scan's LiDAR odometry replaces.
+    anchor: Option<(Pose2, Matrix3<f64>)>,
+    since_scan: Pose2,
     pub stats: LocalizerStats,
     /// The latest scan match (accepted or not), for diagnostics.
     pub last_match: Option<Match>,
@@ -118,6 +141,9 @@ impl Localizer {
             gyro_bias: 0.0,
             last_match_ns: None,
             rejections: 0,
+            lidar_odometry: cfg.lidar_odometry.enabled.then(|| LidarOdometry::new(cfg.lidar_odometry)),
+            anchor: None,
+            since_scan: Pose2::default(),
             stats: LocalizerStats::default(),
             last_match: None,
         }
@@ -138,26 +164,55 @@ impl Localizer {
         self.mean = pose;
         self.cov = diag(sx * sx, sy * sy, sa * sa);
         self.rejections = 0;
+        self.anchor = None;
     }
 
     pub fn set_map(&mut self, map: &StaticMap) {
         self.field = Some(LikelihoodField::new(map, &self.cfg.matcher));
     }
 
-    /// Moves the estimate by a base-frame increment (EKF prediction).
-    fn predict(&mut self, d: &Pose2) {
-        let (s, c) = self.mean.yaw.sin_cos();
-        let f = Matrix3::new(1.0, 0.0, -s * d.x - c * d.y, 0.0, 1.0, c * d.x - s * d.y, 0.0, 0.0, 1.0);
-        let g = Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
+    /// Covariance of a wheel (+ gyro) increment `d`: the odometry motion model.
+    fn odometry_noise(&self, d: &Pose2) -> Matrix3<f64> {
         let [a1, a2, a3, a4] = self.cfg.odom_alpha;
         let trans = d.x.hypot(d.y);
         let rot = d.yaw.abs();
         let st = a1 * trans + a2 * rot + 1e-4;
         let sr = a3 * rot + a4 * trans + 1e-5;
-        let q = diag(st * st, st * st, sr * sr);
-        self.cov = propagate(&f, &self.cov, &g, &q);
+        diag(st * st, st * st, sr * sr)
+    }
+
+    /// Moves the estimate by a wheel (+ gyro) increment (EKF prediction).
+    fn predict(&mut self, d: &Pose2) {
+        let q = self.odometry_noise(d);
+        self.predict_with(d, &q);
+        self.since_scan = self.since_scan.compose(d);
+    }
+
+    /// Moves the estimate by a base-frame increment `d` with covariance `q`.
+    fn predict_with(&mut self, d: &Pose2, q: &Matrix3<f64>) {
+        let (s, c) = self.mean.yaw.sin_cos();
+        let f = Matrix3::new(1.0, 0.0, -s * d.x - c * d.y, 0.0, 1.0, c * d.x - s * d.y, 0.0, 0.0, 1.0);
+        let g = Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
+        self.cov = propagate(&f, &self.cov, &g, q);
         self.mean = self.mean.compose(d);
         self.stats.predictions += 1;
+    }
+
+    /// Registers the slice with the LiDAR odometry and, when it measured the motion since the
+    /// last scan, redoes that prediction from the state then with the wheel and LiDAR
+    /// increments fused. The wheels' increment is charged the motion model's noise over the
+    /// whole interval (not per odometry message): slip is a bias, not white noise, so the
+    /// LiDAR odometry is believed wherever it sees structure.
+    fn lidar_odometry(&mut self, pts: &[(f64, f64)], dense: &[(f64, f64)]) {
+        let wheel = std::mem::take(&mut self.since_scan);
+        let anchor = self.anchor.take();
+        let Some(inc) = self.lidar_odometry.as_mut().and_then(|lo| lo.register(pts, dense, &wheel)) else { return };
+        let Some((mean, cov)) = anchor else { return };
+        let q_wheel = self.odometry_noise(&wheel);
+        let Some((d, q)) = fuse(&wheel, &q_wheel, &inc) else { return };
+        (self.mean, self.cov) = (mean, cov);
+        self.predict_with(&d, &q);
+        self.stats.lidar_odometry += 1;
     }
 
     /// Fuses a scan match (EKF update with H = I); false if gated out.
@@ -198,6 +253,17 @@ impl Localizer {
 
     /// The horizontal slice of a cloud as base-frame 2-D points, downsampled on a voxel grid.
     pub fn slice(&self, cloud: &PointCloud2) -> Result<Vec<(f64, f64)>> {
+        Ok(self.thin(&self.dense_slice(cloud)?))
+    }
+
+    /// At most `max_points` of a dense slice, evenly through its voxel order.
+    fn thin(&self, dense: &[(f64, f64)]) -> Vec<(f64, f64)> {
+        let stride = dense.len().div_ceil(self.cfg.max_points.max(1)).max(1);
+        dense.iter().copied().step_by(stride).collect()
+    }
+
+    /// The slice with one point per voxel (every voxel kept).
+    fn dense_slice(&self, cloud: &PointCloud2) -> Result<Vec<(f64, f64)>> {
         let pts = cloud::decode_xyz(cloud)?;
         let c = &self.cfg;
         let fp = &self.robot.footprint;
@@ -218,8 +284,7 @@ impl Localizer {
         // First point per voxel (stable sort: deterministic for a given cloud).
         keyed.sort_by_key(|k| k.0);
         keyed.dedup_by_key(|k| k.0);
-        let stride = keyed.len().div_ceil(c.max_points.max(1)).max(1);
-        Ok(keyed.into_iter().step_by(stride).map(|k| k.1).collect())
+        Ok(keyed.into_iter().map(|k| k.1).collect())
     }
 
     /// The yaw the gyro measured from `t0` to `t1` [ns] and the mean rate of its samples
@@ -294,7 +359,9 @@ impl Node for Localizer {
         if let Some(cloud) = bus.take_new::<PointCloud2>(topics::POINTS, &mut self.seen[1])? {
             if due && self.field.is_some() && self.last_odom.is_some() {
                 self.last_match_ns = Some(t_ns);
-                let pts = self.slice(&cloud)?;
+                let dense = self.dense_slice(&cloud)?;
+                let pts = self.thin(&dense);
+                self.lidar_odometry(&pts, &dense);
                 let field = self.field.as_ref().unwrap();
                 let mut mcfg = self.cfg.matcher;
                 // Widen the search when the estimate is uncertain (3 sigma), within reason.
@@ -308,6 +375,7 @@ impl Node for Localizer {
                     }
                     None => self.stats.failed += 1,
                 }
+                self.anchor = Some((self.mean, self.cov));
             }
         }
         if let Some(op) = odom_pose {
