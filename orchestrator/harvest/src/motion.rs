@@ -357,26 +357,17 @@ impl Motion {
 
     /// The first of `goals` [`Self::plan_free`] reaches, with its index.
     pub fn plan_free_any(&mut self, arm: Arm, lift: f64, start: [f64; DOF], goals: &[TcpGoal], other: [f64; DOF]) -> Result<(usize, Planned), String> {
-        let mut errors = vec![];
-        for (i, g) in goals.iter().enumerate() {
-            match self.plan_free(arm, lift, start, g, other) {
-                Ok(p) => return Ok((i, p)),
-                Err(e) => errors.push(format!("goal {i}: {e}")),
-            }
-        }
-        Err(errors.join("; "))
+        first_ok(goals, "goal", |g| self.plan_free(arm, lift, start, g, other))
     }
 
     /// The first of `grasps` [`Self::plan_pregrasp`] reaches, with its index.
     pub fn plan_pregrasp_any(&mut self, arm: Arm, lift: f64, start: [f64; DOF], grasps: &[TcpGoal], standoff: f64, other: [f64; DOF]) -> Result<(usize, Planned), String> {
-        let mut errors = vec![];
-        for (i, g) in grasps.iter().enumerate() {
-            match self.plan_pregrasp(arm, lift, start, g, standoff, other) {
-                Ok(p) => return Ok((i, p)),
-                Err(e) => errors.push(format!("approach {i}: {e}")),
-            }
-        }
-        Err(errors.join("; "))
+        first_ok(grasps, "approach", |g| self.plan_pregrasp(arm, lift, start, g, standoff, other))
+    }
+
+    /// The first of `goals` [`Self::plan_linear`] reaches, with its index.
+    pub fn plan_linear_any(&mut self, arm: Arm, lift: f64, start: [f64; DOF], goals: &[TcpGoal], other: [f64; DOF]) -> Result<(usize, Planned), String> {
+        first_ok(goals, "goal", |g| self.plan_linear(arm, lift, start, g, other))
     }
 
     /// Free-space motion back to [`HOME`].
@@ -456,27 +447,32 @@ impl Motion {
             }
             Ok(path)
         };
+        // Checked in full: on the line, collision-free, exact. The jerk-limited motion first;
+        // where it leaves the line or clips a neighbour, a spline through the dense waypoints
+        // (or, where that overshoots a limit, the polyline with small corner blends), which
+        // follows the checked segments.
+        let checked = |samples: Sampled| -> Result<Sampled, String> {
+            let path = on_line(&samples)?;
+            if let Some(qs) = path.iter().find(|q| !checker.is_valid(q)) {
+                let what = checker.contact(qs).map(|c| c.describe(&ctx)).unwrap_or_default();
+                return Err(format!("Cartesian move in collision: {what}"));
+            }
+            exact_check(&ctx, &path, agrisim_manip::exact::EXACT_RESOLUTION).map_err(|c| format!("Cartesian move fails the exact check: {}", c.description))?;
+            Ok(samples)
+        };
         self.meter.add_timing();
         let jerk_limited = time_state_to_state(&JointState::at_rest(start.to_vec()), &JointState::at_rest(end.to_vec()), &self.timing).map_err(|e| format!("jerk-limited motion: {e}"))?;
-        let (samples, path) = match on_line(&jerk_limited) {
-            Ok(path) => (jerk_limited, path),
+        let samples = match checked(jerk_limited) {
+            Ok(s) => s,
             Err(_) => {
-                // A spline through the dense waypoints is smooth; where it overshoots a limit,
-                // the polyline with small corner blends follows the checked segments.
                 self.meter.add_timing();
                 let wv: Vec<Vec<f64>> = wps.iter().map(|q| q.to_vec()).collect();
                 let spline = TimingConfig { shape: PathShape::Spline(PathParam::ChordLength), ..self.timing.clone() };
                 let blended = TimingConfig { shape: PathShape::Blended { radius: 0.01 }, ..self.timing.clone() };
                 let s = time_waypoints(&wv, &spline).or_else(|_| time_waypoints(&wv, &blended)).map_err(|e| format!("time parameterization of the Cartesian path: {e}"))?;
-                let path = on_line(&s)?;
-                (s, path)
+                checked(s)?
             }
         };
-        if let Some(qs) = path.iter().find(|q| !checker.is_valid(q)) {
-            let what = checker.contact(qs).map(|c| c.describe(&ctx)).unwrap_or_default();
-            return Err(format!("Cartesian move in collision: {what}"));
-        }
-        exact_check(&ctx, &path, agrisim_manip::exact::EXACT_RESOLUTION).map_err(|c| format!("Cartesian move fails the exact check: {}", c.description))?;
         Ok(self.to_msg(arm, &samples, end))
     }
 
@@ -496,6 +492,18 @@ impl Motion {
         let msg = JointTrajectory { joint_names: arm.joint_names().to_vec(), points, ..Default::default() };
         Planned { msg, duration: s.t.last().copied().unwrap_or(0.0), goal_q }
     }
+}
+
+/// The first item `plan` succeeds on, with its index; else every item's error, labelled.
+fn first_ok(items: &[TcpGoal], label: &str, mut plan: impl FnMut(&TcpGoal) -> Result<Planned, String>) -> Result<(usize, Planned), String> {
+    let mut errors = vec![];
+    for (i, g) in items.iter().enumerate() {
+        match plan(g) {
+            Ok(p) => return Ok((i, p)),
+            Err(e) => errors.push(format!("{label} {i}: {e}")),
+        }
+    }
+    Err(errors.join("; "))
 }
 
 /// A one-point "stay here" trajectory.
@@ -555,6 +563,35 @@ mod tests {
                 assert!(Checker::new(ctx).is_valid(&HOME), "{arm:?} at lift {lift}");
             }
         }
+    }
+
+    /// A tomato hanging right in front of the target (toward the aisle, 2.5 cm apart: not a
+    /// touching neighbour) blocks the wrist of every straight-in and tilted approach; an
+    /// approach turned along the row reaches round it.
+    #[test]
+    fn a_fruit_in_front_is_reached_round_from_the_side() {
+        use agrisim_msgs::agrisim::CollisionObject;
+        use agrisim_msgs::geometry_msgs::{Point, Pose, Quaternion};
+        let (r, lift) = (0.035, 0.3);
+        let c = [0.4, 0.85, crate::geometry::ARM_Z0 + lift + crate::geometry::SHOULDER_UP - crate::geometry::REACH_BELOW_SHOULDER];
+        let fruit = |id: &str, y: f64| CollisionObject {
+            id: id.into(),
+            kind: "fruit".into(),
+            primitive: SolidPrimitive::sphere(r),
+            pose: Pose { position: Point { x: c[0], y, z: c[2] }, orientation: Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 } },
+        };
+        let scene = PlanningScene { objects: vec![fruit("1", c[1]), fruit("2", c[1] - 2.0 * r - 0.025)], ..Default::default() };
+        let plan = |candidates: &[TcpGoal]| {
+            let mut m = Motion::new(1);
+            m.set_target(c);
+            m.set_scene(&scene, Pose2 { x: 0.0, y: 0.0, yaw: 0.0 });
+            m.ignore_target(false);
+            m.plan_pregrasp_any(Arm::Left, lift, HOME, candidates, crate::geometry::PRE_GRASP, HOME).map(|(i, _)| i)
+        };
+        let all = crate::geometry::grasp_candidates(c, 1.0);
+        assert!(plan(&all[..3]).is_err(), "straight in and tilted must be blocked by the fruit in front");
+        let i = plan(&all).expect("an approach along the row reaches it");
+        assert!(i >= 3 && crate::geometry::APPROACHES[i].0 != 0.0, "approach {i}");
     }
 
     #[test]

@@ -55,8 +55,11 @@ const STAGE_TIMEOUT: f64 = 25.0;
 const GRASP_FORCE: f64 = 20.0;
 /// Time the released fruit gets to fall and settle before the box is checked [s].
 const SETTLE: f64 = 1.5;
-/// Cumulative shifts across the finger pads of the second and third grasp attempt [m].
-const REGRASP_OFFSETS: [f64; 2] = [0.012, -0.024];
+/// Where the later grasp attempts aim, from the first: (across the finger pads, deeper along
+/// the approach) [m]. A miss means the fruit is not where the localized base put it: the
+/// pads tolerate least across them, and a base that stands off a little too far (lateral
+/// localization error) leaves the fruit beyond the pads' tips.
+const REGRASP_SHIFTS: [(f64, f64); 3] = [(0.012, 0.0), (-0.012, 0.0), (0.0, 0.015)];
 /// Taker TCP positions along its approach for the second and third handover attempt [m].
 const HANDOVER_OFFSETS: [f64; 2] = [0.015, -0.015];
 /// Sphere-check margin of the taker's final approach [m]: the hands meet by design there.
@@ -110,9 +113,10 @@ pub struct HarvestNode {
     planned: bool,
     /// Sub-step of multi-motion stages.
     phase: u8,
-    /// Grasp attempts after the first, the offset of the current one, and where it aimed.
+    /// Grasp attempts after the first, the hand's axes (across the pads, approach) at the
+    /// first miss, and where the current attempt aimed.
     attempts: u32,
-    grasp_offset: [f64; 3],
+    regrasp_axes: [[f64; 3]; 2],
     grasp_point: [f64; 3],
     /// The approach the pre-grasp plan chose (position: the target as first seen).
     grasp: TcpGoal,
@@ -162,7 +166,7 @@ impl HarvestNode {
             planned: false,
             phase: 0,
             attempts: 0,
-            grasp_offset: [0.0; 3],
+            regrasp_axes: [[0.0; 3]; 2],
             grasp_point: [0.0; 3],
             grasp: geo::grasp([0.0; 3], side),
             handover_attempts: 0,
@@ -575,10 +579,22 @@ impl HarvestNode {
             Stage::Approach => {
                 if first {
                     let Some(c) = self.target_base() else { return };
-                    let o = self.grasp_offset;
-                    self.grasp_point = [c[0] + o[0], c[1] + o[1], c[2] + o[2]];
-                    let goal = TcpGoal { position: self.grasp_point, ..self.grasp };
-                    self.move_arm(giver, &goal, true, t_ns, bus);
+                    // A later attempt whose aim cannot be reached goes on to the next aim.
+                    let [x, z] = self.regrasp_axes;
+                    let shifts = if self.attempts == 0 { &[(0.0, 0.0)][..] } else { &REGRASP_SHIFTS[self.attempts as usize - 1..] };
+                    let mut goals: Vec<TcpGoal> = shifts.iter().map(|&(a, d)| TcpGoal { position: std::array::from_fn(|i| c[i] + a * x[i] + d * z[i]), ..self.grasp }).collect();
+                    // The target as the localized base sees it now may have moved a few
+                    // millimetres since the pre-grasp plan; where the straight line to it is
+                    // blocked, the line the pre-grasp plan checked.
+                    if self.attempts == 0 && (0..3).any(|i| (c[i] - self.grasp.position[i]).abs() > 1e-3) {
+                        goals.push(self.grasp);
+                    }
+                    if let Some(i) = self.plan_and_send(giver, "linear", t_ns, bus, |m, lift, start, other| m.plan_linear_any(giver, lift, start, &goals, other)) {
+                        if self.attempts > 0 {
+                            self.attempts += i as u32;
+                        }
+                        self.grasp_point = goals[i].position;
+                    }
                 } else if self.arm_done(giver, t_ns, bus) == Some(true) {
                     self.enter(Stage::Grasp, t_ns, bus, "");
                 }
@@ -591,7 +607,7 @@ impl HarvestNode {
                     self.motion.set_held(giver, Some(r));
                     self.enter(Stage::Retreat, t_ns, bus, "fruit held");
                 } else if self.view(giver).gripper.as_ref().is_some_and(|g| g.reached_goal && g.position < 0.005) {
-                    if self.attempts as usize >= REGRASP_OFFSETS.len() {
+                    if self.attempts as usize >= REGRASP_SHIFTS.len() {
                         self.fail(Failure::Grasp, t_ns, bus, format!("the gripper closed on nothing ({} attempts)", self.attempts + 1));
                     } else {
                         self.enter(Stage::Regrasp, t_ns, bus, "the gripper closed on nothing");
@@ -600,8 +616,7 @@ impl HarvestNode {
             }
             Stage::Regrasp => {
                 // The fruit is not where the TCP went (localization error): open, back off to
-                // the pre-grasp and come in again shifted across the finger pads, the
-                // direction in which the grasp tolerates least.
+                // the pre-grasp and come in again at the next aim of REGRASP_SHIFTS.
                 match self.phase_now() {
                     0 => {
                         self.gripper(giver, geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
@@ -614,12 +629,11 @@ impl HarvestNode {
                         }
                     }
                     2 if self.arm_done(giver, t_ns, bus) == Some(true) => {
-                        let tcp = self.motion.model(giver).fk(self.lift, &self.q(giver));
-                        let x = [tcp.rot[0][0], tcp.rot[1][0], tcp.rot[2][0]];
-                        let k = REGRASP_OFFSETS[self.attempts as usize];
+                        if self.attempts == 0 {
+                            let tcp = self.motion.model(giver).fk(self.lift, &self.q(giver));
+                            self.regrasp_axes = [0, 2].map(|k| [tcp.rot[0][k], tcp.rot[1][k], tcp.rot[2][k]]);
+                        }
                         self.attempts += 1;
-                        let o = self.grasp_offset;
-                        self.grasp_offset = [o[0] + k * x[0], o[1] + k * x[1], o[2] + k * x[2]];
                         self.enter(Stage::Approach, t_ns, bus, &format!("attempt {}", self.attempts + 1));
                     }
                     _ => {}
@@ -627,11 +641,16 @@ impl HarvestNode {
             }
             Stage::Retreat => {
                 if first {
-                    let g = TcpGoal { position: self.grasp_point, ..self.grasp }.along(-geo::RETREAT[0]);
-                    let goal = TcpGoal { position: [g.position[0], g.position[1], g.position[2] + geo::RETREAT[1]], ..g };
-                    // The fruit now belongs to the hand: it is no obstacle.
+                    // The fruit now belongs to the hand: it is no obstacle. Back out along the
+                    // approach and a little up; where the held fruit would catch on a
+                    // neighbour that way, straight back, then a shorter way.
                     self.motion.ignore_target(true);
-                    self.move_arm(giver, &goal, true, t_ns, bus);
+                    let grasp = TcpGoal { position: self.grasp_point, ..self.grasp };
+                    let goals = geo::RETREATS.map(|[back, up]| {
+                        let g = grasp.along(-back);
+                        TcpGoal { position: [g.position[0], g.position[1], g.position[2] + up], ..g }
+                    });
+                    self.plan_and_send(giver, "linear", t_ns, bus, |m, lift, start, other| m.plan_linear_any(giver, lift, start, &goals, other));
                 } else if self.arm_done(giver, t_ns, bus) == Some(true) {
                     if !self.holding(giver) {
                         self.fail(Failure::Grasp, t_ns, bus, "the fruit slipped out during the retreat".into());
