@@ -102,6 +102,10 @@ pub struct Motion {
     ignore_target: bool,
     /// Radius of the fruit each arm holds (it moves with the hand in collision checks).
     held: [Option<f64>; 2],
+    /// Scene ids of the fruit this node has held (in the box, or dropped: one that fell on
+    /// the robot would otherwise block its arm for good): loose, pushed aside, never
+    /// planned around.
+    loose: Vec<String>,
     /// Safety margin of the sphere checks [m] (the exact check has none).
     padding: f64,
     /// The straight approach (joint path, pre-grasp first) checked by the last pre-grasp plan.
@@ -123,6 +127,7 @@ impl Motion {
             target_map: None,
             ignore_target: false,
             held: [None, None],
+            loose: vec![],
             padding: agrisim_manip::checker::DEFAULT_PADDING,
             approach: None,
             meter: Meter::default(),
@@ -192,6 +197,9 @@ impl Motion {
 
     fn rebuild(&mut self) {
         let mut objs = self.obstacles.clone();
+        for o in objs.iter_mut().filter(|o| self.loose.contains(&o.name)) {
+            o.kind = ObstacleKind::Soft;
+        }
         if let Some(i) = self.target {
             objs[i].kind = if self.ignore_target { ObstacleKind::Soft } else { ObstacleKind::Target };
             // Tomatoes touching the target are pushed aside by the fingers and brushed when
@@ -229,6 +237,12 @@ impl Motion {
     /// `arm` now holds a fruit of `radius` (None: empty hand).
     pub fn set_held(&mut self, arm: Arm, radius: Option<f64>) {
         self.held[arm.index()] = radius;
+        if let (Some(_), Some(i)) = (radius, self.target) {
+            let id = &self.obstacles[i].name;
+            if !self.loose.contains(id) {
+                self.loose.push(id.clone());
+            }
+        }
     }
 
     fn context<'a>(&'a self, arm: Arm, lift: f64, other_q: [f64; DOF]) -> Context<'a> {
@@ -592,6 +606,38 @@ mod tests {
         assert!(plan(&all[..3]).is_err(), "straight in and tilted must be blocked by the fruit in front");
         let i = plan(&all).expect("an approach along the row reaches it");
         assert!(i >= 3 && crate::geometry::APPROACHES[i].0 != 0.0, "approach {i}");
+    }
+
+    /// A fruit this node once held is loose: lying against the hand afterwards (dropped on
+    /// the robot), it blocks nothing; the same fruit never held does.
+    #[test]
+    fn a_fruit_once_held_is_loose() {
+        use agrisim_msgs::agrisim::CollisionObject;
+        use agrisim_msgs::geometry_msgs::{Point, Pose, Quaternion};
+        let lift = 0.3;
+        let fruit = |id: &str, p: [f64; 3]| CollisionObject {
+            id: id.into(),
+            kind: "fruit".into(),
+            primitive: SolidPrimitive::sphere(0.03),
+            pose: Pose { position: Point { x: p[0], y: p[1], z: p[2] }, orientation: Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 } },
+        };
+        let base = Pose2 { x: 0.0, y: 0.0, yaw: 0.0 };
+        let (picked, next) = ([0.4, 0.85, 1.1], [0.4, -0.85, 1.1]);
+        let at_hand = Motion::new(1).model(Arm::Left).fk(lift, &HOME).trans;
+        let later = PlanningScene { objects: vec![fruit("5", at_hand), fruit("6", next)], ..Default::default() };
+        let home_free = |m: &Motion| Checker::new(m.context(Arm::Left, lift, HOME)).is_valid(&HOME);
+        let mut m = Motion::new(1);
+        m.set_target(picked);
+        m.set_scene(&PlanningScene { objects: vec![fruit("5", picked)], ..Default::default() }, base);
+        m.set_held(Arm::Left, Some(0.03));
+        m.set_held(Arm::Left, None);
+        m.set_target(next);
+        m.set_scene(&later, base);
+        assert!(home_free(&m), "the once-held fruit at the hand must not block");
+        let mut fresh = Motion::new(1);
+        fresh.set_target(next);
+        fresh.set_scene(&later, base);
+        assert!(!home_free(&fresh), "a fruit never held at the hand blocks it");
     }
 
     #[test]
