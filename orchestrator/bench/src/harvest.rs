@@ -8,7 +8,7 @@
 //! (robot against structure, arm against arm, base against anything), within the time
 //! limit. Planning success means every motion the trial asked for was planned.
 
-use crate::trials::{line_without, run_one, run_trials, write_summary, Exec, TrialPlan};
+use crate::trials::{run_one, run_trials, write_summary, Exec, TrialPlan};
 use super::harvest_targets::{draw, eligible, HarvestTarget, Visibility};
 use crate::initial_pose::initial_estimate;
 use crate::scenes::{by_scene, SceneResult, Scenes};
@@ -83,7 +83,7 @@ pub struct HarvestTrial {
     pub mcap: String,
     /// Ground-truth base path (chassis x, y: every 10th exchange and the last); in
     /// trials/NNNN.json, not in trials.jsonl.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub path: Vec<[f64; 2]>,
 }
 
@@ -426,7 +426,7 @@ pub fn bench_harvest(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, 
             HarvestTrial { scene: k, ..failed_trial(setup, i, trial_seed(seed, i), reason) }
         },
         // trials.jsonl without the path (it is in trials/NNNN.json).
-        |t| line_without(t, "path"),
+        |t| serde_json::to_string(&HarvestTrial { path: vec![], ..t.clone() }).expect("plain struct"),
     )?;
     let summary = summarize(s, plan, &done.results);
     write_summary(out, &summary, done.interrupted)?;

@@ -17,7 +17,7 @@ use super::nav::trial_seed;
 use super::report::{self, bar_chart, count_table, interval, opt, per_kind, rate_table, render_with, TrialTrace};
 use super::stats::{cluster_bootstrap95, percentile, wilson, Z95};
 use crate::scenes::Scenes;
-use crate::trials::{line_without, run_one, run_trials, write_summary, Exec, TrialPlan};
+use crate::trials::{run_one, run_trials, write_summary, Exec, TrialPlan};
 use agrisim_bus::Reader;
 use agrisim_error::{err, Result};
 use agrisim_harvest::{topics, RowNode};
@@ -81,7 +81,9 @@ pub struct RowTrial {
     /// Simulated planning time the node charged [s].
     pub thinking_time: f64,
     pub fruit: Vec<RowFruit>,
-    /// Ground-truth base path (every 10th exchange).
+    /// Ground-truth base path (every 10th exchange); in trials/NNNN.json, not in
+    /// trials.jsonl.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub path: Vec<[f64; 2]>,
     pub sim_time: f64,
     pub wall_time: f64,
@@ -340,7 +342,7 @@ pub fn bench_row(s: &Scenario, o: &RunOptions, plan: TrialPlan, length: f64, out
             RowTrial { scene: k, ..failed_trial(setup, length, i, trial_seed(seed, i), reason) }
         },
         // trials.jsonl without the path (it is in trials/NNNN.json).
-        |t| line_without(t, "path"),
+        |t| serde_json::to_string(&RowTrial { path: vec![], ..t.clone() }).expect("plain struct"),
     )?;
     let summary = summarize(s, plan, length, &done.results);
     write_summary(out, &summary, done.interrupted)?;

@@ -287,43 +287,6 @@ fn run_in_process<R: Serialize + DeserializeOwned>(
     Ok(done)
 }
 
-/// `result` as a line of trials.jsonl without its field `key` (a bulky one, such as the base
-/// path, kept in trials/NNNN.json only); the other fields in their order.
-pub fn line_without<R: Serialize>(result: &R, key: &str) -> String {
-    let text = serde_json::to_string(result).expect("plain struct");
-    let fields: Fields = serde_json::from_str(&text).expect("a struct serializes to an object");
-    serde_json::to_string(&Fields(fields.0.into_iter().filter(|(k, _)| k != key).collect())).expect("plain value")
-}
-
-/// A JSON object's fields in their order (serde_json's own map sorts them).
-struct Fields(Vec<(String, serde_json::Value)>);
-
-impl Serialize for Fields {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
-        s.collect_map(self.0.iter().map(|(k, v)| (k, v)))
-    }
-}
-
-impl<'de> serde::Deserialize<'de> for Fields {
-    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Fields, D::Error> {
-        struct Visit;
-        impl<'de> serde::de::Visitor<'de> for Visit {
-            type Value = Fields;
-            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-                f.write_str("a JSON object")
-            }
-            fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> std::result::Result<Fields, A::Error> {
-                let mut fields = vec![];
-                while let Some(field) = map.next_entry()? {
-                    fields.push(field);
-                }
-                Ok(Fields(fields))
-            }
-        }
-        d.deserialize_map(Visit)
-    }
-}
-
 /// Writes `summary` to out/summary.json, with `interrupted_at_trial` when a stop request cut
 /// the benchmark short (the summary then covers the completed trials).
 pub fn write_summary<S: Serialize>(out: &Path, summary: &S, interrupted: Option<u64>) -> Result<()> {
@@ -334,21 +297,3 @@ pub fn write_summary<S: Serialize>(out: &Path, summary: &S, interrupted: Option<
     write_atomic(&out.join("summary.json"), (serde_json::to_string_pretty(&v).expect("plain value") + "\n").as_bytes())
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The field is left out, the others keep their order and their exact values.
-    #[test]
-    fn line_without_keeps_the_order_and_values() {
-        #[derive(Serialize)]
-        struct T {
-            trial: u64,
-            path: Vec<[f64; 2]>,
-            b: f64,
-            a: BTreeMap<String, u64>,
-        }
-        let t = T { trial: 3, path: vec![[0.1, 0.2]], b: 0.1 + 0.2, a: BTreeMap::from([("z".into(), 1), ("y".into(), u64::MAX)]) };
-        assert_eq!(line_without(&t, "path"), format!("{{\"trial\":3,\"b\":{},\"a\":{{\"y\":{},\"z\":1}}}}", 0.1 + 0.2, u64::MAX));
-    }
-}
