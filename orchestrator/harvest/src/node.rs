@@ -109,6 +109,8 @@ pub struct HarvestNode {
     lift_target: f64,
     base_goal: [f64; 3],
     in_place_ticks: u32,
+    /// The base positioning controller (it keeps its crab/drive mode between exchanges).
+    base_ctl: super::base::BaseController,
     /// The current stage has sent its plan.
     planned: bool,
     /// Sub-step of multi-motion stages.
@@ -163,6 +165,7 @@ impl HarvestNode {
             lift_target: 0.0,
             base_goal: [0.0; 3],
             in_place_ticks: 0,
+            base_ctl: super::base::BaseController::default(),
             planned: false,
             phase: 0,
             attempts: 0,
@@ -541,7 +544,10 @@ impl HarvestNode {
             Stage::PositionBase => {
                 bus.set_scalar(topics::LIFT_SETPOINT, self.lift_target);
                 let pose = self.pose.expect("known since SelectTarget");
-                let ctl = super::base::BaseController::default();
+                if first {
+                    self.base_ctl = super::base::BaseController::default();
+                }
+                let ctl = &mut self.base_ctl;
                 if ctl.in_place(pose, self.base_goal) {
                     self.in_place_ticks += 1;
                     self.stop_base(t_ns, bus);
@@ -582,11 +588,12 @@ impl HarvestNode {
                     // A later attempt whose aim cannot be reached goes on to the next aim.
                     let [x, z] = self.regrasp_axes;
                     let shifts = if self.attempts == 0 { &[(0.0, 0.0)][..] } else { &REGRASP_SHIFTS[self.attempts as usize - 1..] };
-                    let mut goals: Vec<TcpGoal> = shifts.iter().map(|&(a, d)| TcpGoal { position: std::array::from_fn(|i| c[i] + a * x[i] + d * z[i]), ..self.grasp }).collect();
+                    let mut goals: Vec<TcpGoal> =
+                        shifts.iter().map(|&(a, d)| TcpGoal { position: std::array::from_fn(|i| c[i] + a * x[i] + d * z[i]), ..self.grasp }.along(geo::GRASP_DEPTH)).collect();
                     // The target as the localized base sees it now may have moved a few
                     // millimetres since the pre-grasp plan; where the straight line to it is
                     // blocked, the line the pre-grasp plan checked.
-                    if self.attempts == 0 && (0..3).any(|i| (c[i] - self.grasp.position[i]).abs() > 1e-3) {
+                    if self.attempts == 0 && (0..3).any(|i| (goals[0].position[i] - self.grasp.position[i]).abs() > 1e-3) {
                         goals.push(self.grasp);
                     }
                     if let Some(i) = self.plan_and_send(giver, "linear", t_ns, bus, |m, lift, start, other| m.plan_linear_any(giver, lift, start, &goals, other)) {

@@ -172,7 +172,7 @@ impl Navigator {
         let (Some(pose), Some(map), Some(local)) = (self.pose, self.map.as_ref(), self.local.as_mut()) else { return Ok(()) };
         let mount = self.cfg.robot.lidar_mount;
         let pts = mount.transform_all(&cloud::decode_xyz(cloud)?);
-        local.update(&pose, (mount.x, mount.y), self.cfg.robot.base_link_height, &pts, map, &self.cfg.robot.footprint);
+        local.update(&pose, [mount.x, mount.y, mount.z], self.cfg.robot.base_link_height, &pts, map, &self.cfg.robot.footprint);
         Ok(())
     }
 

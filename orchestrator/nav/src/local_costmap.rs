@@ -3,9 +3,11 @@
 //!
 //! Marking: points in a height band above the floor, not on the robot itself and not within a
 //! tolerance of a mapped obstacle (those are the map, seen with localization error).
-//! Clearing: 2-D ray tracing from the sensor to the nearest in-band return in each bearing
-//! bin, done before marking so a cell hit in this scan stays marked. Only in-band returns
-//! clear, so a ray passing over a low obstacle towards the roof does not erase it.
+//! Clearing: ray tracing on the grid from the sensor to the nearest in-band return in each
+//! bearing bin, done before marking so a cell hit in this scan stays marked. Only in-band
+//! returns clear, and a marked cell is cleared only where the ray passes it no higher than the
+//! highest point that marked it: a ray passing over a low obstacle (one the LiDAR's lowest
+//! beam no longer sees from close by) towards a plant behind it does not erase it.
 
 use super::distance::distance_transform;
 use super::footprint::Footprint;
@@ -37,6 +39,20 @@ impl Default for LocalCostmapConfig {
     }
 }
 
+/// How far above a cell's highest marking point a ray may pass and still clear it [m]
+/// (the ray's height is taken at the cell centre).
+const TOP_TOLERANCE: f64 = 0.05;
+
+/// The nearest in-band return of a bearing bin: map position, height above the floor and
+/// horizontal range from the sensor.
+#[derive(Debug, Clone, Copy)]
+struct Ray {
+    x: f64,
+    y: f64,
+    z: f64,
+    range: f64,
+}
+
 const UNKNOWN: u8 = 0;
 const FREE: u8 = 1;
 const OCCUPIED: u8 = 2;
@@ -49,6 +65,8 @@ pub struct LocalCostmap {
     pub geom: GridGeom,
     anchor: (f64, f64),
     state: Vec<u8>,
+    /// Height above the floor of the highest point that marked each occupied cell [m].
+    top: Vec<f32>,
     /// Distance from each cell centre to the nearest sensed obstacle [m].
     distance: Vec<f32>,
     occupied_count: usize,
@@ -60,7 +78,7 @@ impl LocalCostmap {
         let res = map_geom.resolution;
         let n = (cfg.size / res).round().max(2.0) as usize;
         let geom = GridGeom { origin_x: map_geom.origin_x, origin_y: map_geom.origin_y, resolution: res, width: n, height: n };
-        LocalCostmap { cfg, geom, anchor: (map_geom.origin_x, map_geom.origin_y), state: vec![UNKNOWN; n * n], distance: vec![f32::INFINITY; n * n], occupied_count: 0 }
+        LocalCostmap { cfg, geom, anchor: (map_geom.origin_x, map_geom.origin_y), state: vec![UNKNOWN; n * n], top: vec![0.0; n * n], distance: vec![f32::INFINITY; n * n], occupied_count: 0 }
     }
 
     /// Forgets everything (a recovery's "clear costmap").
@@ -86,6 +104,7 @@ impl LocalCostmap {
             return;
         }
         let mut state = vec![UNKNOWN; self.state.len()];
+        let mut top = vec![0.0; self.top.len()];
         for ny in 0..n {
             let sy = ny + dy;
             if sy < 0 || sy >= n {
@@ -95,10 +114,12 @@ impl LocalCostmap {
                 let sx = nx + dx;
                 if sx >= 0 && sx < n {
                     state[(ny * n + nx) as usize] = self.state[(sy * n + sx) as usize];
+                    top[(ny * n + nx) as usize] = self.top[(sy * n + sx) as usize];
                 }
             }
         }
         self.state = state;
+        self.top = top;
         self.geom.origin_x = ox;
         self.geom.origin_y = oy;
         self.recompute_distance();
@@ -107,12 +128,13 @@ impl LocalCostmap {
     /// Integrates one scan. `points` are in base_link (z above base_link), `robot` the map pose
     /// of base_link, `sensor` the base-frame position of the LiDAR, `base_height` the height of
     /// base_link above the floor.
-    pub fn update(&mut self, robot: &Pose2, sensor: (f64, f64), base_height: f64, points: &[[f32; 3]], map: &StaticMap, footprint: &Footprint) {
+    pub fn update(&mut self, robot: &Pose2, sensor: [f64; 3], base_height: f64, points: &[[f32; 3]], map: &StaticMap, footprint: &Footprint) {
         self.recentre(robot.x, robot.y);
-        let (sx, sy) = robot.apply(sensor.0, sensor.1);
+        let (sx, sy) = robot.apply(sensor[0], sensor[1]);
+        let sz = sensor[2] + base_height;
         let bins = self.cfg.clearing_bins.max(1);
-        let mut nearest: Vec<Option<(f64, f64, f64)>> = vec![None; bins];
-        let mut marks: Vec<(f64, f64)> = Vec::new();
+        let mut nearest: Vec<Option<Ray>> = vec![None; bins];
+        let mut marks: Vec<(f64, f64, f64)> = Vec::new();
         for p in points {
             let (bx, by, z) = (p[0] as f64, p[1] as f64, p[2] as f64 + base_height);
             if z < self.cfg.min_z || z > self.cfg.max_z || footprint.contains(bx, by, self.cfg.self_filter_margin) {
@@ -125,27 +147,31 @@ impl LocalCostmap {
             }
             let bearing = (my - sy).atan2(mx - sx);
             let b = (((bearing + std::f64::consts::PI) / std::f64::consts::TAU * bins as f64) as usize).min(bins - 1);
-            if nearest[b].is_none_or(|(_, _, rb)| r < rb) {
-                nearest[b] = Some((mx, my, r));
+            if nearest[b].is_none_or(|n| r < n.range) {
+                nearest[b] = Some(Ray { x: mx, y: my, z, range: r });
             }
             if map.distance_at(mx, my) > self.cfg.map_tolerance {
-                marks.push((mx, my));
+                marks.push((mx, my, z));
             }
         }
-        for (mx, my, _) in nearest.into_iter().flatten() {
-            self.clear_ray(sx, sy, mx, my);
+        for ray in nearest.into_iter().flatten() {
+            self.clear_ray((sx, sy, sz), &ray);
         }
-        for (mx, my) in marks {
+        for (mx, my, z) in marks {
             if let Some(i) = self.geom.index_of(mx, my) {
+                self.top[i] = if self.state[i] == OCCUPIED { self.top[i].max(z as f32) } else { z as f32 };
                 self.state[i] = OCCUPIED;
             }
         }
         self.recompute_distance();
     }
 
-    /// Marks cells from (x0, y0) up to, not including, the cell of (x1, y1) free
-    /// (Bresenham's line on the cell lattice), stopping at the window's edge.
-    fn clear_ray(&mut self, x0: f64, y0: f64, x1: f64, y1: f64) {
+    /// Marks cells from the sensor up to, not including, the cell of the return free
+    /// (Bresenham's line on the cell lattice), stopping at the window's edge. An occupied cell
+    /// stays occupied where the ray passes above the highest point seen in it.
+    fn clear_ray(&mut self, sensor: (f64, f64, f64), ray: &Ray) {
+        let (x0, y0, z0) = sensor;
+        let (x1, y1) = (ray.x, ray.y);
         let g = &self.geom;
         let c = |x: f64, y: f64| (((x - g.origin_x) / g.resolution).floor() as i64, ((y - g.origin_y) / g.resolution).floor() as i64);
         let (mut cx, mut cy) = c(x0, y0);
@@ -157,7 +183,12 @@ impl LocalCostmap {
         while (cx, cy) != (ex, ey) {
             if cx >= 0 && cy >= 0 && cx < w && cy < h {
                 let i = (cy * w + cx) as usize;
-                self.state[i] = FREE;
+                let (px, py) = g.center(cx as usize, cy as usize);
+                let t = ((px - x0).hypot(py - y0) / ray.range).min(1.0);
+                let height = z0 + t * (ray.z - z0);
+                if self.state[i] != OCCUPIED || height <= self.top[i] as f64 + TOP_TOLERANCE {
+                    self.state[i] = FREE;
+                }
             } else if (cx < 0 && stx <= 0) || (cy < 0 && sty <= 0) || (cx >= w && stx >= 0) || (cy >= h && sty >= 0) {
                 break;
             }
@@ -242,17 +273,40 @@ mod tests {
         let robot = Pose2::new(0.0, 0.0, 0.0);
         // A post 2 m ahead, floor and self hits ignored.
         let pts = [[2.0f32, 0.0, 0.5], [3.0, 1.0, -0.5], [0.3, 0.0, 0.5], [1.0, 1.0, 2.5]];
-        lc.update(&robot, (0.0, 0.0), 0.0, &pts, &map, &fp);
+        lc.update(&robot, [0.0; 3], 0.0, &pts, &map, &fp);
         assert!(lc.is_occupied(2.0, 0.0));
         assert_eq!(lc.occupied_count(), 1);
         assert!(lc.distance_at(1.5, 0.0) > 0.4 && lc.distance_at(1.5, 0.0) < 0.5);
         // The post moves away: a return farther along the same bearing clears it.
-        lc.update(&robot, (0.0, 0.0), 0.0, &[[3.5, 0.0, 0.5]], &map, &fp);
+        lc.update(&robot, [0.0; 3], 0.0, &[[3.5, 0.0, 0.5]], &map, &fp);
         assert!(!lc.is_occupied(2.0, 0.0) && lc.is_occupied(3.5, 0.0));
         // Rolling 1 m keeps the obstacle at the same map position.
         let robot = Pose2::new(1.0, 0.0, 0.0);
-        lc.update(&robot, (0.0, 0.0), 0.0, &[], &map, &fp);
+        lc.update(&robot, [0.0; 3], 0.0, &[], &map, &fp);
         assert!(lc.is_occupied(3.5, 0.0));
         assert!(lc.geom.index_of(-3.5, 0.0).is_none());
+    }
+
+    /// Regression (blocked-aisles trial 26): a 0.69 m box the LiDAR (1.3 m up, lowest beam
+    /// 7 deg down) saw from afar was erased once the robot came so close that every beam of
+    /// its bearing passed over it to a plant behind, and the robot clipped it.
+    #[test]
+    fn rays_passing_over_a_low_obstacle_keep_it() {
+        let map = empty_map();
+        let mut lc = LocalCostmap::new(LocalCostmapConfig { size: 12.0, ..LocalCostmapConfig::default() }, &map.geom);
+        let fp = Footprint::default();
+        let robot = Pose2::new(0.0, 0.0, 0.0);
+        let sensor = [0.0, 0.0, 1.3];
+        lc.update(&robot, sensor, 0.0, &[[3.0f32, 0.0, 0.6]], &map, &fp);
+        assert!(lc.is_occupied(3.0, 0.0));
+        // Beams over the box to foliage 5 m away (at 1.0 m and at 0.4 m high) keep it.
+        lc.update(&robot, sensor, 0.0, &[[5.0f32, 0.0, 1.0]], &map, &fp);
+        lc.update(&robot, sensor, 0.0, &[[5.0f32, 0.0, 0.4]], &map, &fp);
+        assert!(lc.is_occupied(3.0, 0.0) && lc.is_occupied(5.0, 0.0));
+        // A beam through the box's height (to the floor band just behind it) clears it.
+        lc.update(&robot, sensor, 0.0, &[[3.6f32, 0.0, 0.1]], &map, &fp);
+        assert!(!lc.is_occupied(3.0, 0.0));
+        // Cells it never marked are cleared by any in-band beam.
+        assert!(!lc.is_occupied(2.0, 0.0));
     }
 }
