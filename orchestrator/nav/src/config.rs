@@ -203,7 +203,7 @@ impl Default for ExecutorConfig {
             backup_speed: 0.15,
             backup_time: 2.0,
             max_path_deviation: 0.6,
-            blocked_lookahead: 3.5,
+            blocked_lookahead: 8.0,
             replan_interval: 1.0,
             periodic_replan: 0.0,
             status_period: 1.0,

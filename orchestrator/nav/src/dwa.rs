@@ -158,6 +158,9 @@ pub fn integrate(p: &Pose2, v: &Velocity, dt: f64) -> Pose2 {
     Pose2 { x: p.x + (v.vx * c - v.vy * s) * dt, y: p.y + (v.vx * s + v.vy * c) * dt, yaw: wrap_angle(p.yaw + v.wz * dt) }
 }
 
+/// How much closer than it is now a robot inside the collision margin may come [m].
+pub const ESCAPE_SLACK: f64 = 0.005;
+
 /// One DWA step. `distance(x, y)` is the obstacle distance field (static, sensed and
 /// blocked obstacles combined), `outline` the footprint outline (base frame).
 pub fn dwa(cfg: &ControllerConfig, req: &Request, outline: &[(f64, f64)], distance: impl Fn(f64, f64) -> f64) -> Decision {
@@ -165,6 +168,11 @@ pub fn dwa(cfg: &ControllerConfig, req: &Request, outline: &[(f64, f64)], distan
     let (vy_lo, vy_hi) = window(req.current.vy, cfg.max_vy, cfg.acc_xy, cfg.period);
     let (wz_lo, wz_hi) = window(req.current.wz, cfg.max_wz, cfg.acc_wz, cfg.period);
     let steps = ((cfg.sim_time / cfg.sim_dt).round() as usize).max(1);
+    // A robot already inside the margin (an estimate a few cm off, a wheel slip) may take
+    // any roll-out that does not bring it closer: else every roll-out fails at its first step
+    // and it stays wedged for good.
+    let now = Footprint::clearance(outline, &req.pose, &distance);
+    let margin = cfg.collision_margin.min((now - ESCAPE_SLACK).max(0.0));
     let mut best: Option<(f64, Velocity, f64)> = None;
     for &vx in &samples(vx_lo, vx_hi, cfg.vx_samples) {
         for &vy in &samples(vy_lo, vy_hi, cfg.vy_samples) {
@@ -178,18 +186,18 @@ pub fn dwa(cfg: &ControllerConfig, req: &Request, outline: &[(f64, f64)], distan
                 for _ in 0..steps {
                     p = integrate(&p, &v, cfg.sim_dt);
                     clearance = clearance.min(Footprint::clearance(outline, &p, &distance));
-                    if clearance < cfg.collision_margin {
+                    if clearance < margin {
                         break;
                     }
                 }
-                if clearance < cfg.collision_margin {
+                if clearance < margin {
                     continue;
                 }
                 let progress = (p.x - req.carrot.0).hypot(p.y - req.carrot.1);
                 let path = req.path.iter().map(|q| (q.0 - p.x).hypot(q.1 - p.y)).fold(f64::INFINITY, f64::min);
                 let path = if path.is_finite() { path } else { 0.0 };
                 let heading = wrap_angle(p.yaw - req.desired_yaw).abs();
-                let obstacle = (-(clearance - cfg.collision_margin) / cfg.clearance_scale).exp();
+                let obstacle = (-(clearance - margin) / cfg.clearance_scale).exp();
                 let score = cfg.w_progress * progress + cfg.w_path * path + cfg.w_heading * heading + cfg.w_obstacle * obstacle + cfg.w_spin * wz.abs();
                 if best.is_none_or(|(b, _, _)| score < b) {
                     best = Some((score, v, clearance));

@@ -87,6 +87,33 @@ struct Backup {
     dir: (f64, f64),
 }
 
+/// A turn at the goal made elsewhere ([`turn_spot`](super::turn_spot)): shift out at the
+/// arrival heading, turn, shift back at the goal's heading.
+#[derive(Debug, Clone, Copy)]
+struct Turn {
+    spot: (f64, f64),
+    /// Where it ends, at most `turn_spot::END_RADIUS` from the goal.
+    back: (f64, f64),
+    out_yaw: f64,
+    phase: TurnPhase,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum TurnPhase {
+    Out,
+    Turn,
+    Back,
+}
+
+/// Position tolerance of the turning spot [m].
+const SPOT_TOLERANCE: f64 = 0.03;
+/// Speed and gain of the shifts to and from the turning spot [m/s, 1/s].
+const SHIFT_SPEED: f64 = 0.3;
+const SHIFT_GAIN: f64 = 0.8;
+
+/// How much nearer the other travel direction must be before the executor switches to it [rad].
+const REVERSE_HYSTERESIS: f64 = 0.3;
+
 pub struct Executor {
     cfg: NavConfig,
     outline: Vec<(f64, f64)>,
@@ -102,6 +129,10 @@ pub struct Executor {
     recoveries: usize,
     backup: Option<Backup>,
     stop_until_ns: i64,
+    /// Driving the path backwards (heading = path tangent + pi).
+    reverse: bool,
+    /// A turn at the goal made at a spot beside it.
+    turn: Option<Turn>,
     pub stats: ExecutorStats,
     /// Why the last failed plan failed (the status detail stays "no_path").
     pub last_plan_error: Option<PlanError>,
@@ -124,6 +155,8 @@ impl Executor {
             recoveries: 0,
             backup: None,
             stop_until_ns: i64::MIN,
+            reverse: false,
+            turn: None,
             stats: ExecutorStats::default(),
             last_plan_error: None,
         }
@@ -148,6 +181,8 @@ impl Executor {
     /// Starts (or preempts with) a new goal.
     pub fn set_goal(&mut self, goal: Goal, t_ns: i64) {
         self.goal = Some(goal);
+        self.reverse = false;
+        self.turn = None;
         self.goal_start_ns = t_ns;
         self.recoveries = 0;
         self.backup = None;
@@ -170,6 +205,8 @@ impl Executor {
     /// Rejects a goal it cannot take (e.g. wrong frame).
     pub fn reject(&mut self, goal: Goal, detail: &str, t_ns: i64) {
         self.goal = Some(goal);
+        self.reverse = false;
+        self.turn = None;
         self.goal_start_ns = t_ns;
         self.finish(State::Failed, detail, t_ns);
     }
@@ -239,6 +276,10 @@ impl Executor {
         }
 
         if self.state == State::Rotating {
+            if let Some(turn) = self.turn {
+                out.cmd = Some(self.turn_elsewhere(turn, &pose, &goal, &world, t_ns));
+                return out;
+            }
             if d_goal > ec.xy_goal_tolerance {
                 self.set(State::Following, "");
                 self.anchor = (pose, t_ns);
@@ -281,15 +322,15 @@ impl Executor {
             }
         }
 
-        let c = &self.cfg.controller;
-        let ia = self.path.index_ahead(c.lookahead);
+        let ia = self.path.index_ahead(self.cfg.controller.lookahead);
         let carrot = self.path.points[ia];
         let near_goal = self.path.remaining() <= ec.goal_heading_distance.max(1e-9) || d_goal <= ec.goal_heading_distance;
         let desired_yaw = if near_goal {
             if use_yaw { goal.pose.yaw } else { pose.yaw }
         } else {
-            self.path.tangent(ia)
+            self.travel_heading(self.path.tangent(ia), pose.yaw)
         };
+        let c = &self.cfg.controller;
         let req = dwa::Request { pose, current: self.last_cmd, path: self.path.ahead(c.lookahead + 0.5), carrot, desired_yaw };
         let (global, local) = (&*world.global, &*world.local);
         let grid = ClearanceGrid::from_costmaps(global, local);
@@ -300,6 +341,21 @@ impl Executor {
         self.last_cmd = d.cmd;
         out.cmd = Some(d.cmd);
         out
+    }
+
+    /// The heading to follow a path of tangent `tangent` with: the tangent, or its reverse
+    /// when that is nearer the robot's heading (by more than `REVERSE_HYSTERESIS` to switch).
+    /// The base is omnidirectional and its LiDAR sees all around, so it never has to turn
+    /// about in an aisle (a 1.2 m base turning in a 2 m aisle off its centre line wedged
+    /// itself against a row with no valid roll-out: blocked-aisles trial 132).
+    fn travel_heading(&mut self, tangent: f64, yaw: f64) -> f64 {
+        let forward = wrap_angle(tangent - yaw).abs();
+        let backward = wrap_angle(tangent + std::f64::consts::PI - yaw).abs();
+        let (now, other) = if self.reverse { (backward, forward) } else { (forward, backward) };
+        if other + REVERSE_HYSTERESIS < now {
+            self.reverse = !self.reverse;
+        }
+        if self.reverse { wrap_angle(tangent + std::f64::consts::PI) } else { tangent }
     }
 
     /// The rotate phase's command: turn in place if the footprint sweeps clear of obstacles
@@ -319,26 +375,73 @@ impl Executor {
             self.finish(State::Failed, "stuck", t_ns);
             return Velocity::ZERO;
         }
-        let cmd = self.rotate(pose, goal, err, world);
+        let cmd = self.rotate(pose, goal, err, world, t_ns);
         self.last_cmd = cmd;
         cmd
     }
 
-    fn rotate(&self, pose: &Pose2, goal: &Goal, err: f64, world: &World) -> Velocity {
-        let c = &self.cfg.controller;
-        let steps = ((err.abs() / 0.05).ceil() as usize).max(1);
-        let sweep_clear = (1..=steps).all(|k| {
-            let p = Pose2::new(pose.x, pose.y, pose.yaw + err * k as f64 / steps as f64);
-            footprint_clearance(&self.outline, &p, world) >= c.collision_margin
-        });
-        if sweep_clear {
-            return dwa::rotate_in_place(c, self.last_cmd, err);
+    fn rotate(&mut self, pose: &Pose2, goal: &Goal, err: f64, world: &World, t_ns: i64) -> Velocity {
+        let c = self.cfg.controller;
+        let clearance = |p: &Pose2| footprint_clearance(&self.outline, p, world);
+        if super::turn_spot::turn_clear(pose.x, pose.y, pose.yaw, pose.yaw + err, c.collision_margin, &clearance) {
+            return dwa::rotate_in_place(&c, self.last_cmd, err);
         }
+        if let Some((spot, back)) = super::turn_spot::find(pose, &goal.pose, c.collision_margin, clearance) {
+            let turn = Turn { spot, back, out_yaw: pose.yaw, phase: TurnPhase::Out };
+            self.turn = Some(turn);
+            self.rotate_start_ns = t_ns;
+            return self.turn_elsewhere(turn, pose, goal, world, t_ns);
+        }
+        let c = &self.cfg.controller;
         let path = [(pose.x, pose.y), (goal.pose.x, goal.pose.y)];
         let req = dwa::Request { pose: *pose, current: self.last_cmd, path: &path, carrot: (goal.pose.x, goal.pose.y), desired_yaw: goal.pose.yaw };
         let grid = ClearanceGrid::from_costmaps(world.global, world.local);
         let (global, local) = (&*world.global, &*world.local);
         dwa::dwa(c, &req, &self.outline, |x, y| grid.get(x, y).unwrap_or_else(|| global.distance_at(x, y).min(local.distance_at(x, y)))).cmd
+    }
+
+    /// The command of a turn made at a spot beside the goal; fails "stuck" when it takes
+    /// longer than a turn in place may.
+    fn turn_elsewhere(&mut self, mut turn: Turn, pose: &Pose2, goal: &Goal, world: &World, t_ns: i64) -> Velocity {
+        let ec = self.cfg.executor;
+        if (t_ns - self.rotate_start_ns) as f64 * 1e-9 > 2.0 * ec.progress_timeout {
+            self.turn = None;
+            self.finish(State::Failed, "stuck", t_ns);
+            return Velocity::ZERO;
+        }
+        if turn.phase == TurnPhase::Out && (pose.x - turn.spot.0).hypot(pose.y - turn.spot.1) <= SPOT_TOLERANCE {
+            turn.phase = TurnPhase::Turn;
+        }
+        let err = wrap_angle(goal.pose.yaw - pose.yaw);
+        if turn.phase == TurnPhase::Turn && err.abs() <= 0.5 * ec.yaw_goal_tolerance.unwrap_or(0.1) {
+            turn.phase = TurnPhase::Back;
+        }
+        if turn.phase == TurnPhase::Back && (pose.x - turn.back.0).hypot(pose.y - turn.back.1) <= SPOT_TOLERANCE {
+            self.turn = None;
+            return self.settle_yaw(pose, goal, world, t_ns, false);
+        }
+        self.turn = Some(turn);
+        let cmd = match turn.phase {
+            TurnPhase::Out => self.shift(pose, turn.spot, turn.out_yaw),
+            TurnPhase::Turn => dwa::rotate_in_place(&self.cfg.controller, self.last_cmd, err),
+            TurnPhase::Back => self.shift(pose, turn.back, goal.pose.yaw),
+        };
+        self.last_cmd = cmd;
+        cmd
+    }
+
+    /// A straight holonomic shift towards `to` holding heading `yaw` (checked clear when the
+    /// turning spot was chosen), within the controller's limits.
+    fn shift(&self, pose: &Pose2, to: (f64, f64), yaw: f64) -> Velocity {
+        let c = &self.cfg.controller;
+        let (dx, dy) = (to.0 - pose.x, to.1 - pose.y);
+        let (s, co) = pose.yaw.sin_cos();
+        let (bx, by) = (co * dx + s * dy, -s * dx + co * dy);
+        let d = bx.hypot(by);
+        let speed = (SHIFT_GAIN * d).min(SHIFT_SPEED);
+        let (vx, vy) = if d > 1e-9 { (bx / d * speed, by / d * speed) } else { (0.0, 0.0) };
+        let wz = (c.rotate_gain * wrap_angle(yaw - pose.yaw)).clamp(-c.max_wz, c.max_wz);
+        step_towards(c, self.last_cmd, Velocity { vx, vy, wz })
     }
 
     /// Plans from `pose` after taking the sensed obstacles into the global costmap. Returns

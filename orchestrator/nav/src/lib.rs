@@ -32,6 +32,7 @@ pub mod localization;
 pub mod map;
 pub mod scan_match;
 pub mod tracking;
+pub mod turn_spot;
 
 pub use config::NavConfig;
 /// The name the benchmark harness uses for [`NavConfig`].

@@ -25,8 +25,10 @@ pub struct LocalCostmapConfig {
     pub max_z: f64,
     /// Points farther from the sensor than this neither mark nor clear [m].
     pub max_range: f64,
-    /// Points this close to a mapped obstacle belong to the map [m] (≥ localization error).
+    /// Points this close to a mapped obstacle belong to the map [m] (≥ localization error) ...
     pub map_tolerance: f64,
+    /// ... plus this much per metre of range [m/m] (the heading error's lateral reach).
+    pub map_tolerance_per_m: f64,
     /// Points inside the footprint grown by this are the robot's own body [m].
     pub self_filter_margin: f64,
     /// Bearing bins used for clearing.
@@ -35,7 +37,7 @@ pub struct LocalCostmapConfig {
 
 impl Default for LocalCostmapConfig {
     fn default() -> Self {
-        LocalCostmapConfig { size: 20.0, min_z: 0.05, max_z: 1.5, max_range: 9.5, map_tolerance: 0.15, self_filter_margin: 0.1, clearing_bins: 720 }
+        LocalCostmapConfig { size: 32.0, min_z: 0.05, max_z: 1.5, max_range: 15.0, map_tolerance: 0.15, map_tolerance_per_m: 0.01, self_filter_margin: 0.1, clearing_bins: 720 }
     }
 }
 
@@ -150,7 +152,7 @@ impl LocalCostmap {
             if nearest[b].is_none_or(|n| r < n.range) {
                 nearest[b] = Some(Ray { x: mx, y: my, z, range: r });
             }
-            if map.distance_at(mx, my) > self.cfg.map_tolerance {
+            if map.distance_at(mx, my) > self.cfg.map_tolerance + self.cfg.map_tolerance_per_m * r {
                 marks.push((mx, my, z));
             }
         }
