@@ -644,3 +644,26 @@ fn lidar_odometry_keeps_the_along_aisle_error_small_without_plants_in_the_map() 
     assert!(lidar < 0.25 && lidar < 0.5 * wheels, "{lidar:.3} m");
     assert!(stats.lidar_odometry > 150, "{stats:?}");
 }
+
+#[test]
+fn turns_to_the_goal_heading_beside_a_box_by_shifting_away() {
+    // Regression (blocked-aisles trial 100): a box reaching 0.35 m into the aisle beside the
+    // goal; the goal asks the robot to face back the way it came. Turning in place there
+    // sweeps the base's corners through the box, so it shifts away, turns and comes back.
+    let (geom, occ) = greenhouse();
+    let k = 2;
+    let yc = aisle_centre(k);
+    let start = Pose2::new(1.8, yc, 0.0);
+    let mut sim_only = Sim::new(occ.clone(), geom, start, 0);
+    sim_only.add_box(8.0, 8.55, yc - 0.5 * AISLE, yc - 0.65);
+    let truth = sim_only.truth_occ.clone();
+    let mut h = Harness::with_nodes(&occ, truth, geom, start, 11, true);
+    let goal_yaw = std::f64::consts::PI - 0.25;
+    let (state, detail, t) = h.navigate(8.3, yc, Some(goal_yaw), 120.0);
+    let p = h.sim.truth;
+    println!("turn beside a box: {state} {detail} in {t:.1} s at {p:?}, collisions {}", h.sim.collisions);
+    assert_eq!(state, "succeeded", "{detail}");
+    assert!((p.x - 8.3).hypot(p.y - yc) <= 0.25, "{p:?}");
+    assert!(agrisim_nav::pose2::wrap_angle(p.yaw - goal_yaw).abs() < 0.15, "{p:?}");
+    assert_eq!(h.sim.collisions, 0);
+}
