@@ -155,10 +155,7 @@ pub fn handover_goals(point: [f64; 3], giver_side: f64) -> (TcpGoal, TcpGoal) {
     // Giver: tool z = -side y; tool y (fingers) = z up, so tool x = y cross z.
     let zg = [0.0, -giver_side, 0.0];
     let xg = cross([0.0, 0.0, 1.0], zg);
-    // The giver holds the fruit GRASP_DEPTH short of its TCP: its TCP goes that far past the
-    // point so the fruit is at the point (else the taker closed 10 mm off it and most
-    // handovers needed a second attempt).
-    let giver = TcpGoal { position: point, approach: zg, x_axis: Some(xg) }.along(GRASP_DEPTH);
+    let giver = TcpGoal { position: point, approach: zg, x_axis: Some(xg) };
     // Taker: tool z = +side y; tool y (fingers) = x forward.
     let zt = [0.0, giver_side, 0.0];
     let xt = cross([1.0, 0.0, 0.0], zt);
@@ -166,21 +163,20 @@ pub fn handover_goals(point: [f64; 3], giver_side: f64) -> (TcpGoal, TcpGoal) {
     (giver, taker)
 }
 
-/// Spots over the box a fruit is dropped from (each at two heights): a 3 x 4 grid over the
-/// 0.38 x 0.58 m opening, used in turn, so the fruit spread over the floor of the box. With
-/// the centre and four spots toward the corners, the five heaps reached the rim after about
-/// 96 fruit of a 10 m row segment and every later fruit rolled off (82 placement failures).
-pub const DROP_SPOTS: usize = 12;
+/// Spots over the box a fruit is dropped from (each at two heights): a 3 x 3 grid over the
+/// 0.38 x 0.58 m opening, the centre first, used in turn, so the fruit spread over the floor
+/// of the box. With the centre and four spots toward the corners, the five heaps reached
+/// the rim after about 96 fruit of a 10 m row segment and every later fruit rolled off (82
+/// placement failures).
+pub const DROP_SPOTS: usize = 9;
 
-/// Drop poses above the harvest box, pointing down, roll free: every spot of the grid, row
-/// by row, then the same 0.1 m higher.
+/// Drop poses above the harvest box, pointing down, roll free: every spot of the grid, then
+/// the same 0.1 m higher.
 pub fn drop_goals() -> Vec<TcpGoal> {
     let mut v = vec![];
     for dz in [0.0, 0.1] {
-        for dx in [0.0, 0.11, -0.11] {
-            for dy in [0.07, -0.07, 0.2, -0.2] {
-                v.push(TcpGoal { position: [BOX_TOP[0] + dx, BOX_TOP[1] + dy, BOX_TOP[2] + DROP_ABOVE + dz], approach: [0.0, 0.0, -1.0], x_axis: None });
-            }
+        for (dx, dy) in [(0.0, 0.0), (0.11, 0.19), (-0.11, -0.19), (0.11, -0.19), (-0.11, 0.19), (0.0, 0.19), (0.0, -0.19), (0.11, 0.0), (-0.11, 0.0)] {
+            v.push(TcpGoal { position: [BOX_TOP[0] + dx, BOX_TOP[1] + dy, BOX_TOP[2] + DROP_ABOVE + dz], approach: [0.0, 0.0, -1.0], x_axis: None });
         }
     }
     debug_assert_eq!(v.len(), 2 * DROP_SPOTS);

@@ -747,11 +747,7 @@ impl HarvestNode {
                             let (g, _) = geo::handover_goals(geo::handover_point(self.lift), self.side);
                             let goal = TcpGoal { x_axis: None, ..g.along(-GIVER_BACKOFF) };
                             let (start, other) = (self.q(giver), self.q(taker));
-                            // With the padding of the taker's approach: the hands meet by
-                            // design, and backing off only parts them.
-                            self.motion.set_padding(HANDOVER_PADDING);
                             let r = self.motion.plan_linear(giver, self.lift, start, &goal, other);
-                            self.motion.set_padding(agrisim_manip::checker::DEFAULT_PADDING);
                             self.record(giver, "linear", &r, true, t_ns, bus);
                             if let Ok(p) = r {
                                 self.send(giver, p, t_ns, bus);
