@@ -106,6 +106,11 @@ impl FingerPads {
         (0.5 * width - self.inner_offset).clamp(0.0, self.q_max)
     }
 
+    /// The gap with the fingers open all the way [m].
+    pub fn max_gap(&self) -> f64 {
+        2.0 * (self.q_max + self.inner_offset)
+    }
+
     /// Largest gap the fingers open to.
     pub fn max_width(&self) -> f64 {
         2.0 * (self.q_max + self.inner_offset)

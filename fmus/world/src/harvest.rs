@@ -15,7 +15,10 @@
 //! - **Handover**: a fruit held by one gripper can be grasped by the other by the same rule;
 //!   it is then held by both, still following the first; when the first opens it follows
 //!   the second.
-//! - **Release**: a gripper lets go when its gap exceeds `d + release_margin`. If no other
+//! - **Release**: a gripper lets go when its gap exceeds `d + release_margin`, or, for a fruit
+//!   within that margin of the widest gap the fingers open to, when they are open all the way
+//!   (a 77 mm fruit in the 80 mm Franka gap is no longer squeezed; with the margin alone it
+//!   stayed in the hand for good, and every later grasp of a row closed on it). If no other
 //!   gripper holds the fruit, it becomes a dynamic rapier body (gravity, contacts, CCD) with
 //!   the hand's velocity.
 //! - **Settle**: a falling fruit whose lowest point reaches the floor (z <= 5 mm) is dropped.
@@ -86,6 +89,11 @@ pub struct Harvest {
     pub last_placed: Option<usize>,
 }
 
+/// Whether fingers at gap `w` let go of a fruit of diameter `d` (see the module's rules).
+fn releases(w: f64, d: f64, margin: f64, max_gap: f64) -> bool {
+    w > d + margin || (w >= max_gap - 1e-6 && w > d)
+}
+
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
@@ -141,7 +149,7 @@ impl Harvest {
             let s = side as usize;
             let (w, prev) = (widths[s], self.grippers[s].width);
             if let Some(f) = self.grippers[s].held {
-                if w > 2.0 * world.fruit[f].radius + self.params.release_margin {
+                if releases(w, 2.0 * world.fruit[f].radius, self.params.release_margin, pads[s].max_gap()) {
                     self.release(world, side, f, hands, h);
                 }
             } else if w < prev {
@@ -321,6 +329,16 @@ impl Harvest {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_fruit_nearly_as_wide_as_the_open_gripper_is_let_go_when_it_is_open_all_the_way() {
+        // Regression (10 m row segment, fruit 97 of 179, 77 mm): never let go before.
+        assert!(!releases(0.079, 0.077, 0.005, 0.08));
+        assert!(releases(0.08, 0.077, 0.005, 0.08));
+        // A fruit wider than the open gripper stays jammed; a small one goes at the margin.
+        assert!(!releases(0.08, 0.081, 0.005, 0.08));
+        assert!(releases(0.066, 0.06, 0.005, 0.08) && !releases(0.064, 0.06, 0.005, 0.08));
+    }
 
     #[test]
     fn a_fruit_held_by_both_grippers_is_carried_once() {
