@@ -65,7 +65,7 @@ const HANDOVER_OFFSETS: [f64; 2] = [0.015, -0.015];
 /// Sphere-check margin of the taker's final approach [m]: the hands meet by design there.
 const HANDOVER_PADDING: f64 = 0.002;
 /// How far the giver backs off along its approach after letting go [m].
-const GIVER_BACKOFF: f64 = 0.06;
+const GIVER_BACKOFF: f64 = 0.1;
 /// How far an arm backs off along its approach axis when it cannot plan home from where it
 /// is (a row harvest's recovery) [m].
 const RECOVERY_BACKOFF: f64 = 0.12;
