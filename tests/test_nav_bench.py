@@ -5,6 +5,7 @@ trial's MCAP decoding with rosbags."""
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -40,6 +41,16 @@ def test_files_and_summary(bench):
     assert s["rtf"] > 0
     html = (bench / "report.html").read_text()
     assert "<svg" in html and html.count("<polyline") == TRIALS
+    # The summary rows, the failure taxonomy and the time-to-goal histogram agree with
+    # summary.json and trials.jsonl; no wall-clock figure on the page.
+    summary = dict(re.findall(r"<tr><th>([^<]*)</th><td>([^<]*)</td></tr>", html))
+    assert summary["reached"] == f"{k} / {TRIALS} = {s['success_rate']:.3f}"
+    lo, hi = map(float, summary["Wilson 95 %"].strip("[]").split(", "))
+    assert abs(lo - s["wilson95"][0]) < 1e-3 and abs(hi - s["wilson95"][1]) < 1e-3
+    assert "Failure taxonomy (trials not reached)" in html and "Time to goal (successful trials, simulated)" in html
+    for reason, n in s["failures"].items():
+        assert f"<tr><td>{reason}</td><td>{n}</td>" in html
+    assert "real-time" not in html
 
 
 def test_trials_succeed_and_localize_without_ground_truth(bench):

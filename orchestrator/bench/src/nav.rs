@@ -7,7 +7,7 @@
 //! Ground truth is read here only to judge; the navigation stack never sees it.
 
 use crate::trials::{run_one, run_trials, write_summary, Exec, TrialPlan};
-use super::report::{self, interval, opt, render, view_bounds, TrialTrace};
+use super::report::{self, bar_chart, count_table, interval, opt, rate_table, render_with, view_bounds, TrialTrace};
 use super::stats::{wilson, Z95};
 use super::targets::draw_target;
 use agrisim_error::Result;
@@ -269,20 +269,38 @@ pub fn bench_nav(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, resu
     let results: Vec<NavTrial> = done.results.into_iter().map(|r| r.trial).collect();
     let summary = summarize(s, plan, &results);
     write_summary(out, &summary, done.interrupted)?;
-    let rows = vec![
-        ("scenario".to_string(), summary.scenario.clone()),
-        ("trials".to_string(), summary.trials.to_string()),
-        ("successes".to_string(), summary.successes.to_string()),
-        ("success rate".to_string(), format!("{:.3}", summary.success_rate)),
-        ("Wilson 95 %".to_string(), interval(summary.wilson95)),
-        ("failures".to_string(), format!("{:?}", summary.failures)),
-        ("real-time factor".to_string(), format!("{:.2}", summary.rtf)),
-        ("mean time to goal [s]".to_string(), opt(summary.time_to_goal_mean)),
-        ("min clearance [m]".to_string(), format!("{:.3}", summary.min_clearance_min)),
-    ];
-    let html = render(&format!("agrisim nav benchmark: {}", s.name), &rows, &setup.objects, view_bounds(&setup.layout, &traces), &traces);
+    let html = report_html(&setup.objects, &setup.layout, &summary, &results, &traces);
     report::write(out, &html)?;
     Ok(summary)
+}
+
+/// The report page: figures the seed determines only (the wall-clock ones are in
+/// summary.json), so the same seed gives the same page.
+fn report_html(objects: &[agrisim_greenhouse::Object], layout: &agrisim_greenhouse::Layout, sum: &NavSummary, results: &[NavTrial], traces: &[TrialTrace]) -> String {
+    let rows = vec![
+        ("scenario".to_string(), sum.scenario.clone()),
+        ("seed".to_string(), sum.seed.to_string()),
+        ("trials x scenes".to_string(), format!("{} in {} scene(s)", sum.trials, sum.scenes)),
+        ("reached".to_string(), format!("{} / {} = {:.3}", sum.successes, sum.trials, sum.success_rate)),
+        ("Wilson 95 %".to_string(), interval(sum.wilson95)),
+        ("cluster bootstrap 95 % (over scenes)".to_string(), interval(sum.cluster_bootstrap95)),
+        ("mean time to goal [s]".to_string(), opt(sum.time_to_goal_mean)),
+        ("mean path length [m]".to_string(), format!("{:.2}", sum.path_length_mean)),
+        ("min clearance [m]".to_string(), format!("{:.3}", sum.min_clearance_min)),
+        ("wall-clock figures".to_string(), "in summary.json (rtf, wall_time)".to_string()),
+    ];
+    let mut sections = vec![];
+    if sum.scenes > 1 {
+        let scenes = sum.per_scene.iter().map(|r| (format!("{} (greenhouse seed {})", r.scene, r.scene_seed), r.trials, r.successes, wilson(r.successes, r.trials, Z95)));
+        let note = "<p>The map above is scene 0's; the trials of the other scenes are drawn on it.</p>";
+        sections.push(("Reached per scene".to_string(), rate_table(["scene", "trials", "reached"], scenes) + note));
+    }
+    let times: Vec<f64> = results.iter().filter_map(|t| t.time_to_goal).collect();
+    sections.extend([
+        ("Failure taxonomy (trials not reached)".to_string(), count_table(["reason", "trials"], &sum.failures)),
+        ("Time to goal (successful trials, simulated)".to_string(), bar_chart(&times, 5.0, "time to goal [s]")),
+    ]);
+    render_with(&format!("agrisim nav benchmark: {}", sum.scenario), &rows, objects, view_bounds(layout, traces), traces, &sections)
 }
 
 /// Every `every`-th point of `path`, and its last.
