@@ -381,12 +381,12 @@ impl Executor {
     }
 
     fn rotate(&mut self, pose: &Pose2, goal: &Goal, err: f64, world: &World, t_ns: i64) -> Velocity {
-        let c = self.cfg.controller;
+        let margin = self.cfg.controller.collision_margin;
         let clearance = |p: &Pose2| footprint_clearance(&self.outline, p, world);
-        if super::turn_spot::turn_clear(pose.x, pose.y, pose.yaw, pose.yaw + err, c.collision_margin, &clearance) {
-            return dwa::rotate_in_place(&c, self.last_cmd, err);
+        if super::turn_spot::turn_clear(pose.x, pose.y, pose.yaw, pose.yaw + err, margin, &clearance) {
+            return dwa::rotate_in_place(&self.cfg.controller, self.last_cmd, err);
         }
-        if let Some((spot, back)) = super::turn_spot::find(pose, &goal.pose, c.collision_margin, clearance) {
+        if let Some((spot, back)) = super::turn_spot::find(pose, &goal.pose, margin, clearance) {
             let turn = Turn { spot, back, out_yaw: pose.yaw, phase: TurnPhase::Out };
             self.turn = Some(turn);
             self.rotate_start_ns = t_ns;

@@ -185,10 +185,13 @@ impl LocalCostmap {
         while (cx, cy) != (ex, ey) {
             if cx >= 0 && cy >= 0 && cx < w && cy < h {
                 let i = (cy * w + cx) as usize;
-                let (px, py) = g.center(cx as usize, cy as usize);
-                let t = ((px - x0).hypot(py - y0) / ray.range).min(1.0);
-                let height = z0 + t * (ray.z - z0);
-                if self.state[i] != OCCUPIED || height <= self.top[i] as f64 + TOP_TOLERANCE {
+                // The ray's height over the cell centre matters only for a marked cell.
+                let passes_through = || {
+                    let (px, py) = g.center(cx as usize, cy as usize);
+                    let t = ((px - x0).hypot(py - y0) / ray.range).min(1.0);
+                    z0 + t * (ray.z - z0) <= self.top[i] as f64 + TOP_TOLERANCE
+                };
+                if self.state[i] != OCCUPIED || passes_through() {
                     self.state[i] = FREE;
                 }
             } else if (cx < 0 && stx <= 0) || (cy < 0 && sty <= 0) || (cx >= w && stx >= 0) || (cy >= h && sty >= 0) {
@@ -267,12 +270,16 @@ mod tests {
         StaticMap::from_cells(geom, vec![false; 400 * 400], "map".into())
     }
 
+    /// An empty map, a `size` m window on it, the default footprint and the robot at the origin.
+    fn window(size: f64) -> (StaticMap, LocalCostmap, Footprint, Pose2) {
+        let map = empty_map();
+        let lc = LocalCostmap::new(LocalCostmapConfig { size, ..LocalCostmapConfig::default() }, &map.geom);
+        (map, lc, Footprint::default(), Pose2::new(0.0, 0.0, 0.0))
+    }
+
     #[test]
     fn marks_clears_and_rolls() {
-        let map = empty_map();
-        let mut lc = LocalCostmap::new(LocalCostmapConfig { size: 8.0, ..LocalCostmapConfig::default() }, &map.geom);
-        let fp = Footprint::default();
-        let robot = Pose2::new(0.0, 0.0, 0.0);
+        let (map, mut lc, fp, robot) = window(8.0);
         // A post 2 m ahead, floor and self hits ignored.
         let pts = [[2.0f32, 0.0, 0.5], [3.0, 1.0, -0.5], [0.3, 0.0, 0.5], [1.0, 1.0, 2.5]];
         lc.update(&robot, [0.0; 3], 0.0, &pts, &map, &fp);
@@ -294,10 +301,7 @@ mod tests {
     /// its bearing passed over it to a plant behind, and the robot clipped it.
     #[test]
     fn rays_passing_over_a_low_obstacle_keep_it() {
-        let map = empty_map();
-        let mut lc = LocalCostmap::new(LocalCostmapConfig { size: 12.0, ..LocalCostmapConfig::default() }, &map.geom);
-        let fp = Footprint::default();
-        let robot = Pose2::new(0.0, 0.0, 0.0);
+        let (map, mut lc, fp, robot) = window(12.0);
         let sensor = [0.0, 0.0, 1.3];
         lc.update(&robot, sensor, 0.0, &[[3.0f32, 0.0, 0.6]], &map, &fp);
         assert!(lc.is_occupied(3.0, 0.0));

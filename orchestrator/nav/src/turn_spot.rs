@@ -34,19 +34,30 @@ pub fn shift_clear(a: (f64, f64), b: (f64, f64), yaw: f64, margin: f64, clearanc
     })
 }
 
-/// Points on a [`STEP`] grid about `c` within `radius`, nearest first (ties in grid order).
-fn around(c: (f64, f64), radius: f64) -> impl Iterator<Item = (f64, f64)> {
-    let n = (radius / STEP).round() as i64;
-    let mut v: Vec<(i64, i64, i64)> = Vec::new();
-    for i in -n..=n {
-        for j in -n..=n {
-            if i * i + j * j <= n * n {
-                v.push((i * i + j * j, i, j));
+/// Grid offsets (squared length, i, j) in steps within [`RADIUS`], nearest first (ties in
+/// grid order): sorted once, since the executor searches every exchange it cannot turn.
+fn offsets() -> &'static [(i64, i64, i64)] {
+    static OFFSETS: std::sync::OnceLock<Vec<(i64, i64, i64)>> = std::sync::OnceLock::new();
+    OFFSETS.get_or_init(|| {
+        let n = (RADIUS / STEP).round() as i64;
+        let mut v: Vec<(i64, i64, i64)> = Vec::new();
+        for i in -n..=n {
+            for j in -n..=n {
+                if i * i + j * j <= n * n {
+                    v.push((i * i + j * j, i, j));
+                }
             }
         }
-    }
-    v.sort_unstable();
-    v.into_iter().map(move |(_, i, j)| (c.0 + i as f64 * STEP, c.1 + j as f64 * STEP))
+        v.sort_unstable();
+        v
+    })
+}
+
+/// Points on a [`STEP`] grid about `c` within `radius` (at most [`RADIUS`]), nearest first
+/// (ties in grid order).
+fn around(c: (f64, f64), radius: f64) -> impl Iterator<Item = (f64, f64)> {
+    let n = (radius / STEP).round() as i64;
+    offsets().iter().take_while(move |&&(d2, _, _)| d2 <= n * n).map(move |&(_, i, j)| (c.0 + i as f64 * STEP, c.1 + j as f64 * STEP))
 }
 
 /// The spot nearest `goal` (within [`RADIUS`]) that the robot at `pose` reaches by a straight
