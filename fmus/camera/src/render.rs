@@ -73,6 +73,8 @@ const EPS: f64 = 1e-6;
 const CHUNK_ROWS: usize = 8;
 /// Columns of a primary-ray packet (CHUNK_ROWS x TILE_COLS <= MAX_PACKET rays).
 const TILE_COLS: usize = 8;
+/// Most shadow rays in one packet (a tile's lit points, nearest first).
+const SHADOW_PACKET: usize = 16;
 
 /// Renders one frame on `threads` threads (>= 1). `dynamic` are moving objects (the robot's
 /// base box); their ids must not collide with scene ids. `rng` gives the frame's noise key
@@ -101,34 +103,32 @@ pub fn render(
     let movers = RayCaster::new(dynamic);
     let ctx = Ctx { scene, movers: &movers, k, pose, light, palette: Palette::default() };
     let threads = threads.clamp(1, h.div_ceil(CHUNK_ROWS).max(1));
-    let chunks = f
-        .rgb
-        .chunks_mut(3 * w * CHUNK_ROWS)
-        .zip(f.true_depth.chunks_mut(w * CHUNK_ROWS))
-        .zip(f.labels.chunks_mut(w * CHUNK_ROWS))
-        .enumerate();
-    if threads == 1 {
-        for (c, ((rgb, z), l)) in chunks {
-            ctx.rows(c * CHUNK_ROWS, rgb, z, l);
-        }
-    } else {
-        let mut work: Vec<Vec<_>> = (0..threads).map(|_| Vec::new()).collect();
-        for (c, parts) in chunks {
-            work[c % threads].push((c, parts));
-        }
-        let ctx = &ctx;
-        std::thread::scope(|s| {
-            for list in work {
-                s.spawn(move || {
-                    for (c, ((rgb, z), l)) in list {
-                        ctx.rows(c * CHUNK_ROWS, rgb, z, l);
-                    }
-                });
-            }
-        });
-    }
-    apply_depth_model(&mut f, k, depth, light.fog.map(|g| g.depth_limit), rng.next_u64());
+    let chunks = f.rgb.chunks_mut(3 * w * CHUNK_ROWS).zip(f.true_depth.chunks_mut(w * CHUNK_ROWS)).zip(f.labels.chunks_mut(w * CHUNK_ROWS));
+    let ctx = &ctx;
+    by_chunks(threads, chunks, |c, ((rgb, z), l)| {
+        ctx.rows(c * CHUNK_ROWS, rgb, z, l);
+        0
+    });
+    apply_depth_model(&mut f, k, depth, light.fog.map(|g| g.depth_limit), rng.next_u64(), threads);
     f
+}
+
+/// Runs `work` on every chunk (chunk c covers rows from c * [`CHUNK_ROWS`]), chunks dealt to
+/// `threads` threads round-robin; returns the sum of what it returns. Each chunk's result
+/// depends on the chunk alone, so the outcome is the same for any number of threads.
+fn by_chunks<T: Send>(threads: usize, chunks: impl Iterator<Item = T>, work: impl Fn(usize, T) -> usize + Sync) -> usize {
+    if threads <= 1 {
+        return chunks.enumerate().map(|(c, t)| work(c, t)).sum();
+    }
+    let mut lists: Vec<Vec<(usize, T)>> = (0..threads).map(|_| Vec::new()).collect();
+    for (c, t) in chunks.enumerate() {
+        lists[c % threads].push((c, t));
+    }
+    let work = &work;
+    std::thread::scope(|s| {
+        let running: Vec<_> = lists.into_iter().map(|list| s.spawn(move || list.into_iter().map(|(c, t)| work(c, t)).sum::<usize>())).collect();
+        running.into_iter().map(|r| r.join().expect("render thread")).sum()
+    })
 }
 
 /// What every pixel needs.
@@ -220,31 +220,42 @@ impl Ctx<'_> {
     fn beams(&self, surfaces: &[Surface]) -> [f64; MAX_PACKET] {
         let l = self.light;
         let mut beams = [0.0; MAX_PACKET];
-        let mut points = [[0.0; 3]; MAX_PACKET];
-        let mut which = [0usize; MAX_PACKET];
+        // Lit points by their distance from the camera, so each shadow packet holds points
+        // close together (a tile across an edge holds a near leaf and the far background:
+        // one packet spanning both culls almost nothing).
+        let mut lit = [(0.0, 0usize); MAX_PACKET];
         let mut m = 0;
         for (i, s) in surfaces.iter().enumerate() {
             if let Surface::Lit { p, cos_sun, .. } = s {
                 if l.sun_up && *cos_sun > 0.0 {
-                    points[m] = *p;
-                    which[m] = i;
+                    let o = self.pose.origin;
+                    lit[m] = ((p[0] - o[0]).powi(2) + (p[1] - o[1]).powi(2) + (p[2] - o[2]).powi(2), i);
                     m += 1;
                 }
             }
         }
         let Some(samples) = self.sun_samples() else {
-            which[..m].iter().for_each(|&i| beams[i] = l.cover_tau);
+            lit[..m].iter().for_each(|&(_, i)| beams[i] = l.cover_tau);
             return beams;
         };
-        let mut out = [None; MAX_PACKET];
-        for k in 0..samples {
-            let s = sun_disc_sample(l.sun, k, samples);
-            self.scene.caster.pass_through_packet(&points[..m], s, EPS, FAR, self.movers, |id| shading::casts_shadow(self.scene.kind(id)), &mut out[..m]);
-            for (q, &i) in which[..m].iter().enumerate() {
-                beams[i] += transmittance(out[q], l.cover_tau);
+        lit[..m].sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let mut out = [None; SHADOW_PACKET];
+        let mut points = [[0.0; 3]; SHADOW_PACKET];
+        for group in lit[..m].chunks(SHADOW_PACKET) {
+            for (q, &(_, i)) in group.iter().enumerate() {
+                let Surface::Lit { p, .. } = surfaces[i] else { unreachable!("lit points are surfaces") };
+                points[q] = p;
+            }
+            let g = group.len();
+            for k in 0..samples {
+                let s = sun_disc_sample(l.sun, k, samples);
+                self.scene.caster.pass_through_packet(&points[..g], s, EPS, FAR, self.movers, |id| shading::casts_shadow(self.scene.kind(id)), &mut out[..g]);
+                for (q, &(_, i)) in group.iter().enumerate() {
+                    beams[i] += transmittance(out[q], l.cover_tau);
+                }
             }
         }
-        which[..m].iter().for_each(|&i| beams[i] /= samples as f64);
+        lit[..m].iter().for_each(|&(_, i)| beams[i] /= samples as f64);
         beams
     }
 
@@ -389,12 +400,19 @@ fn mix64(mut z: u64) -> u64 {
 }
 
 /// Range clip, fog limit (along the ray), discontinuities, left band, noise: true_depth ->
-/// depth. Pixel i's noise is drawn from a generator seeded by mix(key, i).
-pub fn apply_depth_model(f: &mut Frame, k: &Intrinsics, m: &DepthModel, fog_limit: Option<f64>, key: u64) {
-    let (w, h) = (k.width as usize, k.height as usize);
+/// depth, rows in chunks on `threads` threads. Pixel i's noise is drawn from a generator
+/// seeded by mix(key, i), so the result does not depend on the threads.
+pub fn apply_depth_model(f: &mut Frame, k: &Intrinsics, m: &DepthModel, fog_limit: Option<f64>, key: u64, threads: usize) {
+    let w = k.width as usize;
     let zt = &f.true_depth;
-    f.valid = 0;
-    for v in 0..h {
+    f.valid = by_chunks(threads, f.depth.chunks_mut(w * CHUNK_ROWS), |c, out| depth_rows(c * CHUNK_ROWS, out, zt, k, m, fog_limit, key));
+}
+
+/// [`apply_depth_model`] for the rows from `v0` that `out` holds; returns how many are valid.
+fn depth_rows(v0: usize, out: &mut [f32], zt: &[f32], k: &Intrinsics, m: &DepthModel, fog_limit: Option<f64>, key: u64) -> usize {
+    let (w, h) = (k.width as usize, k.height as usize);
+    let mut valid = 0;
+    for v in v0..v0 + out.len() / w {
         for u in 0..w {
             let i = v * w + u;
             let z = zt[i] as f64;
@@ -419,11 +437,11 @@ pub fn apply_depth_model(f: &mut Frame, k: &Intrinsics, m: &DepthModel, fog_limi
                     ok = false;
                 }
             }
-            f.depth[i] = if ok {
+            out[i - v0 * w] = if ok {
                 let mut rng = Rng::new(mix64(key ^ mix64(i as u64)));
                 let zm = z + rng.gauss(m.noise.sigma(z, k.fx, m.baseline));
                 if zm > 0.0 {
-                    f.valid += 1;
+                    valid += 1;
                     zm as f32
                 } else {
                     0.0
@@ -433,4 +451,5 @@ pub fn apply_depth_model(f: &mut Frame, k: &Intrinsics, m: &DepthModel, fog_limi
             };
         }
     }
+    valid
 }

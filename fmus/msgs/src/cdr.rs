@@ -372,6 +372,23 @@ pub trait CdrField: Sized {
     const MIN_SIZE: usize;
     fn write_field(&self, w: &mut CdrWriter);
     fn read_field(r: &mut CdrReader<'_>) -> Result<Self, CdrError>;
+
+    /// The elements of a sequence (after its count), one by one; bytes override it with one
+    /// copy (images and clouds are megabytes of them).
+    fn write_items(items: &[Self], w: &mut CdrWriter) {
+        for v in items {
+            v.write_field(w);
+        }
+    }
+
+    /// `n` elements of a sequence (after its count; `n` already checked against the input).
+    fn read_items(r: &mut CdrReader<'_>, n: usize) -> Result<Vec<Self>, CdrError> {
+        let mut v = Vec::with_capacity(n);
+        for _ in 0..n {
+            v.push(Self::read_field(r)?);
+        }
+        Ok(v)
+    }
 }
 
 macro_rules! prim_field {
@@ -388,7 +405,6 @@ macro_rules! prim_field {
     };
 }
 prim_field!(bool, write_bool, read_bool);
-prim_field!(u8, write_u8, read_u8);
 prim_field!(i8, write_i8, read_i8);
 prim_field!(u16, write_u16, read_u16);
 prim_field!(i16, write_i16, read_i16);
@@ -409,23 +425,33 @@ impl CdrField for String {
     }
 }
 
+impl CdrField for u8 {
+    const MIN_SIZE: usize = 1;
+    fn write_field(&self, w: &mut CdrWriter) {
+        w.write_u8(*self)
+    }
+    fn read_field(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+        r.read_u8()
+    }
+    fn write_items(items: &[Self], w: &mut CdrWriter) {
+        w.buf.extend_from_slice(items);
+    }
+    fn read_items(r: &mut CdrReader<'_>, n: usize) -> Result<Vec<Self>, CdrError> {
+        Ok(r.read_bytes(n)?.to_vec())
+    }
+}
+
 /// Unbounded sequence `T[]`.
 impl<T: CdrField> CdrField for Vec<T> {
     const MIN_SIZE: usize = 4;
     fn write_field(&self, w: &mut CdrWriter) {
         w.write_sequence_len(self.len());
-        for v in self {
-            v.write_field(w);
-        }
+        T::write_items(self, w);
     }
     fn read_field(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
         let n = r.read_sequence_len(T::MIN_SIZE)?;
         // `n` is bounded by the remaining input (checked above), so this is safe to reserve.
-        let mut v = Vec::with_capacity(n);
-        for _ in 0..n {
-            v.push(T::read_field(r)?);
-        }
-        Ok(v)
+        T::read_items(r, n)
     }
 }
 

@@ -85,10 +85,26 @@ impl RayCaster {
     /// tile), traversing together: `out[i]` is exactly what `cast_among` gives for `dirs[i]`,
     /// at a fraction of the node work when the rays are coherent.
     pub fn cast_packet(&self, origin: [f64; 3], dirs: &[[f64; 3]], min: f64, max: f64, movers: &RayCaster, out: &mut [Option<Hit>]) {
-        let mut best = self.packet_static(&[origin], dirs, min, max);
-        for (i, (d, o)) in dirs.iter().zip(out.iter_mut()).enumerate() {
-            movers.nearest(origin, *d, min, &mut best[i], &mut ());
-            *o = best[i].hit();
+        assert!(dirs.len() <= MAX_PACKET, "a packet of {} rays (at most {MAX_PACKET})", dirs.len());
+        let mut best = [Best { t: max, id: u32::MAX, normal: [0.0; 3] }; MAX_PACKET];
+        match Packet::new(&[origin], dirs, max) {
+            // The movers (the robot's links, seen by every tile at the image's bottom) with the
+            // same packet, each ray's far limit already lowered to its static hit.
+            Some(mut packet) => {
+                for set in [self, movers] {
+                    let mut v = PacketNearest { caster: set, origins: &[origin], dirs, tmin: min, best: &mut best };
+                    traverse_packet(&set.nodes, &mut packet, min, &mut v);
+                }
+            }
+            None => {
+                for (i, d) in dirs.iter().enumerate() {
+                    self.nearest(origin, *d, min, &mut best[i], &mut ());
+                    movers.nearest(origin, *d, min, &mut best[i], &mut ());
+                }
+            }
+        }
+        for (b, o) in best.iter().zip(out.iter_mut()) {
+            *o = b.hit();
         }
     }
 
@@ -180,20 +196,14 @@ impl RayCaster {
         };
         let mut at = [Crossings { t: [0.0; MAX_CROSSINGS], len: 0 }; MAX_PACKET];
         let mut blocked = [false; MAX_PACKET];
-        let mut v = PacketThrough { caster: self, origins, d: dir, tmin: min, tmax: max, opaque: &opaque, at: &mut at, blocked: &mut blocked };
-        traverse_packet(&self.nodes, &mut packet, min, &mut v);
+        // The scene, then the movers with the same packet (blocked rays have left it), each
+        // ray continuing its crossing list.
+        for set in [self, movers] {
+            let mut v = PacketThrough { caster: set, origins, d: dir, tmin: min, tmax: max, opaque: &opaque, at: &mut at, blocked: &mut blocked };
+            traverse_packet(&set.nodes, &mut packet, min, &mut v);
+        }
         for i in 0..n {
-            out[i] = if blocked[i] {
-                None
-            } else {
-                // The movers (a handful) per ray, continuing the same crossing list.
-                let mut w = Through { caster: movers, o: origins[i], d: dir, tmin: min, tmax: max, far: far(max), opaque: &opaque, at: &mut at[i] };
-                if traverse(&movers.nodes, origins[i], dir, min, &mut w) {
-                    None
-                } else {
-                    Some(at[i].count(min))
-                }
-            };
+            out[i] = (!blocked[i]).then(|| at[i].count(min));
         }
     }
 

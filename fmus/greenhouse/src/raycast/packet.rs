@@ -29,6 +29,8 @@ pub(crate) struct Packet {
     /// Inverse-direction interval per axis.
     lo: [f32; 3],
     hi: [f32; 3],
+    /// Rays in use (lanes from here on are idle).
+    len: usize,
 }
 
 impl Packet {
@@ -44,6 +46,7 @@ impl Packet {
             far: [f32::NEG_INFINITY; MAX_PACKET],
             lo: [f32::INFINITY; 3],
             hi: [f32::NEG_INFINITY; 3],
+            len: dirs.len(),
         };
         for (i, d) in dirs.iter().enumerate() {
             let r = Ray32::new(origins[i.min(origins.len() - 1)], *d);
@@ -61,7 +64,7 @@ impl Packet {
     }
 
     fn far_max(&self) -> f32 {
-        self.far.iter().fold(f32::NEG_INFINITY, |m, &f| if f > m { f } else { m })
+        self.far[..self.len].iter().fold(f32::NEG_INFINITY, |m, &f| if f > m { f } else { m })
     }
 
     /// Flags the rays that may meet the box in lane `lane` of node `n` (each ray's own robust
@@ -71,7 +74,7 @@ impl Packet {
         let bmin = [n.min[0][lane], n.min[1][lane], n.min[2][lane]];
         let bmax = [n.max[0][lane], n.max[1][lane], n.max[2][lane]];
         let mut any = false;
-        for i in 0..MAX_PACKET {
+        for i in 0..self.len {
             let mut t0 = tmin;
             let mut t1 = self.far[i];
             for k in 0..3 {
