@@ -152,6 +152,33 @@ enum Surface {
     Lit { p: Vec3, n_z: f64, cos_sun: f64, through: f64, fog_path: f64, object: u32 },
 }
 
+/// Panes of glass or film a camera ray sees through (beyond: the last one is shown).
+const SEE_THROUGH: usize = 4;
+
+/// A camera ray seeing through panes: its current hit, the light passed so far and the
+/// distance to the first pane (where the air inside the greenhouse ends).
+#[derive(Clone, Copy, Debug)]
+struct Layers {
+    hit: Option<Hit>,
+    through: f64,
+    inside: f64,
+}
+
+impl Layers {
+    /// If the current hit is a pane (an object casting no shadow), counts it and gives the
+    /// near limit to cast on from; None when the ray is done.
+    fn pane(&mut self, kind: &impl Fn(u32) -> agrisim_greenhouse::Kind, tau: f64) -> Option<f64> {
+        match self.hit {
+            Some(h) if !shading::casts_shadow(kind(h.object)) => {
+                self.through *= tau;
+                self.inside = self.inside.min(h.distance);
+                Some(h.distance + 1e-4)
+            }
+            _ => None,
+        }
+    }
+}
+
 /// Sub-pixel offsets of 2x2 supersampling.
 const SUB: [(f64, f64); 4] = [(-0.25, -0.25), (0.25, -0.25), (-0.25, 0.25), (0.25, 0.25)];
 
@@ -189,10 +216,16 @@ impl Ctx<'_> {
                 }
                 continue;
             }
-            // Surfaces, then their shadow rays toward the sun as one packet, then colours.
+            // Surfaces (through glass: the tile's rays that met a pane go on as packets),
+            // then their shadow rays toward the sun, then colours.
+            let mut layers = [Layers { hit: None, through: 1.0, inside: f64::INFINITY }; MAX_PACKET];
+            for i in 0..n {
+                layers[i].hit = hits[i];
+            }
+            self.see_through_packet(&dirs[..n], &mut layers[..n]);
             let mut surfaces = [Surface::Sky([0.0; 3]); MAX_PACKET];
             for i in 0..n {
-                surfaces[i] = self.surface(dirs[i], hits[i].as_ref());
+                surfaces[i] = self.surface_beyond(dirs[i], &layers[i]);
             }
             let beams = self.beams(&surfaces[..n]);
             for i in 0..n {
@@ -273,22 +306,50 @@ impl Ctx<'_> {
     /// the sky or a surface. Fog and haze fill the greenhouse up to its cover (the air outside
     /// is not modelled).
     fn surface(&self, d: Vec3, hit: Option<&Hit>) -> Surface {
-        let l = self.light;
-        let mut hit = hit.cloned();
-        let mut through = 1.0;
-        let mut inside = f64::INFINITY;
-        if let Some(tau) = l.cover_see_through {
-            for _ in 0..4 {
-                match &hit {
-                    Some(h) if !shading::casts_shadow(self.scene.kind(h.object)) => {
-                        through *= tau;
-                        inside = inside.min(h.distance);
-                        hit = self.scene.caster.cast_among(self.pose.origin, d, h.distance + 1e-4, FAR, self.movers);
-                    }
-                    _ => break,
+        let mut layers = Layers { hit: hit.cloned(), through: 1.0, inside: f64::INFINITY };
+        let kind = |id| self.scene.kind(id);
+        if let Some(tau) = self.light.cover_see_through {
+            for _ in 0..SEE_THROUGH {
+                match layers.pane(&kind, tau) {
+                    Some(beyond) => layers.hit = self.scene.caster.cast_among(self.pose.origin, d, beyond, FAR, self.movers),
+                    None => break,
                 }
             }
         }
+        self.surface_beyond(d, &layers)
+    }
+
+    /// [`Ctx::surface`] for a tile's rays at once: the rays whose hit is a pane go on past it
+    /// together, up to [`SEE_THROUGH`] panes, each ray exactly as it would alone.
+    fn see_through_packet(&self, dirs: &[Vec3], layers: &mut [Layers]) {
+        let Some(tau) = self.light.cover_see_through else { return };
+        let kind = |id| self.scene.kind(id);
+        let mut which = [0usize; MAX_PACKET];
+        let mut sub = [[0.0; 3]; MAX_PACKET];
+        let mut mins = [0.0; MAX_PACKET];
+        let mut out = [None; MAX_PACKET];
+        for _ in 0..SEE_THROUGH {
+            let mut m = 0;
+            for (i, layer) in layers.iter_mut().enumerate() {
+                if let Some(beyond) = layer.pane(&kind, tau) {
+                    (which[m], sub[m], mins[m]) = (i, dirs[i], beyond);
+                    m += 1;
+                }
+            }
+            if m == 0 {
+                return;
+            }
+            self.scene.caster.cast_packet_beyond(self.pose.origin, &sub[..m], &mins[..m], FAR, self.movers, &mut out[..m]);
+            for q in 0..m {
+                layers[which[q]].hit = out[q];
+            }
+        }
+    }
+
+    /// What a ray shows given its first hit past the panes it saw through.
+    fn surface_beyond(&self, d: Vec3, layers: &Layers) -> Surface {
+        let l = self.light;
+        let (hit, through, inside) = (layers.hit, layers.through, layers.inside);
         let Some(hit) = hit else {
             let sky = l.sky.map(|v| v * through);
             return Surface::Sky(match l.fog {

@@ -297,7 +297,7 @@ fn packets_equal_single_rays() {
     let movers = RayCaster::new(std::slice::from_ref(&base));
     // A robot in its own frame, placed per ray by a pose.
     let local = RayCaster::new(&[Object { id: 1_000_001, placement: Placement::at(0.0, 0.0, 0.5), ..base.clone() }]);
-    let (mut packets, mut hits, mut posed_hits) = (0, 0, 0);
+    let (mut packets, mut hits, mut posed_hits, mut beyond_hits) = (0, 0, 0, 0);
     for (objs, origins) in [(&gh.objects, 0), (&solids, 1)] {
         let rc = RayCaster::new(objs);
         for k in 0..300 {
@@ -323,6 +323,15 @@ fn packets_equal_single_rays() {
                 assert_eq!(out[i], single, "packet {k} ray {i} from {o:?} along {d:?}");
                 hits += single.is_some() as usize;
             }
+            // Each ray going on from its own near limit (past a pane it met): the single ray
+            // cast from that limit.
+            let mins: Vec<f64> = out.iter().map(|h| h.map_or(rng.range(0.0, 1.0), |h| h.distance + [1e-4, 0.0, -1e-3][k % 3])).collect();
+            let mut beyond = vec![None; n];
+            rc.cast_packet_beyond(o, &dirs, &mins, tmax, &movers, &mut beyond);
+            for i in 0..n {
+                assert_eq!(beyond[i], rc.cast_among(o, dirs[i], mins[i], tmax, &movers), "packet {k} ray {i} beyond {}", mins[i]);
+                beyond_hits += (beyond[i].is_some() && beyond[i] != out[i]) as usize;
+            }
             // Own origins (a moving LiDAR: up to 5 cm apart) and own mover poses.
             let origins: Vec<[f64; 3]> = (0..n).map(|_| [0, 1, 2].map(|a| o[a] + rng.range(-0.05, 0.05))).collect();
             let poses: Vec<RigidPose> = (0..n).map(|_| RigidPose::yawed(o[0] + rng.range(-1.0, 1.0), o[1] + rng.range(-1.0, 1.0), 0.0, rng.range(-3.0, 3.0))).collect();
@@ -334,5 +343,5 @@ fn packets_equal_single_rays() {
             }
         }
     }
-    assert!(packets == 600 && hits > 5_000 && posed_hits > 50, "{hits} hits, {posed_hits} on the posed robot");
+    assert!(packets == 600 && hits > 5_000 && posed_hits > 50 && beyond_hits > 1_000, "{hits} hits, {posed_hits} on the posed robot, {beyond_hits} further hits beyond");
 }

@@ -85,19 +85,28 @@ impl RayCaster {
     /// tile), traversing together: `out[i]` is exactly what `cast_among` gives for `dirs[i]`,
     /// at a fraction of the node work when the rays are coherent.
     pub fn cast_packet(&self, origin: [f64; 3], dirs: &[[f64; 3]], min: f64, max: f64, movers: &RayCaster, out: &mut [Option<Hit>]) {
-        assert!(dirs.len() <= MAX_PACKET, "a packet of {} rays (at most {MAX_PACKET})", dirs.len());
+        self.cast_packet_beyond(origin, dirs, &[min], max, movers, out);
+    }
+
+    /// [`RayCaster::cast_packet`] with a near limit per ray (`mins[i]`, or one for all): rays
+    /// going on past the surfaces they met (a camera tile's rays seeing through glass).
+    pub fn cast_packet_beyond(&self, origin: [f64; 3], dirs: &[[f64; 3]], mins: &[f64], max: f64, movers: &RayCaster, out: &mut [Option<Hit>]) {
+        assert!(dirs.len() <= MAX_PACKET && (mins.len() == 1 || mins.len() == dirs.len()), "a packet of {} rays (at most {MAX_PACKET}) with {} near limits", dirs.len(), mins.len());
         let mut best = [Best { t: max, id: u32::MAX, normal: [0.0; 3] }; MAX_PACKET];
+        // The packet culls from the nearest limit; each ray's primitive tests keep its own.
+        let min = mins.iter().fold(f64::INFINITY, |m, &v| m.min(v));
         match Packet::new(&[origin], dirs, max) {
             // The movers (the robot's links, seen by every tile at the image's bottom) with the
             // same packet, each ray's far limit already lowered to its static hit.
             Some(mut packet) => {
                 for set in [self, movers] {
-                    let mut v = PacketNearest { caster: set, origins: &[origin], dirs, tmin: min, best: &mut best };
+                    let mut v = PacketNearest { caster: set, origins: &[origin], dirs, tmins: mins, best: &mut best };
                     traverse_packet(&set.nodes, &mut packet, min, &mut v);
                 }
             }
             None => {
                 for (i, d) in dirs.iter().enumerate() {
+                    let min = mins[i.min(mins.len() - 1)];
                     self.nearest(origin, *d, min, &mut best[i], &mut ());
                     movers.nearest(origin, *d, min, &mut best[i], &mut ());
                 }
@@ -134,7 +143,7 @@ impl RayCaster {
         let origin = |i: usize| origins[i.min(origins.len() - 1)];
         match Packet::new(origins, dirs, max) {
             Some(mut packet) => {
-                let mut v = PacketNearest { caster: self, origins, dirs, tmin: min, best: &mut best };
+                let mut v = PacketNearest { caster: self, origins, dirs, tmins: &[min], best: &mut best };
                 traverse_packet(&self.nodes, &mut packet, min, &mut v);
             }
             None => {
@@ -306,7 +315,8 @@ struct PacketNearest<'a> {
     /// One origin for all rays, or one per ray.
     origins: &'a [[f64; 3]],
     dirs: &'a [[f64; 3]],
-    tmin: f64,
+    /// One near limit for all rays, or one per ray.
+    tmins: &'a [f64],
     best: &'a mut [Best; MAX_PACKET],
 }
 
@@ -319,8 +329,9 @@ impl PacketVisit for PacketNearest<'_> {
             let best = &mut self.best[i];
             let before = best.t;
             let o = self.origins[i.min(self.origins.len() - 1)];
+            let tmin = self.tmins[i.min(self.tmins.len() - 1)];
             for k in start..start + count {
-                if let Some((t, n)) = self.caster.prims[k].intersect(o, *d, self.tmin, best.t) {
+                if let Some((t, n)) = self.caster.prims[k].intersect(o, *d, tmin, best.t) {
                     best.offer(t, self.caster.ids[k], n);
                 }
             }
