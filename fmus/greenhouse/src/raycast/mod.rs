@@ -322,6 +322,28 @@ struct PacketNearest<'a> {
 
 impl PacketVisit for PacketNearest<'_> {
     fn leaf(&mut self, packet: &mut Packet, start: usize, count: usize, rays: &[bool; MAX_PACKET]) {
+        if let [o] = self.origins {
+            // One origin: each primitive takes it into its frame once for all the rays. Each
+            // ray still meets the primitives in leaf order, so its answer is the same.
+            let before: [f64; MAX_PACKET] = std::array::from_fn(|i| self.best[i].t);
+            for k in start..start + count {
+                let seen = self.caster.prims[k].seen_from(*o);
+                for (i, d) in self.dirs.iter().enumerate() {
+                    if rays[i] {
+                        let best = &mut self.best[i];
+                        if let Some((t, n)) = seen.intersect(*d, self.tmins[i.min(self.tmins.len() - 1)], best.t) {
+                            best.offer(t, self.caster.ids[k], n);
+                        }
+                    }
+                }
+            }
+            for i in 0..self.dirs.len() {
+                if self.best[i].t != before[i] {
+                    packet.far[i] = far(self.best[i].t);
+                }
+            }
+            return;
+        }
         for (i, d) in self.dirs.iter().enumerate() {
             if !rays[i] {
                 continue;
@@ -357,13 +379,28 @@ struct PacketThrough<'a, F> {
 
 impl<F: Fn(u32) -> bool> PacketVisit for PacketThrough<'_, F> {
     fn leaf(&mut self, packet: &mut Packet, start: usize, count: usize, rays: &[bool; MAX_PACKET]) {
-        for (i, o) in self.origins.iter().enumerate() {
-            if !rays[i] {
-                continue;
-            }
-            if cross_leaf(self.caster, start, count, *o, self.d, self.tmin, self.tmax, self.opaque, &mut self.at[i]) {
-                self.blocked[i] = true;
-                packet.far[i] = f32::NEG_INFINITY;
+        // Primitive by primitive, each taking the shared direction into its frame once; each
+        // ray still meets them in leaf order and stops at the first opaque one, as
+        // [`cross_leaf`] has it.
+        let mut live = *rays;
+        for k in start..start + count {
+            let along = self.caster.prims[k].along(self.d);
+            let mut opaque = None;
+            for (i, o) in self.origins.iter().enumerate() {
+                if !live[i] {
+                    continue;
+                }
+                let Some((t, _)) = along.intersect(*o, self.tmin, self.tmax) else { continue };
+                if *opaque.get_or_insert_with(|| (self.opaque)(self.caster.ids[k])) {
+                    self.blocked[i] = true;
+                    packet.far[i] = f32::NEG_INFINITY;
+                    live[i] = false;
+                    continue;
+                }
+                self.at[i].push(t);
+                if let Some((t2, _)) = along.intersect(*o, t + RESTART, self.tmax) {
+                    self.at[i].push(t2);
+                }
             }
         }
     }

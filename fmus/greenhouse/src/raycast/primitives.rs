@@ -78,36 +78,103 @@ impl Prim {
     /// First surface crossing along `o + t d` with `t` in `[tmin, tmax]`: (t, outward normal).
     #[inline]
     pub(crate) fn intersect(&self, o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64) -> Option<(f64, [f64; 3])> {
+        self.local_hit(self.local_origin(o), self.local_dir(d), tmin, tmax)
+    }
+
+    /// The primitive as rays from `o` see it: `o` taken into its frame once for all of them
+    /// (the rays of a camera tile share their origin).
+    #[inline(always)]
+    pub(crate) fn seen_from(&self, o: [f64; 3]) -> Seen<'_> {
+        Seen { prim: self, lo: self.local_origin(o) }
+    }
+
+    /// The primitive as rays along `d` see it: `d` taken into its frame once for all of them
+    /// (shadow rays toward the sun).
+    #[inline(always)]
+    pub(crate) fn along(&self, d: [f64; 3]) -> Along<'_> {
+        Along { prim: self, ld: self.local_dir(d) }
+    }
+
+    /// A map point in the primitive's frame (centred; rotated for the rotated shapes).
+    #[inline(always)]
+    fn local_origin(&self, o: [f64; 3]) -> [f64; 3] {
         match *self {
-            Prim::Sphere { c, r } => sphere(c, r, o, d, tmin, tmax),
-            Prim::AaBox { c, half } => box_local(half, sub(o, c), d, tmin, tmax),
-            Prim::Box { c, ref rt, half } => {
-                let (t, n) = box_local(half, apply(rt, sub(o, c)), apply(rt, d), tmin, tmax)?;
+            Prim::Sphere { c, .. } | Prim::AaBox { c, .. } | Prim::AxisCylinder { c, .. } => sub(o, c),
+            Prim::Box { c, ref rt, .. } | Prim::Cylinder { c, ref rt, .. } => apply(rt, sub(o, c)),
+        }
+    }
+
+    /// A map direction in the primitive's frame.
+    #[inline(always)]
+    fn local_dir(&self, d: [f64; 3]) -> [f64; 3] {
+        match *self {
+            Prim::Sphere { .. } | Prim::AaBox { .. } | Prim::AxisCylinder { .. } => d,
+            Prim::Box { ref rt, .. } | Prim::Cylinder { ref rt, .. } => apply(rt, d),
+        }
+    }
+
+    /// The crossing of a ray given in the primitive's frame, normal back in the map.
+    #[inline(always)]
+    fn local_hit(&self, lo: [f64; 3], ld: [f64; 3], tmin: f64, tmax: f64) -> Option<(f64, [f64; 3])> {
+        match *self {
+            Prim::Sphere { r, .. } => sphere(lo, r, ld, tmin, tmax),
+            Prim::AaBox { half, .. } => box_local(half, lo, ld, tmin, tmax),
+            Prim::Box { ref rt, half, .. } => {
+                let (t, n) = box_local(half, lo, ld, tmin, tmax)?;
                 Some((t, apply_t(rt, n)))
             }
-            Prim::AxisCylinder { c, axis, r, h } => {
+            Prim::AxisCylinder { axis, r, h, .. } => {
                 // Swizzle so the axis is local z: (u, v, w) = (axis + 1, axis + 2, axis), a
                 // cyclic permutation (a proper rotation).
                 let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
-                let p = sub(o, c);
-                let (t, n) = cylinder_local(r, h, [p[i], p[j], p[axis]], [d[i], d[j], d[axis]], tmin, tmax)?;
+                let (t, n) = cylinder_local(r, h, [lo[i], lo[j], lo[axis]], [ld[i], ld[j], ld[axis]], tmin, tmax)?;
                 let mut m = [0.0; 3];
                 m[i] = n[0];
                 m[j] = n[1];
                 m[axis] = n[2];
                 Some((t, m))
             }
-            Prim::Cylinder { c, ref rt, r, h } => {
-                let (t, n) = cylinder_local(r, h, apply(rt, sub(o, c)), apply(rt, d), tmin, tmax)?;
+            Prim::Cylinder { ref rt, r, h, .. } => {
+                let (t, n) = cylinder_local(r, h, lo, ld, tmin, tmax)?;
                 Some((t, apply_t(rt, n)))
             }
         }
     }
 }
 
+/// A primitive and a ray origin in its frame (see [`Prim::seen_from`]).
+#[derive(Clone, Copy)]
+pub(crate) struct Seen<'a> {
+    prim: &'a Prim,
+    lo: [f64; 3],
+}
+
+impl Seen<'_> {
+    /// [`Prim::intersect`] from the origin this was made for.
+    #[inline(always)]
+    pub(crate) fn intersect(&self, d: [f64; 3], tmin: f64, tmax: f64) -> Option<(f64, [f64; 3])> {
+        self.prim.local_hit(self.lo, self.prim.local_dir(d), tmin, tmax)
+    }
+}
+
+/// A primitive and a ray direction in its frame (see [`Prim::along`]).
+#[derive(Clone, Copy)]
+pub(crate) struct Along<'a> {
+    prim: &'a Prim,
+    ld: [f64; 3],
+}
+
+impl Along<'_> {
+    /// [`Prim::intersect`] along the direction this was made for.
+    #[inline(always)]
+    pub(crate) fn intersect(&self, o: [f64; 3], tmin: f64, tmax: f64) -> Option<(f64, [f64; 3])> {
+        self.prim.local_hit(self.prim.local_origin(o), self.ld, tmin, tmax)
+    }
+}
+
+/// Sphere centred at the origin, ray origin `oc` relative to its centre.
 #[inline]
-fn sphere(c: [f64; 3], r: f64, o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64) -> Option<(f64, [f64; 3])> {
-    let oc = sub(o, c);
+fn sphere(oc: [f64; 3], r: f64, d: [f64; 3], tmin: f64, tmax: f64) -> Option<(f64, [f64; 3])> {
     let a = dot(d, d);
     let b = dot(oc, d);
     let cc = dot(oc, oc) - r * r;
