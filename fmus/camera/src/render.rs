@@ -499,8 +499,8 @@ fn depth_rows(v0: usize, out: &mut [f32], zt: &[f32], k: &Intrinsics, m: &DepthM
                 }
             }
             out[i - v0 * w] = if ok {
-                let mut rng = Rng::new(mix64(key ^ mix64(i as u64)));
-                let zm = z + rng.gauss(m.noise.sigma(z, k.fx, m.baseline));
+                let sigma = m.noise.sigma(z, k.fx, m.baseline);
+                let zm = if sigma == 0.0 { z } else { z + sigma * Rng::new(mix64(key ^ mix64(i as u64))).normal_once() };
                 if zm > 0.0 {
                     valid += 1;
                     zm as f32

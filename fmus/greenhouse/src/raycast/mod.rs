@@ -196,8 +196,7 @@ impl RayCaster {
     pub fn pass_through_packet(&self, origins: &[[f64; 3]], dir: [f64; 3], min: f64, max: f64, movers: &RayCaster, opaque: impl Fn(u32) -> bool, out: &mut [Option<u32>]) {
         let n = origins.len();
         assert!(n <= MAX_PACKET && out.len() == n, "pass_through_packet: {n} rays, {} results", out.len());
-        let dirs = [dir; MAX_PACKET];
-        let Some(mut packet) = Packet::new(origins, &dirs[..n], max) else {
+        let Some(mut packet) = Packet::new(origins, &[dir], max) else {
             for (o, r) in origins.iter().zip(out.iter_mut()) {
                 *r = self.pass_through(*o, dir, min, max, movers, &opaque);
             }

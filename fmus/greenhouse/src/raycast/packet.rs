@@ -35,9 +35,10 @@ pub(crate) struct Packet {
 
 impl Packet {
     /// None when some axis has directions of both signs: the interval test would cull nothing.
-    /// `origins` holds one origin for all rays or one per ray.
+    /// `origins` and `dirs` each hold one for all rays or one per ray.
     pub(crate) fn new(origins: &[[f64; 3]], dirs: &[[f64; 3]], tmax: f64) -> Option<Packet> {
-        debug_assert!(dirs.len() <= MAX_PACKET && (origins.len() == 1 || origins.len() == dirs.len()));
+        let n = origins.len().max(dirs.len());
+        debug_assert!(n <= MAX_PACKET && (origins.len() == 1 || origins.len() == n) && (dirs.len() == 1 || dirs.len() == n));
         let mut p = Packet {
             o: [[0.0; MAX_PACKET]; 3],
             o_lo: [f32::INFINITY; 3],
@@ -46,10 +47,16 @@ impl Packet {
             far: [f32::NEG_INFINITY; MAX_PACKET],
             lo: [f32::INFINITY; 3],
             hi: [f32::NEG_INFINITY; 3],
-            len: dirs.len(),
+            len: n,
         };
-        for (i, d) in dirs.iter().enumerate() {
-            let r = Ray32::new(origins[i.min(origins.len() - 1)], *d);
+        // One direction for all (shadow rays): its inverse worked out once.
+        let shared = (dirs.len() == 1).then(|| Ray32::new(origins[0], dirs[0]).inv);
+        for i in 0..n {
+            let o = origins[i.min(origins.len() - 1)];
+            let r = match shared {
+                Some(inv) => Ray32 { o: o.map(|v| v as f32), inv },
+                None => Ray32::new(o, dirs[i]),
+            };
             for a in 0..3 {
                 p.o[a][i] = r.o[a];
                 p.o_lo[a] = p.o_lo[a].min(r.o[a]);
