@@ -12,6 +12,9 @@ namespace with only loopback (tests/netns.py), bounded in time.
 * Garbage and wrongly typed messages on /cmd_vel and on an arm trajectory topic, and a NaN
   on the scalar lift set-point, are rejected and reported (topic, sender, reason); the run
   goes on. Scalars cross as std_msgs/Float64 in both directions.
+* The bridge is a node of the ROS 2 graph: its `ros_discovery_info` names node /agrisim with
+  exactly the readers and writers DDS discovery shows for it, in the Humble and the Jazzy
+  layout.
 """
 
 from __future__ import annotations
@@ -181,3 +184,28 @@ def test_camera_images_over_dds_equal_the_recording(tmp_path):
         # DDS pads a sample to 4 bytes; the message is the recorded bytes.
         for s in samples:
             assert any(s == rec or (s.startswith(rec) and len(s) - len(rec) < 4 and not s[len(rec):].strip(b"\0")) for rec in recorded[topic]), topic
+
+
+@pytest.mark.parametrize("distro", ["jazzy", "humble"])
+def test_the_bridge_is_a_node_of_the_ros2_graph(tmp_path, distro):
+    cmd = [str(agrisim_bin()), "run", "--scenario", str(REPO / "models/scenarios/default.toml"), "--duration", "2", "--record", "judge",
+           "--ros2", "--ros2-mode", "realtime", "--ros2-rate", "4", "--ros2-distro", distro, "--out", str(tmp_path / "run")]
+    r = netns.run([PY, str(HERE / "ros2_graph_peer.py"), "--distro", distro, "--", *cmd], timeout=120, capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout + r.stderr
+    peer = json.loads(r.stdout.strip().splitlines()[-1])
+    assert peer["returncode"] == 0, r.stderr
+    # One participant announced, holding the one node /agrisim.
+    (participant, nodes), = peer["nodes"].items()
+    assert [(n["namespace"], n["name"]) for n in nodes] == [("/", "agrisim")]
+    # Gids: the 16-byte DDS GUID, zero-padded to 24 bytes in the Humble layout.
+    width = 48 if distro == "humble" else 32
+    gids = [participant, *nodes[0]["readers"], *nodes[0]["writers"]]
+    assert all(len(g) == width and g[32:] == "0" * (width - 32) for g in gids), gids
+    guid = lambda g: g[:32]  # noqa: E731
+    # Exactly the endpoints DDS discovery shows for that participant (the graph topic's own
+    # writer is the participant's, not the node's).
+    mine = {k: e for k, e in peer["endpoints"].items() if e["participant"] == guid(participant) and e["topic"] != "ros_discovery_info"}
+    assert {guid(g) for g in nodes[0]["writers"]} == {k for k, e in mine.items() if e["kind"] == "writer"}
+    assert {guid(g) for g in nodes[0]["readers"]} == {k for k, e in mine.items() if e["kind"] == "reader"}
+    topics = {(e["kind"], e["topic"]) for e in mine.values()}
+    assert {("writer", "rt/clock"), ("writer", "rt/odom"), ("writer", "rt/points"), ("reader", "rt/cmd_vel")} <= topics, topics

@@ -5,7 +5,7 @@
 
 use agrisim_error::{err, Result};
 use agrisim_ros2::names::Remap;
-use agrisim_ros2::{BridgeConfig, Mode, Ros2Bridge, Stats};
+use agrisim_ros2::{BridgeConfig, Distro, Mode, Ros2Bridge, Stats};
 use agrisim_session::run::{NodePlan, SystemIo};
 use std::collections::BTreeSet;
 use std::sync::{Arc, Mutex};
@@ -47,6 +47,10 @@ pub struct LiveArgs {
     /// Talk on every network interface, not only loopback (exposes the run to the network).
     #[arg(long)]
     pub ros2_all_interfaces: bool,
+    /// The peers' ROS 2 distro (humble, or iron/jazzy/kilted/rolling): the layout of the graph
+    /// information that names the bridge's node in `ros2 node list`.
+    #[arg(long, value_name = "DISTRO", default_value = "jazzy")]
+    pub ros2_distro: String,
     /// Write the bridge's statistics to FILE (JSON): messages and bytes per topic, received,
     /// rejected, lockstep round trips [s].
     #[arg(long, value_name = "FILE")]
@@ -144,6 +148,7 @@ impl LiveArgs {
             return Err(err!("--ros2-startup-timeout {}: must be a number of seconds", self.ros2_startup_timeout));
         }
         let startup_timeout = Duration::from_secs_f64(self.ros2_startup_timeout);
+        let distro = Distro::parse(&self.ros2_distro).map_err(|e| err!("--ros2-distro: {e}"))?;
         let stats = stats.clone();
         let factory = move |inputs: &SystemIo| -> Result<Vec<Box<dyn agrisim_bus::Node>>> {
             let mut inbound: Vec<(String, String)> = inputs.messages.clone();
@@ -152,7 +157,7 @@ impl LiveArgs {
                     inbound.push(t.clone());
                 }
             }
-            let config = BridgeConfig { domain, mode, inbound, inbound_scalars: inputs.scalars.clone(), outbound: inputs.outputs.clone(), lockstep: lockstep.clone(), remap: remap.clone(), loopback_only, startup_timeout };
+            let config = BridgeConfig { domain, mode, inbound, inbound_scalars: inputs.scalars.clone(), outbound: inputs.outputs.clone(), lockstep: lockstep.clone(), remap: remap.clone(), loopback_only, startup_timeout, distro };
             let (bridge, s) = Ros2Bridge::new(config)?;
             stats.lock().expect("stats lock").push(s);
             let mut nodes: Vec<Box<dyn agrisim_bus::Node>> = vec![Box::new(bridge)];

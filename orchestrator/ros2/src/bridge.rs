@@ -5,6 +5,7 @@
 //! each message against its topic's type. It runs last among the nodes, so the commands it
 //! brings reach the FMUs at this very instant, as a built-in node's would.
 
+use crate::graph::{self, Distro};
 use crate::names::{dds_topic, dds_type, Remap};
 use crate::qos;
 use crate::raw::{RawAdapter, RawCdr};
@@ -15,7 +16,7 @@ use agrisim_msgs::rosgraph_msgs::Clock;
 use agrisim_msgs::std_msgs::Float64;
 use agrisim_msgs::Message;
 use rustdds::no_key::{DataReader, DataWriter};
-use rustdds::{DomainParticipant, DomainParticipantBuilder, Publisher, Subscriber, TopicKind};
+use rustdds::{DomainParticipant, DomainParticipantBuilder, Publisher, RTPSEntity, Subscriber, TopicKind};
 use std::collections::{BTreeMap, BTreeSet};
 use std::net::{IpAddr, Ipv4Addr};
 use std::sync::{Arc, Mutex};
@@ -55,6 +56,8 @@ pub struct BridgeConfig {
     /// Lockstep: before the first instant, wait this long at most for the peers (a writer on
     /// every lockstep topic, a reader of /clock), so nothing is sent before they listen.
     pub startup_timeout: Duration,
+    /// The distro whose graph-information layout `ros_discovery_info` follows.
+    pub distro: Distro,
 }
 
 /// What crossed the bridge (for reports and benchmarks).
@@ -93,6 +96,8 @@ pub struct Ros2Bridge {
     inbound: Vec<Inbound>,
     inbound_topics: BTreeSet<String>,
     tap: Tap,
+    /// The writer of `ros_discovery_info` (see [`graph`]).
+    graph: DataWriter<RawCdr, RawAdapter>,
     /// Wall time and simulated time of the first instant (real-time pacing).
     start: Option<(Instant, i64)>,
     stats: Arc<Mutex<Stats>>,
@@ -132,6 +137,9 @@ impl Ros2Bridge {
         }
         let inbound_topics = config.inbound.iter().map(|(t, _)| t.clone()).chain(config.inbound_scalars.iter().cloned()).collect();
         let stats = Arc::new(Mutex::new(Stats::default()));
+        let q = qos::writer(qos::Kind::Latched);
+        let t = participant.create_topic(graph::TOPIC.to_string(), graph::TYPE.to_string(), &q, TopicKind::NoKey).map_err(|e| dds_err(graph::TOPIC, e))?;
+        let graph = publisher.create_datawriter_no_key::<RawCdr, RawAdapter>(&t, Some(q)).map_err(|e| dds_err(&format!("writer of {}", graph::TOPIC), e))?;
         let mut bridge = Ros2Bridge {
             publisher,
             config,
@@ -140,6 +148,7 @@ impl Ros2Bridge {
             inbound,
             inbound_topics,
             tap: Tap::default(),
+            graph,
             start: None,
             stats: stats.clone(),
             warned_timeout: false,
@@ -147,12 +156,30 @@ impl Ros2Bridge {
         };
         let outbound: Vec<(String, String)> = bridge.config.outbound.iter().filter(|(t, _)| !bridge.inbound_topics.contains(t)).cloned().collect();
         for (t, ty) in outbound.iter().chain([&("/clock".to_string(), Clock::TYPE_NAME.to_string())]) {
-            bridge.writer(t, ty)?;
+            bridge.add_writer(t, ty)?;
         }
+        bridge.announce()?;
         Ok((bridge, stats))
     }
 
+    /// Publishes the bridge's node with its readers and writers on `ros_discovery_info`.
+    fn announce(&mut self) -> Result<()> {
+        let readers: Vec<[u8; 16]> = self.inbound.iter().map(|i| i.reader.guid().to_bytes()).collect();
+        let writers: Vec<[u8; 16]> = self.writers.values().map(|w| w.guid().to_bytes()).collect();
+        let cdr = graph::participant_info(self.config.distro, self.participant.guid().to_bytes(), &readers, &writers);
+        self.graph.write(RawCdr(cdr), None).map_err(|e| dds_err(&format!("publishing on {}", graph::TOPIC), e))
+    }
+
+    /// A writer for `topic` made on the fly, announced to the graph.
     fn writer(&mut self, topic: &str, ros_type: &str) -> Result<()> {
+        if !self.writers.contains_key(topic) {
+            self.add_writer(topic, ros_type)?;
+            self.announce()?;
+        }
+        Ok(())
+    }
+
+    fn add_writer(&mut self, topic: &str, ros_type: &str) -> Result<()> {
         if !self.writers.contains_key(topic) {
             let ty = dds_type(ros_type).ok_or_else(|| err!("ROS 2 bridge: topic {topic}: '{ros_type}' is not a pkg/msg/Type name"))?;
             let name = dds_topic(self.config.remap.apply(topic));

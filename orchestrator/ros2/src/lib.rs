@@ -11,11 +11,14 @@
 //! * [`names`]: ROS 2 topic and type names on DDS (`rt/...`, `pkg::msg::dds_::Type_`), remapping;
 //! * [`qos`]: the QoS ROS 2 users expect per topic;
 //! * [`raw`]: the raw-CDR sample type and its RustDDS adapters;
-//! * [`bridge`]: the bridge node (lockstep or real time) and its statistics.
+//! * [`bridge`]: the bridge node (lockstep or real time) and its statistics;
+//! * [`graph`]: the bridge as a node of the ROS 2 graph (`ros_discovery_info`).
 
 pub mod bridge;
+pub mod graph;
 pub mod names;
 pub mod qos;
 pub mod raw;
 
 pub use bridge::{BridgeConfig, Mode, Ros2Bridge, Stats};
+pub use graph::Distro;
