@@ -321,43 +321,30 @@ struct PacketNearest<'a> {
 
 impl PacketVisit for PacketNearest<'_> {
     fn leaf(&mut self, packet: &mut Packet, start: usize, count: usize, rays: &[bool; MAX_PACKET]) {
-        if let [o] = self.origins {
-            // One origin: each primitive takes it into its frame once for all the rays. Each
-            // ray still meets the primitives in leaf order, so its answer is the same.
-            let before: [f64; MAX_PACKET] = std::array::from_fn(|i| self.best[i].t);
-            for k in start..start + count {
-                let seen = self.caster.prims[k].seen_from(*o);
-                for (i, d) in self.dirs.iter().enumerate() {
-                    if rays[i] {
-                        let best = &mut self.best[i];
-                        if let Some((t, n)) = seen.intersect(*d, self.tmins[i.min(self.tmins.len() - 1)], best.t) {
-                            best.offer(t, self.caster.ids[k], n);
-                        }
-                    }
+        // Primitive by primitive: with one origin for all rays (a camera tile) each primitive
+        // takes it into its frame once. Each ray still meets the primitives in leaf order, so
+        // its answer is the one it gets alone.
+        let before: [f64; MAX_PACKET] = std::array::from_fn(|i| self.best[i].t);
+        for k in start..start + count {
+            let prim = &self.caster.prims[k];
+            let shared = match self.origins {
+                [o] => Some(prim.seen_from(*o)),
+                _ => None,
+            };
+            for (i, d) in self.dirs.iter().enumerate() {
+                if !rays[i] {
+                    continue;
                 }
-            }
-            for i in 0..self.dirs.len() {
-                if self.best[i].t != before[i] {
-                    packet.far[i] = far(self.best[i].t);
-                }
-            }
-            return;
-        }
-        for (i, d) in self.dirs.iter().enumerate() {
-            if !rays[i] {
-                continue;
-            }
-            let best = &mut self.best[i];
-            let before = best.t;
-            let o = self.origins[i.min(self.origins.len() - 1)];
-            let tmin = self.tmins[i.min(self.tmins.len() - 1)];
-            for k in start..start + count {
-                if let Some((t, n)) = self.caster.prims[k].intersect(o, *d, tmin, best.t) {
+                let seen = shared.unwrap_or_else(|| prim.seen_from(self.origins[i]));
+                let best = &mut self.best[i];
+                if let Some((t, n)) = seen.intersect(*d, self.tmins[i.min(self.tmins.len() - 1)], best.t) {
                     best.offer(t, self.caster.ids[k], n);
                 }
             }
-            if best.t != before {
-                packet.far[i] = far(best.t);
+        }
+        for i in 0..self.dirs.len() {
+            if self.best[i].t != before[i] {
+                packet.far[i] = far(self.best[i].t);
             }
         }
     }
@@ -386,19 +373,10 @@ impl<F: Fn(u32) -> bool> PacketVisit for PacketThrough<'_, F> {
             let along = self.caster.prims[k].along(self.d);
             let mut opaque = None;
             for (i, o) in self.origins.iter().enumerate() {
-                if !live[i] {
-                    continue;
-                }
-                let Some((t, _)) = along.intersect(*o, self.tmin, self.tmax) else { continue };
-                if *opaque.get_or_insert_with(|| (self.opaque)(self.caster.ids[k])) {
+                if live[i] && cross(&along, *o, self.tmin, self.tmax, || *opaque.get_or_insert_with(|| (self.opaque)(self.caster.ids[k])), &mut self.at[i]) {
                     self.blocked[i] = true;
                     packet.far[i] = f32::NEG_INFINITY;
                     live[i] = false;
-                    continue;
-                }
-                self.at[i].push(t);
-                if let Some((t2, _)) = along.intersect(*o, t + RESTART, self.tmax) {
-                    self.at[i].push(t2);
                 }
             }
         }
@@ -470,17 +448,20 @@ impl<F: Fn(u32) -> bool> Visit for Through<'_, F> {
 /// hit, else the translucent ones' surface crossings (in and out) go to `at`.
 #[allow(clippy::too_many_arguments)]
 fn cross_leaf(caster: &RayCaster, start: usize, count: usize, o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, opaque: &impl Fn(u32) -> bool, at: &mut Crossings) -> bool {
-    for k in start..start + count {
-        let p = &caster.prims[k];
-        if let Some((t, _)) = p.intersect(o, d, tmin, tmax) {
-            if opaque(caster.ids[k]) {
-                return true;
-            }
-            at.push(t);
-            if let Some((t2, _)) = p.intersect(o, d, t + RESTART, tmax) {
-                at.push(t2);
-            }
-        }
+    (start..start + count).any(|k| cross(&caster.prims[k].along(d), o, tmin, tmax, || opaque(caster.ids[k]), at))
+}
+
+/// One shadow ray from `o` across one primitive: true if it meets it and the primitive is
+/// opaque (asked only then), else the translucent surfaces it crosses (in and out) go to `at`.
+#[inline(always)]
+fn cross(along: &primitives::Along<'_>, o: [f64; 3], tmin: f64, tmax: f64, opaque: impl FnOnce() -> bool, at: &mut Crossings) -> bool {
+    let Some((t, _)) = along.intersect(o, tmin, tmax) else { return false };
+    if opaque() {
+        return true;
+    }
+    at.push(t);
+    if let Some((t2, _)) = along.intersect(o, t + RESTART, tmax) {
+        at.push(t2);
     }
     false
 }
