@@ -209,3 +209,26 @@ def test_the_bridge_is_a_node_of_the_ros2_graph(tmp_path, distro):
     assert {guid(g) for g in nodes[0]["readers"]} == {k for k, e in mine.items() if e["kind"] == "reader"}
     topics = {(e["kind"], e["topic"]) for e in mine.values()}
     assert {("writer", "rt/clock"), ("writer", "rt/odom"), ("writer", "rt/points"), ("reader", "rt/cmd_vel")} <= topics, topics
+
+
+@pytest.mark.parametrize("all_interfaces", [False, True])
+def test_the_bridge_listens_on_loopback_only_unless_asked(tmp_path, all_interfaces):
+    """A host on a LAN (another namespace, joined by a veth pair) sends a datagram to each of
+    the bridge's well-known DDS ports. By default the kernel refuses them all (every socket
+    is held to the loopback device), while the same datagrams sent over loopback are taken;
+    with --ros2-all-interfaces the LAN's are taken too (the probe can tell)."""
+    cmd = [str(agrisim_bin()), "run", "--scenario", str(REPO / "models/scenarios/default.toml"), "--duration", "8", "--record", "none",
+           "--ros2", "--ros2-mode", "realtime", "--ros2-rate", "1", "--out", str(tmp_path / "run")]
+    cmd += ["--ros2-all-interfaces"] if all_interfaces else []
+    r = netns.run([PY, str(HERE / "ros2_lan_probe.py"), "--", *cmd], timeout=120, capture_output=True, text=True)
+    assert r.returncode == 0, r.stdout + r.stderr
+    seen = json.loads(r.stdout.strip().splitlines()[-1])
+    assert seen["returncode"] == 0, seen["stderr"]
+    assert set(seen["loopback"].values()) == {"delivered"}, seen
+    assert len(seen["sockets"]) >= 5, seen["sockets"]
+    if all_interfaces:
+        assert set(seen["lan"].values()) == {"delivered"}, seen
+    else:
+        assert set(seen["lan"].values()) == {"refused"}, seen
+        # `ss` shows every one of the bridge's UDP sockets held to the loopback device.
+        assert all("%lo:" in s for s in seen["sockets"]), seen["sockets"]

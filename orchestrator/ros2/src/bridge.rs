@@ -5,6 +5,7 @@
 //! each message against its topic's type. It runs last among the nodes, so the commands it
 //! brings reach the FMUs at this very instant, as a built-in node's would.
 
+use crate::confine;
 use crate::graph::{self, Distro};
 use crate::names::{dds_topic, dds_type, Remap};
 use crate::qos;
@@ -51,7 +52,8 @@ pub struct BridgeConfig {
     /// In lockstep: the inbound topics that must answer at each message instant.
     pub lockstep: Vec<String>,
     pub remap: Remap,
-    /// Advertise and talk on the loopback interface only (the default); false: every one.
+    /// Advertise, talk and listen on the loopback interface only (the default; see
+    /// [`confine`]); false: every one.
     pub loopback_only: bool,
     /// Lockstep: before the first instant, wait this long at most for the peers (a writer on
     /// every lockstep topic, a reader of /clock), so nothing is sent before they listen.
@@ -114,10 +116,16 @@ impl Ros2Bridge {
     /// handle's [`Stats`] fill in as the run goes.
     pub fn new(config: BridgeConfig) -> Result<(Ros2Bridge, Arc<Mutex<Stats>>)> {
         let mut b = DomainParticipantBuilder::new(config.domain);
-        if config.loopback_only {
+        let before = if config.loopback_only {
             b = b.with_only_networks([IpAddr::V4(Ipv4Addr::LOCALHOST)]);
-        }
+            Some(confine::udp_sockets()?)
+        } else {
+            None
+        };
         let participant = b.build().map_err(|e| dds_err(&format!("cannot join DDS domain {}", config.domain), e))?;
+        if let Some(before) = before {
+            confine::confine_new(&before)?;
+        }
         let publisher = participant.create_publisher(&qos::writer(qos::Kind::Default)).map_err(|e| dds_err("publisher", e))?;
         let subscriber: Subscriber = participant.create_subscriber(&qos::reader()).map_err(|e| dds_err("subscriber", e))?;
         for t in &config.lockstep {

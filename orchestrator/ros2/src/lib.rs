@@ -12,9 +12,11 @@
 //! * [`qos`]: the QoS ROS 2 users expect per topic;
 //! * [`raw`]: the raw-CDR sample type and its RustDDS adapters;
 //! * [`bridge`]: the bridge node (lockstep or real time) and its statistics;
-//! * [`graph`]: the bridge as a node of the ROS 2 graph (`ros_discovery_info`).
+//! * [`graph`]: the bridge as a node of the ROS 2 graph (`ros_discovery_info`);
+//! * [`confine`]: the bridge's sockets kept on the loopback device.
 
 pub mod bridge;
+pub mod confine;
 pub mod graph;
 pub mod names;
 pub mod qos;
