@@ -3,12 +3,18 @@ command given after `--` (so both share this network namespace) and, while it ru
 `ros_discovery_info` (rmw_dds_common/msg/ParticipantEntitiesInfo, with the Gid layout of
 --distro) as an rmw layer does, and the DDS built-in topics that list every participant,
 publication and subscription. Prints what it saw as JSON: the announced nodes with their
-reader and writer GIDs, and the discovered endpoints (GUID, participant, topic, type)."""
+reader and writer GIDs, and the discovered endpoints (GUID, participant, topic, type).
+
+With --lan ADDR/LEN it first gives this namespace a LAN interface (a dummy device) with that
+address (one end of a veth pair; kernels without the dummy device have it), so a peer that
+selects a non-loopback interface (rmw_cyclonedds's LOCALHOST range does) has one. With --after-bridge it starts agrisim first and joins DDS once the bridge's
+discovery port is open, as a ROS 2 node started while the simulation runs."""
 
 import argparse
 import json
 import subprocess
 import time
+from pathlib import Path
 from dataclasses import dataclass, field
 
 from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsPublication, BuiltinTopicDcpsSubscription
@@ -54,8 +60,24 @@ def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--distro", choices=["humble", "jazzy"], default="jazzy")
     ap.add_argument("--seconds", type=float, default=60.0, help="give up after this long")
+    ap.add_argument("--lan", help="add a LAN interface with this address (ADDR/LEN) first")
+    ap.add_argument("--after-bridge", action="store_true", help="join DDS after the bridge is up")
     ap.add_argument("agrisim", nargs=argparse.REMAINDER)
     a = ap.parse_args()
+    if a.lan:
+        for cmd in (["ip", "link", "add", "lan0", "type", "veth", "peer", "name", "lan1"], ["ip", "addr", "add", a.lan, "dev", "lan0"],
+                    ["ip", "link", "set", "lan1", "up"], ["ip", "link", "set", "lan0", "multicast", "on", "up"]):
+            subprocess.run(cmd, check=True)
+    agrisim = a.agrisim[1:] if a.agrisim[:1] == ["--"] else a.agrisim
+    proc = None
+    if a.after_bridge:
+        proc = subprocess.Popen(agrisim, stdout=subprocess.DEVNULL)
+        # The bridge's SPDP port for domain 0, participant 0 (7410 = 0x1CF2) in /proc/net/udp.
+        deadline = time.monotonic() + 60
+        while ":1CF2 " not in Path("/proc/net/udp").read_text():
+            if proc.poll() is not None or time.monotonic() > deadline:
+                raise SystemExit(f"the bridge's discovery port did not open (exit {proc.poll()})")
+            time.sleep(0.05)
     dp = DomainParticipant(0)
     info_type = graph_types(24 if a.distro == "humble" else 16)
     info = DataReader(dp, Topic(dp, "ros_discovery_info", info_type), qos=GRAPH_QOS)
@@ -76,7 +98,8 @@ def main() -> int:
                 if e.topic_name is not None:
                     endpoints[e.key.bytes.hex()] = {"kind": kind, "participant": e.participant_key.bytes.hex(), "topic": e.topic_name, "type": e.type_name}
 
-    proc = subprocess.Popen(a.agrisim[1:] if a.agrisim[:1] == ["--"] else a.agrisim, stdout=subprocess.DEVNULL)
+    if proc is None:
+        proc = subprocess.Popen(agrisim, stdout=subprocess.DEVNULL)
     start = time.monotonic()
     while proc.poll() is None and time.monotonic() - start < a.seconds:
         poll()

@@ -1,12 +1,15 @@
 """A host on a LAN, probing the bridge's DDS ports, for the bridge's loopback test. Run inside
 a private network namespace (tests/netns.py): it makes a second namespace (the "LAN host",
-10.77.0.2) joined to this one (10.77.0.1) by a veth pair, starts the agrisim command given
-after `--`, and once its DDS ports are open, sends one datagram from the LAN host to each
-well-known RTPS port of domain 0 (7400, 7401, 7410, 7411) at 10.77.0.1 and, as a control,
-one from this namespace to each at 127.0.0.1. A datagram that no socket takes is answered
-by the kernel with "port unreachable", which a connected UDP socket reports as
-ConnectionRefusedError: "refused"; one taken by a socket draws no answer: "delivered".
-Prints JSON: per port and origin the outcome, and `ss`'s listing of agrisim's UDP sockets."""
+10.77.0.2) joined to this one (10.77.0.1, this machine's LAN address) by a veth pair, starts
+the agrisim command given after `--`, and once its DDS ports are open sends one datagram to
+each well-known RTPS port of domain 0 (7400, 7401, 7410, 7411), in turn:
+  - "lan": from the LAN host to 10.77.0.1;
+  - "local": from this machine to its own LAN address 10.77.0.1;
+  - "loopback": from this machine to 127.0.0.1.
+For each it records what the kernel did: the datagrams the bridge's sockets dropped (the
+drops column of /proc/net/udp, summed over agrisim's sockets: a socket filter's drops count
+there) and whether the sender got "port unreachable" (no socket at all took the port).
+Prints JSON: per origin the drops and the per-port outcome ("refused" or "sent")."""
 
 import argparse
 import json
@@ -35,7 +38,7 @@ for p in ports:
     except ConnectionRefusedError:
         out[p] = "refused"
     except socket.timeout:
-        out[p] = "delivered"
+        out[p] = "sent"
     s.close()
 print(json.dumps(out))
 """
@@ -71,6 +74,25 @@ def listening(pid: int) -> list[str]:
     return sorted(line.split()[3] for line in out.splitlines() if f"pid={pid}," in line)
 
 
+def drops(pid: int) -> int:
+    """Datagrams dropped by the UDP sockets of process `pid` (/proc/net/udp, last column)."""
+    inodes = set()
+    for fd in os.listdir(f"/proc/{pid}/fd"):
+        try:
+            link = os.readlink(f"/proc/{pid}/fd/{fd}")
+        except OSError:
+            continue
+        if link.startswith("socket:["):
+            inodes.add(link[8:-1])
+    total = 0
+    with open("/proc/net/udp") as f:
+        for line in f.readlines()[1:]:
+            cols = line.split()
+            if cols[9] in inodes:
+                total += int(cols[-1])
+    return total
+
+
 def probe(prefix: list[str], dst: str) -> dict:
     r = subprocess.run([*prefix, sys.executable, "-c", PROBE, dst, *map(str, PORTS)], capture_output=True, text=True, timeout=60)
     if r.returncode != 0:
@@ -91,10 +113,14 @@ def main() -> int:
                 raise RuntimeError(f"agrisim's DDS ports did not open (exit {run.poll()})")
             time.sleep(0.05)
         sockets = listening(run.pid)
-        lan = probe(["nsenter", "-t", str(holder.pid), "-n"], HOST)
-        loop = probe([], "127.0.0.1")
+        seen = {}
+        for origin, prefix, dst in (("lan", ["nsenter", "-t", str(holder.pid), "-n"], HOST), ("local", [], HOST), ("loopback", [], "127.0.0.1")):
+            before = drops(run.pid)
+            outcome = probe(prefix, dst)
+            # The kernel counts a drop as the datagram arrives; the probe waited 0.5 s per port.
+            seen[origin] = {"drops": drops(run.pid) - before, "ports": outcome}
         out, err = run.communicate(timeout=120)
-        print(json.dumps({"sockets": sockets, "lan": lan, "loopback": loop, "returncode": run.returncode, "stderr": err[-2000:]}))
+        print(json.dumps({"sockets": sockets, **seen, "returncode": run.returncode, "stderr": err[-2000:]}))
         return 0
     finally:
         if run.poll() is None:
