@@ -241,15 +241,20 @@ JAZZY_LOCALHOST = ("<CycloneDDS><Domain><General><AllowMulticast>false</AllowMul
                    "<MaxAutoParticipantIndex>32</MaxAutoParticipantIndex><Peers><Peer address=\"localhost\"/></Peers></Discovery></Domain></CycloneDDS>")
 
 
-def test_a_jazzy_localhost_node_started_after_the_bridge_finds_it(tmp_path):
+@pytest.mark.parametrize("order", ["after", "before"])
+def test_a_jazzy_localhost_node_finds_the_bridge(tmp_path, order):
     """A ROS 2 Jazzy node with ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST on a machine with a LAN
-    interface (Cyclone DDS configured as rmw_cyclonedds configures it), started while the
-    simulation runs, sees the bridge's node: its packets to the LAN address reach the bridge
-    (they come in through the loopback device), and the bridge's answers reach it there."""
+    interface (Cyclone DDS configured as rmw_cyclonedds configures it) sees the bridge's node,
+    whether it starts while the simulation runs ("after") or before it ("before"). After: its
+    packets to the LAN address reach the bridge (they come in through the loopback device)
+    and the bridge answers there. Before: its own announcements went out before the bridge
+    existed, and it hears the bridge only through the announcements the bridge repeats to
+    the LAN address (orchestrator/ros2/src/announce.rs)."""
     cmd = [str(agrisim_bin()), "run", "--scenario", str(REPO / "models/scenarios/default.toml"), "--duration", "6", "--record", "none",
            "--ros2", "--ros2-mode", "realtime", "--ros2-rate", "1", "--out", str(tmp_path / "run")]
     env = dict(os.environ, CYCLONEDDS_URI=JAZZY_LOCALHOST)
-    r = netns.run([PY, str(HERE / "ros2_graph_peer.py"), "--lan", "10.77.0.1/24", "--after-bridge", "--", *cmd], timeout=120, capture_output=True, text=True, env=env)
+    peer_args = ["--lan", "10.77.0.1/24"] + (["--after-bridge"] if order == "after" else [])
+    r = netns.run([PY, str(HERE / "ros2_graph_peer.py"), *peer_args, "--", *cmd], timeout=120, capture_output=True, text=True, env=env)
     assert r.returncode == 0, r.stdout + r.stderr
     peer = json.loads(r.stdout.strip().splitlines()[-1])
     assert peer["returncode"] == 0, r.stderr

@@ -5,6 +5,7 @@
 //! each message against its topic's type. It runs last among the nodes, so the commands it
 //! brings reach the FMUs at this very instant, as a built-in node's would.
 
+use crate::announce::{self, Announcer};
 use crate::confine;
 use crate::graph::{self, Distro};
 use crate::names::{dds_topic, dds_type, Remap};
@@ -52,8 +53,8 @@ pub struct BridgeConfig {
     /// In lockstep: the inbound topics that must answer at each message instant.
     pub lockstep: Vec<String>,
     pub remap: Remap,
-    /// Advertise, talk and listen on the loopback interface only (the default; see
-    /// [`confine`]); false: every one.
+    /// Advertise and talk on the loopback interface only and hear only this machine (the
+    /// default; see [`confine`]); false: every interface.
     pub loopback_only: bool,
     /// Lockstep: before the first instant, wait this long at most for the peers (a writer on
     /// every lockstep topic, a reader of /clock), so nothing is sent before they listen.
@@ -105,6 +106,9 @@ pub struct Ros2Bridge {
     stats: Arc<Mutex<Stats>>,
     warned_timeout: bool,
     started: bool,
+    /// Loopback only: the participant's announcements repeated to this machine's LAN
+    /// addresses (see [`announce`]).
+    _announcer: Option<Announcer>,
 }
 
 fn dds_err(what: &str, e: impl std::fmt::Debug) -> agrisim_error::Error {
@@ -116,16 +120,27 @@ impl Ros2Bridge {
     /// handle's [`Stats`] fill in as the run goes.
     pub fn new(config: BridgeConfig) -> Result<(Ros2Bridge, Arc<Mutex<Stats>>)> {
         let mut b = DomainParticipantBuilder::new(config.domain);
-        let before = if config.loopback_only {
+        // Loopback only: the repeater's socket first (it must catch the first announcement),
+        // then the participant's sockets, each filtered to traffic from this machine.
+        let (catch, before) = if config.loopback_only {
             b = b.with_only_networks([IpAddr::V4(Ipv4Addr::LOCALHOST)]);
-            Some(confine::udp_sockets()?)
+            (announce::listen(config.domain), Some(confine::udp_sockets()?))
         } else {
-            None
+            (None, None)
         };
         let participant = b.build().map_err(|e| dds_err(&format!("cannot join DDS domain {}", config.domain), e))?;
         if let Some(before) = before {
             confine::confine_new(&before)?;
         }
+        let targets = announce::lan_addresses();
+        let announcer = match catch {
+            Some(socket) if !targets.is_empty() => {
+                let guid = participant.guid().to_bytes();
+                let prefix: [u8; 12] = guid[..12].try_into().expect("a GUID has a 12-byte prefix");
+                Some(Announcer::start(socket, config.domain, prefix, targets)?)
+            }
+            _ => None,
+        };
         let publisher = participant.create_publisher(&qos::writer(qos::Kind::Default)).map_err(|e| dds_err("publisher", e))?;
         let subscriber: Subscriber = participant.create_subscriber(&qos::reader()).map_err(|e| dds_err("subscriber", e))?;
         for t in &config.lockstep {
@@ -161,6 +176,7 @@ impl Ros2Bridge {
             stats: stats.clone(),
             warned_timeout: false,
             started: false,
+            _announcer: announcer,
         };
         let outbound: Vec<(String, String)> = bridge.config.outbound.iter().filter(|(t, _)| !bridge.inbound_topics.contains(t)).cloned().collect();
         for (t, ty) in outbound.iter().chain([&("/clock".to_string(), Clock::TYPE_NAME.to_string())]) {

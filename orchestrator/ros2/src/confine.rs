@@ -20,7 +20,9 @@
 //!
 //! The participant's sockets are the internet datagram sockets that appear in this process
 //! while it is built: RustDDS's `build()` returns only after its event loop has made its
-//! sender sockets, and readers and writers made later share them.
+//! sender sockets, and readers and writers made later share them. A filter applies to what
+//! arrives after it is attached: a datagram from elsewhere in the few milliseconds between
+//! the socket's creation and the filter would still be read.
 
 use agrisim_error::{err, Result};
 use socket2::{Domain, SockFilter, SockRef, Type};
@@ -127,6 +129,7 @@ mod tests {
 
     #[test]
     fn filters_exactly_the_sockets_opened_since() {
+        let _serial = crate::SOCKET_TESTS.lock().unwrap_or_else(|e| e.into_inner());
         let old = UdpSocket::bind("0.0.0.0:0").unwrap();
         let before = udp_sockets().unwrap();
         assert!(before.iter().any(|&(fd, _)| fd == old.as_raw_fd()));

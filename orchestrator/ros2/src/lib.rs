@@ -13,8 +13,10 @@
 //! * [`raw`]: the raw-CDR sample type and its RustDDS adapters;
 //! * [`bridge`]: the bridge node (lockstep or real time) and its statistics;
 //! * [`graph`]: the bridge as a node of the ROS 2 graph (`ros_discovery_info`);
-//! * [`confine`]: the bridge's sockets kept on the loopback device.
+//! * [`confine`]: the bridge's sockets kept to traffic from this machine;
+//! * [`announce`]: its announcements repeated to this machine's LAN addresses.
 
+pub mod announce;
 pub mod bridge;
 pub mod confine;
 pub mod graph;
@@ -24,3 +26,8 @@ pub mod raw;
 
 pub use bridge::{BridgeConfig, Mode, Ros2Bridge, Stats};
 pub use graph::Distro;
+
+/// Tests that open sockets hold this: the confinement test counts the sockets that appear
+/// in the process while it runs.
+#[cfg(test)]
+pub(crate) static SOCKET_TESTS: std::sync::Mutex<()> = std::sync::Mutex::new(());
