@@ -5,17 +5,18 @@ command given after `--` (so both share this network namespace) and, while it ru
 publication and subscription. Prints what it saw as JSON: the announced nodes with their
 reader and writer GIDs, and the discovered endpoints (GUID, participant, topic, type).
 
-With --lan ADDR/LEN it first gives this namespace a LAN interface (a dummy device) with that
-address (one end of a veth pair; kernels without the dummy device have it), so a peer that
-selects a non-loopback interface (rmw_cyclonedds's LOCALHOST range does) has one. With --after-bridge it starts agrisim first and joins DDS once the bridge's
-discovery port is open, as a ROS 2 node started while the simulation runs."""
+With --lan ADDR/LEN it first gives this namespace a LAN interface with that address (one end
+of a veth pair: kernels without the dummy device have veth), so a peer that selects a
+non-loopback interface (rmw_cyclonedds's LOCALHOST range does) has one. With --after-bridge
+it starts agrisim first and joins DDS once the bridge's discovery port is open, as a ROS 2
+node started while the simulation runs."""
 
 import argparse
 import json
 import subprocess
 import time
-from pathlib import Path
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsPublication, BuiltinTopicDcpsSubscription
 from cyclonedds.core import Policy, Qos

@@ -14,7 +14,6 @@ Prints JSON: per origin the drops and the per-port outcome ("refused" or "sent")
 import argparse
 import json
 import os
-import socket
 import subprocess
 import sys
 import time

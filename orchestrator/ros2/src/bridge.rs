@@ -132,9 +132,8 @@ impl Ros2Bridge {
         if let Some(before) = before {
             confine::confine_new(&before)?;
         }
-        let targets = announce::lan_addresses();
-        let announcer = match catch {
-            Some(socket) if !targets.is_empty() => {
+        let announcer = match (catch, announce::lan_addresses()) {
+            (Some(socket), targets) if !targets.is_empty() => {
                 let guid = participant.guid().to_bytes();
                 let prefix: [u8; 12] = guid[..12].try_into().expect("a GUID has a 12-byte prefix");
                 Some(Announcer::start(socket, config.domain, prefix, targets)?)
