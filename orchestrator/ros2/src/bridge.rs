@@ -132,8 +132,9 @@ impl Ros2Bridge {
         if let Some(before) = before {
             confine::confine_new(&before)?;
         }
-        let announcer = match (catch, announce::lan_addresses()) {
-            (Some(socket), targets) if !targets.is_empty() => {
+        let targets = if catch.is_some() { announce::lan_addresses() } else { vec![] };
+        let announcer = match catch {
+            Some(socket) if !targets.is_empty() => {
                 let guid = participant.guid().to_bytes();
                 let prefix: [u8; 12] = guid[..12].try_into().expect("a GUID has a 12-byte prefix");
                 Some(Announcer::start(socket, config.domain, prefix, targets)?)
