@@ -51,6 +51,9 @@ pub struct Camera {
     /// image, depth, camera_info, labels.
     ports: Option<[OutPort; 4]>,
     window_ns: i64,
+    /// The last frame's buffers, rendered into again (derived: not serialized).
+    #[serde(skip)]
+    frame: Frame,
 }
 
 fn new_ports() -> [OutPort; 4] {
@@ -171,12 +174,20 @@ impl Camera {
     /// A frame with the camera raised by `lift` and the robot's links at `coords` (None: the
     /// base box only).
     pub fn capture_posed(&mut self, x: f64, y: f64, yaw: f64, lift: f64, coords: Option<&Coords>) -> Frame {
+        let mut frame = Frame::default();
+        self.render_posed(&mut frame, x, y, yaw, lift, coords);
+        frame
+    }
+
+    /// [`Camera::capture_posed`] into `frame`'s buffers.
+    fn render_posed(&mut self, frame: &mut Frame, x: f64, y: f64, yaw: f64, lift: f64, coords: Option<&Coords>) {
         let c = self.config.as_ref().expect("initialized");
         let robot = c.robot.objects(coords, x, y, yaw);
         let mut mount = c.mount;
         mount.translation[2] += lift;
         let pose = CameraPose::new(&mount, x, y, yaw);
-        render::render(
+        render::render_into(
+            frame,
             &c.scene,
             &robot,
             &c.intrinsics,
@@ -185,7 +196,7 @@ impl Camera {
             &c.depth,
             &mut self.rng,
             c.threads,
-        )
+        );
     }
 
     pub fn config(&self) -> Option<&Config> {
@@ -265,15 +276,16 @@ impl Camera {
 
     #[allow(clippy::too_many_arguments)]
     fn capture_and_publish(&mut self, io: &mut Store, stamp: i64, x: f64, y: f64, yaw: f64, lift: f64, coords: Option<&Coords>) {
-        let frame = self.capture_posed(x, y, yaw, lift, coords);
+        let mut frame = std::mem::take(&mut self.frame);
+        self.render_posed(&mut frame, x, y, yaw, lift, coords);
         let c = self.config.as_ref().expect("initialized");
         let (w, hh, id) = (c.intrinsics.width, c.intrinsics.height, c.frame_id.as_str());
         let info = c.intrinsics.camera_info(stamp, id).to_cdr();
-        let rgb = image::rgb8(stamp, id, w, hh, &frame.rgb).to_cdr();
-        let depth = image::depth_32fc1(stamp, id, w, hh, &frame.depth).to_cdr();
+        let rgb = image::rgb8_cdr(stamp, id, w, hh, &frame.rgb);
+        let depth = image::depth_32fc1_cdr(stamp, id, w, hh, &frame.depth);
         let labels = c
             .labels
-            .then(|| image::labels_32sc1(stamp, id, w, hh, &frame.labels).to_cdr());
+            .then(|| image::labels_32sc1_cdr(stamp, id, w, hh, &frame.labels));
         let ports = self.ports.get_or_insert_with(new_ports);
         ports[0].publish(stamp, rgb);
         ports[1].publish(stamp, depth);
@@ -282,5 +294,6 @@ impl Camera {
             ports[3].publish(stamp, l);
         }
         io.set_i32(VALID_DEPTH, frame.valid as i32);
+        self.frame = frame;
     }
 }

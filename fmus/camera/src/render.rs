@@ -7,7 +7,7 @@ use crate::lighting::{self, Lighting, Shadows};
 use crate::optics::{mat_vec, CameraPose, Intrinsics, Vec3};
 use crate::scene::Scene;
 use crate::shading::{self, Palette};
-use agrisim_greenhouse::raycast::MAX_PACKET;
+use agrisim_greenhouse::raycast::{Occluders, MAX_PACKET};
 use agrisim_greenhouse::{Hit, Object, RayCaster};
 use agrisim_math::Rng;
 
@@ -91,15 +91,32 @@ pub fn render(
     rng: &mut Rng,
     threads: usize,
 ) -> Frame {
+    let mut f = Frame::default();
+    render_into(&mut f, scene, dynamic, k, pose, light, depth, rng, threads);
+    f
+}
+
+/// [`render`] into the buffers of an earlier frame (any size: they are resized), which it
+/// overwrites entirely. A camera renders every frame into the same buffers: fresh ones of
+/// 14 MB (1280x720) were pages the kernel had to map and clear at every frame.
+#[allow(clippy::too_many_arguments)]
+pub fn render_into(
+    f: &mut Frame,
+    scene: &Scene,
+    dynamic: &[Object],
+    k: &Intrinsics,
+    pose: &CameraPose,
+    light: &Lighting,
+    depth: &DepthModel,
+    rng: &mut Rng,
+    threads: usize,
+) {
     let (w, h) = (k.width as usize, k.height as usize);
     let n = w * h;
-    let mut f = Frame {
-        rgb: vec![0; 3 * n],
-        depth: vec![0.0; n],
-        true_depth: vec![0.0; n],
-        labels: vec![0; n],
-        valid: 0,
-    };
+    f.rgb.resize(3 * n, 0);
+    f.depth.resize(n, 0.0);
+    f.true_depth.resize(n, 0.0);
+    f.labels.resize(n, 0);
     let movers = RayCaster::new(dynamic);
     let ctx = Ctx { scene, movers: &movers, k, pose, light, palette: Palette::default() };
     let threads = threads.clamp(1, h.div_ceil(CHUNK_ROWS).max(1));
@@ -109,8 +126,7 @@ pub fn render(
         ctx.rows(c * CHUNK_ROWS, rgb, z, l);
         0
     });
-    apply_depth_model(&mut f, k, depth, light.fog.map(|g| g.depth_limit), rng.next_u64(), threads);
-    f
+    apply_depth_model(f, k, depth, light.fog.map(|g| g.depth_limit), rng.next_u64(), threads);
 }
 
 /// Runs `work` on every chunk (chunk c covers rows from c * [`CHUNK_ROWS`]), chunks dealt to
@@ -192,6 +208,8 @@ impl Ctx<'_> {
         let mut d_opt = [[0.0; 3]; MAX_PACKET];
         let mut dirs = [[0.0; 3]; MAX_PACKET];
         let mut hits = [None; MAX_PACKET];
+        // The occluders of the chunk's latest shadow rays, tried first by the next ones.
+        let mut recent = Occluders::default();
         for u0 in (0..w).step_by(TILE_COLS) {
             let cols = TILE_COLS.min(w - u0);
             let n = rows * cols;
@@ -203,10 +221,10 @@ impl Ctx<'_> {
             self.scene.caster.cast_packet(self.pose.origin, &dirs[..n], 0.0, FAR, self.movers, &mut hits[..n]);
             for i in 0..n {
                 let j = (i / cols) * w + u0 + i % cols;
-                if let Some(hit) = &hits[i] {
-                    z[j] = (hit.distance * d_opt[i][2]) as f32;
-                    labels[j] = hit.object as i32 + 1;
-                }
+                (z[j], labels[j]) = match &hits[i] {
+                    Some(hit) => ((hit.distance * d_opt[i][2]) as f32, hit.object as i32 + 1),
+                    None => (0.0, 0),
+                };
             }
             if self.light.supersample {
                 for i in 0..n {
@@ -227,7 +245,7 @@ impl Ctx<'_> {
             for i in 0..n {
                 surfaces[i] = self.surface_beyond(dirs[i], &layers[i]);
             }
-            let beams = self.beams(&surfaces[..n]);
+            let beams = self.beams(&surfaces[..n], &mut recent);
             for i in 0..n {
                 let j = (i / cols) * w + u0 + i % cols;
                 let lin = self.shade(&surfaces[i], beams[i]);
@@ -250,7 +268,7 @@ impl Ctx<'_> {
 
     /// Unblocked fraction of the sun's beam at each lit surface of a tile (0 elsewhere): the
     /// shadow rays of each sun sample go as one packet.
-    fn beams(&self, surfaces: &[Surface]) -> [f64; MAX_PACKET] {
+    fn beams(&self, surfaces: &[Surface], recent: &mut Occluders) -> [f64; MAX_PACKET] {
         let l = self.light;
         let mut beams = [0.0; MAX_PACKET];
         // Lit points by their distance from the camera, so each shadow packet holds points
@@ -281,7 +299,7 @@ impl Ctx<'_> {
             }
             for k in 0..samples {
                 let s = sun_disc_sample(l.sun, k, samples);
-                self.scene.caster.pass_through_packet(&points[..g], s, EPS, FAR, self.movers, |id| shading::casts_shadow(self.scene.kind(id)), &mut out[..g]);
+                self.scene.caster.pass_through_cached(&points[..g], s, EPS, FAR, self.movers, |id| shading::casts_shadow(self.scene.kind(id)), recent, &mut out[..g]);
                 for (q, &(_, i, _)) in group.iter().enumerate() {
                     beams[i] += transmittance(out[q], l.cover_tau);
                 }

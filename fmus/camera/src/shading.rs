@@ -69,26 +69,40 @@ pub fn linear_to_srgb(l: f64) -> u8 {
 
 /// [`linear_to_srgb`] by table: the 255 linear values where the code steps up, found once by
 /// bisecting `linear_to_srgb` itself, so the two agree exactly (the function is monotonic) and
-/// a pixel costs a binary search instead of a `powf`.
+/// a pixel costs two table reads instead of a `powf`.
 pub fn encode_srgb(l: f64) -> u8 {
-    // A bucket of the linear range gives the code at its start; at most a few steps follow
-    // inside it (they are densest near black, 1 / (255 x 12.92) apart: > 1 / BUCKETS).
-    const BUCKETS: usize = 4096;
-    static START: std::sync::LazyLock<Vec<u8>> = std::sync::LazyLock::new(|| {
-        (0..BUCKETS).map(|b| srgb_steps().partition_point(|&t| t <= b as f64 / BUCKETS as f64) as u8).collect()
-    });
     if !(l > 0.0) {
         return 0; // black, and NaN as `linear_to_srgb` gives it
     }
     if l >= 1.0 {
         return 255;
     }
-    let steps = srgb_steps();
-    let mut c = START[(l * BUCKETS as f64) as usize] as usize;
-    while c < 255 && steps[c] <= l {
-        c += 1;
-    }
-    c as u8
+    let t = srgb_table();
+    // The code at the start of l's bucket; steps are further apart than a bucket is wide
+    // (they are densest near black, 1 / (255 x 12.92) apart: > 1 / BUCKETS), so at most one
+    // more lies before l. No loop, no branch: the step after the last is +inf.
+    let c = t.start[(l * BUCKETS as f64) as usize] as usize;
+    (c + (t.steps[c] <= l) as usize) as u8
+}
+
+/// Buckets of the linear range [0, 1) in the encoder's index.
+const BUCKETS: usize = 4096;
+
+/// The encoder's tables: the code at each bucket's start, and the steps (with +inf after
+/// the last).
+struct SrgbTable {
+    start: [u8; BUCKETS],
+    steps: [f64; 256],
+}
+
+fn srgb_table() -> &'static SrgbTable {
+    static TABLE: std::sync::LazyLock<SrgbTable> = std::sync::LazyLock::new(|| {
+        let mut steps = [f64::INFINITY; 256];
+        steps[..255].copy_from_slice(srgb_steps());
+        let start = std::array::from_fn(|b| srgb_steps().partition_point(|&t| t <= b as f64 / BUCKETS as f64) as u8);
+        SrgbTable { start, steps }
+    });
+    &TABLE
 }
 
 /// The linear values where [`linear_to_srgb`] steps from code k to k + 1.
@@ -178,6 +192,10 @@ mod tests {
                 let v = f64::from_bits(b);
                 assert_eq!(encode_srgb(v), linear_to_srgb(v), "{v}");
             }
+        }
+        // At most one step inside any bucket (what the encoder's single increment relies on).
+        for w in srgb_steps().windows(2) {
+            assert!(w[1] - w[0] > 1.0 / BUCKETS as f64, "steps {} and {} closer than a bucket", w[0], w[1]);
         }
         // Each step is exactly where the curve steps (with the curve monotonic, the table
         // then equals it everywhere).

@@ -59,6 +59,8 @@ fn main() {
     println!("cast               {:.3} s (best of 3)", cast_s);
     println!("per ray            {:.1} nodes, {:.1} primitive tests", nodes as f64 / k, prims as f64 / k);
     println!("rays/s             {:.3e} (single thread; LiDAR needs 2.0e5)", n as f64 / cast_s);
+    let digest = dist.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, v| (h ^ v.to_bits()).wrapping_mul(0x0100_0000_01b3));
+    println!("distance digest    {digest:016x} (FNV-1a of the hit distances: equal digests = identical answers)");
 
     if let Some(dir) = common::arg("--out") {
         let dir = std::path::PathBuf::from(dir);

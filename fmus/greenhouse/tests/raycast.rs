@@ -1,6 +1,6 @@
 //! The BVH caster must agree exactly with a brute-force scan over all objects.
 
-use agrisim_greenhouse::raycast::cast_brute_force;
+use agrisim_greenhouse::raycast::{cast_brute_force, Occluders};
 use agrisim_greenhouse::{generate, GreenhouseConfig, Kind, Object, Placement, RayCaster, RigidPose, Shape};
 use agrisim_math::Rng;
 
@@ -260,6 +260,9 @@ fn pass_through_equals_the_hit_to_hit_walk() {
     // Packets: one sun direction, origins spread over a patch of canopy (a camera tile's
     // surface points), every answer equal to the single-ray query.
     let (mut blocked, mut through) = (0, 0);
+    // The cached query with one cache across all packets (its occluders mostly miss a new
+    // packet: the answers must not depend on them).
+    let mut recent = Occluders::default();
     for k in 0..400 {
         let s = unit([rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(0.05, 1.0)]);
         let c = [rng.range(0.0, cfg.length), rng.range(0.0, cfg.width), rng.range(0.0, 3.0)];
@@ -268,6 +271,12 @@ fn pass_through_equals_the_hit_to_hit_walk() {
         let origins: Vec<[f64; 3]> = (0..m).map(|_| [0, 1, 2].map(|a| c[a] + rng.range(-size, size))).collect();
         let mut out = vec![None; m];
         rc.pass_through_packet(&origins, s, 1e-6, 1000.0, &movers, opaque, &mut out);
+        // Twice through the cache: the second time its newest occluder is this packet's own.
+        let mut cached = vec![None; m];
+        for _ in 0..2 {
+            rc.pass_through_cached(&origins, s, 1e-6, 1000.0, &movers, opaque, &mut recent, &mut cached);
+            assert_eq!(cached, out, "packet {k}, cached");
+        }
         for (i, o) in origins.iter().enumerate() {
             assert_eq!(out[i], rc.pass_through(*o, s, 1e-6, 1000.0, &movers, opaque), "packet {k} ray {i}");
             blocked += out[i].is_none() as usize;
@@ -275,6 +284,7 @@ fn pass_through_equals_the_hit_to_hit_walk() {
         }
     }
     assert!(blocked > 100 && through > 1000, "{blocked} blocked, {through} through glass");
+    assert!(recent.held() > 0, "no occluder remembered");
 }
 
 /// Packets (camera tiles of up to 64 rays from one origin) give exactly the single-ray

@@ -194,11 +194,36 @@ impl RayCaster {
     /// `out[i]` is exactly the single-ray answer for origin i.
     #[allow(clippy::too_many_arguments)]
     pub fn pass_through_packet(&self, origins: &[[f64; 3]], dir: [f64; 3], min: f64, max: f64, movers: &RayCaster, opaque: impl Fn(u32) -> bool, out: &mut [Option<u32>]) {
+        self.pass_through_cached(origins, dir, min, max, movers, opaque, &mut Occluders::default(), out);
+    }
+
+    /// [`RayCaster::pass_through_packet`] that first tries the opaque objects that blocked
+    /// earlier rays (`recent`, which it keeps up to date): a ray one of them blocks is in
+    /// shadow whatever else lies on it, so it needs no traversal. Neighbouring surface points
+    /// are often shaded by the same leaf. The answers are the same whatever `recent` holds.
+    #[allow(clippy::too_many_arguments)]
+    pub fn pass_through_cached(&self, origins: &[[f64; 3]], dir: [f64; 3], min: f64, max: f64, movers: &RayCaster, opaque: impl Fn(u32) -> bool, recent: &mut Occluders, out: &mut [Option<u32>]) {
         let n = origins.len();
         assert!(n <= MAX_PACKET && out.len() == n, "pass_through_packet: {n} rays, {} results", out.len());
-        let Some(mut packet) = Packet::new(origins, &[dir], max) else {
-            for (o, r) in origins.iter().zip(out.iter_mut()) {
-                *r = self.pass_through(*o, dir, min, max, movers, &opaque);
+        // Rays not blocked by a recent occluder go on, compacted into one packet.
+        let mut live = [0usize; MAX_PACKET];
+        let mut m = 0;
+        let occluders = recent.slots.map(|r| r.map(|(in_movers, k)| if in_movers { &movers.prims[k as usize] } else { &self.prims[k as usize] }.along(dir)));
+        for (i, o) in origins.iter().enumerate() {
+            out[i] = None;
+            if !occluders.iter().flatten().any(|a| a.intersect(*o, min, max).is_some()) {
+                live[m] = i;
+                m += 1;
+            }
+        }
+        if m == 0 {
+            return;
+        }
+        let sub: [[f64; 3]; MAX_PACKET] = std::array::from_fn(|q| if q < m { origins[live[q]] } else { [0.0; 3] });
+        let sub = &sub[..m];
+        let Some(mut packet) = Packet::new(sub, &[dir], max) else {
+            for q in 0..m {
+                out[live[q]] = self.pass_through(sub[q], dir, min, max, movers, &opaque);
             }
             return;
         };
@@ -206,12 +231,15 @@ impl RayCaster {
         let mut blocked = [false; MAX_PACKET];
         // The scene, then the movers with the same packet (blocked rays have left it), each
         // ray continuing its crossing list.
-        for set in [self, movers] {
-            let mut v = PacketThrough { caster: set, origins, d: dir, tmin: min, tmax: max, opaque: &opaque, at: &mut at, blocked: &mut blocked };
+        for (in_movers, set) in [(false, self), (true, movers)] {
+            let mut v = PacketThrough { caster: set, origins: sub, d: dir, tmin: min, tmax: max, opaque: &opaque, at: &mut at, blocked: &mut blocked, blocker: None };
             traverse_packet(&set.nodes, &mut packet, min, &mut v);
+            if let Some(k) = v.blocker {
+                recent.remember(in_movers, k);
+            }
         }
-        for i in 0..n {
-            out[i] = (!blocked[i]).then(|| at[i].count(min));
+        for q in 0..m {
+            out[live[q]] = (!blocked[q]).then(|| at[q].count(min));
         }
     }
 
@@ -324,7 +352,9 @@ impl PacketVisit for PacketNearest<'_> {
         // Primitive by primitive: with one origin for all rays (a camera tile) each primitive
         // takes it into its frame once. Each ray still meets the primitives in leaf order, so
         // its answer is the one it gets alone.
-        let before: [f64; MAX_PACKET] = std::array::from_fn(|i| self.best[i].t);
+        // Rays offered a hit (their far limit is recomputed; unchanged if the offer was not
+        // taken), one bit each.
+        let mut offered = 0u64;
         for k in start..start + count {
             let prim = &self.caster.prims[k];
             let shared = match self.origins {
@@ -339,13 +369,14 @@ impl PacketVisit for PacketNearest<'_> {
                 let best = &mut self.best[i];
                 if let Some((t, n)) = seen.intersect(*d, self.tmins[i.min(self.tmins.len() - 1)], best.t) {
                     best.offer(t, self.caster.ids[k], n);
+                    offered |= 1 << i;
                 }
             }
         }
-        for i in 0..self.dirs.len() {
-            if self.best[i].t != before[i] {
-                packet.far[i] = far(self.best[i].t);
-            }
+        while offered != 0 {
+            let i = offered.trailing_zeros() as usize;
+            offered &= offered - 1;
+            packet.far[i] = far(self.best[i].t);
         }
     }
 }
@@ -361,6 +392,8 @@ struct PacketThrough<'a, F> {
     opaque: &'a F,
     at: &'a mut [Crossings; MAX_PACKET],
     blocked: &'a mut [bool; MAX_PACKET],
+    /// The last primitive found blocking a ray.
+    blocker: Option<u32>,
 }
 
 impl<F: Fn(u32) -> bool> PacketVisit for PacketThrough<'_, F> {
@@ -374,11 +407,38 @@ impl<F: Fn(u32) -> bool> PacketVisit for PacketThrough<'_, F> {
             let mut opaque = None;
             for (i, o) in self.origins.iter().enumerate() {
                 if live[i] && cross(&along, *o, self.tmin, self.tmax, || *opaque.get_or_insert_with(|| (self.opaque)(self.caster.ids[k])), &mut self.at[i]) {
+                    self.blocker = Some(k as u32);
                     self.blocked[i] = true;
                     packet.far[i] = f32::NEG_INFINITY;
                     live[i] = false;
                 }
             }
+        }
+    }
+}
+
+/// Most recent occluders [`RayCaster::pass_through_cached`] tries first.
+const OCCLUDERS: usize = 2;
+
+/// The opaque primitives that blocked the latest shadow rays, newest first (for
+/// [`RayCaster::pass_through_cached`]; one per thread, any content is correct).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Occluders {
+    /// (in the movers, primitive index).
+    slots: [Option<(bool, u32)>; OCCLUDERS],
+}
+
+impl Occluders {
+    /// How many occluders it holds.
+    pub fn held(&self) -> usize {
+        self.slots.iter().flatten().count()
+    }
+
+    fn remember(&mut self, in_movers: bool, k: u32) {
+        let new = Some((in_movers, k));
+        if self.slots[0] != new {
+            self.slots.copy_within(0..OCCLUDERS - 1, 1);
+            self.slots[0] = new;
         }
     }
 }

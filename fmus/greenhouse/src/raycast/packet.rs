@@ -11,7 +11,7 @@
 //! the packet it lies between the smallest and largest of its four corner values, and since
 //! rounding is monotonic the same holds for the f32 values each ray computes alone.
 
-use super::wide::{as_leaf, down, far, Node4, Ray32};
+use super::wide::{as_leaf, down, far, inverse, near_corner, Node4, Ray32};
 use std::mem::MaybeUninit;
 
 /// Most rays in a packet.
@@ -29,44 +29,50 @@ pub(crate) struct Packet {
     /// Inverse-direction interval per axis.
     lo: [f32; 3],
     hi: [f32; 3],
+    /// Per axis, the box corners every ray of the packet meets first ([`Ray32::near`]: the
+    /// rays' directions share their signs).
+    near: [usize; 3],
     /// Rays in use (lanes from here on are idle).
     len: usize,
 }
 
 impl Packet {
     /// None when some axis has directions of both signs: the interval test would cull nothing.
-    /// `origins` and `dirs` each hold one for all rays or one per ray.
+    /// `origins` and `dirs` each hold one for all rays or one per ray. Axis by axis over the
+    /// lanes, so the conversions, inverses and bounds run in SIMD; inlined so the packet is
+    /// built where it is used rather than moved there.
+    #[inline(always)]
     pub(crate) fn new(origins: &[[f64; 3]], dirs: &[[f64; 3]], tmax: f64) -> Option<Packet> {
         let n = origins.len().max(dirs.len());
         debug_assert!(n <= MAX_PACKET && (origins.len() == 1 || origins.len() == n) && (dirs.len() == 1 || dirs.len() == n));
         let mut p = Packet {
             o: [[0.0; MAX_PACKET]; 3],
-            o_lo: [f32::INFINITY; 3],
-            o_hi: [f32::NEG_INFINITY; 3],
+            o_lo: [0.0; 3],
+            o_hi: [0.0; 3],
             inv: [[0.0; MAX_PACKET]; 3],
             far: [f32::NEG_INFINITY; MAX_PACKET],
-            lo: [f32::INFINITY; 3],
-            hi: [f32::NEG_INFINITY; 3],
+            lo: [0.0; 3],
+            hi: [0.0; 3],
+            near: [0; 3],
             len: n,
         };
-        // One direction for all (shadow rays): its inverse worked out once.
-        let shared = (dirs.len() == 1).then(|| Ray32::new(origins[0], dirs[0]).inv);
-        for i in 0..n {
-            let o = origins[i.min(origins.len() - 1)];
-            let r = match shared {
-                Some(inv) => Ray32 { o: o.map(|v| v as f32), inv },
-                None => Ray32::new(o, dirs[i]),
-            };
-            for a in 0..3 {
-                p.o[a][i] = r.o[a];
-                p.o_lo[a] = p.o_lo[a].min(r.o[a]);
-                p.o_hi[a] = p.o_hi[a].max(r.o[a]);
-                p.inv[a][i] = r.inv[a];
-                p.lo[a] = p.lo[a].min(r.inv[a]);
-                p.hi[a] = p.hi[a].max(r.inv[a]);
+        for a in 0..3 {
+            let o = &mut p.o[a][..n];
+            match origins {
+                [one] => o.fill(one[a] as f32),
+                _ => o.iter_mut().zip(origins).for_each(|(v, s)| *v = s[a] as f32),
             }
-            p.far[i] = far(tmax);
+            (p.o_lo[a], p.o_hi[a]) = bounds(o);
+            // The same inverse as a single ray's (`Ray32::new`).
+            let inv = &mut p.inv[a][..n];
+            match dirs {
+                [one] => inv.fill(Ray32::new(origins[0], *one).inv[a]),
+                _ => inv.iter_mut().zip(dirs).for_each(|(v, d)| *v = inverse(d[a])),
+            }
+            (p.lo[a], p.hi[a]) = bounds(inv);
         }
+        p.far[..n].fill(far(tmax));
+        p.near = p.lo.map(near_corner);
         (0..3).all(|a| p.lo[a] > 0.0 || p.hi[a] < 0.0).then_some(p)
     }
 
@@ -78,8 +84,8 @@ impl Packet {
     /// slab test, lane-wise over rays); true if any may.
     #[inline(always)]
     fn rays_meeting(&self, n: &Node4, lane: usize, tmin: f32, hit: &mut [bool; MAX_PACKET]) -> bool {
-        let bmin = [n.min[0][lane], n.min[1][lane], n.min[2][lane]];
-        let bmax = [n.max[0][lane], n.max[1][lane], n.max[2][lane]];
+        let bmin = [n.b[0][0][lane], n.b[0][1][lane], n.b[0][2][lane]];
+        let bmax = [n.b[1][0][lane], n.b[1][1][lane], n.b[1][2][lane]];
         let mut any = false;
         for i in 0..self.len {
             let mut t0 = tmin;
@@ -103,18 +109,21 @@ impl Packet {
         let mut t0 = [tmin; 4];
         let mut t1 = [tmax; 4];
         for k in 0..3 {
+            let (near, far) = (&n.b[self.near[k]][k], &n.b[1 - self.near[k]][k]);
             for i in 0..4 {
                 // Each plane's distance over the packet's (origin, inverse direction) box: its
-                // corner values bound every ray's (the nearer plane's distance is the entry).
-                let (a0, a1) = (n.min[k][i] - self.o_hi[k], n.min[k][i] - self.o_lo[k]);
-                let (b0, b1) = (n.max[k][i] - self.o_hi[k], n.max[k][i] - self.o_lo[k]);
+                // corner values bound every ray's. The entry is the least over the near plane,
+                // the exit the greatest over the far one (each ray's near distance is below its
+                // far one, so the other plane's corners could not change them).
+                let (a0, a1) = (near[i] - self.o_hi[k], near[i] - self.o_lo[k]);
+                let (b0, b1) = (far[i] - self.o_hi[k], far[i] - self.o_lo[k]);
                 let (lo, hi) = (self.lo[k], self.hi[k]);
-                let c = [a0 * lo, a0 * hi, a1 * lo, a1 * hi, b0 * lo, b0 * hi, b1 * lo, b1 * hi];
-                let mut entry = c[0];
-                let mut exit = c[0];
-                for &x in &c[1..] {
-                    entry = if x < entry { x } else { entry };
-                    exit = if x > exit { x } else { exit };
+                let (ca, cb) = ([a0 * lo, a0 * hi, a1 * lo, a1 * hi], [b0 * lo, b0 * hi, b1 * lo, b1 * hi]);
+                let mut entry = ca[0];
+                let mut exit = cb[0];
+                for j in 1..4 {
+                    entry = if ca[j] < entry { ca[j] } else { entry };
+                    exit = if cb[j] > exit { cb[j] } else { exit };
                 }
                 t0[i] = if entry > t0[i] { entry } else { t0[i] };
                 t1[i] = if exit < t1[i] { exit } else { t1[i] };
@@ -128,6 +137,12 @@ impl Packet {
     }
 }
 
+/// Smallest and largest of `v` (plain comparisons: SIMD min and max).
+#[inline(always)]
+fn bounds(v: &[f32]) -> (f32, f32) {
+    v.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &x| (if x < lo { x } else { lo }, if x > hi { x } else { hi }))
+}
+
 /// What a packet traversal does at leaves.
 pub(crate) trait PacketVisit {
     /// Tests primitives `start .. start + count` for the rays flagged in `rays`, lowering
@@ -136,6 +151,22 @@ pub(crate) trait PacketVisit {
 }
 
 const STACK: usize = 96;
+
+/// Orders the first `k` (at most 4) children by entry distance, farthest first, so the
+/// nearest is popped first: an insertion sort inline (the library sort's call cost more than
+/// the sorting of four).
+#[inline(always)]
+fn far_first(kids: &mut [(u32, f32); 4], k: usize) {
+    for i in 1..k {
+        let x = kids[i];
+        let mut j = i;
+        while j > 0 && kids[j - 1].1.total_cmp(&x.1).is_lt() {
+            kids[j] = kids[j - 1];
+            j -= 1;
+        }
+        kids[j] = x;
+    }
+}
 
 /// Visits, for each ray, every leaf whose box it may meet before its current far limit.
 pub(crate) fn traverse_packet<V: PacketVisit>(nodes: &[Node4], p: &mut Packet, tmin: f64, v: &mut V) {
@@ -172,7 +203,7 @@ pub(crate) fn traverse_packet<V: PacketVisit>(nodes: &[Node4], p: &mut Packet, t
                 }
             }
         }
-        kids[..k].sort_unstable_by(|x, y| y.1.total_cmp(&x.1));
+        far_first(&mut kids, k);
         for &(c, tc) in &kids[..k] {
             if sp < STACK {
                 stack[sp].write((c, tc));

@@ -128,11 +128,7 @@ impl Prim {
                 // cyclic permutation (a proper rotation).
                 let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
                 let (t, n) = cylinder_local(r, h, [lo[i], lo[j], lo[axis]], [ld[i], ld[j], ld[axis]], tmin, tmax)?;
-                let mut m = [0.0; 3];
-                m[i] = n[0];
-                m[j] = n[1];
-                m[axis] = n[2];
-                Some((t, m))
+                Some((t, [0, 1, 2].map(|k| if k == axis { n[2] } else if k == i { n[0] } else { n[1] })))
             }
             Prim::Cylinder { ref rt, r, h, .. } => {
                 let (t, n) = cylinder_local(r, h, lo, ld, tmin, tmax)?;
@@ -237,9 +233,9 @@ fn box_local(half: [f64; 3], lo: [f64; 3], ld: [f64; 3], tmin: f64, tmax: f64) -
     } else {
         return None;
     };
-    let mut n = [0.0; 3];
-    n[axis] = sign;
-    Some((t, n))
+    // Built by selects: a store at a variable index, read back as a vector, stalled the
+    // store forwarding on every hit.
+    Some((t, [0, 1, 2].map(|k| if k == axis { sign } else { 0.0 })))
 }
 
 /// Cylinder centred at the origin along z, ray in its frame.
