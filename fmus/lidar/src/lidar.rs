@@ -46,6 +46,8 @@ struct Config {
     /// Extinction coefficient of the air [1/m] (0 = clear).
     extinction: f64,
     visibility: f64,
+    /// Threads casting a frame's rays.
+    threads: usize,
 }
 
 /// What one captured frame produced.
@@ -68,6 +70,18 @@ pub struct Lidar {
     /// from parameters and inputs: rebuilt, not serialized).
     #[serde(skip)]
     robot: Option<RobotInBaseLink>,
+    /// The last frame's rays, cast into again (derived: not serialized).
+    #[serde(skip)]
+    rays: Vec<Ray>,
+}
+
+/// One point's ray: direction in the map and in lidar_link, time offset in the frame, hit.
+#[derive(Clone, Copy, Debug, Default)]
+struct Ray {
+    dir: [f64; 3],
+    sensor: [f64; 3],
+    t: f32,
+    hit: Option<agrisim_greenhouse::Hit>,
 }
 
 fn param(io: &Store, i: usize, ok: impl Fn(f64) -> bool, what: &str) -> Result<f64, String> {
@@ -103,7 +117,12 @@ impl Config {
             }
         };
         let scene = SENSOR_PORTS.scene(io)?;
+        let threads = match io.i32(CAST_THREADS) {
+            t @ 1..=64 => t as usize,
+            t => return Err(format!("parameter cast_threads must be in [1, 64], got {t}")),
+        };
         Ok(Config {
+            threads,
             scene,
             pattern: ScanPattern::mid360(point_rate, el_min.to_radians(), el_max.to_radians()),
             points_per_frame: points_per_frame as usize,
@@ -137,26 +156,16 @@ const LIDAR_PACKET: usize = 64;
 /// One packet's rays and results.
 struct Batch {
     len: usize,
-    sensor: [[f64; 3]; LIDAR_PACKET],
-    dirs: [[f64; 3]; LIDAR_PACKET],
     origins: [[f64; 3]; LIDAR_PACKET],
+    dirs: [[f64; 3]; LIDAR_PACKET],
     poses: [RigidPose; LIDAR_PACKET],
-    times: [f32; LIDAR_PACKET],
     hits: [Option<agrisim_greenhouse::Hit>; LIDAR_PACKET],
 }
 
 impl Default for Batch {
     fn default() -> Batch {
         let pose = RigidPose::yawed(0.0, 0.0, 0.0, 0.0);
-        Batch {
-            len: 0,
-            sensor: [[0.0; 3]; LIDAR_PACKET],
-            dirs: [[0.0; 3]; LIDAR_PACKET],
-            origins: [[0.0; 3]; LIDAR_PACKET],
-            poses: [pose; LIDAR_PACKET],
-            times: [0.0; LIDAR_PACKET],
-            hits: [None; LIDAR_PACKET],
-        }
+        Batch { len: 0, origins: [[0.0; 3]; LIDAR_PACKET], dirs: [[0.0; 3]; LIDAR_PACKET], poses: [pose; LIDAR_PACKET], hits: [None; LIDAR_PACKET] }
     }
 }
 
@@ -167,26 +176,66 @@ impl Lidar {
     /// before the frame; arms move little in one frame).
     pub fn capture(&mut self, end_ns: i64) -> Frame {
         let c = self.config.as_ref().expect("initialized");
-        let robot = &self.robot.as_ref().expect("initialized").caster;
         let p = &c.pattern;
         let n_end = (end_ns as f64 * 1e-9 * p.point_rate).floor() as i64;
         let n0 = n_end - c.points_per_frame as i64;
-        let end_s = end_ns as f64 * 1e-9;
         let stamp_ns = if c.deskewed { end_ns } else { (p.time(n0) * 1e9).round() as i64 };
-        let stamp_s = stamp_ns as f64 * 1e-9;
-        let end_pose = self.trajectory.at(end_s);
+        // The rays, cast on the threads in runs of whole packets, then the points in order
+        // (the range noise is drawn in point order, so the cloud does not depend on the
+        // threads).
+        let mut rays = std::mem::take(&mut self.rays);
+        rays.clear();
+        rays.resize(c.points_per_frame, Ray::default());
+        let packets = c.points_per_frame.div_ceil(LIDAR_PACKET);
+        let run = packets.div_ceil(c.threads).max(1) * LIDAR_PACKET;
+        let this = &*self;
+        if c.threads == 1 || rays.len() <= run {
+            this.cast_run(n0, end_ns, stamp_ns, &mut rays);
+        } else {
+            std::thread::scope(|s| {
+                for (j, part) in rays.chunks_mut(run).enumerate() {
+                    s.spawn(move || this.cast_run(n0 + (j * run) as i64, end_ns, stamp_ns, part));
+                }
+            });
+        }
         let mut cloud = CloudBuilder::with_capacity(c.points_per_frame);
         let mut returns = 0;
+        for ray in &rays {
+            let (d, d_sensor, t) = (ray.dir, ray.sensor, ray.t);
+            match ray.hit.filter(|h| detected(h.distance, c.range.1, c.extinction)) {
+                Some(hit) => {
+                    let rho = reflectivity::of_kind(c.scene.kind(hit.object));
+                    let cos_incidence = -(hit.normal[0] * d[0] + hit.normal[1] * d[1] + hit.normal[2] * d[2]);
+                    let r = hit.distance + self.rng.gauss(c.noise);
+                    let xyz = [(d_sensor[0] * r) as f32, (d_sensor[1] * r) as f32, (d_sensor[2] * r) as f32];
+                    cloud.push(&Point { xyz, intensity: reflectivity::intensity(rho, cos_incidence), t });
+                    returns += 1;
+                }
+                None if c.drop_no_return => {}
+                None => cloud.push(&Point { t, ..Point::default() }),
+            }
+        }
+        self.rays = rays;
+        Frame { cloud: cloud.finish(stamp_ns, &c.frame_id), returns }
+    }
+
+    /// Casts the rays of points `n0 ..` into `out` (one per point) in packets of consecutive
+    /// points (successive firings look close together); each ray's hit is exactly its
+    /// single-ray hit.
+    fn cast_run(&self, n0: i64, end_ns: i64, stamp_ns: i64, out: &mut [Ray]) {
+        let c = self.config.as_ref().expect("initialized");
+        let robot = &self.robot.as_ref().expect("initialized").caster;
+        let p = &c.pattern;
+        let end_pose = self.trajectory.at(end_ns as f64 * 1e-9);
+        let stamp_s = stamp_ns as f64 * 1e-9;
         // What the beams of one firing share: its time, pattern state and base pose.
         let mut firing: Option<(i64, Firing, RigidPose)> = None;
         let beams = p.beams as i64;
-        // Rays go as packets of consecutive points (successive firings look close together);
-        // each ray's hit is exactly its single-ray hit, so the cloud does not depend on it.
         let mut batch = Batch::default();
-        let mut n = n0;
-        while n < n_end {
-            batch.len = 0;
-            while batch.len < LIDAR_PACKET && n < n_end {
+        for (k0, rays) in out.chunks_mut(LIDAR_PACKET).enumerate() {
+            batch.len = rays.len();
+            for (i, ray) in rays.iter_mut().enumerate() {
+                let n = n0 + (k0 * LIDAR_PACKET + i) as i64;
                 let f = n.div_euclid(beams);
                 let (fs, base) = match firing {
                     Some((g, fs, base)) if g == f => (fs, base),
@@ -201,34 +250,19 @@ impl Lidar {
                 let (sin, cos) = (base.rotation[1][0], base.rotation[0][0]);
                 let d_sensor = p.beam_direction(&fs, p.beam(n));
                 let m = yaw_rotate(sin, cos, c.mount.translation);
-                let i = batch.len;
-                batch.sensor[i] = d_sensor;
-                batch.dirs[i] = yaw_rotate(sin, cos, c.mount.rotate(d_sensor));
+                ray.sensor = d_sensor;
+                ray.dir = yaw_rotate(sin, cos, c.mount.rotate(d_sensor));
+                ray.t = (fs.time - stamp_s) as f32;
+                batch.dirs[i] = ray.dir;
                 batch.origins[i] = [base.translation[0] + m[0], base.translation[1] + m[1], m[2]];
                 batch.poses[i] = base;
-                batch.times[i] = (fs.time - stamp_s) as f32;
-                batch.len += 1;
-                n += 1;
             }
             let k = batch.len;
             c.scene.caster.cast_packet_posed(&batch.origins[..k], &batch.dirs[..k], c.range.0, c.range.1, robot, &batch.poses[..k], &mut batch.hits[..k]);
-            for i in 0..k {
-                let (d, d_sensor, t) = (batch.dirs[i], batch.sensor[i], batch.times[i]);
-                match batch.hits[i].filter(|h| detected(h.distance, c.range.1, c.extinction)) {
-                    Some(hit) => {
-                        let rho = reflectivity::of_kind(c.scene.kind(hit.object));
-                        let cos_incidence = -(hit.normal[0] * d[0] + hit.normal[1] * d[1] + hit.normal[2] * d[2]);
-                        let r = hit.distance + self.rng.gauss(c.noise);
-                        let xyz = [(d_sensor[0] * r) as f32, (d_sensor[1] * r) as f32, (d_sensor[2] * r) as f32];
-                        cloud.push(&Point { xyz, intensity: reflectivity::intensity(rho, cos_incidence), t });
-                        returns += 1;
-                    }
-                    None if c.drop_no_return => {}
-                    None => cloud.push(&Point { t, ..Point::default() }),
-                }
+            for (ray, hit) in rays.iter_mut().zip(&batch.hits[..k]) {
+                ray.hit = *hit;
             }
         }
-        Frame { cloud: cloud.finish(stamp_ns, &c.frame_id), returns }
     }
 
     /// Poses the robot's links for `coords` (None: the base box only).

@@ -20,6 +20,8 @@ agrisim_sensor_ports::sensor_variables! { pub VARIABLES {
   params: {
     ENVIRONMENT = Var::param("environment", Start::String(""))
         .desc("The keys of the scenario's [environment] table as TOML (no header); fog, rain and haze attenuate returns (two-way Koschmieder extinction); empty = clear air, no attenuation"),
+    CAST_THREADS = Var::param("cast_threads", Start::Int32(2))
+        .desc("Threads casting a frame's rays, 1-64 (results do not depend on it)"),
     // --- sensor (Livox MID-360 defaults) ---
     NOISE_SEED = Var::param("seed", Start::Int32(0)).desc("Seed of the range noise (set per run by the orchestrator)"),
     FRAME_RATE = Var::param("frame_rate", Start::Float64(ds::FRAME_RATE)).unit("Hz").range(0.1, 1000.0)

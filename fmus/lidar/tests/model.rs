@@ -258,6 +258,30 @@ fn same_seed_same_bytes_other_seed_differs() {
     assert_ne!(a, bytes(4));
 }
 
+/// The frames cast on 1, 2, 3 and 7 threads, in the default greenhouse while the base drives
+/// (points measured along the motion, the robot's links seen).
+#[test]
+fn clouds_do_not_depend_on_the_cast_threads() {
+    let clouds = |threads: i32| {
+        let (mut m, mut io) = start("", [2.0, 27.5, 0.3], |io| io.set_i32(CAST_THREADS, threads));
+        let mut out = vec![];
+        for k in 0..15 {
+            io.set_f64(BASE_X, 2.0 + 0.01 * k as f64);
+            out.extend(run(&mut m, &mut io, k, 1).into_iter().map(|c| c.to_cdr()));
+        }
+        out
+    };
+    let one = clouds(1);
+    assert_eq!(one.len(), 3);
+    for threads in [2, 3, 7] {
+        assert!(clouds(threads) == one, "{threads} threads");
+    }
+    let mut io = Store::new(Lidar::VARIABLES);
+    io.set_i32(CAST_THREADS, 0);
+    let err = Lidar::new().initialize(&mut io, 0.0, &mut Quiet).unwrap_err();
+    assert!(err.contains("cast_threads"), "{err}");
+}
+
 #[test]
 fn drop_no_return_leaves_only_returns() {
     let (mut m, mut io) = start("", [2.0, 27.5, 0.0], |io| io.set_bool(DROP_NO_RETURN, true));

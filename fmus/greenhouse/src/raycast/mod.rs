@@ -207,19 +207,19 @@ impl RayCaster {
         assert!(n <= MAX_PACKET && out.len() == n, "pass_through_packet: {n} rays, {} results", out.len());
         // Rays not blocked by a recent occluder go on, compacted into one packet.
         let mut live = [0usize; MAX_PACKET];
+        let mut sub = [[0.0; 3]; MAX_PACKET];
         let mut m = 0;
         let occluders = recent.slots.map(|r| r.map(|(in_movers, k)| if in_movers { &movers.prims[k as usize] } else { &self.prims[k as usize] }.along(dir)));
         for (i, o) in origins.iter().enumerate() {
             out[i] = None;
             if !occluders.iter().flatten().any(|a| a.intersect(*o, min, max).is_some()) {
-                live[m] = i;
+                (live[m], sub[m]) = (i, *o);
                 m += 1;
             }
         }
         if m == 0 {
             return;
         }
-        let sub: [[f64; 3]; MAX_PACKET] = std::array::from_fn(|q| if q < m { origins[live[q]] } else { [0.0; 3] });
         let sub = &sub[..m];
         let Some(mut packet) = Packet::new(sub, &[dir], max) else {
             for q in 0..m {
