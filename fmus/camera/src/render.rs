@@ -230,7 +230,7 @@ impl Ctx<'_> {
                 for i in 0..n {
                     let j = (i / cols) * w + u0 + i % cols;
                     let lin = self.supersampled(((j % w) as f64, (v0 + j / w) as f64));
-                    rgb[3 * j..3 * j + 3].copy_from_slice(&lin.map(shading::encode_srgb));
+                    rgb[3 * j..3 * j + 3].copy_from_slice(&shading::encode_srgb_rgb(lin));
                 }
                 continue;
             }
@@ -249,7 +249,7 @@ impl Ctx<'_> {
             for i in 0..n {
                 let j = (i / cols) * w + u0 + i % cols;
                 let lin = self.shade(&surfaces[i], beams[i]);
-                rgb[3 * j..3 * j + 3].copy_from_slice(&lin.map(shading::encode_srgb));
+                rgb[3 * j..3 * j + 3].copy_from_slice(&shading::encode_srgb_rgb(lin));
             }
         }
     }
@@ -274,38 +274,42 @@ impl Ctx<'_> {
         // Lit points by their distance from the camera, so each shadow packet holds points
         // close together (a tile across an edge holds a near leaf and the far background:
         // one packet spanning both culls almost nothing).
+        // Sorted as (squared distance's bits, pixel): for non-negative floats the bits order as
+        // the values, and integer keys sort faster.
         let o = self.pose.origin;
-        let mut lit = [(0.0, 0usize, [0.0; 3]); MAX_PACKET];
+        let mut lit = [(0u64, 0usize); MAX_PACKET];
+        let mut at = [[0.0; 3]; MAX_PACKET];
         let mut m = 0;
         for (i, s) in surfaces.iter().enumerate() {
             if let Surface::Lit { p, cos_sun, .. } = *s {
                 if l.sun_up && cos_sun > 0.0 {
-                    lit[m] = ((p[0] - o[0]).powi(2) + (p[1] - o[1]).powi(2) + (p[2] - o[2]).powi(2), i, p);
+                    lit[m] = (((p[0] - o[0]).powi(2) + (p[1] - o[1]).powi(2) + (p[2] - o[2]).powi(2)).to_bits(), i);
+                    at[i] = p;
                     m += 1;
                 }
             }
         }
         let Some(samples) = self.sun_samples() else {
-            lit[..m].iter().for_each(|&(_, i, _)| beams[i] = l.cover_tau);
+            lit[..m].iter().for_each(|&(_, i)| beams[i] = l.cover_tau);
             return beams;
         };
-        lit[..m].sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        lit[..m].sort_unstable();
         let mut out = [None; SHADOW_PACKET];
         let mut points = [[0.0; 3]; SHADOW_PACKET];
         for group in lit[..m].chunks(SHADOW_PACKET) {
             let g = group.len();
-            for (q, &(_, _, p)) in group.iter().enumerate() {
-                points[q] = p;
+            for (q, &(_, i)) in group.iter().enumerate() {
+                points[q] = at[i];
             }
             for k in 0..samples {
                 let s = sun_disc_sample(l.sun, k, samples);
                 self.scene.caster.pass_through_cached(&points[..g], s, EPS, FAR, self.movers, |id| shading::casts_shadow(self.scene.kind(id)), recent, &mut out[..g]);
-                for (q, &(_, i, _)) in group.iter().enumerate() {
+                for (q, &(_, i)) in group.iter().enumerate() {
                     beams[i] += transmittance(out[q], l.cover_tau);
                 }
             }
         }
-        lit[..m].iter().for_each(|&(_, i, _)| beams[i] /= samples as f64);
+        lit[..m].iter().for_each(|&(_, i)| beams[i] /= samples as f64);
         beams
     }
 

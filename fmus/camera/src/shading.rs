@@ -71,25 +71,34 @@ pub fn linear_to_srgb(l: f64) -> u8 {
 /// bisecting `linear_to_srgb` itself, so the two agree exactly (the function is monotonic) and
 /// a pixel costs two table reads instead of a `powf`.
 pub fn encode_srgb(l: f64) -> u8 {
-    if !(l > 0.0) {
-        return 0; // black, and NaN as `linear_to_srgb` gives it
-    }
-    if l >= 1.0 {
-        return 255;
-    }
+    srgb_table().encode(l)
+}
+
+/// An RGB pixel by [`encode_srgb`], the tables fetched once for the three.
+#[inline]
+pub fn encode_srgb_rgb(lin: [f64; 3]) -> [u8; 3] {
     let t = srgb_table();
-    // The code at the start of l's bucket; steps are further apart than a bucket is wide
-    // (they are densest near black, 1 / (255 x 12.92) apart: > 1 / BUCKETS), so at most one
-    // more lies before l. No loop, no branch: the step after the last is +inf.
-    let c = t.start[(l * BUCKETS as f64) as usize] as usize;
-    (c + (t.steps[c] <= l) as usize) as u8
+    [t.encode(lin[0]), t.encode(lin[1]), t.encode(lin[2])]
+}
+
+impl SrgbTable {
+    /// The code at the start of l's bucket; steps are further apart than a bucket is wide
+    /// (they are densest near black, 1 / (255 x 12.92) apart: > 1 / BUCKETS), so at most one
+    /// more lies before l. No loop and no branch: below 0 and NaN index the first bucket
+    /// (code 0, as `linear_to_srgb` gives them), 1 and above the last (code 255), and the
+    /// step after the last is NaN, which no value reaches.
+    #[inline(always)]
+    fn encode(&self, l: f64) -> u8 {
+        let c = self.start[((l * BUCKETS as f64) as usize).min(BUCKETS - 1)] as usize;
+        (c + (self.steps[c] <= l) as usize) as u8
+    }
 }
 
 /// Buckets of the linear range [0, 1) in the encoder's index.
 const BUCKETS: usize = 4096;
 
-/// The encoder's tables: the code at each bucket's start, and the steps (with +inf after
-/// the last).
+/// The encoder's tables: the code at each bucket's start, and the steps (with NaN after the
+/// last).
 struct SrgbTable {
     start: [u8; BUCKETS],
     steps: [f64; 256],
@@ -97,7 +106,7 @@ struct SrgbTable {
 
 fn srgb_table() -> &'static SrgbTable {
     static TABLE: std::sync::LazyLock<SrgbTable> = std::sync::LazyLock::new(|| {
-        let mut steps = [f64::INFINITY; 256];
+        let mut steps = [f64::NAN; 256];
         steps[..255].copy_from_slice(srgb_steps());
         let start = std::array::from_fn(|b| srgb_steps().partition_point(|&t| t <= b as f64 / BUCKETS as f64) as u8);
         SrgbTable { start, steps }
@@ -205,5 +214,8 @@ mod tests {
         }
         assert_eq!(encode_srgb(f64::NAN), linear_to_srgb(f64::NAN));
         assert_eq!(encode_srgb(f64::INFINITY), 255);
+        assert_eq!(encode_srgb(f64::NEG_INFINITY), 0);
+        assert_eq!(encode_srgb(-0.0), 0);
+        assert_eq!(encode_srgb_rgb([0.5, -1.0, 2.0]), [linear_to_srgb(0.5), 0, 255]);
     }
 }
