@@ -129,21 +129,31 @@ pub fn render_into(
     apply_depth_model(f, k, depth, light.fog.map(|g| g.depth_limit), rng.next_u64(), threads);
 }
 
-/// Runs `work` on every chunk (chunk c covers rows from c * [`CHUNK_ROWS`]), chunks dealt to
-/// `threads` threads round-robin; returns the sum of what it returns. Each chunk's result
-/// depends on the chunk alone, so the outcome is the same for any number of threads.
-fn by_chunks<T: Send>(threads: usize, chunks: impl Iterator<Item = T>, work: impl Fn(usize, T) -> usize + Sync) -> usize {
+/// Runs `work` on every chunk (chunk c covers rows from c * [`CHUNK_ROWS`]) on `threads`
+/// threads (the caller's among them), each taking the next chunk when it is done with one;
+/// returns the sum of what it returns. Each chunk's result depends on the chunk alone, so the
+/// outcome is the same for any number of threads. Taken as they go, not dealt in advance: a
+/// thread the system holds back (the recorder's, the other sensors') no longer holds up the
+/// frame while the others idle.
+fn by_chunks<T: Send>(threads: usize, chunks: impl Iterator<Item = T> + Send, work: impl Fn(usize, T) -> usize + Sync) -> usize {
+    let queue = std::sync::Mutex::new(chunks.enumerate());
+    let drain = || {
+        let mut sum = 0;
+        loop {
+            let next = queue.lock().expect("chunk queue").next();
+            match next {
+                Some((c, t)) => sum += work(c, t),
+                None => return sum,
+            }
+        }
+    };
     if threads <= 1 {
-        return chunks.enumerate().map(|(c, t)| work(c, t)).sum();
+        return drain();
     }
-    let mut lists: Vec<Vec<(usize, T)>> = (0..threads).map(|_| Vec::new()).collect();
-    for (c, t) in chunks.enumerate() {
-        lists[c % threads].push((c, t));
-    }
-    let work = &work;
     std::thread::scope(|s| {
-        let running: Vec<_> = lists.into_iter().map(|list| s.spawn(move || list.into_iter().map(|(c, t)| work(c, t)).sum::<usize>())).collect();
-        running.into_iter().map(|r| r.join().expect("render thread")).sum()
+        let others: Vec<_> = (1..threads).map(|_| s.spawn(drain)).collect();
+        let mine = drain();
+        mine + others.into_iter().map(|r| r.join().expect("render thread")).sum::<usize>()
     })
 }
 

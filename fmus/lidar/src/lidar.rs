@@ -152,6 +152,9 @@ pub fn detected(r: f64, range_max: f64, beta: f64) -> bool {
 
 /// Points per ray packet (a few firings).
 const LIDAR_PACKET: usize = 64;
+/// Points per run a thread casts at a time (whole packets: the packets are those of one
+/// thread).
+const RUN: usize = 8 * LIDAR_PACKET;
 
 /// One packet's rays and results.
 struct Batch {
@@ -180,22 +183,28 @@ impl Lidar {
         let n_end = (end_ns as f64 * 1e-9 * p.point_rate).floor() as i64;
         let n0 = n_end - c.points_per_frame as i64;
         let stamp_ns = if c.deskewed { end_ns } else { (p.time(n0) * 1e9).round() as i64 };
-        // The rays, cast on the threads in runs of whole packets, then the points in order
-        // (the range noise is drawn in point order, so the cloud does not depend on the
-        // threads).
+        // The rays, cast on the threads in runs of whole packets (each thread takes the next
+        // run when done with one, so a thread the system holds back does not hold up the
+        // frame), then the points in order (the range noise is drawn in point order, so the
+        // cloud does not depend on the threads).
         let mut rays = std::mem::take(&mut self.rays);
         rays.clear();
         rays.resize(c.points_per_frame, Ray::default());
-        let packets = c.points_per_frame.div_ceil(LIDAR_PACKET);
-        let run = packets.div_ceil(c.threads).max(1) * LIDAR_PACKET;
         let this = &*self;
-        if c.threads == 1 || rays.len() <= run {
-            this.cast_run(n0, end_ns, stamp_ns, &mut rays);
+        let runs = std::sync::Mutex::new(rays.chunks_mut(RUN).enumerate());
+        let cast = || loop {
+            let next = runs.lock().expect("ray runs").next();
+            let Some((j, part)) = next else { return };
+            this.cast_run(n0 + (j * RUN) as i64, end_ns, stamp_ns, part);
+        };
+        if c.threads == 1 || c.points_per_frame <= RUN {
+            cast();
         } else {
             std::thread::scope(|s| {
-                for (j, part) in rays.chunks_mut(run).enumerate() {
-                    s.spawn(move || this.cast_run(n0 + (j * run) as i64, end_ns, stamp_ns, part));
+                for _ in 1..c.threads {
+                    s.spawn(cast);
                 }
+                cast();
             });
         }
         let mut cloud = CloudBuilder::with_capacity(c.points_per_frame);
