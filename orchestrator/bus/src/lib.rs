@@ -11,7 +11,6 @@ pub mod check;
 pub mod node;
 pub mod policy;
 pub mod recorder;
-mod sink;
 
 pub use agrisim_error::{err, Context, Error, Result};
 pub use bus::{Bus, Published, Reader, Sample, Tap};

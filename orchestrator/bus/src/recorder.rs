@@ -7,12 +7,10 @@
 //! and a killed process leaves a `.part` whose chunks up to the last one written an MCAP
 //! recovery reader salvages. The writer is finished on drop as well, so a run that stops on
 //! an error still leaves a complete, readable file with everything recorded up to the failure.
-//! A [`RecordPolicy`] says which messages are kept. The file is written on a thread of its
-//! own ([`crate::sink`]), in the order the messages come.
+//! A [`RecordPolicy`] says which messages are kept.
 
 use crate::error::{Context, Result};
 use crate::policy::{RecordPolicy, TopicFilter};
-use crate::sink::Sink;
 use agrisim_msgs::Message;
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -37,25 +35,12 @@ struct Topic {
 }
 
 pub struct Recorder {
-    sink: Option<Sink>,
+    writer: Option<mcap::Writer<BufWriter<File>>>,
     path: PathBuf,
     policy: RecordPolicy,
     schemas: BTreeMap<String, u16>,
     topics: Vec<Topic>,
     by_name: BTreeMap<String, usize>,
-}
-
-/// How recordings are written. zstd chunks, single-threaded: point clouds make trials large,
-/// and one compression thread keeps the output a pure function of the input (byte-identical
-/// logs). Level 1: at level 3 (the default) it took about a tenth of a camera run's CPU time
-/// for files only a few per cent smaller (README, "Sensor rendering speed").
-pub(crate) fn write_options() -> mcap::WriteOptions {
-    mcap::WriteOptions::new()
-        .profile("ros2")
-        .library("agrisim")
-        .compression(Some(mcap::Compression::Zstd))
-        .compression_level(1)
-        .compression_threads(0)
 }
 
 /// The temporary name a recording is written under until it is finished.
@@ -76,14 +61,24 @@ impl Recorder {
         policy.validate().map_err(|e| crate::err!("{e}"))?;
         let part = part_path(path);
         let file = File::create(&part).context(|| format!("cannot create {}", part.display()))?;
-        let writer = write_options().create(BufWriter::new(file)).context(|| format!("cannot start MCAP file {}", path.display()))?;
-        let sink = Sink::start(writer, path.display().to_string())?;
-        Ok(Recorder { sink: Some(sink), path: path.to_path_buf(), policy, schemas: BTreeMap::new(), topics: vec![], by_name: BTreeMap::new() })
+        // zstd chunks, single-threaded: point clouds make trials large, and one compression thread
+        // keeps the output a pure function of the input (byte-identical logs). Level 1: it
+        // runs on the stepping thread, and at level 3 (the default) it took about a tenth of a
+        // camera run's CPU time for files only a few per cent smaller (README, "Sensor
+        // rendering speed").
+        let options = mcap::WriteOptions::new()
+            .profile("ros2")
+            .library("agrisim")
+            .compression(Some(mcap::Compression::Zstd))
+            .compression_level(1)
+            .compression_threads(0);
+        let writer = options.create(BufWriter::new(file)).context(|| format!("cannot start MCAP file {}", path.display()))?;
+        Ok(Recorder { writer: Some(writer), path: path.to_path_buf(), policy, schemas: BTreeMap::new(), topics: vec![], by_name: BTreeMap::new() })
     }
 
-    fn sink(&mut self) -> Result<&mut Sink> {
+    fn writer(&mut self) -> Result<&mut mcap::Writer<BufWriter<File>>> {
         let path = self.path.display().to_string();
-        self.sink.as_mut().ok_or_else(|| crate::err!("{path}: recording already finished"))
+        self.writer.as_mut().ok_or_else(|| crate::err!("{path}: recording already finished"))
     }
 
     /// The channel for `topic` carrying `type_name` (e.g. `nav_msgs/msg/Odometry`), created
@@ -116,13 +111,13 @@ impl Recorder {
             Some(id) => *id,
             None => {
                 let text = agrisim_msgs::ros2msg_schema(&type_name).expect("checked when the channel was made");
-                let id = self.sink()?.schema(&type_name, "ros2msg", text.as_bytes())?;
+                let id = self.writer()?.add_schema(&type_name, "ros2msg", text.as_bytes()).context(|| format!("MCAP schema {type_name}"))?;
                 self.schemas.insert(type_name.clone(), id);
                 id
             }
         };
         let metadata = BTreeMap::from([("offered_qos_profiles".to_string(), QOS_VOLATILE.to_string())]);
-        let id = self.sink()?.channel(schema_id, &topic, "cdr", metadata)?;
+        let id = self.writer()?.add_channel(schema_id, &topic, "cdr", &metadata).context(|| format!("MCAP channel {topic}"))?;
         self.topics[i].mcap_id = Some(id);
         Ok(id)
     }
@@ -137,7 +132,8 @@ impl Recorder {
         let t = &mut self.topics[i];
         t.sequence += 1;
         let header = mcap::records::MessageHeader { channel_id: id, sequence: t.sequence, log_time: time_ns as u64, publish_time: time_ns as u64 };
-        self.sink()?.message(header, cdr)
+        let path = self.path.display().to_string();
+        self.writer()?.write_to_known_channel(&header, cdr).context(|| format!("writing {path}"))
     }
 
     /// Records a message on `topic` (creating the channel if needed).
@@ -149,7 +145,7 @@ impl Recorder {
     /// A metadata record (run settings: scenario, seed, parameters), sorted by key.
     pub fn metadata(&mut self, name: &str, entries: BTreeMap<String, String>) -> Result<()> {
         let m = mcap::records::Metadata { name: name.to_string(), metadata: entries };
-        self.sink()?.metadata(m)
+        self.writer()?.write_metadata(&m).context(|| format!("MCAP metadata {name}"))
     }
 
     /// Writes the summary and footer. Also done on drop; calling it reports errors.
@@ -160,8 +156,9 @@ impl Recorder {
     /// [`Recorder::finish`] for a recorder owned by something else; later writes are errors.
     /// The file gets its own name once complete.
     pub fn finish_in_place(&mut self) -> Result<()> {
-        if let Some(sink) = self.sink.take() {
-            sink.finish()?;
+        if let Some(mut w) = self.writer.take() {
+            w.finish().context(|| format!("finishing {}", self.path.display()))?;
+            drop(w);
             let part = part_path(&self.path);
             std::fs::rename(&part, &self.path).context(|| format!("renaming {} to {}", part.display(), self.path.display()))?;
         }
