@@ -133,8 +133,8 @@ pub fn render_into(
 /// threads (the caller's among them), each taking the next chunk when it is done with one;
 /// returns the sum of what it returns. Each chunk's result depends on the chunk alone, so the
 /// outcome is the same for any number of threads. Taken as they go, not dealt in advance: a
-/// thread the system holds back (the recorder's, the other sensors') no longer holds up the
-/// frame while the others idle.
+/// thread the system holds back (the other sensors' threads, other processes) no longer
+/// holds up the frame while the others idle.
 fn by_chunks<T: Send>(threads: usize, chunks: impl Iterator<Item = T> + Send, work: impl Fn(usize, T) -> usize + Sync) -> usize {
     let queue = std::sync::Mutex::new(chunks.enumerate());
     let drain = || {
