@@ -43,10 +43,17 @@ impl Intrinsics {
 
     /// Unit ray of pixel (u, v) in the optical frame (z forward, x right, y down).
     pub fn ray(&self, u: f64, v: f64) -> Vec3 {
-        let x = (u - self.cx) / self.fx;
-        let y = (v - self.cy) / self.fy;
-        let n = (x * x + y * y + 1.0).sqrt();
-        [x / n, y / n, 1.0 / n]
+        ray_through(self.plane_x(u), self.plane_y(v))
+    }
+
+    /// x on the z = 1 plane of the pixel column u (shared by a column's pixels).
+    pub fn plane_x(&self, u: f64) -> f64 {
+        (u - self.cx) / self.fx
+    }
+
+    /// y on the z = 1 plane of the pixel row v.
+    pub fn plane_y(&self, v: f64) -> f64 {
+        (v - self.cy) / self.fy
     }
 
     /// Optical-frame point of pixel (u, v) at depth z (what a consumer does with K).
@@ -172,4 +179,11 @@ mod tests {
         assert!(near(pose.to_map([1.0, 0.0, 0.0]), [1.6, 1.0, 1.2])); // x right = map -y
         assert!(near(pose.to_map([0.0, 1.0, 0.0]), [1.6, 2.0, 0.2])); // y down = map -z
     }
+}
+
+/// The unit ray through (x, y, 1): [`Intrinsics::ray`] from a pixel's plane coordinates.
+#[inline]
+pub fn ray_through(x: f64, y: f64) -> Vec3 {
+    let n = (x * x + y * y + 1.0).sqrt();
+    [x / n, y / n, 1.0 / n]
 }

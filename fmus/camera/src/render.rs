@@ -4,7 +4,7 @@
 //! result (noise included) depends on the pixel alone, so frames are bit-reproducible.
 
 use crate::lighting::{self, Lighting, Shadows};
-use crate::optics::{mat_vec, CameraPose, Intrinsics, Vec3};
+use crate::optics::{mat_vec, ray_through, CameraPose, Intrinsics, Vec3};
 use crate::scene::Scene;
 use crate::shading::{self, Palette};
 use agrisim_greenhouse::raycast::{Occluders, MAX_PACKET};
@@ -215,6 +215,9 @@ impl Ctx<'_> {
     fn rows(&self, v0: usize, rgb: &mut [u8], z: &mut [f32], labels: &mut [i32]) {
         let w = self.k.width as usize;
         let rows = z.len() / w;
+        // The pixels' plane coordinates, a division each per column and per row.
+        let xs: Vec<f64> = (0..w).map(|u| self.k.plane_x(u as f64)).collect();
+        let ys: Vec<f64> = (v0..v0 + rows).map(|v| self.k.plane_y(v as f64)).collect();
         let mut d_opt = [[0.0; 3]; MAX_PACKET];
         let mut dirs = [[0.0; 3]; MAX_PACKET];
         let mut hits = [None; MAX_PACKET];
@@ -224,8 +227,7 @@ impl Ctx<'_> {
             let cols = TILE_COLS.min(w - u0);
             let n = rows * cols;
             for i in 0..n {
-                let (u, v) = ((u0 + i % cols) as f64, (v0 + i / cols) as f64);
-                d_opt[i] = self.k.ray(u, v);
+                d_opt[i] = ray_through(xs[u0 + i % cols], ys[i / cols]);
                 dirs[i] = mat_vec(&self.pose.rotation, d_opt[i]);
             }
             self.scene.caster.cast_packet(self.pose.origin, &dirs[..n], 0.0, FAR, self.movers, &mut hits[..n]);
@@ -504,13 +506,18 @@ pub fn apply_depth_model(f: &mut Frame, k: &Intrinsics, m: &DepthModel, fog_limi
 fn depth_rows(v0: usize, out: &mut [f32], zt: &[f32], k: &Intrinsics, m: &DepthModel, fog_limit: Option<f64>, key: u64) -> usize {
     let (w, h) = (k.width as usize, k.height as usize);
     let mut valid = 0;
+    let xs: Vec<f64> = match fog_limit {
+        Some(_) => (0..w).map(|u| k.plane_x(u as f64)).collect(),
+        None => vec![],
+    };
     for v in v0..v0 + out.len() / w {
+        let y = k.plane_y(v as f64);
         for u in 0..w {
             let i = v * w + u;
             let z = zt[i] as f64;
             let mut ok = z > 0.0 && z >= m.range.0 && z <= m.range.1;
             if let (true, Some(limit)) = (ok, fog_limit) {
-                ok = z / k.ray(u as f64, v as f64)[2] <= limit;
+                ok = z / ray_through(xs[u], y)[2] <= limit;
             }
             if ok && m.invalid_band && (u as f64) < invalid_band_width(k.fx, m.baseline, z) {
                 ok = false;
