@@ -418,8 +418,9 @@ impl<F: Fn(u32) -> bool> PacketVisit for PacketThrough<'_, F> {
 }
 
 /// Most recent occluders [`RayCaster::pass_through_cached`] tries first. One: on the camera's
-/// frames it caught 80 % of the blocked rays; a second or third cost lit rays more tests
-/// than it saved (2 % slower frames).
+/// frames (`camera_fps`, both views, with and without `sensors.toml`'s sky) it stops 20-28 %
+/// of all shadow rays, about three quarters of the blocked ones; a second or third cost the
+/// lit rays more tests than they saved (2 % slower frames).
 const OCCLUDERS: usize = 1;
 
 /// The opaque primitives that blocked the latest shadow rays, newest first (for
