@@ -14,7 +14,7 @@ Needs numpy, pygltflib and open3d (Open3D 0.20 also needs Debian's libusb-1.0-0)
     .venv-bench/bin/python python/bench_raycast.py [--rays N] [--config FILE] [--out DIR] [--no-run]
 
 With --lidar-pattern the rays are the LiDAR's own (the MID-360 pattern from the Rust example
-`pattern_rays` of agrisim-fmu-lidar, cast in packets of 64 as the FMU casts them).
+`pattern_rays` of agrisim-fmu-lidar, cast in packets as the FMU casts them).
 With --camera the rays are the RGB-D camera's depth rays instead (one per pixel centre of
 1280x720 D435i frames in the middle aisle, from the Rust example `depth_rays` of
 agrisim-fmu-camera; --rays is then ignored, --poses sets the number of frames).

@@ -1,6 +1,6 @@
 //! Ray casting throughput on the LiDAR's own rays: the MID-360 pattern (20,000 points per
 //! 0.1 s frame) from 8 spots along the aisles at the sensor's height, cast as the FMU casts
-//! them (runs of 64 consecutive points as packets) and as single rays, single thread.
+//! them (runs of `LIDAR_PACKET` consecutive points as packets) and as single rays, single thread.
 //!
 //! cargo run --release -p agrisim-fmu-lidar --example pattern_rays -- [--frames N] [--out DIR]
 //!
@@ -11,8 +11,8 @@
 mod common;
 
 use agrisim_fmu_lidar::datasheet as ds;
+use agrisim_fmu_lidar::lidar::LIDAR_PACKET;
 use agrisim_fmu_lidar::pattern::ScanPattern;
-use agrisim_greenhouse::raycast::MAX_PACKET;
 use agrisim_greenhouse::{generate, gltf, GreenhouseConfig, RayCaster};
 
 fn main() {
@@ -47,10 +47,11 @@ fn main() {
     };
     let packets = || -> Vec<f64> {
         let mut dist = Vec::with_capacity(rays.len());
-        let mut hits = [None; MAX_PACKET];
-        for chunk in rays.chunks(MAX_PACKET) {
-            // Frames never straddle a chunk (20,000 is not a multiple of 64, but a chunk from
-            // two spots just gets a wider origin interval; hits are exact either way).
+        let mut hits = [None; LIDAR_PACKET];
+        for chunk in rays.chunks(LIDAR_PACKET) {
+            // Packets as the FMU casts them. A chunk may straddle two spots (a frame's 20,000
+            // rays are not a multiple of the packet): it just gets a wider origin interval;
+            // hits are exact either way.
             let origins: Vec<[f64; 3]> = chunk.iter().map(|r| [r[0], r[1], r[2]]).collect();
             let dirs: Vec<[f64; 3]> = chunk.iter().map(|r| [r[3], r[4], r[5]]).collect();
             let poses = vec![agrisim_greenhouse::RigidPose::yawed(0.0, 0.0, 0.0, 0.0); chunk.len()];
@@ -63,7 +64,7 @@ fn main() {
     let n = rays.len();
     let hits = dist.iter().filter(|d| d.is_finite()).count();
     println!("LiDAR pattern rays {n} ({frames} frames x {} spots), hits {:.1} %", spots.len(), 100.0 * hits as f64 / n as f64);
-    println!("rays/s             {:.3e} in packets of {MAX_PACKET}, {:.3e} as single rays (single thread, best of 3; identical hits)", n as f64 / secs, n as f64 / secs_single);
+    println!("rays/s             {:.3e} in packets of {LIDAR_PACKET}, {:.3e} as single rays (single thread, best of 3; identical hits)", n as f64 / secs, n as f64 / secs_single);
     if let Some(dir) = common::arg("--out") {
         let dir = std::path::PathBuf::from(dir);
         std::fs::create_dir_all(&dir).expect("out dir");
