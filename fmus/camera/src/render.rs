@@ -75,6 +75,7 @@ const CHUNK_ROWS: usize = 8;
 const TILE_COLS: usize = 8;
 /// Most shadow rays in one packet (a tile's lit points, nearest first).
 const SHADOW_PACKET: usize = 16;
+const _: () = assert!(CHUNK_ROWS * TILE_COLS <= MAX_PACKET && SHADOW_PACKET <= MAX_PACKET);
 
 /// Renders one frame on `threads` threads (>= 1). `dynamic` are moving objects (the robot's
 /// base box); their ids must not collide with scene ids. `rng` gives the frame's noise key

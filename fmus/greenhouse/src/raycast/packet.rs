@@ -14,8 +14,9 @@
 use super::wide::{as_leaf, down, far, inverse, near_corner, Node4, Ray32};
 use std::mem::MaybeUninit;
 
-/// Most rays in a packet.
+/// Most rays in a packet (at most 64: the visitors keep one bit per ray in a `u64`).
 pub const MAX_PACKET: usize = 64;
+const _: () = assert!(MAX_PACKET <= 64);
 
 /// The rays of a packet, lane-wise (structure of arrays) for the leaf tests.
 pub(crate) struct Packet {
