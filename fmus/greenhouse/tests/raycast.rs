@@ -308,6 +308,7 @@ fn packets_equal_single_rays() {
     // A robot in its own frame, placed per ray by a pose.
     let local = RayCaster::new(&[Object { id: 1_000_001, placement: Placement::at(0.0, 0.0, 0.5), ..base.clone() }]);
     let (mut packets, mut hits, mut posed_hits, mut beyond_hits) = (0, 0, 0, 0);
+    let mut coherent_posed_hits = 0;
     for (objs, origins) in [(&gh.objects, 0), (&solids, 1)] {
         let rc = RayCaster::new(objs);
         for k in 0..300 {
@@ -344,14 +345,23 @@ fn packets_equal_single_rays() {
             }
             // Own origins (a moving LiDAR: up to 5 cm apart) and own mover poses.
             let origins: Vec<[f64; 3]> = (0..n).map(|_| [0, 1, 2].map(|a| o[a] + rng.range(-0.05, 0.05))).collect();
-            let poses: Vec<RigidPose> = (0..n).map(|_| RigidPose::yawed(o[0] + rng.range(-1.0, 1.0), o[1] + rng.range(-1.0, 1.0), 0.0, rng.range(-3.0, 3.0))).collect();
+            // Poses all over (the rays' directions in the robot's frame then differ in sign:
+            // single rays), or a base that moved a little between firings (one packet).
+            let poses: Vec<RigidPose> = match k % 2 {
+                0 => (0..n).map(|_| RigidPose::yawed(o[0] + rng.range(-1.0, 1.0), o[1] + rng.range(-1.0, 1.0), 0.0, rng.range(-3.0, 3.0))).collect(),
+                _ => {
+                    let (x, y, yaw) = (o[0] + rng.range(-1.0, 1.0), o[1] + rng.range(-1.0, 1.0), rng.range(-3.0, 3.0));
+                    (0..n).map(|_| RigidPose::yawed(x + rng.range(-0.02, 0.02), y + rng.range(-0.02, 0.02), 0.0, yaw + rng.range(-0.01, 0.01))).collect()
+                }
+            };
             rc.cast_packet_posed(&origins, &dirs, tmin, tmax, &local, &poses, &mut out);
             for i in 0..n {
                 let single = rc.cast_among_posed(origins[i], dirs[i], tmin, tmax, &local, &poses[i]);
                 assert_eq!(out[i], single, "posed packet {k} ray {i}");
                 posed_hits += single.map_or(false, |h| h.object == 1_000_001) as usize;
+                coherent_posed_hits += (k % 2 == 1 && single.map_or(false, |h| h.object == 1_000_001)) as usize;
             }
         }
     }
-    assert!(packets == 600 && hits > 5_000 && posed_hits > 50 && beyond_hits > 1_000, "{hits} hits, {posed_hits} on the posed robot, {beyond_hits} further hits beyond");
+    assert!(packets == 600 && hits > 5_000 && coherent_posed_hits > 25 && posed_hits > 50 && beyond_hits > 1_000, "{hits} hits, {posed_hits} on the posed robot ({coherent_posed_hits} from coherent poses), {beyond_hits} further hits beyond");
 }

@@ -123,14 +123,34 @@ impl RayCaster {
     #[allow(clippy::too_many_arguments)]
     pub fn cast_packet_posed(&self, origins: &[[f64; 3]], dirs: &[[f64; 3]], min: f64, max: f64, movers: &RayCaster, poses: &[RigidPose], out: &mut [Option<Hit>]) {
         assert!(origins.len() == dirs.len() && poses.len() == dirs.len(), "cast_packet_posed: {} origins, {} rays, {} poses", origins.len(), dirs.len(), poses.len());
+        let n = dirs.len();
         let mut best = self.packet_static(origins, dirs, min, max);
-        for i in 0..dirs.len() {
+        let before: [(f64, u32); MAX_PACKET] = std::array::from_fn(|i| (best[i].t, best[i].id));
+        // The movers with the rays taken into their frame, each by its own pose, as one packet
+        // whose far limits are the static hits.
+        let mut lo = [[0.0; 3]; MAX_PACKET];
+        let mut ld = [[0.0; 3]; MAX_PACKET];
+        for i in 0..n {
             let pose = &poses[i];
-            let before = (best[i].t, best[i].id);
-            let (o, d) = (pose.local_of(sub(origins[i], pose.translation)), pose.local_of(dirs[i]));
-            movers.nearest(o, d, min, &mut best[i], &mut ());
-            if (best[i].t, best[i].id) != before {
-                best[i].normal = pose.map_of(best[i].normal);
+            (lo[i], ld[i]) = (pose.local_of(sub(origins[i], pose.translation)), pose.local_of(dirs[i]));
+        }
+        match Packet::new(&lo[..n], &ld[..n], max) {
+            Some(mut packet) => {
+                for i in 0..n {
+                    packet.far[i] = far(best[i].t);
+                }
+                let mut v = PacketNearest { caster: movers, origins: &lo[..n], dirs: &ld[..n], tmins: &[min], best: &mut best };
+                traverse_packet(&movers.nodes, &mut packet, min, &mut v);
+            }
+            None => {
+                for i in 0..n {
+                    movers.nearest(lo[i], ld[i], min, &mut best[i], &mut ());
+                }
+            }
+        }
+        for i in 0..n {
+            if (best[i].t, best[i].id) != before[i] {
+                best[i].normal = poses[i].map_of(best[i].normal);
             }
             out[i] = best[i].hit();
         }
