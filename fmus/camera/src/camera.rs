@@ -10,7 +10,7 @@ use crate::image;
 use crate::lighting::Lighting;
 use crate::optics::{CameraPose, Intrinsics, Mount};
 use crate::ports::*;
-use crate::render::{self, DepthModel, DepthNoise, Frame};
+use crate::render::{self, DepthModel, DepthNoise, Frame, Shot};
 use crate::scene::Scene;
 use agrisim_sensor_ports::robot::{Coords, RobotBody};
 use agrisim_fmi::{Log, Model, OutPort, Store, Var};
@@ -186,17 +186,8 @@ impl Camera {
         let mut mount = c.mount;
         mount.translation[2] += lift;
         let pose = CameraPose::new(&mount, x, y, yaw);
-        render::render_into(
-            frame,
-            &c.scene,
-            &robot,
-            &c.intrinsics,
-            &pose,
-            &c.light,
-            &c.depth,
-            &mut self.rng,
-            c.threads,
-        );
+        let shot = Shot { scene: &c.scene, dynamic: &robot, k: &c.intrinsics, pose: &pose, light: &c.light, depth: &c.depth };
+        render::render_into(frame, &shot, &mut self.rng, c.threads);
     }
 
     pub fn config(&self) -> Option<&Config> {

@@ -77,41 +77,32 @@ const TILE_COLS: usize = 8;
 const SHADOW_PACKET: usize = 16;
 const _: () = assert!(CHUNK_ROWS * TILE_COLS <= MAX_PACKET && SHADOW_PACKET <= MAX_PACKET);
 
-/// Renders one frame on `threads` threads (>= 1). `dynamic` are moving objects (the robot's
-/// base box); their ids must not collide with scene ids. `rng` gives the frame's noise key
-/// (one draw per frame); each pixel's depth noise is then drawn from that key and the pixel
-/// index alone, so the frame is the same whatever the number of threads.
-#[allow(clippy::too_many_arguments)]
-pub fn render(
-    scene: &Scene,
-    dynamic: &[Object],
-    k: &Intrinsics,
-    pose: &CameraPose,
-    light: &Lighting,
-    depth: &DepthModel,
-    rng: &mut Rng,
-    threads: usize,
-) -> Frame {
+/// What a frame is rendered from. `dynamic` are moving objects (the robot's body); their ids
+/// must not collide with scene ids.
+#[derive(Clone, Copy)]
+pub struct Shot<'a> {
+    pub scene: &'a Scene,
+    pub dynamic: &'a [Object],
+    pub k: &'a Intrinsics,
+    pub pose: &'a CameraPose,
+    pub light: &'a Lighting,
+    pub depth: &'a DepthModel,
+}
+
+/// Renders one frame on `threads` threads (>= 1). `rng` gives the frame's noise key (one draw
+/// per frame); each pixel's depth noise is then drawn from that key and the pixel index alone,
+/// so the frame is the same whatever the number of threads.
+pub fn render(shot: &Shot, rng: &mut Rng, threads: usize) -> Frame {
     let mut f = Frame::default();
-    render_into(&mut f, scene, dynamic, k, pose, light, depth, rng, threads);
+    render_into(&mut f, shot, rng, threads);
     f
 }
 
 /// [`render`] into the buffers of an earlier frame (any size: they are resized), which it
 /// overwrites entirely. A camera renders every frame into the same buffers: fresh ones of
 /// 14 MB (1280x720) were pages the kernel had to map and clear at every frame.
-#[allow(clippy::too_many_arguments)]
-pub fn render_into(
-    f: &mut Frame,
-    scene: &Scene,
-    dynamic: &[Object],
-    k: &Intrinsics,
-    pose: &CameraPose,
-    light: &Lighting,
-    depth: &DepthModel,
-    rng: &mut Rng,
-    threads: usize,
-) {
+pub fn render_into(f: &mut Frame, shot: &Shot, rng: &mut Rng, threads: usize) {
+    let &Shot { scene, dynamic, k, pose, light, depth } = shot;
     let (w, h) = (k.width as usize, k.height as usize);
     let n = w * h;
     f.rgb.resize(3 * n, 0);

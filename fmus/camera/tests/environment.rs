@@ -151,7 +151,7 @@ fn shadow_centroid(environment: &str) -> ([f64; 2], f64) {
     let c = Conditions::of(&Environment::from_toml_str(environment).unwrap());
     let light = Lighting::from_conditions(&c);
     let model = DepthModel { range: (0.1, 20.0), noise: DepthNoise::None, baseline: 0.05, invalid_band: false, edge_ratio: 0.0 };
-    let f = render::render(&scene, &[], &k, &pose, &light, &model, &mut Rng::new(1), 2);
+    let f = render::render(&render::Shot { scene: &scene, dynamic: &[], k: &k, pose: &pose, light: &light, depth: &model }, &mut Rng::new(1), 2);
     // Sunlit floor is far brighter than the floor lit by the sky alone.
     let floor: Vec<usize> = (0..f.labels.len()).filter(|&i| f.labels[i] == 1).collect();
     let max = floor.iter().map(|&i| f.rgb[3 * i] as u32).max().unwrap();
@@ -188,7 +188,7 @@ fn shadows_point_away_from_the_sun() {
     let (scene, k, pose) = post_scene();
     let c = Conditions::of(&Environment::from_toml_str("date = \"2025-06-21\"\ntime = \"09:00\"\nrender_quality = \"low\"").unwrap());
     let model = DepthModel { range: (0.1, 20.0), noise: DepthNoise::None, baseline: 0.05, invalid_band: false, edge_ratio: 0.0 };
-    let f = render::render(&scene, &[], &k, &pose, &Lighting::from_conditions(&c), &model, &mut Rng::new(1), 1);
+    let f = render::render(&render::Shot { scene: &scene, dynamic: &[], k: &k, pose: &pose, light: &Lighting::from_conditions(&c), depth: &model }, &mut Rng::new(1), 1);
     let floor: Vec<u8> = (0..f.labels.len()).filter(|&i| f.labels[i] == 1).map(|i| f.rgb[3 * i]).collect();
     assert_eq!(floor.iter().min(), floor.iter().max(), "flat floor, one colour");
 }
