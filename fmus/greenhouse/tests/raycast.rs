@@ -285,6 +285,18 @@ fn pass_through_equals_the_hit_to_hit_walk() {
     }
     assert!(blocked > 100 && through > 1000, "{blocked} blocked, {through} through glass");
     assert!(recent.held() > 0, "no occluder remembered");
+    // A cache filled on one scene and used with another: its entries name other primitives
+    // there (here a pane of glass where an opaque slab was), and the answers stay exact.
+    let slab = |id: u32, kind: Kind| Object { id, name: "slab".into(), kind, shape: Shape::Box { half: [1.0, 1.0, 0.01] }, placement: Placement::yawed([0.0, 0.0, 2.0], 0.0) };
+    let (roof, glass) = (RayCaster::new(&[slab(0, Kind::Obstacle)]), RayCaster::new(&[slab(0, Kind::Roof)]));
+    let nothing = RayCaster::new(&[]);
+    let below: Vec<[f64; 3]> = (0..8).map(|i| [0.1 * i as f64 - 0.4, 0.0, 0.5]).collect();
+    let (mut reused, mut out) = (Occluders::default(), vec![None; 8]);
+    roof.pass_through_cached(&below, [0.0, 0.0, 1.0], 1e-6, 1000.0, &nothing, |_| true, &mut reused, &mut out);
+    assert!(out.iter().all(Option::is_none) && reused.held() == 1, "{out:?}");
+    let through_glass = |id: u32| id != 0;
+    glass.pass_through_cached(&below, [0.0, 0.0, 1.0], 1e-6, 1000.0, &nothing, through_glass, &mut reused, &mut out);
+    assert_eq!(out, vec![Some(2); 8], "the remembered slab is glass here");
 }
 
 /// Packets (camera tiles of up to 64 rays from one origin) give exactly the single-ray

@@ -229,7 +229,14 @@ impl RayCaster {
         let mut live = [0usize; MAX_PACKET];
         let mut sub = [[0.0; 3]; MAX_PACKET];
         let mut m = 0;
-        let occluders = recent.slots.map(|r| r.map(|(in_movers, k)| if in_movers { &movers.prims[k as usize] } else { &self.prims[k as usize] }.along(dir)));
+        // Each checked against these sets (an entry from another scene is passed over or, if
+        // it names an opaque primitive here, still a correct test).
+        let occluders = recent.slots.map(|r| {
+            r.and_then(|(in_movers, k)| {
+                let (set, k) = (if in_movers { movers } else { self }, k as usize);
+                (k < set.prims.len() && opaque(set.ids[k])).then(|| set.prims[k].along(dir))
+            })
+        });
         for (i, o) in origins.iter().enumerate() {
             out[i] = None;
             if !occluders.iter().flatten().any(|a| a.intersect(*o, min, max).is_some()) {
@@ -444,7 +451,8 @@ impl<F: Fn(u32) -> bool> PacketVisit for PacketThrough<'_, F> {
 const OCCLUDERS: usize = 1;
 
 /// The opaque primitives that blocked the latest shadow rays, newest first (for
-/// [`RayCaster::pass_through_cached`]; one per thread, any content is correct).
+/// [`RayCaster::pass_through_cached`]; one per thread). Any content gives correct answers:
+/// an entry is used only if it names an opaque primitive of the sets it is used with.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Occluders {
     /// (in the movers, primitive index).
