@@ -9,6 +9,7 @@ use crate::scene::Scene;
 use crate::shading::{self, Palette};
 use agrisim_greenhouse::raycast::{Occluders, MAX_PACKET};
 use agrisim_greenhouse::{Hit, Object, RayCaster};
+use agrisim_fmu_util::on_threads;
 use agrisim_math::Rng;
 
 /// Depth noise (issue 5 item 2).
@@ -110,43 +111,16 @@ pub fn render_into(f: &mut Frame, shot: &Shot, rng: &mut Rng, threads: usize) {
     f.true_depth.resize(n, 0.0);
     f.labels.resize(n, 0);
     let movers = RayCaster::new(dynamic);
-    let ctx = Ctx { scene, movers: &movers, k, pose, light, palette: Palette::default() };
+    let xs: Vec<f64> = (0..w).map(|u| k.plane_x(u as f64)).collect();
+    let ctx = Ctx { scene, movers: &movers, k, pose, light, palette: Palette::default(), xs: &xs };
     let threads = threads.clamp(1, h.div_ceil(CHUNK_ROWS).max(1));
     let chunks = f.rgb.chunks_mut(3 * w * CHUNK_ROWS).zip(f.true_depth.chunks_mut(w * CHUNK_ROWS)).zip(f.labels.chunks_mut(w * CHUNK_ROWS));
     let ctx = &ctx;
-    by_chunks(threads, chunks, |c, ((rgb, z), l)| {
+    on_threads(threads, chunks, |c, ((rgb, z), l)| {
         ctx.rows(c * CHUNK_ROWS, rgb, z, l);
         0
     });
     apply_depth_model(f, k, depth, light.fog.map(|g| g.depth_limit), rng.next_u64(), threads);
-}
-
-/// Runs `work` on every chunk (chunk c covers rows from c * [`CHUNK_ROWS`]) on `threads`
-/// threads (the caller's among them), each taking the next chunk when it is done with one;
-/// returns the sum of what it returns. Each chunk's result depends on the chunk alone, so the
-/// outcome is the same for any number of threads. Taken as they go, not dealt in advance: a
-/// thread the system holds back (the other sensors' threads, other processes) no longer
-/// holds up the frame while the others idle.
-fn by_chunks<T: Send>(threads: usize, chunks: impl Iterator<Item = T> + Send, work: impl Fn(usize, T) -> usize + Sync) -> usize {
-    let queue = std::sync::Mutex::new(chunks.enumerate());
-    let drain = || {
-        let mut sum = 0;
-        loop {
-            let next = queue.lock().expect("chunk queue").next();
-            match next {
-                Some((c, t)) => sum += work(c, t),
-                None => return sum,
-            }
-        }
-    };
-    if threads <= 1 {
-        return drain();
-    }
-    std::thread::scope(|s| {
-        let others: Vec<_> = (1..threads).map(|_| s.spawn(drain)).collect();
-        let mine = drain();
-        mine + others.into_iter().map(|r| r.join().expect("render thread")).sum::<usize>()
-    })
 }
 
 /// What every pixel needs.
@@ -158,6 +132,9 @@ struct Ctx<'a> {
     pose: &'a CameraPose,
     light: &'a Lighting,
     palette: Palette,
+    /// The pixel columns' plane coordinates ([`Intrinsics::plane_x`]), a division each once
+    /// per frame.
+    xs: &'a [f64],
 }
 
 /// What a primary ray shows, before the sun's beam is known.
@@ -207,8 +184,6 @@ impl Ctx<'_> {
     fn rows(&self, v0: usize, rgb: &mut [u8], z: &mut [f32], labels: &mut [i32]) {
         let w = self.k.width as usize;
         let rows = z.len() / w;
-        // The pixels' plane coordinates, a division each per column and per row.
-        let xs: Vec<f64> = (0..w).map(|u| self.k.plane_x(u as f64)).collect();
         let ys: Vec<f64> = (v0..v0 + rows).map(|v| self.k.plane_y(v as f64)).collect();
         let mut d_opt = [[0.0; 3]; MAX_PACKET];
         let mut dirs = [[0.0; 3]; MAX_PACKET];
@@ -219,7 +194,7 @@ impl Ctx<'_> {
             let cols = TILE_COLS.min(w - u0);
             let n = rows * cols;
             for i in 0..n {
-                d_opt[i] = ray_through(xs[u0 + i % cols], ys[i / cols]);
+                d_opt[i] = ray_through(self.xs[u0 + i % cols], ys[i / cols]);
                 dirs[i] = mat_vec(&self.pose.rotation, d_opt[i]);
             }
             self.scene.caster.cast_packet(self.pose.origin, &dirs[..n], 0.0, FAR, self.movers, &mut hits[..n]);
@@ -491,17 +466,19 @@ fn mix64(mut z: u64) -> u64 {
 pub fn apply_depth_model(f: &mut Frame, k: &Intrinsics, m: &DepthModel, fog_limit: Option<f64>, key: u64, threads: usize) {
     let w = k.width as usize;
     let zt = &f.true_depth;
-    f.valid = by_chunks(threads, f.depth.chunks_mut(w * CHUNK_ROWS), |c, out| depth_rows(c * CHUNK_ROWS, out, zt, k, m, fog_limit, key));
-}
-
-/// [`apply_depth_model`] for the rows from `v0` that `out` holds; returns how many are valid.
-fn depth_rows(v0: usize, out: &mut [f32], zt: &[f32], k: &Intrinsics, m: &DepthModel, fog_limit: Option<f64>, key: u64) -> usize {
-    let (w, h) = (k.width as usize, k.height as usize);
-    let mut valid = 0;
+    // The pixel columns' plane coordinates, for the fog limit along each ray.
     let xs: Vec<f64> = match fog_limit {
         Some(_) => (0..w).map(|u| k.plane_x(u as f64)).collect(),
         None => vec![],
     };
+    f.valid = on_threads(threads, f.depth.chunks_mut(w * CHUNK_ROWS), |c, out| depth_rows(c * CHUNK_ROWS, out, zt, &xs, k, m, fog_limit, key));
+}
+
+/// [`apply_depth_model`] for the rows from `v0` that `out` holds; returns how many are valid.
+#[allow(clippy::too_many_arguments)]
+fn depth_rows(v0: usize, out: &mut [f32], zt: &[f32], xs: &[f64], k: &Intrinsics, m: &DepthModel, fog_limit: Option<f64>, key: u64) -> usize {
+    let (w, h) = (k.width as usize, k.height as usize);
+    let mut valid = 0;
     for v in v0..v0 + out.len() / w {
         let y = k.plane_y(v as f64);
         for u in 0..w {

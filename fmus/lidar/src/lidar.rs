@@ -18,7 +18,7 @@ use crate::reflectivity;
 use crate::scene::{RobotInBaseLink, Scene};
 use crate::trajectory::Trajectory;
 use agrisim_fmi::{Log, Model, OutPort, Store, Var};
-use agrisim_fmu_util::{to_ns, Schedule};
+use agrisim_fmu_util::{on_threads, to_ns, Schedule};
 use agrisim_greenhouse::environment::Environment;
 use agrisim_greenhouse::RigidPose;
 use agrisim_greenhouse::weather::Conditions;
@@ -160,7 +160,6 @@ const RUN: usize = 16 * LIDAR_PACKET;
 
 /// One packet's rays and results.
 struct Batch {
-    len: usize,
     origins: [[f64; 3]; LIDAR_PACKET],
     dirs: [[f64; 3]; LIDAR_PACKET],
     poses: [RigidPose; LIDAR_PACKET],
@@ -170,7 +169,7 @@ struct Batch {
 impl Default for Batch {
     fn default() -> Batch {
         let pose = RigidPose::yawed(0.0, 0.0, 0.0, 0.0);
-        Batch { len: 0, origins: [[0.0; 3]; LIDAR_PACKET], dirs: [[0.0; 3]; LIDAR_PACKET], poses: [pose; LIDAR_PACKET], hits: [None; LIDAR_PACKET] }
+        Batch { origins: [[0.0; 3]; LIDAR_PACKET], dirs: [[0.0; 3]; LIDAR_PACKET], poses: [pose; LIDAR_PACKET], hits: [None; LIDAR_PACKET] }
     }
 }
 
@@ -193,22 +192,10 @@ impl Lidar {
         rays.clear();
         rays.resize(c.points_per_frame, Ray::default());
         let this = &*self;
-        let runs = std::sync::Mutex::new(rays.chunks_mut(RUN).enumerate());
-        let cast = || loop {
-            let next = runs.lock().expect("ray runs").next();
-            let Some((j, part)) = next else { return };
+        on_threads(c.threads, rays.chunks_mut(RUN), |j, part| {
             this.cast_run(n0 + (j * RUN) as i64, end_ns, stamp_ns, part);
-        };
-        if c.threads == 1 || c.points_per_frame <= RUN {
-            cast();
-        } else {
-            std::thread::scope(|s| {
-                for _ in 1..c.threads {
-                    s.spawn(cast);
-                }
-                cast();
-            });
-        }
+            0
+        });
         let mut cloud = CloudBuilder::with_capacity(c.points_per_frame);
         let mut returns = 0;
         for ray in &rays {
@@ -244,7 +231,6 @@ impl Lidar {
         let beams = p.beams as i64;
         let mut batch = Batch::default();
         for (k0, rays) in out.chunks_mut(LIDAR_PACKET).enumerate() {
-            batch.len = rays.len();
             for (i, ray) in rays.iter_mut().enumerate() {
                 let n = n0 + (k0 * LIDAR_PACKET + i) as i64;
                 let f = n.div_euclid(beams);
@@ -268,7 +254,7 @@ impl Lidar {
                 batch.origins[i] = [base.translation[0] + m[0], base.translation[1] + m[1], m[2]];
                 batch.poses[i] = base;
             }
-            let k = batch.len;
+            let k = rays.len();
             c.scene.caster.cast_packet_posed(&batch.origins[..k], &batch.dirs[..k], c.range.0, c.range.1, robot, &batch.poses[..k], &mut batch.hits[..k]);
             for (ray, hit) in rays.iter_mut().zip(&batch.hits[..k]) {
                 ray.hit = *hit;

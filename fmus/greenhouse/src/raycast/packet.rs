@@ -11,7 +11,7 @@
 //! the packet it lies between the smallest and largest of its four corner values, and since
 //! rounding is monotonic the same holds for the f32 values each ray computes alone.
 
-use super::wide::{as_leaf, down, far, inverse, near_corner, Node4, Ray32};
+use super::wide::{as_leaf, down, far, inverse, near_corner, Node4};
 use std::mem::MaybeUninit;
 
 /// Most rays in a packet (at most 64: the visitors keep one bit per ray in a `u64`).
@@ -30,8 +30,8 @@ pub(crate) struct Packet {
     /// Inverse-direction interval per axis.
     lo: [f32; 3],
     hi: [f32; 3],
-    /// Per axis, the box corners every ray of the packet meets first ([`Ray32::near`]: the
-    /// rays' directions share their signs).
+    /// Per axis, the box corners every ray of the packet meets first (as
+    /// [`Ray32::near`](super::wide::Ray32::near): the rays' directions share their signs).
     near: [usize; 3],
     /// Rays in use (lanes from here on are idle).
     len: usize,
@@ -67,7 +67,7 @@ impl Packet {
             // The same inverse as a single ray's (`Ray32::new`).
             let inv = &mut p.inv[a][..n];
             match dirs {
-                [one] => inv.fill(Ray32::new(origins[0], *one).inv[a]),
+                [one] => inv.fill(inverse(one[a])),
                 _ => inv.iter_mut().zip(dirs).for_each(|(v, d)| *v = inverse(d[a])),
             }
             (p.lo[a], p.hi[a]) = bounds(inv);
