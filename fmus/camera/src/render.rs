@@ -253,42 +253,50 @@ impl Ctx<'_> {
         // Lit points by their distance from the camera, so each shadow packet holds points
         // close together (a tile across an edge holds a near leaf and the far background:
         // one packet spanning both culls almost nothing).
-        // Sorted as (squared distance's bits, pixel): for non-negative floats the bits order as
-        // the values, and integer keys sort faster.
+        // Keyed as (squared distance as f32, pixel) in one u64: for non-negative floats the
+        // bits order as the values. Each ray's answer is exact whatever rays share its packet,
+        // so only the groups matter, not the order within one: selecting each group's
+        // boundary is enough, no sort.
         let o = self.pose.origin;
-        let mut lit = [(0u64, 0usize); MAX_PACKET];
+        let mut lit = [0u64; MAX_PACKET];
         let mut at = [[0.0; 3]; MAX_PACKET];
         let mut m = 0;
         for (i, s) in surfaces.iter().enumerate() {
             if let Surface::Lit { p, cos_sun, .. } = *s {
                 if l.sun_up && cos_sun > 0.0 {
-                    lit[m] = (((p[0] - o[0]).powi(2) + (p[1] - o[1]).powi(2) + (p[2] - o[2]).powi(2)).to_bits(), i);
+                    let d2 = (p[0] - o[0]) * (p[0] - o[0]) + (p[1] - o[1]) * (p[1] - o[1]) + (p[2] - o[2]) * (p[2] - o[2]);
+                    lit[m] = ((d2 as f32).to_bits() as u64) << 32 | i as u64;
                     at[i] = p;
                     m += 1;
                 }
             }
         }
+        let pixel = |key: u64| (key & 0xFFFF_FFFF) as usize;
         let Some(samples) = self.sun_samples() else {
-            lit[..m].iter().for_each(|&(_, i)| beams[i] = l.cover_tau);
+            lit[..m].iter().for_each(|&key| beams[pixel(key)] = l.cover_tau);
             return beams;
         };
-        lit[..m].sort_unstable();
+        let mut rest = &mut lit[..m];
+        while rest.len() > SHADOW_PACKET {
+            rest.select_nth_unstable(SHADOW_PACKET);
+            rest = &mut rest[SHADOW_PACKET..];
+        }
         let mut out = [None; SHADOW_PACKET];
         let mut points = [[0.0; 3]; SHADOW_PACKET];
         for group in lit[..m].chunks(SHADOW_PACKET) {
             let g = group.len();
-            for (q, &(_, i)) in group.iter().enumerate() {
-                points[q] = at[i];
+            for (q, &key) in group.iter().enumerate() {
+                points[q] = at[pixel(key)];
             }
             for k in 0..samples {
                 let s = sun_disc_sample(l.sun, k, samples);
                 self.scene.caster.pass_through_cached(&points[..g], s, EPS, FAR, self.movers, |id| shading::casts_shadow(self.scene.kind(id)), recent, &mut out[..g]);
-                for (q, &(_, i)) in group.iter().enumerate() {
-                    beams[i] += transmittance(out[q], l.cover_tau);
+                for (q, &key) in group.iter().enumerate() {
+                    beams[pixel(key)] += transmittance(out[q], l.cover_tau);
                 }
             }
         }
-        lit[..m].iter().for_each(|&(_, i)| beams[i] /= samples as f64);
+        lit[..m].iter().for_each(|&key| beams[pixel(key)] /= samples as f64);
         beams
     }
 
@@ -507,7 +515,7 @@ fn depth_rows(v0: usize, out: &mut [f32], zt: &[f32], xs: &[f64], k: &Intrinsics
             }
             out[i - v0 * w] = if ok {
                 let sigma = m.noise.sigma(z, k.fx, m.baseline);
-                let zm = if sigma == 0.0 { z } else { z + sigma * Rng::new(mix64(key ^ mix64(i as u64))).normal_once() };
+                let zm = if sigma == 0.0 { z } else { z + sigma * Rng::new(mix64(key ^ mix64(i as u64))).normal_ziggurat() };
                 if zm > 0.0 {
                     valid += 1;
                     zm as f32

@@ -27,6 +27,11 @@ struct Shot {
 
 /// One frame of the FMU in the middle of an aisle of the default greenhouse, looking at a row.
 fn shot(environment: &str, threads: i32) -> Shot {
+    shot_with(environment, threads, |_| ())
+}
+
+/// [`shot`] with more of the camera's parameters set by `set`.
+fn shot_with(environment: &str, threads: i32, set: impl FnOnce(&mut Store)) -> Shot {
     let cfg = GreenhouseConfig::from_toml_str("").unwrap();
     let gh = generate(&cfg, cfg.seed);
     let a = &gh.layout.aisles[1];
@@ -39,6 +44,7 @@ fn shot(environment: &str, threads: i32) -> Shot {
     io.set_f64(BASE_X, 0.5 * (a.x_start + a.x_end));
     io.set_f64(BASE_Y, a.y);
     io.set_f64(BASE_YAW, 0.3);
+    set(&mut io);
     let mut m = Camera::new();
     m.initialize(&mut io, 0.0, &mut Quiet).unwrap();
     m.do_step(&mut io, 0.0, 0.02, &mut Quiet).unwrap();
@@ -93,21 +99,22 @@ fn fog_removes_far_depth_only_and_fades_colour() {
     let clear = shot(NOON, 2);
     let fog = shot(&format!("{NOON}\nweather = \"fog\"\nvisibility = 8.0"), 2);
     assert_eq!(fog.labels, clear.labels);
+    let exact = shot_with(NOON, 2, |io| *io.value_mut(DEPTH_NOISE_MODEL) = Value::Int32(0));
     let k = Intrinsics::from_fov(160, 90, 87.0, 58.0);
     let limit = 10f64.ln() / (3.912 / 8.0);
     let z = |b: &[u8], i: usize| f32::from_le_bytes(b[4 * i..4 * i + 4].try_into().unwrap()) as f64;
     let (mut kept, mut lost) = (0, 0);
     for i in 0..160 * 90 {
         let (zc, zf) = (z(&clear.depth, i), z(&fog.depth, i));
+        // The true range along the ray: the noise-free image's depth.
+        let range = z(&exact.depth, i) / k.ray((i % 160) as f64, (i / 160) as f64)[2];
         if zf > 0.0 {
             assert_eq!(zf, zc, "pixel {i}: fog keeps depth where it keeps any");
+            assert!(range <= limit, "pixel {i} at {range} m kept (limit {limit})");
             kept += 1;
         } else if zc > 0.0 {
-            // Lost pixels are beyond the fog's depth range (along the ray, up to 5 sigma of
-            // the stereo noise on the clear image's measured depth).
-            let ray_z = k.ray((i % 160) as f64, (i / 160) as f64)[2];
-            let sigma = zc * zc * 0.08 / (k.fx * 0.05);
-            assert!((zc + 5.0 * sigma) / ray_z > limit, "pixel {i} at {} m lost (limit {limit})", zc / ray_z);
+            // Lost pixels are beyond the fog's depth range.
+            assert!(range > limit, "pixel {i} at {range} m lost (limit {limit})");
             lost += 1;
         }
     }

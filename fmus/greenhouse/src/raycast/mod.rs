@@ -14,6 +14,7 @@ use crate::scene::{Object, Placement};
 use bvh::Bvh;
 use primitives::Prim;
 use wide::{far, traverse, Node4, Visit};
+use std::mem::MaybeUninit;
 
 /// A ray hit: distance along the (unit) direction, the object's id, outward surface normal.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -198,15 +199,14 @@ impl RayCaster {
     /// from hit to hit restarting 0.1 mm past each would count them. One traversal that stops
     /// at the first opaque object found: a shadow ray.
     pub fn pass_through(&self, origin: [f64; 3], dir: [f64; 3], min: f64, max: f64, movers: &RayCaster, opaque: impl Fn(u32) -> bool) -> Option<u32> {
-        let mut at = Crossings { t: [0.0; MAX_CROSSINGS], len: 0 };
-        let at = &mut at;
+        let (mut t, mut len) = ([MaybeUninit::uninit(); MAX_CROSSINGS], 0);
         for set in [self, movers] {
-            let mut v = Through { caster: set, o: origin, d: dir, tmin: min, tmax: max, far: far(max), opaque: &opaque, at: &mut *at };
+            let mut v = Through { caster: set, o: origin, d: dir, tmin: min, tmax: max, far: far(max), opaque: &opaque, at: Crossings { t: &mut t, len: &mut len } };
             if traverse(&set.nodes, origin, dir, min, &mut v) {
                 return None;
             }
         }
-        Some(at.count(min))
+        Some(Crossings { t: &mut t, len: &mut len }.count(min))
     }
 
     /// [`RayCaster::pass_through`] for up to [`MAX_PACKET`] rays with their own origins and a
@@ -254,19 +254,21 @@ impl RayCaster {
             }
             return;
         };
-        let mut at = [Crossings { t: [0.0; MAX_CROSSINGS], len: 0 }; MAX_PACKET];
+        // Per ray: its crossings (not cleared: only the first `len` are ever read) and `len`.
+        let mut ts = [[MaybeUninit::uninit(); MAX_CROSSINGS]; MAX_PACKET];
+        let mut lens = [0; MAX_PACKET];
         let mut blocked = [false; MAX_PACKET];
         // The scene, then the movers with the same packet (blocked rays have left it), each
         // ray continuing its crossing list.
         for (in_movers, set) in [(false, self), (true, movers)] {
-            let mut v = PacketThrough { caster: set, origins: sub, d: dir, tmin: min, tmax: max, opaque: &opaque, at: &mut at, blocked: &mut blocked, blocker: None };
+            let mut v = PacketThrough { caster: set, origins: sub, d: dir, tmin: min, tmax: max, opaque: &opaque, ts: &mut ts, lens: &mut lens, blocked: &mut blocked, blocker: None };
             traverse_packet(&set.nodes, &mut packet, min, &mut v);
             if let Some(k) = v.blocker {
                 recent.remember(in_movers, k);
             }
         }
         for q in 0..m {
-            out[live[q]] = (!blocked[q]).then(|| at[q].count(min));
+            out[live[q]] = (!blocked[q]).then(|| Crossings { t: &mut ts[q], len: &mut lens[q] }.count(min));
         }
     }
 
@@ -417,7 +419,8 @@ struct PacketThrough<'a, F> {
     tmin: f64,
     tmax: f64,
     opaque: &'a F,
-    at: &'a mut [Crossings; MAX_PACKET],
+    ts: &'a mut [[MaybeUninit<f64>; MAX_CROSSINGS]; MAX_PACKET],
+    lens: &'a mut [u8; MAX_PACKET],
     blocked: &'a mut [bool; MAX_PACKET],
     /// The last primitive found blocking a ray.
     blocker: Option<u32>,
@@ -433,7 +436,7 @@ impl<F: Fn(u32) -> bool> PacketVisit for PacketThrough<'_, F> {
             let along = self.caster.prims[k].along(self.d);
             let mut opaque = None;
             for (i, o) in self.origins.iter().enumerate() {
-                if live[i] && cross(&along, *o, self.tmin, self.tmax, || *opaque.get_or_insert_with(|| (self.opaque)(self.caster.ids[k])), &mut self.at[i]) {
+                if live[i] && cross(&along, *o, self.tmin, self.tmax, || *opaque.get_or_insert_with(|| (self.opaque)(self.caster.ids[k])), &mut Crossings { t: &mut self.ts[i], len: &mut self.lens[i] }) {
                     self.blocker = Some(k as u32);
                     self.blocked[i] = true;
                     packet.far[i] = f32::NEG_INFINITY;
@@ -484,24 +487,33 @@ struct Through<'a, F> {
     tmax: f64,
     far: f32,
     opaque: &'a F,
-    at: &'a mut Crossings,
+    at: Crossings<'a>,
 }
 
 /// Most translucent surface crossings a shadow ray records (beyond: treated as dark).
 const MAX_CROSSINGS: usize = 16;
 
-#[derive(Clone, Copy)]
-struct Crossings {
-    t: [f64; MAX_CROSSINGS],
-    len: usize,
+/// A shadow ray's translucent surface crossings, kept where the ray's traversal keeps them:
+/// `t[..len]` are set, the rest is never read and not cleared either (a packet's 64 lists of
+/// zeros were 8.7 KB written per shadow packet, 2 % of a camera frame).
+struct Crossings<'a> {
+    t: &'a mut [MaybeUninit<f64>; MAX_CROSSINGS],
+    len: &'a mut u8,
 }
 
-impl Crossings {
+impl Crossings<'_> {
+    /// The crossings recorded.
+    fn recorded(&mut self) -> &mut [f64] {
+        let len = *self.len as usize;
+        // SAFETY: `push` wrote t[..len] before raising len, and MaybeUninit<f64> has f64's layout.
+        unsafe { &mut *std::ptr::slice_from_raw_parts_mut(self.t.as_mut_ptr().cast::<f64>(), len) }
+    }
+
     /// Counts as the walk would: a surface within one restart step of the last one counted
     /// (a pane resting on another) is passed over with it. A full list counts as at least
     /// [`MAX_CROSSINGS`].
     fn count(&mut self, tmin: f64) -> u32 {
-        let t = &mut self.t[..self.len];
+        let t = self.recorded();
         t.sort_unstable_by(f64::total_cmp);
         let mut n = 0;
         let mut last = f64::NEG_INFINITY;
@@ -511,13 +523,14 @@ impl Crossings {
                 last = x;
             }
         }
-        n + (self.len == MAX_CROSSINGS) as u32 * MAX_CROSSINGS as u32
+        n + (*self.len as usize == MAX_CROSSINGS) as u32 * MAX_CROSSINGS as u32
     }
 
     fn push(&mut self, t: f64) {
-        if self.len < MAX_CROSSINGS {
-            self.t[self.len] = t;
-            self.len += 1;
+        let len = *self.len as usize;
+        if len < MAX_CROSSINGS {
+            self.t[len].write(t);
+            *self.len += 1;
         }
     }
 }
@@ -531,7 +544,7 @@ impl<F: Fn(u32) -> bool> Visit for Through<'_, F> {
     }
 
     fn leaf(&mut self, start: usize, count: usize) -> bool {
-        cross_leaf(self.caster, start, count, self.o, self.d, self.tmin, self.tmax, self.opaque, self.at)
+        cross_leaf(self.caster, start, count, self.o, self.d, self.tmin, self.tmax, self.opaque, &mut self.at)
     }
 }
 
