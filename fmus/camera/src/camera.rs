@@ -16,6 +16,7 @@ use agrisim_sensor_ports::robot::{Coords, RobotBody};
 use agrisim_fmi::{Log, Model, OutPort, Store, Var};
 use agrisim_fmu_util::{to_ns, Schedule};
 use agrisim_greenhouse::environment::Environment;
+use agrisim_greenhouse::raycast::SunColumns;
 use agrisim_greenhouse::weather::Conditions;
 use agrisim_math::Rng;
 use agrisim_msgs::Message;
@@ -31,6 +32,9 @@ pub struct Config {
     pub mount: Mount,
     pub depth: DepthModel,
     pub light: Lighting,
+    /// Per sun sample of `light`, which shadow rays no opaque object can stop
+    /// ([`render::sun_columns`]; empty without shadows).
+    pub columns: Arc<Vec<SunColumns>>,
     pub labels: bool,
     /// Sun, weather and visibility from the `environment` parameter (None = fixed sun).
     pub conditions: Option<Conditions>,
@@ -134,6 +138,7 @@ impl Config {
             t => return Err(format!("parameter render_threads must be in [1, 64], got {t}")),
         };
         let scene = SENSOR_PORTS.scene(io)?;
+        let columns = Arc::new(render::sun_columns(&scene, &light));
         Ok(Config {
             robot: SENSOR_PORTS.robot_body(io, scene.object_count() as u32)?,
             robot_links: io.bool(ROBOT_LINKS),
@@ -149,6 +154,7 @@ impl Config {
                 edge_ratio: param(io, EDGE_RATIO, |v| v >= 0.0, ">= 0")?,
             },
             light,
+            columns,
             labels: io.bool(LABELS),
             conditions,
             threads,
@@ -186,7 +192,7 @@ impl Camera {
         let mut mount = c.mount;
         mount.translation[2] += lift;
         let pose = CameraPose::new(&mount, x, y, yaw);
-        let shot = Shot { scene: &c.scene, dynamic: &robot, k: &c.intrinsics, pose: &pose, light: &c.light, depth: &c.depth };
+        let shot = Shot { scene: &c.scene, dynamic: &robot, k: &c.intrinsics, pose: &pose, light: &c.light, columns: &c.columns, depth: &c.depth };
         render::render_into(frame, &shot, &mut self.rng, c.threads);
     }
 

@@ -131,6 +131,18 @@ impl Lighting {
     }
 }
 
+impl Lighting {
+    /// Shadow rays per lit point (directions by `render`'s sun disc samples); None: no
+    /// shadows.
+    pub fn sun_samples(&self) -> Option<u32> {
+        match self.shadows {
+            Shadows::None => None,
+            Shadows::Hard => Some(1),
+            Shadows::Soft(n) => Some(n.max(1)),
+        }
+    }
+}
+
 /// Relative irradiance on a surface with normal z-component `n_z`: the beam (`beam` = its
 /// unblocked fraction, after cover layers) times cos(incidence), diffuse sky light (weighted
 /// by the sky view factor (1 + n_z) / 2 when `sky_view`), and light from the floor on

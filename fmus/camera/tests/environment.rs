@@ -158,7 +158,7 @@ fn shadow_centroid(environment: &str) -> ([f64; 2], f64) {
     let c = Conditions::of(&Environment::from_toml_str(environment).unwrap());
     let light = Lighting::from_conditions(&c);
     let model = DepthModel { range: (0.1, 20.0), noise: DepthNoise::None, baseline: 0.05, invalid_band: false, edge_ratio: 0.0 };
-    let f = render::render(&render::Shot { scene: &scene, dynamic: &[], k: &k, pose: &pose, light: &light, depth: &model }, &mut Rng::new(1), 2);
+    let f = render::render(&render::Shot { scene: &scene, dynamic: &[], k: &k, pose: &pose, light: &light, columns: &[], depth: &model }, &mut Rng::new(1), 2);
     // Sunlit floor is far brighter than the floor lit by the sky alone.
     let floor: Vec<usize> = (0..f.labels.len()).filter(|&i| f.labels[i] == 1).collect();
     let max = floor.iter().map(|&i| f.rgb[3 * i] as u32).max().unwrap();
@@ -195,7 +195,7 @@ fn shadows_point_away_from_the_sun() {
     let (scene, k, pose) = post_scene();
     let c = Conditions::of(&Environment::from_toml_str("date = \"2025-06-21\"\ntime = \"09:00\"\nrender_quality = \"low\"").unwrap());
     let model = DepthModel { range: (0.1, 20.0), noise: DepthNoise::None, baseline: 0.05, invalid_band: false, edge_ratio: 0.0 };
-    let f = render::render(&render::Shot { scene: &scene, dynamic: &[], k: &k, pose: &pose, light: &Lighting::from_conditions(&c), depth: &model }, &mut Rng::new(1), 1);
+    let f = render::render(&render::Shot { scene: &scene, dynamic: &[], k: &k, pose: &pose, light: &Lighting::from_conditions(&c), columns: &[], depth: &model }, &mut Rng::new(1), 1);
     let floor: Vec<u8> = (0..f.labels.len()).filter(|&i| f.labels[i] == 1).map(|i| f.rgb[3 * i]).collect();
     assert_eq!(floor.iter().min(), floor.iter().max(), "flat floor, one colour");
 }
@@ -212,4 +212,35 @@ fn solar_outputs_and_bad_environment() {
     *io.value_mut(ENVIRONMENT) = Value::String("weather = \"hail\"".into());
     let e = Camera::new().initialize(&mut io, 0.0, &mut Quiet).unwrap_err();
     assert!(e.contains("environment") && e.contains("weather"), "{e}");
+}
+
+/// The shadow grids ([`render::sun_columns`]) only skip work: frames with them equal frames
+/// without, pixel for pixel, with hard shadows (packets) and with soft shadows and
+/// supersampled colour (single rays), with the robot's base among the movers.
+#[test]
+fn sun_columns_change_no_pixel() {
+    let cfg = GreenhouseConfig::from_toml_str("").unwrap();
+    let gh = generate(&cfg, cfg.seed);
+    let scene = Scene::from_objects(&gh.objects);
+    let a = &gh.layout.aisles[1];
+    let (x, y) = (0.5 * (a.x_start + a.x_end), a.y);
+    let base = Object { id: gh.objects.len() as u32, name: "base".into(), kind: Kind::Robot, shape: Shape::Box { half: [0.6, 0.45, 0.3] }, placement: Placement::yawed([x + 1.5, y, 0.35], 0.2) };
+    let model = DepthModel { range: (0.1, 10.0), noise: DepthNoise::None, baseline: 0.05, invalid_band: false, edge_ratio: 0.0 };
+    for (quality, w, h) in [("medium", 320, 180), ("high", 96, 54)] {
+        let c = Conditions::of(&Environment::from_toml_str(&format!("{NOON}\nrender_quality = \"{quality}\"")).unwrap());
+        let light = Lighting::from_conditions(&c);
+        let columns = render::sun_columns(&scene, &light);
+        assert_eq!(columns.len(), light.sun_samples().unwrap() as usize, "{quality}: a grid per sun sample");
+        let k = Intrinsics::from_fov(w, h, 87.0, 58.0);
+        for yaw in [0.3, 1.9] {
+            let mount = Mount { translation: [0.0, 0.0, 1.2], roll: 0.0, pitch: 0.2, yaw: 0.0 };
+            let pose = CameraPose::new(&mount, x, y, yaw);
+            let frame = |columns: &[_]| render::render(&render::Shot { scene: &scene, dynamic: std::slice::from_ref(&base), k: &k, pose: &pose, light: &light, columns, depth: &model }, &mut Rng::new(1), 2);
+            let (with, without) = (frame(&columns), frame(&[]));
+            assert!(with.rgb == without.rgb && with.depth == without.depth && with.labels == without.labels, "{quality}, yaw {yaw}");
+            // A grid for another sun is not used.
+            let other = render::sun_columns(&scene, &Lighting::from_conditions(&Conditions::of(&Environment::from_toml_str(&format!("{DUSK}\nrender_quality = \"{quality}\"").replace("21:15", "16:00")).unwrap())));
+            assert!(frame(&other).rgb == without.rgb, "{quality}, yaw {yaw}: another sun's grid");
+        }
+    }
 }

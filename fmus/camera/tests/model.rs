@@ -51,7 +51,7 @@ fn light() -> Lighting {
 
 /// A frame of `scene` alone (no robot objects), noise seeded with `seed`, on 2 threads.
 fn shoot(scene: &Scene, k: &Intrinsics, pose: &CameraPose, light: &Lighting, depth: DepthModel, seed: u64) -> render::Frame {
-    render::render(&Shot { scene, dynamic: &[], k, pose, light, depth: &depth }, &mut Rng::new(seed), 2)
+    render::render(&Shot { scene, dynamic: &[], k, pose, light, columns: &[], depth: &depth }, &mut Rng::new(seed), 2)
 }
 
 #[test]
@@ -495,8 +495,8 @@ fn keyed_pixel_noise_is_uncorrelated_and_new_every_frame() {
     let scene = wall_scene(3.0);
     let m = model(DepthNoise::Stereo { subpixel: 0.08 }, false, 0.0);
     let mut rng = Rng::new(5);
-    let f1 = render::render(&Shot { scene: &scene, dynamic: &[], k: &k, pose: &pose, light: &light(), depth: &m }, &mut rng, 2);
-    let f2 = render::render(&Shot { scene: &scene, dynamic: &[], k: &k, pose: &pose, light: &light(), depth: &m }, &mut rng, 2);
+    let f1 = render::render(&Shot { scene: &scene, dynamic: &[], k: &k, pose: &pose, light: &light(), columns: &[], depth: &m }, &mut rng, 2);
+    let f2 = render::render(&Shot { scene: &scene, dynamic: &[], k: &k, pose: &pose, light: &light(), columns: &[], depth: &m }, &mut rng, 2);
     let err = |f: &render::Frame| -> Vec<f64> { f.depth.iter().zip(&f.true_depth).map(|(d, t)| *d as f64 - *t as f64).collect() };
     let (e1, e2) = (err(&f1), err(&f2));
     let corr = |a: &[f64], b: &[f64]| {

@@ -6,9 +6,11 @@
 mod bvh;
 mod packet;
 mod primitives;
+mod sun_columns;
 mod wide;
 
 pub use packet::MAX_PACKET;
+pub use sun_columns::SunColumns;
 use packet::{traverse_packet, Packet, PacketVisit};
 use crate::scene::{Object, Placement};
 use bvh::Bvh;
@@ -33,16 +35,38 @@ pub struct RayCaster {
     /// Primitives in BVH leaf order, with their object ids.
     prims: Vec<Prim>,
     ids: Vec<u32>,
+    /// The primitives' exact bounding boxes (for [`RayCaster::subset`] and [`SunColumns`]).
+    boxes: Vec<([f64; 3], [f64; 3])>,
 }
 
 impl RayCaster {
     /// Builds the BVH over `objects` (any ids; they are reported back in [`Hit::object`]).
     pub fn new(objects: &[Object]) -> RayCaster {
+        let prims: Vec<_> = objects.iter().map(Prim::from_object).collect();
+        let ids: Vec<_> = objects.iter().map(|o| o.id).collect();
         let boxes: Vec<_> = objects.iter().map(Object::aabb).collect();
-        let bvh = Bvh::build(&boxes);
-        let prims = bvh.order.iter().map(|&i| Prim::from_object(&objects[i as usize])).collect();
-        let ids = bvh.order.iter().map(|&i| objects[i as usize].id).collect();
-        RayCaster { nodes: wide::collapse(&bvh.nodes, objects.len()), prims, ids }
+        RayCaster::from_prims(&prims, &ids, &boxes)
+    }
+
+    /// The tree over primitives given with their ids and bounding boxes (any order).
+    fn from_prims(prims: &[Prim], ids: &[u32], boxes: &[([f64; 3], [f64; 3])]) -> RayCaster {
+        let bvh = Bvh::build(boxes);
+        RayCaster {
+            nodes: wide::collapse(&bvh.nodes, prims.len()),
+            prims: bvh.order.iter().map(|&i| prims[i as usize]).collect(),
+            ids: bvh.order.iter().map(|&i| ids[i as usize]).collect(),
+            boxes: bvh.order.iter().map(|&i| boxes[i as usize]).collect(),
+        }
+    }
+
+    /// The objects for which `keep(id)` holds, in a tree of their own: answers for rays that
+    /// only these can meet, without walking past the others.
+    pub fn subset(&self, keep: impl Fn(u32) -> bool) -> RayCaster {
+        let k: Vec<usize> = (0..self.prims.len()).filter(|&k| keep(self.ids[k])).collect();
+        let prims: Vec<_> = k.iter().map(|&k| self.prims[k]).collect();
+        let ids: Vec<_> = k.iter().map(|&k| self.ids[k]).collect();
+        let boxes: Vec<_> = k.iter().map(|&k| self.boxes[k]).collect();
+        RayCaster::from_prims(&prims, &ids, &boxes)
     }
 
     /// Number of objects.
