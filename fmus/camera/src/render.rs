@@ -536,6 +536,13 @@ fn mix64(mut z: u64) -> u64 {
 pub fn apply_depth_model(f: &mut Frame, k: &Intrinsics, m: &DepthModel, fog_limit: Option<f64>, key: u64, threads: usize) {
     let w = k.width as usize;
     let zt = &f.true_depth;
+    // No pixel in range lies beyond a fog limit past the range's end along the frame's most
+    // oblique ray (a corner's): clear air's limit is kilometres, no test per pixel then.
+    // Division rounds monotonically, so the per-pixel test could not fail either.
+    let x = k.plane_x(0.0).abs().max(k.plane_x(w as f64 - 1.0).abs());
+    let y = k.plane_y(0.0).abs().max(k.plane_y(k.height as f64 - 1.0).abs());
+    let corner = ray_through(x, y)[2];
+    let fog_limit = fog_limit.filter(|&limit| !(m.range.1 / corner <= limit));
     // The pixel columns' plane coordinates, for the fog limit along each ray.
     let xs: Vec<f64> = match fog_limit {
         Some(_) => (0..w).map(|u| k.plane_x(u as f64)).collect(),

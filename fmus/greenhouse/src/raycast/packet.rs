@@ -59,18 +59,28 @@ impl Packet {
         };
         for a in 0..3 {
             let o = &mut p.o[a][..n];
-            match origins {
-                [one] => o.fill(one[a] as f32),
-                _ => o.iter_mut().zip(origins).for_each(|(v, s)| *v = s[a] as f32),
-            }
-            (p.o_lo[a], p.o_hi[a]) = bounds(o);
+            (p.o_lo[a], p.o_hi[a]) = match origins {
+                [one] => {
+                    o.fill(one[a] as f32);
+                    (one[a] as f32, one[a] as f32)
+                }
+                _ => {
+                    o.iter_mut().zip(origins).for_each(|(v, s)| *v = s[a] as f32);
+                    bounds(o)
+                }
+            };
             // The same inverse as a single ray's (`Ray32::new`).
             let inv = &mut p.inv[a][..n];
-            match dirs {
-                [one] => inv.fill(inverse(one[a])),
-                _ => inv.iter_mut().zip(dirs).for_each(|(v, d)| *v = inverse(d[a])),
-            }
-            (p.lo[a], p.hi[a]) = bounds(inv);
+            (p.lo[a], p.hi[a]) = match dirs {
+                [one] => {
+                    inv.fill(inverse(one[a]));
+                    (inverse(one[a]), inverse(one[a]))
+                }
+                _ => {
+                    inv.iter_mut().zip(dirs).for_each(|(v, d)| *v = inverse(d[a]));
+                    bounds(inv)
+                }
+            };
         }
         p.far[..n].fill(far(tmax));
         p.near = p.lo.map(near_corner);
@@ -138,10 +148,25 @@ impl Packet {
     }
 }
 
-/// Smallest and largest of `v` (plain comparisons: SIMD min and max).
+/// Smallest and largest of `v` (no NaN), over 8 lanes at a time: one running bound through
+/// all of `v` was a chain of dependent compares the compiler could not split.
 #[inline(always)]
 fn bounds(v: &[f32]) -> (f32, f32) {
-    v.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &x| (if x < lo { x } else { lo }, if x > hi { x } else { hi }))
+    let (mut lo, mut hi) = ([f32::INFINITY; 8], [f32::NEG_INFINITY; 8]);
+    let mut chunks = v.chunks_exact(8);
+    for c in &mut chunks {
+        for j in 0..8 {
+            lo[j] = if c[j] < lo[j] { c[j] } else { lo[j] };
+            hi[j] = if c[j] > hi[j] { c[j] } else { hi[j] };
+        }
+    }
+    for (j, &x) in chunks.remainder().iter().enumerate() {
+        lo[j] = if x < lo[j] { x } else { lo[j] };
+        hi[j] = if x > hi[j] { x } else { hi[j] };
+    }
+    let lo = lo.iter().fold(f32::INFINITY, |m, &x| if x < m { x } else { m });
+    let hi = hi.iter().fold(f32::NEG_INFINITY, |m, &x| if x > m { x } else { m });
+    (lo, hi)
 }
 
 /// What a packet traversal does at leaves.
