@@ -93,19 +93,9 @@ impl Rng {
         r * c
     }
 
-    /// Noise flavour: [`Rng::normal`]'s value from a generator that will draw no more (a
-    /// per-pixel generator): the same number, without working out the spare it would keep.
-    pub fn normal_once(&mut self) -> f64 {
-        if let Some(z) = self.spare.take() {
-            return z;
-        }
-        let (u1, u2) = (self.uniform(), self.uniform());
-        (-2.0 * u1.ln()).sqrt() * (2.0 * PI * u2).cos()
-    }
-
     /// Noise flavour: a standard normal deviate by the ziggurat method (Marsaglia and Tsang
     /// 2000; rand_distr's `StandardNormal`, with its fixed tables), usually from one draw. A
-    /// quarter of the cost of [`Rng::normal_once`]'s logarithm and cosine, for the camera's
+    /// fraction of the cost of Box-Muller's logarithm and cosine, for the camera's
     /// per-pixel depth noise; a different sequence from [`Rng::normal`].
     pub fn normal_ziggurat(&mut self) -> f64 {
         StandardNormal.sample(self)
@@ -267,14 +257,6 @@ mod tests {
             let v = s.scene_uniform();
             assert!((0.0..1.0).contains(&v));
             assert!(r.below(7) < 7 && s.scene_below(7) < 7);
-        }
-    }
-
-    #[test]
-    fn normal_once_is_the_first_normal_draw() {
-        for seed in 0..100_000u64 {
-            let (mut a, mut b) = (Rng::new(seed), Rng::new(seed));
-            assert_eq!(a.normal_once().to_bits(), b.normal().to_bits(), "seed {seed}");
         }
     }
 
