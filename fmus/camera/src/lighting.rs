@@ -129,9 +129,7 @@ impl Lighting {
             fog: (c.extinction > 0.0).then(|| Fog::new(c.extinction, [0.9 * global_inside; 3])),
         }
     }
-}
 
-impl Lighting {
     /// Shadow rays per lit point (directions by `render`'s sun disc samples); None: no
     /// shadows.
     pub fn sun_samples(&self) -> Option<u32> {

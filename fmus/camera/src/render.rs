@@ -276,7 +276,7 @@ impl Ctx<'_> {
                 }
             }
         }
-        let Some(samples) = self.sun_samples() else {
+        let Some(samples) = self.light.sun_samples() else {
             lit[..m].iter().for_each(|&key| beams[pixel(key)] = l.cover_tau);
             return beams;
         };
@@ -438,14 +438,9 @@ impl Ctx<'_> {
     /// Fraction of the sun's beam reaching `p` (0 = shadow; cover layers attenuate).
     fn beam(&self, p: Vec3) -> f64 {
         let l = self.light;
-        let Some(n) = self.sun_samples() else { return l.cover_tau };
+        let Some(n) = self.light.sun_samples() else { return l.cover_tau };
         let sum: f64 = (0..n).map(|k| transmitted(self.scene, self.columns.get(k as usize), self.movers, p, sun_disc_sample(l.sun, k, n), &self.cover_pow)).sum();
         sum / n as f64
-    }
-
-    /// Shadow rays per lit point (directions by [`sun_disc_sample`]); None: no shadows.
-    fn sun_samples(&self) -> Option<u32> {
-        self.light.sun_samples()
     }
 }
 

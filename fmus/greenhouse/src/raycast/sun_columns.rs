@@ -139,11 +139,6 @@ impl SunColumns {
     pub fn translucent(&self) -> &RayCaster {
         &self.translucent
     }
-
-    /// Share of the grid's cells some opaque object covers (for reports).
-    pub fn covered(&self) -> f64 {
-        self.top.iter().filter(|t| t.is_finite()).count() as f64 / self.top.len().max(1) as f64
-    }
 }
 
 /// The least f32 at or above `v` (finite v).
