@@ -7,10 +7,11 @@
    world, LiDAR, IMU, camera at 10 Hz, both arms publishing joint states): `agrisim run` of
    models/scenarios/sensors.toml for --seconds of simulated time, once per camera size of
    --sizes; RTF = simulated / wall time (wall time includes loading the FMUs and building
-   the scene).
+   the scene). The run records every topic (`agrisim run`'s default profile, full) unless
+   --record says otherwise (none: the sensors alone).
 
     python3 python/bench_camera_suite.py [--seconds 5] [--frames 5] [--sizes 1280x720,640x480]
-        [--skip-fps] [--agrisim PATH] [--fmu-dir DIR]
+        [--skip-fps] [--agrisim PATH] [--fmu-dir DIR] [--record full|standard|judge|none]
 
 Wall times on a shared machine vary; run it on an idle one for figures to quote.
 """
@@ -36,6 +37,7 @@ def main():
     ap.add_argument("--fmu-dir", help="packed FMUs (default: the CLI's)")
     ap.add_argument("--sizes", default="1280x720,640x480", help="camera WIDTHxHEIGHT of the suite runs, comma-separated")
     ap.add_argument("--skip-fps", action="store_true", help="only the suite runs (no camera_fps example)")
+    ap.add_argument("--record", help="recording profile of the suite runs (default: agrisim run's, full)")
     args = ap.parse_args()
     sizes = [tuple(int(v) for v in size.split("x")) for size in args.sizes.split(",")]
 
@@ -51,11 +53,13 @@ def main():
             cmd = [args.agrisim, "run", "--scenario", str(scenario), "--duration", str(args.seconds), "--out", out]
             if args.fmu_dir:
                 cmd[2:2] = ["--fmu-dir", args.fmu_dir]
+            if args.record:
+                cmd += ["--record", args.record]
             print("$", " ".join(cmd), flush=True)
             t = time.perf_counter()
             subprocess.run(cmd, cwd=ROOT, check=True)
             wall = time.perf_counter() - t
-        print(f"sensor suite, camera {width}x{height}: {args.seconds:g} s simulated in {wall:.1f} s wall: "
+        print(f"sensor suite, camera {width}x{height}, recording {args.record or 'full'}: {args.seconds:g} s simulated in {wall:.1f} s wall: "
               f"real-time factor {args.seconds / wall:.3f}", flush=True)
     return 0
 
