@@ -321,7 +321,7 @@ impl Ctx<'_> {
         }
         let mut out = [None; SHADOW_PACKET];
         let mut points = [[0.0; 3]; SHADOW_PACKET];
-        let opaque = |id| shading::casts_shadow(self.scene.kind(id));
+        let opaque = opaque(self.scene);
         for group in keys.chunks(SHADOW_PACKET) {
             let g = group.len();
             for (q, &key) in group.iter().enumerate() {
@@ -455,7 +455,7 @@ const MAX_COLUMN_CELLS: usize = 1 << 22;
 /// alone. Empty without shadows or with the sun too low.
 pub fn sun_columns(scene: &Scene, light: &Lighting) -> Vec<SunColumns> {
     let Some(n) = light.sun_samples().filter(|_| light.sun_up) else { return vec![] };
-    let opaque = |id| shading::casts_shadow(scene.kind(id));
+    let opaque = opaque(scene);
     let columns: Option<Vec<_>> = (0..n).map(|k| SunColumns::new(&scene.caster, sun_disc_sample(light.sun, k, n), opaque, COLUMN_CELL, MAX_COLUMN_CELLS)).collect();
     columns.unwrap_or_default()
 }
@@ -502,7 +502,12 @@ fn transmitted(scene: &Scene, columns: Option<&SunColumns>, movers: &RayCaster, 
         Some(c) if c.clear(p) => c.translucent(),
         _ => &scene.caster,
     };
-    transmittance(caster.pass_through(p, s, EPS, FAR, movers, |id| shading::casts_shadow(scene.kind(id))), cover_pow)
+    transmittance(caster.pass_through(p, s, EPS, FAR, movers, opaque(scene)), cover_pow)
+}
+
+/// Which of `scene`'s object ids stop sunlight (all but glass and film; the robot's links too).
+fn opaque(scene: &Scene) -> impl Fn(u32) -> bool + Copy + '_ {
+    |id| shading::casts_shadow(scene.kind(id))
 }
 
 /// The pixel of a lit point's key in [`Ctx::beams`].
