@@ -7,7 +7,7 @@ use crate::lighting::{self, Lighting};
 use crate::optics::{mat_vec, ray_through, CameraPose, Intrinsics, Vec3};
 use crate::scene::Scene;
 use crate::shading::{self, Palette};
-use agrisim_greenhouse::raycast::{Occluders, SunColumns, MAX_PACKET};
+use agrisim_greenhouse::raycast::{Occluders, Shadow, SunColumns, MAX_PACKET};
 use agrisim_greenhouse::{Hit, Object, RayCaster};
 use agrisim_fmu_util::on_threads;
 use agrisim_math::Rng;
@@ -198,7 +198,7 @@ impl Ctx<'_> {
         let mut dirs = [[0.0; 3]; MAX_PACKET];
         let mut hits = [None; MAX_PACKET];
         // The occluders of the chunk's latest shadow rays, tried first by the next ones.
-        let mut recent = [Occluders::default(), Occluders::default()];
+        let mut recent = Recent::default();
         for u0 in (0..w).step_by(TILE_COLS) {
             let cols = TILE_COLS.min(w - u0);
             let n = rows * cols;
@@ -254,10 +254,11 @@ impl Ctx<'_> {
         acc
     }
 
-    /// Unblocked fraction of the sun's beam at each lit surface of a tile (0 elsewhere): the
-    /// shadow rays of each sun sample go as packets, those the sample's [`SunColumns`] clear
-    /// of every opaque object through the scene's glass and film alone.
-    fn beams(&self, surfaces: &[Surface], recent: &mut [Occluders; 2]) -> [f64; MAX_PACKET] {
+    /// Unblocked fraction of the sun's beam at each lit surface of a tile (0 elsewhere): per
+    /// sun sample, the sample's [`SunColumns`] tell which shadow rays an opaque object stops
+    /// and which none can (those go through the scene's glass and film alone, as packets);
+    /// without them, the rays go through the whole scene as packets.
+    fn beams(&self, surfaces: &[Surface], recent: &mut Recent) -> [f64; MAX_PACKET] {
         let l = self.light;
         let mut beams = [0.0; MAX_PACKET];
         // Keyed as (squared distance as f32, pixel) in one u64: for non-negative floats the
@@ -280,27 +281,36 @@ impl Ctx<'_> {
             lit[..m].iter().for_each(|&key| beams[pixel(key)] = l.cover_tau);
             return beams;
         };
-        let [recent_scene, recent_clear] = recent;
         for k in 0..samples {
             let s = sun_disc_sample(l.sun, k, samples);
             let Some(columns) = self.columns.get(k as usize) else {
-                self.shadow_packets(&mut lit[..m], &at, s, &self.scene.caster, recent_scene, &mut beams);
+                self.shadow_packets(&mut lit[..m], &at, s, &self.scene.caster, &mut recent.scene, &mut beams);
                 continue;
             };
-            // The points the columns clear to the back (the order does not matter).
+            // What the columns tell: blocked points get nothing from this sample, clear ones
+            // go through the glass and film alone (to the back), the rest through the scene.
             let mut r = m;
             let mut q = 0;
+            let mut unknown = 0;
             while q < r {
-                if columns.clear(at[pixel(lit[q])]) {
-                    r -= 1;
-                    lit.swap(q, r);
-                } else {
-                    q += 1;
+                match columns.occluder(&self.scene.caster, at[pixel(lit[q])], EPS, FAR, recent.blocker) {
+                    Shadow::Clear => {
+                        r -= 1;
+                        lit.swap(q, r);
+                    }
+                    Shadow::Blocked(b) => {
+                        recent.blocker = Some(b);
+                        q += 1;
+                    }
+                    Shadow::Unknown => {
+                        lit.swap(q, unknown);
+                        unknown += 1;
+                        q += 1;
+                    }
                 }
             }
-            let (rest, clear) = lit[..m].split_at_mut(r);
-            self.shadow_packets(rest, &at, s, &self.scene.caster, recent_scene, &mut beams);
-            self.shadow_packets(clear, &at, s, columns.translucent(), recent_clear, &mut beams);
+            self.shadow_packets(&mut lit[..unknown], &at, s, &self.scene.caster, &mut recent.scene, &mut beams);
+            self.shadow_packets(&mut lit[r..m], &at, s, columns.translucent(), &mut recent.clear, &mut beams);
         }
         lit[..m].iter().for_each(|&key| beams[pixel(key)] /= samples as f64);
         beams
@@ -498,11 +508,21 @@ fn normalize(v: Vec3) -> Vec3 {
 /// or film surface crossed (16 or more: 0, as deep as anyone renders). With the sample's
 /// columns, a ray they clear goes through the glass and film alone.
 fn transmitted(scene: &Scene, columns: Option<&SunColumns>, movers: &RayCaster, p: Vec3, s: Vec3, cover_pow: &[f64; 16]) -> f64 {
-    let caster = match columns {
-        Some(c) if c.clear(p) => c.translucent(),
+    let caster = match columns.map(|c| (c, c.occluder(&scene.caster, p, EPS, FAR, None))) {
+        Some((_, Shadow::Blocked(_))) => return 0.0,
+        Some((c, Shadow::Clear)) => c.translucent(),
         _ => &scene.caster,
     };
     transmittance(caster.pass_through(p, s, EPS, FAR, movers, opaque(scene)), cover_pow)
+}
+
+/// What a chunk's shadow rays remember for the next ones: the occluders found by the scene's
+/// and by the glass-and-film traversals, and the last object the columns found blocking.
+#[derive(Default)]
+struct Recent {
+    scene: Occluders,
+    clear: Occluders,
+    blocker: Option<u32>,
 }
 
 /// Which of `scene`'s object ids stop sunlight (all but glass and film; the robot's links too).

@@ -10,7 +10,7 @@ mod sun_columns;
 mod wide;
 
 pub use packet::MAX_PACKET;
-pub use sun_columns::SunColumns;
+pub use sun_columns::{Shadow, SunColumns};
 use packet::{traverse_packet, Packet, PacketVisit};
 use crate::scene::{Object, Placement};
 use bvh::Bvh;

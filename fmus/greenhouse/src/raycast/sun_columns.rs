@@ -7,6 +7,13 @@
 //! climbs (the light is above the horizon), so it meets none of them: it needs only the
 //! translucent objects (glass, film), a tree a fraction of the scene's size. The grid is
 //! conservative, so every other ray takes the full traversal and the answers stay exact.
+//!
+//! Each cell also lists the opaque objects covering it, highest top first. A ray from a
+//! point in the cell can meet only those whose top is above the point, so testing them one
+//! by one tells exactly whether something opaque stops it, without a traversal: a few
+//! primitive tests where the scene's tree took a walk from its root. Lists cost memory, so a
+//! grid whose lists would exceed [`ENTRIES_PER_CELL`] times its cell limit keeps the tops
+//! alone.
 
 use super::RayCaster;
 
@@ -22,6 +29,10 @@ const PAD: f64 = 1e-6;
 /// primitives' intersection arithmetic (~1e-12 m at greenhouse scales), below the offset
 /// off a surface that shadow rays start from (1e-6 m: a point on the floor is above it).
 const TOP_PAD: f64 = 1e-9;
+
+/// Most (cell, object) entries in the lists of one grid (8 bytes each), per cell the grid
+/// may have.
+const ENTRIES_PER_CELL: usize = 4;
 
 /// The grid of one light direction over one scene, with the scene's translucent objects.
 #[derive(Clone)]
@@ -39,7 +50,28 @@ pub struct SunColumns {
     /// Per cell (row-major in y): the highest top (z, padded up) of an opaque object whose
     /// swept box covers the cell, rounded up to f32; -inf where none does.
     top: Vec<f32>,
+    /// Per cell c, the opaque objects whose swept box covers it, highest top first:
+    /// `list[start[c] .. start[c + 1]]` (indices into the scene's primitives) with their tops
+    /// (as `top`) in `tops`. All empty when the lists would be too long ([`ENTRIES_PER_CELL`]).
+    start: Vec<u32>,
+    list: Vec<u32>,
+    tops: Vec<f32>,
+    /// Primitive count of the scene the lists index (a check against another scene), and
+    /// which of its primitives are opaque (one bit each).
+    scene_prims: usize,
+    opaque: Vec<u64>,
     translucent: RayCaster,
+}
+
+/// What a grid tells of one shadow ray ([`SunColumns::occluder`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shadow {
+    /// No opaque object of the scene stops it: the glass and film alone answer.
+    Clear,
+    /// This opaque primitive of the scene (an index, as [`Occluders`](super::Occluders) keep) stops it.
+    Blocked(u32),
+    /// The grid cannot tell (it keeps no lists): the whole scene must answer.
+    Unknown,
 }
 
 impl SunColumns {
@@ -51,7 +83,10 @@ impl SunColumns {
             return None;
         }
         let w = [dir[0] / dir[2], dir[1] / dir[2]];
-        let boxes: Vec<_> = (0..caster.prims.len()).filter(|&k| opaque(caster.ids[k])).map(|k| caster.boxes[k]).collect();
+        let opaque_prims: Vec<usize> = (0..caster.prims.len()).filter(|&k| opaque(caster.ids[k])).collect();
+        let boxes: Vec<_> = opaque_prims.iter().map(|&k| caster.boxes[k]).collect();
+        let mut bits = vec![0u64; caster.prims.len().div_ceil(64)];
+        opaque_prims.iter().for_each(|&k| bits[k / 64] |= 1 << (k % 64));
         let mut lo = [f64::INFINITY; 2];
         let mut hi = [f64::NEG_INFINITY; 2];
         for (mn, mx) in &boxes {
@@ -63,23 +98,61 @@ impl SunColumns {
         }
         let translucent = caster.subset(|id| !opaque(id));
         if boxes.is_empty() {
-            return Some(SunColumns { dir, w, origin: [0.0; 2], cell, per_metre: 1.0 / cell, nx: 0, ny: 0, top: vec![], translucent });
+            let (start, list, tops) = (vec![], vec![], vec![]);
+            return Some(SunColumns { dir, w, origin: [0.0; 2], cell, per_metre: 1.0 / cell, nx: 0, ny: 0, top: vec![], start, list, tops, scene_prims: caster.prims.len(), opaque: bits, translucent });
         }
         let area = (hi[0] - lo[0]) * (hi[1] - lo[1]);
         let cell = cell.max((area / max_cells as f64).sqrt() * 1.01);
         let nx = ((hi[0] - lo[0]) / cell).ceil().max(1.0) as usize;
         let ny = ((hi[1] - lo[1]) / cell).ceil().max(1.0) as usize;
-        let mut grid = SunColumns { dir, w, origin: lo, cell, per_metre: 1.0 / cell, nx, ny, top: vec![f32::NEG_INFINITY; nx * ny], translucent };
+        let (start, list, tops) = (vec![], vec![], vec![]);
+        let mut grid = SunColumns { dir, w, origin: lo, cell, per_metre: 1.0 / cell, nx, ny, top: vec![f32::NEG_INFINITY; nx * ny], start, list, tops, scene_prims: caster.prims.len(), opaque: bits, translucent };
+        // The tops and the counts per cell, then (if not too many) the lists, each ordered.
+        let mut count = vec![0u32; nx * ny];
+        let mut entries = 0usize;
+        let mut cells = vec![];
         for b in &boxes {
-            grid.cover(b);
+            let top = padded_top(b.1[2]);
+            cells.clear();
+            grid.cells(b, |c| cells.push(c));
+            for &c in &cells {
+                grid.top[c] = grid.top[c].max(top);
+                count[c] += 1;
+            }
+            entries += cells.len();
+        }
+        if entries <= ENTRIES_PER_CELL * max_cells && entries < u32::MAX as usize {
+            let mut start = Vec::with_capacity(nx * ny + 1);
+            start.push(0u32);
+            for &n in &count {
+                start.push(start[start.len() - 1] + n);
+            }
+            // Objects taken highest top first, so each cell's list comes out in that order.
+            let tops: Vec<f32> = boxes.iter().map(|b| padded_top(b.1[2])).collect();
+            let mut order: Vec<usize> = (0..boxes.len()).collect();
+            order.sort_by(|&a, &b| tops[b].total_cmp(&tops[a]).then(a.cmp(&b)));
+            let mut at = start[..nx * ny].to_vec();
+            let mut list = vec![0u32; entries];
+            let mut listed_tops = vec![0f32; entries];
+            for i in order {
+                cells.clear();
+                grid.cells(&boxes[i], |c| cells.push(c));
+                for &c in &cells {
+                    list[at[c] as usize] = opaque_prims[i] as u32;
+                    listed_tops[at[c] as usize] = tops[i];
+                    at[c] += 1;
+                }
+            }
+            grid.tops = listed_tops;
+            grid.list = list;
+            grid.start = start;
         }
         Some(grid)
     }
 
-    /// Raises the cells that the box `(mn, mx)` swept along the direction covers to its top.
-    fn cover(&mut self, &(mn, mx): &([f64; 3], [f64; 3])) {
+    /// Calls `f` with every cell that the box `(mn, mx)` swept along the direction covers.
+    fn cells(&self, &(mn, mx): &([f64; 3], [f64; 3]), mut f: impl FnMut(usize)) {
         let [wx, wy] = self.w;
-        let top = up_f32(mx[2] + TOP_PAD * (1.0 + mx[2].abs()));
         // The box's points at height z have feet in its (x, y) rectangle shifted by -z w.
         let (sy0, sy1) = (mn[2] * wy, mx[2] * wy);
         let rows = self.index(mn[1] - sy0.max(sy1) - PAD, 1)..=self.index(mx[1] - sy0.min(sy1) + PAD, 1);
@@ -101,10 +174,7 @@ impl SunColumns {
             }
             let (sx0, sx1) = (z0 * wx, z1 * wx);
             let cols = self.index(mn[0] - sx0.max(sx1) - PAD, 0)..=self.index(mx[0] - sx0.min(sx1) + PAD, 0);
-            let row = &mut self.top[j * self.nx..(j + 1) * self.nx];
-            for t in &mut row[cols] {
-                *t = t.max(top);
-            }
+            cols.for_each(|i| f(j * self.nx + i));
         }
     }
 
@@ -123,15 +193,56 @@ impl SunColumns {
     /// any near limit >= 0): its foot lies in no opaque object's swept box, or lies above the
     /// top of every one that covers it. False means only "maybe".
     pub fn clear(&self, p: [f64; 3]) -> bool {
+        match self.foot_cell(p) {
+            Foot::Outside => true,
+            Foot::Cell(c) => p[2] > self.top[c] as f64,
+            Foot::NotFinite => false,
+        }
+    }
+
+    /// Whether an opaque object of `scene` stops the ray from `p` along the direction with
+    /// `t` in `[tmin, tmax]` (`tmin >= 0`), exactly as the scene's own shadow query would
+    /// decide it: the objects listed for the ray's cell whose top is above `p` are tested
+    /// one by one with the same primitive test, `hint` first (an object an earlier answer of
+    /// this grid named: neighbouring points are often shaded by the same leaf).
+    /// [`Shadow::Unknown`] for a grid without lists or a `scene` it was not built from.
+    pub fn occluder(&self, scene: &RayCaster, p: [f64; 3], tmin: f64, tmax: f64, hint: Option<u32>) -> Shadow {
+        let c = match self.foot_cell(p) {
+            Foot::Outside => return Shadow::Clear,
+            Foot::Cell(c) if p[2] > self.top[c] as f64 => return Shadow::Clear,
+            Foot::Cell(c) if !self.start.is_empty() && scene.prims.len() == self.scene_prims && tmin >= 0.0 => c,
+            _ => return Shadow::Unknown,
+        };
+        let stops = |k: u32| scene.prims[k as usize].along(self.dir).intersect(p, tmin, tmax).is_some();
+        let (a, b) = (self.start[c] as usize, self.start[c + 1] as usize);
+        // An opaque object that stops the ray decides it, listed here or not.
+        let hint = hint.filter(|&k| (k as usize) < self.scene_prims && self.opaque[k as usize / 64] >> (k % 64) & 1 == 1);
+        if let Some(k) = hint.filter(|&k| stops(k)) {
+            return Shadow::Blocked(k);
+        }
+        for (&k, &top) in self.list[a..b].iter().zip(&self.tops[a..b]) {
+            if p[2] > top as f64 {
+                // Listed highest top first: the rest lie wholly below the ray too.
+                break;
+            }
+            if Some(k) != hint && stops(k) {
+                return Shadow::Blocked(k);
+            }
+        }
+        Shadow::Clear
+    }
+
+    /// The cell of `p`'s foot.
+    fn foot_cell(&self, p: [f64; 3]) -> Foot {
         let f = [p[0] - p[2] * self.w[0], p[1] - p[2] * self.w[1]];
         if !(f[0].is_finite() && f[1].is_finite() && p[2].is_finite()) {
-            return false;
+            return Foot::NotFinite;
         }
         let (u, v) = ((f[0] - self.origin[0]) * self.per_metre, (f[1] - self.origin[1]) * self.per_metre);
         if self.top.is_empty() || u < 0.0 || v < 0.0 || u >= self.nx as f64 || v >= self.ny as f64 {
-            return true;
+            return Foot::Outside;
         }
-        p[2] > self.top[v as usize * self.nx + u as usize] as f64
+        Foot::Cell(v as usize * self.nx + u as usize)
     }
 
     /// The scene's translucent objects: for a [`SunColumns::clear`] ray,
@@ -139,6 +250,19 @@ impl SunColumns {
     pub fn translucent(&self) -> &RayCaster {
         &self.translucent
     }
+}
+
+/// Where a point's foot lies.
+enum Foot {
+    /// Outside the grid: no opaque object's swept box covers it.
+    Outside,
+    Cell(usize),
+    NotFinite,
+}
+
+/// An object's top `z` padded up for rounding ([`TOP_PAD`]), as an f32 at or above it.
+fn padded_top(z: f64) -> f32 {
+    up_f32(z + TOP_PAD * (1.0 + z.abs()))
 }
 
 /// The least f32 at or above `v` (finite v).
@@ -153,6 +277,6 @@ fn up_f32(v: f64) -> f32 {
 
 impl std::fmt::Debug for SunColumns {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "SunColumns({}x{} cells of {} m toward {:?})", self.nx, self.ny, self.cell, self.dir)
+        write!(f, "SunColumns({}x{} cells of {} m toward {:?}, {} listed)", self.nx, self.ny, self.cell, self.dir, self.list.len())
     }
 }
