@@ -50,12 +50,9 @@ pub struct SunColumns {
     /// Per cell (row-major in y): the highest top (z, padded up) of an opaque object whose
     /// swept box covers the cell, rounded up to f32; -inf where none does.
     top: Vec<f32>,
-    /// Per cell c, the opaque objects whose swept box covers it, highest top first:
-    /// `list[start[c] .. start[c + 1]]` (indices into the scene's primitives) with their tops
-    /// (as `top`) in `tops`. All empty when the lists would be too long ([`ENTRIES_PER_CELL`]).
-    start: Vec<u32>,
-    list: Vec<u32>,
-    tops: Vec<f32>,
+    /// Per cell, the opaque objects whose swept box covers it (empty when they would be too
+    /// long, [`ENTRIES_PER_CELL`]).
+    lists: Lists,
     /// Primitive count of the scene the lists index (a check against another scene), and
     /// which of its primitives are opaque (one bit each).
     scene_prims: usize,
@@ -98,56 +95,75 @@ impl SunColumns {
         }
         let translucent = caster.subset(|id| !opaque(id));
         if boxes.is_empty() {
-            let (start, list, tops) = (vec![], vec![], vec![]);
-            return Some(SunColumns { dir, w, origin: [0.0; 2], cell, per_metre: 1.0 / cell, nx: 0, ny: 0, top: vec![], start, list, tops, scene_prims: caster.prims.len(), opaque: bits, translucent });
+            return Some(SunColumns { dir, w, origin: [0.0; 2], cell, per_metre: 1.0 / cell, nx: 0, ny: 0, top: vec![], lists: Lists::default(), scene_prims: caster.prims.len(), opaque: bits, translucent });
         }
         let area = (hi[0] - lo[0]) * (hi[1] - lo[1]);
         let cell = cell.max((area / max_cells as f64).sqrt() * 1.01);
         let nx = ((hi[0] - lo[0]) / cell).ceil().max(1.0) as usize;
         let ny = ((hi[1] - lo[1]) / cell).ceil().max(1.0) as usize;
-        let (start, list, tops) = (vec![], vec![], vec![]);
-        let mut grid = SunColumns { dir, w, origin: lo, cell, per_metre: 1.0 / cell, nx, ny, top: vec![f32::NEG_INFINITY; nx * ny], start, list, tops, scene_prims: caster.prims.len(), opaque: bits, translucent };
-        // The tops and the counts per cell, then (if not too many) the lists, each ordered.
-        let mut count = vec![0u32; nx * ny];
-        let mut entries = 0usize;
-        let mut cells = vec![];
-        for b in &boxes {
-            let top = padded_top(b.1[2]);
-            cells.clear();
-            grid.cells(b, |c| cells.push(c));
-            for &c in &cells {
-                grid.top[c] = grid.top[c].max(top);
-                count[c] += 1;
+        let mut grid = SunColumns { dir, w, origin: lo, cell, per_metre: 1.0 / cell, nx, ny, top: vec![f32::NEG_INFINITY; nx * ny], lists: Lists::default(), scene_prims: caster.prims.len(), opaque: bits, translucent };
+        match grid.lists(caster, &opaque_prims, ENTRIES_PER_CELL * max_cells) {
+            Some(lists) => {
+                // A cell's top is its list's first.
+                for (c, top) in grid.top.iter_mut().enumerate() {
+                    if lists.start[c] < lists.start[c + 1] {
+                        *top = lists.tops[lists.start[c] as usize];
+                    }
+                }
+                grid.lists = lists;
             }
-            entries += cells.len();
-        }
-        if entries <= ENTRIES_PER_CELL * max_cells && entries < u32::MAX as usize {
-            let mut start = Vec::with_capacity(nx * ny + 1);
-            start.push(0u32);
-            for &n in &count {
-                start.push(start[start.len() - 1] + n);
-            }
-            // Objects taken highest top first, so each cell's list comes out in that order.
-            let tops: Vec<f32> = boxes.iter().map(|b| padded_top(b.1[2])).collect();
-            let mut order: Vec<usize> = (0..boxes.len()).collect();
-            order.sort_by(|&a, &b| tops[b].total_cmp(&tops[a]).then(a.cmp(&b)));
-            let mut at = start[..nx * ny].to_vec();
-            let mut list = vec![0u32; entries];
-            let mut listed_tops = vec![0f32; entries];
-            for i in order {
-                cells.clear();
-                grid.cells(&boxes[i], |c| cells.push(c));
-                for &c in &cells {
-                    list[at[c] as usize] = opaque_prims[i] as u32;
-                    listed_tops[at[c] as usize] = tops[i];
-                    at[c] += 1;
+            None => {
+                let mut cells = vec![];
+                for b in &boxes {
+                    let top = padded_top(b.1[2]);
+                    cells.clear();
+                    grid.cells(b, |c| cells.push(c));
+                    for &c in &cells {
+                        grid.top[c] = grid.top[c].max(top);
+                    }
                 }
             }
-            grid.tops = listed_tops;
-            grid.list = list;
-            grid.start = start;
         }
         Some(grid)
+    }
+
+    /// The lists of the primitives `prims` of `caster`, if they hold at most `max_entries`.
+    fn lists(&self, caster: &RayCaster, prims: &[usize], max_entries: usize) -> Option<Lists> {
+        let n = self.nx * self.ny;
+        let mut count = vec![0u32; n];
+        let mut entries = 0usize;
+        let mut cells = vec![];
+        for &k in prims {
+            cells.clear();
+            self.cells(&caster.boxes[k], |c| cells.push(c));
+            cells.iter().for_each(|&c| count[c] += 1);
+            entries += cells.len();
+            if entries > max_entries || entries >= u32::MAX as usize {
+                return None;
+            }
+        }
+        let mut start = Vec::with_capacity(n + 1);
+        start.push(0u32);
+        for &c in &count {
+            start.push(start[start.len() - 1] + c);
+        }
+        // Primitives taken highest top first, so each cell's list comes out in that order.
+        let tops: Vec<f32> = prims.iter().map(|&k| padded_top(caster.boxes[k].1[2])).collect();
+        let mut order: Vec<usize> = (0..prims.len()).collect();
+        order.sort_by(|&a, &b| tops[b].total_cmp(&tops[a]).then(a.cmp(&b)));
+        let mut at = start[..n].to_vec();
+        let mut list = vec![0u32; entries];
+        let mut listed_tops = vec![0f32; entries];
+        for i in order {
+            cells.clear();
+            self.cells(&caster.boxes[prims[i]], |c| cells.push(c));
+            for &c in &cells {
+                list[at[c] as usize] = prims[i] as u32;
+                listed_tops[at[c] as usize] = tops[i];
+                at[c] += 1;
+            }
+        }
+        Some(Lists { start, list, tops: listed_tops })
     }
 
     /// Calls `f` with every cell that the box `(mn, mx)` swept along the direction covers.
@@ -210,26 +226,19 @@ impl SunColumns {
         let c = match self.foot_cell(p) {
             Foot::Outside => return Shadow::Clear,
             Foot::Cell(c) if p[2] > self.top[c] as f64 => return Shadow::Clear,
-            Foot::Cell(c) if !self.start.is_empty() && scene.prims.len() == self.scene_prims && tmin >= 0.0 => c,
+            Foot::Cell(c) if !self.lists.start.is_empty() && scene.prims.len() == self.scene_prims && tmin >= 0.0 => c,
             _ => return Shadow::Unknown,
         };
         let stops = |k: u32| scene.prims[k as usize].along(self.dir).intersect(p, tmin, tmax).is_some();
-        let (a, b) = (self.start[c] as usize, self.start[c + 1] as usize);
         // An opaque object that stops the ray decides it, listed here or not.
         let hint = hint.filter(|&k| (k as usize) < self.scene_prims && self.opaque[k as usize / 64] >> (k % 64) & 1 == 1);
         if let Some(k) = hint.filter(|&k| stops(k)) {
             return Shadow::Blocked(k);
         }
-        for (&k, &top) in self.list[a..b].iter().zip(&self.tops[a..b]) {
-            if p[2] > top as f64 {
-                // Listed highest top first: the rest lie wholly below the ray too.
-                break;
-            }
-            if Some(k) != hint && stops(k) {
-                return Shadow::Blocked(k);
-            }
+        match self.lists.above(c, p[2]).find(|&k| Some(k) != hint && stops(k)) {
+            Some(k) => Shadow::Blocked(k),
+            None => Shadow::Clear,
         }
-        Shadow::Clear
     }
 
     /// The cell of `p`'s foot.
@@ -249,6 +258,24 @@ impl SunColumns {
     /// `translucent().pass_through(..)` gives what the whole scene's would.
     pub fn translucent(&self) -> &RayCaster {
         &self.translucent
+    }
+}
+
+/// Per cell c, primitives (indices into the scene's) highest top first,
+/// `list[start[c] .. start[c + 1]]`, with their padded tops in `tops`; all empty for none.
+#[derive(Clone, Default)]
+struct Lists {
+    start: Vec<u32>,
+    list: Vec<u32>,
+    tops: Vec<f32>,
+}
+
+impl Lists {
+    /// The primitives of cell `c` whose top is at or above `z`: listed highest top first, the
+    /// rest lie wholly below a ray climbing from `z`.
+    fn above(&self, c: usize, z: f64) -> impl Iterator<Item = u32> + '_ {
+        let (a, b) = (self.start[c] as usize, self.start[c + 1] as usize);
+        self.list[a..b].iter().zip(&self.tops[a..b]).take_while(move |&(_, &top)| z <= top as f64).map(|(&k, _)| k)
     }
 }
 
@@ -277,6 +304,6 @@ fn up_f32(v: f64) -> f32 {
 
 impl std::fmt::Debug for SunColumns {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "SunColumns({}x{} cells of {} m toward {:?}, {} listed)", self.nx, self.ny, self.cell, self.dir, self.list.len())
+        write!(f, "SunColumns({}x{} cells of {} m toward {:?}, {} listed)", self.nx, self.ny, self.cell, self.dir, self.lists.list.len())
     }
 }
