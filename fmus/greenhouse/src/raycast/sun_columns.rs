@@ -67,7 +67,8 @@ pub enum Shadow {
     Clear,
     /// This opaque primitive of the scene (an index, as [`Occluders`](super::Occluders) keep) stops it.
     Blocked(u32),
-    /// The grid cannot tell (it keeps no lists): the whole scene must answer.
+    /// The grid cannot tell (it keeps no lists, was built for another scene, or the near
+    /// limit is negative): the whole scene must answer.
     Unknown,
 }
 
@@ -223,10 +224,13 @@ impl SunColumns {
     /// this grid named: neighbouring points are often shaded by the same leaf).
     /// [`Shadow::Unknown`] for a grid without lists or a `scene` it was not built from.
     pub fn occluder(&self, scene: &RayCaster, p: [f64; 3], tmin: f64, tmax: f64, hint: Option<u32>) -> Shadow {
+        if scene.prims.len() != self.scene_prims || !(tmin >= 0.0) {
+            return Shadow::Unknown;
+        }
         let c = match self.foot_cell(p) {
             Foot::Outside => return Shadow::Clear,
             Foot::Cell(c) if p[2] > self.top[c] as f64 => return Shadow::Clear,
-            Foot::Cell(c) if !self.lists.start.is_empty() && scene.prims.len() == self.scene_prims && tmin >= 0.0 => c,
+            Foot::Cell(c) if !self.lists.start.is_empty() => c,
             _ => return Shadow::Unknown,
         };
         let stops = |k: u32| scene.prims[k as usize].along(self.dir).intersect(p, tmin, tmax).is_some();
