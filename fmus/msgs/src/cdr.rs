@@ -389,6 +389,17 @@ pub trait CdrField: Sized {
         }
         Ok(v)
     }
+
+    /// Reads past one value, failing exactly where [`CdrField::read_field`] would, without
+    /// building it: checking a message needs no copy of an image's bytes.
+    fn skip_field(r: &mut CdrReader<'_>) -> Result<(), CdrError> {
+        Self::read_field(r).map(drop)
+    }
+
+    /// [`CdrField::read_items`] without building them.
+    fn skip_items(r: &mut CdrReader<'_>, n: usize) -> Result<(), CdrError> {
+        (0..n).try_for_each(|_| Self::skip_field(r))
+    }
 }
 
 macro_rules! prim_field {
@@ -439,6 +450,9 @@ impl CdrField for u8 {
     fn read_items(r: &mut CdrReader<'_>, n: usize) -> Result<Vec<Self>, CdrError> {
         Ok(r.read_bytes(n)?.to_vec())
     }
+    fn skip_items(r: &mut CdrReader<'_>, n: usize) -> Result<(), CdrError> {
+        r.read_bytes(n).map(drop)
+    }
 }
 
 /// Unbounded sequence `T[]`.
@@ -452,6 +466,10 @@ impl<T: CdrField> CdrField for Vec<T> {
         let n = r.read_sequence_len(T::MIN_SIZE)?;
         // `n` is bounded by the remaining input (checked above), so this is safe to reserve.
         T::read_items(r, n)
+    }
+    fn skip_field(r: &mut CdrReader<'_>) -> Result<(), CdrError> {
+        let n = r.read_sequence_len(T::MIN_SIZE)?;
+        T::skip_items(r, n)
     }
 }
 

@@ -12,7 +12,7 @@ use crate::{
 /// do not, `None` when the type is not one this crate defines.
 pub fn check_cdr(type_name: &str, bytes: &[u8]) -> Option<Result<(), CdrError>> {
     fn ok<M: Message>(b: &[u8]) -> Option<Result<(), CdrError>> {
-        Some(M::from_cdr(b).map(|_| ()))
+        Some(M::check_cdr(b))
     }
     match type_name {
         "agrisim_msgs/msg/Signals" => ok::<agrisim::Signals>(bytes),

@@ -34,6 +34,18 @@ pub trait Message: Sized {
         let mut r = CdrReader::new(bytes)?;
         Self::read(&mut r)
     }
+
+    /// Reads past the fields, failing exactly where [`Message::read`] would, without
+    /// building the message.
+    fn skip(r: &mut CdrReader<'_>) -> Result<(), CdrError> {
+        Self::read(r).map(drop)
+    }
+
+    /// [`Message::from_cdr`]'s verdict without the message: the same error, or Ok.
+    fn check_cdr(bytes: &[u8]) -> Result<(), CdrError> {
+        let mut r = CdrReader::new(bytes)?;
+        Self::skip(&mut r)
+    }
 }
 
 /// `application/x-ros2-cdr-frames; version=1; type=<M::TYPE_NAME>`. Every built-in type also has an
@@ -94,6 +106,12 @@ macro_rules! ros_message {
                 // Struct-literal fields are evaluated in source order: the wire order.
                 Ok(Self { $( $field: <$fty as $crate::cdr::CdrField>::read_field(r)?, )* })
             }
+            fn skip(
+                r: &mut $crate::cdr::CdrReader<'_>,
+            ) -> Result<(), $crate::cdr::CdrError> {
+                $( <$fty as $crate::cdr::CdrField>::skip_field(r)?; )*
+                Ok(())
+            }
         }
 
         impl $crate::cdr::CdrField for $name {
@@ -105,6 +123,11 @@ macro_rules! ros_message {
                 r: &mut $crate::cdr::CdrReader<'_>,
             ) -> Result<Self, $crate::cdr::CdrError> {
                 <Self as $crate::message::Message>::read(r)
+            }
+            fn skip_field(
+                r: &mut $crate::cdr::CdrReader<'_>,
+            ) -> Result<(), $crate::cdr::CdrError> {
+                <Self as $crate::message::Message>::skip(r)
             }
         }
     };

@@ -11,7 +11,7 @@ use agrisim_msgs::sensor_msgs::JointState;
 use agrisim_msgs::std_msgs::Header;
 use agrisim_msgs::tf2_msgs::TFMessage;
 use agrisim_msgs::*;
-use common::samples::all_samples;
+use common::samples::{all_samples, Sample};
 use std::collections::BTreeSet;
 
 // ---------------------------------------------------------------- round trips & coverage
@@ -448,12 +448,24 @@ fn truncations_always_fail_cleanly() {
     }
 }
 
+/// Decodes `buf` as `s`'s type; the message check without decoding (`check_cdr`, which
+/// skips byte sequences instead of copying them) must give the same verdict and error.
+fn verdict(s: &Sample, buf: &[u8], checked: &mut usize) -> bool {
+    let decoded = (s.decode)(buf);
+    if let Some(check) = agrisim_msgs::check_cdr(s.type_name, buf) {
+        assert_eq!(check, decoded, "{}: check_cdr and the decoder disagree", s.name);
+        *checked += 1;
+    }
+    decoded.is_ok()
+}
+
 #[test]
 fn garbage_never_panics() {
     let samples = all_samples();
     let mut rng = Rng::new(0x9e37_79b9_7f4a_7c15);
     let mut cases = 0usize;
     let mut ok = 0usize;
+    let mut checked = 0usize;
     // Random byte strings, mostly behind a valid header so the body decoders are reached;
     // counts/lengths are biased small so some sequences and strings actually parse.
     for _ in 0..20_000 {
@@ -473,7 +485,7 @@ fn garbage_never_panics() {
         }
         for s in &samples {
             cases += 1;
-            ok += (s.decode)(&buf).is_ok() as usize;
+            ok += verdict(s, &buf, &mut checked) as usize;
         }
     }
     // Mutations of valid messages: flipped bytes, then random truncation.
@@ -489,11 +501,12 @@ fn garbage_never_panics() {
             }
             for t in &samples {
                 cases += 1;
-                ok += (t.decode)(&buf).is_ok() as usize;
+                ok += verdict(t, &buf, &mut checked) as usize;
             }
         }
     }
     assert!(cases > 100_000, "{cases}");
+    assert!(checked > cases / 2, "check_cdr compared on {checked} of {cases}");
     assert!(
         ok > 0,
         "fuzz never produced a decodable message: generator too weak"
