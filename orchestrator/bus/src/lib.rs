@@ -16,7 +16,7 @@ pub use agrisim_error::{err, Context, Error, Result};
 pub use bus::{Bus, Published, Reader, Sample, Tap};
 pub use node::Node;
 pub use policy::{Profile, RecordPolicy};
-pub use recorder::{part_path, Channel, Recorder};
+pub use recorder::{part_path, Channel, Chunks, Recorder};
 
 /// `crate::error::...` paths inside this crate.
 pub(crate) mod error {

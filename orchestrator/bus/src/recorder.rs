@@ -43,6 +43,22 @@ pub struct Recorder {
     by_name: BTreeMap<String, usize>,
 }
 
+/// How a recording is cut into compressed chunks. A chunk is written when complete, so a
+/// killed run loses at most its last one (a finished or interrupted run loses nothing).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Chunks {
+    /// 1 MiB, compressed on the stepping thread: what a stream of small messages (poses,
+    /// clouds, joint states) wants; a killed run loses little.
+    Small,
+    /// 16 MiB (three 1280x720 camera frames), compressed by one zstd worker thread beside the
+    /// stepping thread, which hands each message over and waits only when a chunk ends. In
+    /// 1 MiB chunks every camera image ended one, so the stepping thread waited for its
+    /// compression all the same. zstd's multithreaded output depends on the input and the
+    /// worker count alone, never on timing (zstd issue 2327 and its determinism tests), so
+    /// logs stay byte-identical run after run.
+    Large,
+}
+
 /// The temporary name a recording is written under until it is finished.
 pub fn part_path(path: &Path) -> PathBuf {
     let mut name = path.file_name().unwrap_or_default().to_os_string();
@@ -56,26 +72,29 @@ impl Recorder {
         Recorder::with_policy(path, RecordPolicy::default())
     }
 
-    /// Records to `path` what `policy` keeps.
+    /// Records to `path` what `policy` keeps, in [`Chunks::Small`].
     pub fn with_policy(path: &Path, policy: RecordPolicy) -> Result<Recorder> {
+        Recorder::with_chunks(path, policy, Chunks::Small)
+    }
+
+    /// Records to `path` what `policy` keeps, in `chunks`.
+    pub fn with_chunks(path: &Path, policy: RecordPolicy, chunks: Chunks) -> Result<Recorder> {
         policy.validate().map_err(|e| crate::err!("{e}"))?;
         let part = part_path(path);
         let file = File::create(&part).context(|| format!("cannot create {}", part.display()))?;
-        // zstd chunks at level 1 (level 3, the default, took about a tenth of a camera run's
-        // CPU time for files only a few per cent smaller), compressed by one zstd worker
-        // thread beside the stepping thread: the stepping thread hands a message over and
-        // goes on, and waits only when a chunk ends. zstd's multithreaded output depends on
-        // the input and the worker count alone, never on timing (zstd issue 2327, its
-        // determinism tests), so logs stay byte-identical. Chunks of 16 MiB (three camera
-        // frames at 1280x720; the default 1 MiB ended a chunk, and so waited, at every
-        // image): a killed run loses at most the last one (README, "Sensor rendering speed").
+        // zstd chunks at level 1: level 3, the default, took about a tenth of a camera run's
+        // CPU time for files only a few per cent smaller (README, "Sensor rendering speed").
+        let (bytes, workers) = match chunks {
+            Chunks::Small => (1 << 20, 0),
+            Chunks::Large => (16 << 20, 1),
+        };
         let options = mcap::WriteOptions::new()
             .profile("ros2")
             .library("agrisim")
             .compression(Some(mcap::Compression::Zstd))
             .compression_level(1)
-            .compression_threads(1)
-            .chunk_size(Some(16 << 20));
+            .compression_threads(workers)
+            .chunk_size(Some(bytes));
         let writer = options.create(BufWriter::new(file)).context(|| format!("cannot start MCAP file {}", path.display()))?;
         Ok(Recorder { writer: Some(writer), path: path.to_path_buf(), policy, schemas: BTreeMap::new(), topics: vec![], by_name: BTreeMap::new() })
     }
@@ -179,5 +198,65 @@ impl Drop for Recorder {
     /// file under its own name.
     fn drop(&mut self) {
         let _ = self.finish_in_place();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use agrisim_msgs::sensor_msgs::Image;
+
+    /// Images of `n` bytes with contents that compress a little (noise in the low bits).
+    fn images(count: usize, n: usize) -> Vec<Image> {
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        (0..count)
+            .map(|k| {
+                let data = (0..n)
+                    .map(|i| {
+                        x ^= x << 13;
+                        x ^= x >> 7;
+                        x ^= x << 17;
+                        ((i / 997 + k) as u8).wrapping_add((x & 7) as u8)
+                    })
+                    .collect();
+                Image { height: 1, width: n as u32, encoding: "mono8".into(), step: n as u32, data, ..Default::default() }
+            })
+            .collect()
+    }
+
+    fn record(dir: &Path, name: &str, chunks: Chunks, msgs: &[Image]) -> Vec<u8> {
+        let path = dir.join(name);
+        let mut r = Recorder::with_chunks(&path, RecordPolicy::default(), chunks).unwrap();
+        for (k, m) in msgs.iter().enumerate() {
+            r.publish("/camera/image", k as i64 * 100_000_000, m).unwrap();
+        }
+        r.finish().unwrap();
+        std::fs::read(&path).unwrap()
+    }
+
+    fn messages(file: &[u8]) -> Vec<(u64, Vec<u8>)> {
+        mcap::MessageStream::new(file).unwrap().map(|m| m.unwrap()).map(|m| (m.log_time, m.data.into_owned())).collect()
+    }
+
+    /// Large chunks (a zstd worker thread) give the same file every time and the same
+    /// messages as small ones; 40 MB of images span several chunks.
+    #[test]
+    fn large_chunks_are_deterministic_and_lose_nothing() {
+        let dir = std::env::temp_dir().join(format!("agrisim-recorder-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let msgs = images(20, 2_000_000);
+        let a = record(&dir, "a.mcap", Chunks::Large, &msgs);
+        let b = record(&dir, "b.mcap", Chunks::Large, &msgs);
+        let small = record(&dir, "c.mcap", Chunks::Small, &msgs);
+        std::fs::remove_dir_all(&dir).unwrap();
+        assert!(a == b, "two recordings of the same messages differ");
+        let got = messages(&a);
+        assert_eq!(got.len(), msgs.len());
+        assert_eq!(got, messages(&small));
+        for (k, (t, cdr)) in got.iter().enumerate() {
+            assert_eq!((*t, Image::from_cdr(cdr).unwrap()), (k as u64 * 100_000_000, msgs[k].clone()));
+        }
+        let chunks = mcap::Summary::read(&a).unwrap().unwrap().chunk_indexes.len();
+        assert!((2..=4).contains(&chunks), "{chunks} chunks of 16 MiB for 40 MB");
     }
 }

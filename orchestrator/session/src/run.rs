@@ -3,10 +3,11 @@
 
 use crate::scenario::Scenario;
 use crate::session::{message_types, Session};
-use agrisim_bus::{Node, Recorder};
+use agrisim_bus::{Chunks, Node, Recorder};
 use agrisim_cosim::system::ticks_of;
 use agrisim_cosim::{LoadOptions, Master, System};
 use agrisim_error::{err, Context, Result};
+use agrisim_msgs::{sensor_msgs::Image, Message};
 use agrisim_nodes::{CommandScript, FaultInjector, OdomTf};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -156,7 +157,9 @@ pub fn prepare(s: &Scenario, o: &RunOptions, mcap: &Path, nodes: Vec<Box<dyn Nod
     if let Some(p) = o.record {
         policy.profile = p;
     }
-    let mut recorder = Recorder::with_policy(mcap, policy).map_err(|e| err!("scenario {}: {e}", s.path.display()))?;
+    // Camera images are megabytes each: large chunks (see `Chunks`).
+    let chunks = if types.iter().flatten().any(|t| t == Image::TYPE_NAME) { Chunks::Large } else { Chunks::Small };
+    let mut recorder = Recorder::with_chunks(mcap, policy, chunks).map_err(|e| err!("scenario {}: {e}", s.path.display()))?;
     let mut run_info = BTreeMap::from([
         ("scenario".to_string(), s.name.clone()),
         ("scenario_file".to_string(), s.path.display().to_string()),
