@@ -347,6 +347,11 @@ fn packets_equal_single_rays() {
                     (0..n).map(|_| RigidPose::yawed(x + rng.range(-0.02, 0.02), y + rng.range(-0.02, 0.02), 0.0, yaw + rng.range(-0.01, 0.01))).collect()
                 }
             };
+            // No movers at all (the scene alone).
+            rc.cast_packet_posed(&origins, &dirs, tmin, tmax, &RayCaster::new(&[]), &poses, &mut out);
+            for i in 0..n {
+                assert_eq!(out[i], rc.cast(origins[i], dirs[i], tmin, tmax, &[]), "posed packet {k} ray {i} without movers");
+            }
             rc.cast_packet_posed(&origins, &dirs, tmin, tmax, &local, &poses, &mut out);
             for i in 0..n {
                 let single = rc.cast_among_posed(origins[i], dirs[i], tmin, tmax, &local, &poses[i]);

@@ -150,6 +150,12 @@ impl RayCaster {
         assert!(origins.len() == dirs.len() && poses.len() == dirs.len(), "cast_packet_posed: {} origins, {} rays, {} poses", origins.len(), dirs.len(), poses.len());
         let n = dirs.len();
         let mut best = self.packet_static(origins, dirs, min, max);
+        if movers.is_empty() {
+            for i in 0..n {
+                out[i] = best[i].hit();
+            }
+            return;
+        }
         let before: [(f64, u32); MAX_PACKET] = std::array::from_fn(|i| (best[i].t, best[i].id));
         // The movers with the rays taken into their frame, each by its own pose, as one packet
         // whose far limits are the static hits.
@@ -401,7 +407,7 @@ struct PacketNearest<'a> {
 }
 
 impl PacketVisit for PacketNearest<'_> {
-    fn leaf(&mut self, packet: &mut Packet, start: usize, count: usize, rays: &[bool; MAX_PACKET]) {
+    fn leaf(&mut self, packet: &mut Packet, start: usize, count: usize, rays: u64) {
         // Primitive by primitive: with one origin for all rays (a camera tile) each primitive
         // takes it into its frame once. Each ray still meets the primitives in leaf order, so
         // its answer is the one it gets alone.
@@ -414,10 +420,11 @@ impl PacketVisit for PacketNearest<'_> {
                 [o] => Some(prim.seen_from(*o)),
                 _ => None,
             };
-            for (i, d) in self.dirs.iter().enumerate() {
-                if !rays[i] {
-                    continue;
-                }
+            let mut m = rays;
+            while m != 0 {
+                let i = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let d = &self.dirs[i];
                 let seen = shared.unwrap_or_else(|| prim.seen_from(self.origins[i]));
                 let best = &mut self.best[i];
                 if let Some((t, n)) = seen.intersect(*d, self.tmins[i.min(self.tmins.len() - 1)], best.t) {
@@ -451,20 +458,23 @@ struct PacketThrough<'a, F> {
 }
 
 impl<F: Fn(u32) -> bool> PacketVisit for PacketThrough<'_, F> {
-    fn leaf(&mut self, packet: &mut Packet, start: usize, count: usize, rays: &[bool; MAX_PACKET]) {
+    fn leaf(&mut self, packet: &mut Packet, start: usize, count: usize, rays: u64) {
         // Primitive by primitive, each taking the shared direction into its frame once; each
         // ray still meets them in leaf order and stops at the first opaque one, as
         // [`cross_leaf`] has it.
-        let mut live = *rays;
+        let mut live = rays;
         for k in start..start + count {
             let along = self.caster.prims[k].along(self.d);
             let mut opaque = None;
-            for (i, o) in self.origins.iter().enumerate() {
-                if live[i] && cross(&along, *o, self.tmin, self.tmax, || *opaque.get_or_insert_with(|| (self.opaque)(self.caster.ids[k])), &mut Crossings { t: &mut self.ts[i], len: &mut self.lens[i] }) {
+            let mut m = live;
+            while m != 0 {
+                let i = m.trailing_zeros() as usize;
+                m &= m - 1;
+                if cross(&along, self.origins[i], self.tmin, self.tmax, || *opaque.get_or_insert_with(|| (self.opaque)(self.caster.ids[k])), &mut Crossings { t: &mut self.ts[i], len: &mut self.lens[i] }) {
                     self.blocker = Some(k as u32);
                     self.blocked[i] = true;
                     packet.far[i] = f32::NEG_INFINITY;
-                    live[i] = false;
+                    live &= !(1 << i);
                 }
             }
         }

@@ -91,13 +91,14 @@ impl Packet {
         self.far[..self.len].iter().fold(f32::NEG_INFINITY, |m, &f| if f > m { f } else { m })
     }
 
-    /// Flags the rays that may meet the box in lane `lane` of node `n` (each ray's own robust
-    /// slab test, lane-wise over rays); true if any may.
+    /// The rays that may meet the box in lane `lane` of node `n`, one bit each (each ray's
+    /// own robust slab test, lane-wise over rays): visitors walk the set bits rather than
+    /// test a flag per lane.
     #[inline(always)]
-    fn rays_meeting(&self, n: &Node4, lane: usize, tmin: f32, hit: &mut [bool; MAX_PACKET]) -> bool {
+    fn rays_meeting(&self, n: &Node4, lane: usize, tmin: f32) -> u64 {
         let bmin = [n.b[0][0][lane], n.b[0][1][lane], n.b[0][2][lane]];
         let bmax = [n.b[1][0][lane], n.b[1][1][lane], n.b[1][2][lane]];
-        let mut any = false;
+        let mut hit = [false; MAX_PACKET];
         for i in 0..self.len {
             let mut t0 = tmin;
             let mut t1 = self.far[i];
@@ -109,9 +110,8 @@ impl Packet {
                 t1 = if h < t1 { h } else { t1 };
             }
             hit[i] = t0 <= t1;
-            any |= hit[i];
         }
-        any
+        hit[..self.len].iter().enumerate().fold(0, |m, (i, &h)| m | (h as u64) << i)
     }
 
     /// Packet slab test of a node's four boxes: entry bound and mask of possibly met boxes.
@@ -171,9 +171,9 @@ fn bounds(v: &[f32]) -> (f32, f32) {
 
 /// What a packet traversal does at leaves.
 pub(crate) trait PacketVisit {
-    /// Tests primitives `start .. start + count` for the rays flagged in `rays`, lowering
-    /// `packet.far` of the rays whose nearest hit moved closer.
-    fn leaf(&mut self, packet: &mut Packet, start: usize, count: usize, rays: &[bool; MAX_PACKET]);
+    /// Tests primitives `start .. start + count` for the rays whose bits `rays` sets,
+    /// lowering `packet.far` of the rays whose nearest hit moved closer.
+    fn leaf(&mut self, packet: &mut Packet, start: usize, count: usize, rays: u64);
 }
 
 const STACK: usize = 96;
@@ -204,7 +204,6 @@ pub(crate) fn traverse_packet<V: PacketVisit>(nodes: &[Node4], p: &mut Packet, t
     let mut sp = 0usize;
     let mut cur = 0u32;
     let mut far_max = p.far_max();
-    let mut rays = [false; MAX_PACKET];
     // `cur` is always an interior node: leaves are tested where their parent's lane (their
     // box) is at hand.
     'next: loop {
@@ -218,8 +217,9 @@ pub(crate) fn traverse_packet<V: PacketVisit>(nodes: &[Node4], p: &mut Packet, t
             mask &= mask - 1;
             match as_leaf(n.child[i]) {
                 Some((s, count)) => {
-                    if p.rays_meeting(n, i, tmin, &mut rays) {
-                        v.leaf(p, s, count, &rays);
+                    let rays = p.rays_meeting(n, i, tmin);
+                    if rays != 0 {
+                        v.leaf(p, s, count, rays);
                         far_max = p.far_max();
                     }
                 }
@@ -259,15 +259,15 @@ pub(crate) fn traverse_packet<V: PacketVisit>(nodes: &[Node4], p: &mut Packet, t
 fn traverse_from<V: PacketVisit>(nodes: &[Node4], root: u32, p: &mut Packet, tmin: f32, v: &mut V) {
     let n = &nodes[root as usize];
     let (_, mask) = p.slab4(n, tmin, p.far_max());
-    let mut rays = [false; MAX_PACKET];
     for i in 0..4 {
         if mask & (1 << i) == 0 {
             continue;
         }
         match as_leaf(n.child[i]) {
             Some((s, count)) => {
-                if p.rays_meeting(n, i, tmin, &mut rays) {
-                    v.leaf(p, s, count, &rays);
+                let rays = p.rays_meeting(n, i, tmin);
+                if rays != 0 {
+                    v.leaf(p, s, count, rays);
                 }
             }
             None => traverse_from(nodes, n.child[i], p, tmin, v),
