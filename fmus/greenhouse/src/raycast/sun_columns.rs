@@ -108,7 +108,7 @@ impl SunColumns {
                 // A cell's top is its list's first.
                 for (c, top) in grid.top.iter_mut().enumerate() {
                     if lists.start[c] < lists.start[c + 1] {
-                        *top = lists.tops[lists.start[c] as usize];
+                        *top = lists.entries[lists.start[c] as usize].0;
                     }
                 }
                 grid.lists = lists;
@@ -153,18 +153,16 @@ impl SunColumns {
         let mut order: Vec<usize> = (0..prims.len()).collect();
         order.sort_by(|&a, &b| tops[b].total_cmp(&tops[a]).then(a.cmp(&b)));
         let mut at = start[..n].to_vec();
-        let mut list = vec![0u32; entries];
-        let mut listed_tops = vec![0f32; entries];
+        let mut list = vec![(0f32, 0u32); entries];
         for i in order {
             cells.clear();
             self.cells(&caster.boxes[prims[i]], |c| cells.push(c));
             for &c in &cells {
-                list[at[c] as usize] = prims[i] as u32;
-                listed_tops[at[c] as usize] = tops[i];
+                list[at[c] as usize] = (tops[i], prims[i] as u32);
                 at[c] += 1;
             }
         }
-        Some(Lists { start, list, tops: listed_tops })
+        Some(Lists { start, entries: list })
     }
 
     /// Calls `f` with every cell that the box `(mn, mx)` swept along the direction covers.
@@ -266,12 +264,12 @@ impl SunColumns {
 }
 
 /// Per cell c, primitives (indices into the scene's) highest top first,
-/// `list[start[c] .. start[c + 1]]`, with their padded tops in `tops`; all empty for none.
+/// `entries[start[c] .. start[c + 1]]` as (padded top, primitive): side by side, one cache
+/// line serves both. All empty for none.
 #[derive(Clone, Default)]
 struct Lists {
     start: Vec<u32>,
-    list: Vec<u32>,
-    tops: Vec<f32>,
+    entries: Vec<(f32, u32)>,
 }
 
 impl Lists {
@@ -279,7 +277,7 @@ impl Lists {
     /// rest lie wholly below a ray climbing from `z`.
     fn above(&self, c: usize, z: f64) -> impl Iterator<Item = u32> + '_ {
         let (a, b) = (self.start[c] as usize, self.start[c + 1] as usize);
-        self.list[a..b].iter().zip(&self.tops[a..b]).take_while(move |&(_, &top)| z <= top as f64).map(|(&k, _)| k)
+        self.entries[a..b].iter().take_while(move |&&(top, _)| z <= top as f64).map(|&(_, k)| k)
     }
 }
 
@@ -308,6 +306,6 @@ fn up_f32(v: f64) -> f32 {
 
 impl std::fmt::Debug for SunColumns {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "SunColumns({}x{} cells of {} m toward {:?}, {} listed)", self.nx, self.ny, self.cell, self.dir, self.lists.list.len())
+        write!(f, "SunColumns({}x{} cells of {} m toward {:?}, {} listed)", self.nx, self.ny, self.cell, self.dir, self.lists.entries.len())
     }
 }
