@@ -8,6 +8,7 @@
 use crate::error::Result;
 use agrisim_msgs::Message;
 use std::collections::{BTreeMap, VecDeque};
+use std::sync::Arc;
 
 /// The latest message on a topic.
 #[derive(Clone, Debug, PartialEq)]
@@ -17,7 +18,9 @@ pub struct Sample {
     pub seq: u64,
     /// Simulation time of publication [ns].
     pub time_ns: i64,
-    pub cdr: Vec<u8>,
+    /// Shared by the topic's latest sample, its readers' queue and the outbox: a camera
+    /// image is copied once onto the bus, not once per holder.
+    pub cdr: Arc<[u8]>,
 }
 
 /// A message published in the current exchange, not yet routed and recorded.
@@ -26,7 +29,7 @@ pub struct Published {
     pub topic: String,
     pub type_name: String,
     pub time_ns: i64,
-    pub cdr: Vec<u8>,
+    pub cdr: Arc<[u8]>,
 }
 
 #[derive(Default, Debug, Clone)]
@@ -144,7 +147,8 @@ impl Tap {
 
 impl Bus {
     /// Publishes CDR bytes on `topic`.
-    pub fn publish_raw(&mut self, topic: &str, type_name: &str, time_ns: i64, cdr: Vec<u8>) {
+    pub fn publish_raw(&mut self, topic: &str, type_name: &str, time_ns: i64, cdr: impl Into<Arc<[u8]>>) {
+        let cdr = cdr.into();
         let seq = self.latest.get(topic).map_or(1, |s| s.seq + 1);
         let sample = Sample { type_name: type_name.to_string(), seq, time_ns, cdr: cdr.clone() };
         if let Some(q) = self.queues.get_mut(topic) {
@@ -236,13 +240,13 @@ mod tests {
         bus.publish_raw("/b", "x/msg/B", 1, vec![1]);
         bus.publish_raw("/a", "x/msg/A", 1, vec![2]);
         bus.publish_raw("/a", "x/msg/A", 2, vec![3]);
-        let got: Vec<(String, Vec<u8>)> = tap.take(&mut bus, |t| t != "/c").into_iter().map(|(t, _, s)| (t, s.cdr)).collect();
+        let got: Vec<(String, Vec<u8>)> = tap.take(&mut bus, |t| t != "/c").into_iter().map(|(t, _, s)| (t, s.cdr.to_vec())).collect();
         // A topic is joined at its newest message, then followed in full.
         assert_eq!(got, [("/a".to_string(), vec![3]), ("/b".to_string(), vec![1])]);
         bus.publish_raw("/a", "x/msg/A", 3, vec![4]);
         bus.publish_raw("/a", "x/msg/A", 4, vec![5]);
         bus.publish_raw("/c", "x/msg/C", 4, vec![6]);
-        let got: Vec<Vec<u8>> = tap.take(&mut bus, |t| t != "/c").into_iter().map(|(_, _, s)| s.cdr).collect();
+        let got: Vec<Vec<u8>> = tap.take(&mut bus, |t| t != "/c").into_iter().map(|(_, _, s)| s.cdr.to_vec()).collect();
         assert_eq!(got, [vec![4], vec![5]]);
         assert!(tap.take(&mut bus, |t| t != "/c").is_empty());
     }

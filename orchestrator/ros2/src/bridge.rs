@@ -303,7 +303,7 @@ impl Node for Ros2Bridge {
             if qos::kind_of(&topic, &ty) != qos::Kind::Sensor {
                 reliable_written.insert(topic.clone());
             }
-            self.write(&topic, &ty, s.cdr)?;
+            self.write(&topic, &ty, s.cdr.to_vec())?;
         }
         if let Mode::Lockstep { timeout } = self.config.mode {
             // DDS orders messages per writer only: a peer could see this instant's /clock

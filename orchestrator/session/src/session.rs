@@ -185,7 +185,7 @@ impl Hooks for Link<'_> {
         if let Port::Fmu { comp, var, .. } = &r.from {
             check_message(&system.components[*comp].name, &var.name, ty, bytes, t_ns)?;
         }
-        self.bus.publish_raw(&r.topic, ty, t_ns, bytes.to_vec());
+        self.bus.publish_raw(&r.topic, ty, t_ns, bytes);
         Ok(())
     }
 
@@ -206,7 +206,7 @@ impl Hooks for Link<'_> {
 
     fn message_input(&mut self, route: usize, connector: &str, out: &mut Vec<(i64, Vec<u8>)>) -> Result<()> {
         let reader = self.readers.entry(route).or_insert_with(|| Reader::new(connector));
-        out.extend(reader.take_samples(self.bus).into_iter().map(|s| (s.time_ns, s.cdr)));
+        out.extend(reader.take_samples(self.bus).into_iter().map(|s| (s.time_ns, s.cdr.to_vec())));
         Ok(())
     }
 
