@@ -454,7 +454,8 @@ impl Ctx<'_> {
     }
 }
 
-/// Cell size of the shadow grids [m] and most cells per grid (4 bytes each). On the default
+/// Cell size of the shadow grids [m] and most cells per grid (8 bytes each, plus their
+/// lists: at most 4 entries of 8 bytes per cell, see [`SunColumns`]). On the default
 /// greenhouse under `sensors.toml`'s sun, 5 cm cells clear 36 % of the shadow rays of a
 /// view along an aisle and 24 % of one at a row (2 cm: 40 % and 24 %; 10 cm: 32 % and 18 %).
 const COLUMN_CELL: f64 = 0.05;

@@ -208,17 +208,10 @@ mod tests {
 
     /// Images of `n` bytes with contents that compress a little (noise in the low bits).
     fn images(count: usize, n: usize) -> Vec<Image> {
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rng = agrisim_math::Rng::new(0x9e37_79b9_7f4a_7c15);
         (0..count)
             .map(|k| {
-                let data = (0..n)
-                    .map(|i| {
-                        x ^= x << 13;
-                        x ^= x >> 7;
-                        x ^= x << 17;
-                        ((i / 997 + k) as u8).wrapping_add((x & 7) as u8)
-                    })
-                    .collect();
+                let data = (0..n).map(|i| ((i / 997 + k) as u8).wrapping_add((rng.next_u64() & 7) as u8)).collect();
                 Image { height: 1, width: n as u32, encoding: "mono8".into(), step: n as u32, data, ..Default::default() }
             })
             .collect()
