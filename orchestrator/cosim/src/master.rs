@@ -358,7 +358,11 @@ impl Master {
         if n == route.cursor.last {
             return Ok(());
         }
-        let Value::Bin(bytes) = value::get(inst, var)? else { unreachable!("message port is Binary") };
+        // Borrowed, not copied (a camera image is megabytes). SAFETY: the bytes stay valid
+        // until the FMU's next call; nothing below calls any FMU (`each` sees the system by
+        // shared reference, and every FMU call needs the instance by `&mut`).
+        let bytes: *const [u8] = inst.get_binary_ref(var.value_reference)?;
+        let bytes = unsafe { &*bytes };
         let lost = |system: &System, e: agrisim_frames::Error| {
             let route = &system.routes[r];
             let Port::Fmu { var, .. } = &route.from else { unreachable!("FMU source") };

@@ -494,13 +494,19 @@ impl Instance {
 
     /// Copies the bytes out of FMU-owned memory (valid only until the FMU's next call).
     pub fn get_binary(&mut self, vr: Vr) -> Result<Vec<u8>, FmiError> {
+        Ok(self.get_binary_ref(vr)?.to_vec())
+    }
+
+    /// The bytes in FMU-owned memory, borrowed: they stay valid until the FMU's next call,
+    /// which needs `&mut self` again. A camera image is read without a copy.
+    pub fn get_binary_ref(&mut self, vr: Vr) -> Result<&[u8], FmiError> {
         let mut size: usize = 0;
         let mut p: *const u8 = ptr::null();
         self.call("fmi3GetBinary", &[vr], Ctx::None, |f, h| unsafe {
             (f.get_binary)(h, &vr, 1, &mut size, &mut p, 1)
         })?;
         if size == 0 {
-            return Ok(Vec::new());
+            return Ok(&[]);
         }
         if p.is_null() {
             return Err(self.refuse(
@@ -509,8 +515,9 @@ impl Instance {
                 &format!("the FMU returned NULL for {size} bytes"),
             ));
         }
-        // SAFETY: the FMU guarantees `size` readable bytes at `p` until its next call.
-        Ok(unsafe { std::slice::from_raw_parts(p, size) }.to_vec())
+        // SAFETY: the FMU guarantees `size` readable bytes at `p` until its next call, and
+        // every call takes `&mut self`, which the returned borrow holds.
+        Ok(unsafe { std::slice::from_raw_parts(p, size) })
     }
 
     /// Saves the FMU's state (needs canGetAndSetFMUState).
