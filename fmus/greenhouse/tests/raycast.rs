@@ -301,7 +301,7 @@ fn packets_equal_single_rays() {
     // A robot in its own frame, placed per ray by a pose.
     let local = RayCaster::new(&[Object { id: 1_000_001, placement: Placement::at(0.0, 0.0, 0.5), ..base.clone() }]);
     let (mut packets, mut hits, mut posed_hits, mut beyond_hits) = (0, 0, 0, 0);
-    let mut coherent_posed_hits = 0;
+    let (mut coherent_posed_hits, mut mixed_signs) = (0, 0);
     for (objs, origins) in [(&gh.objects, 0), (&solids, 1)] {
         let rc = RayCaster::new(objs);
         for k in 0..300 {
@@ -311,9 +311,10 @@ fn packets_equal_single_rays() {
             } else {
                 [rng.range(-1.0, 11.0), rng.range(-1.0, 11.0), rng.range(-1.0, 11.0)]
             };
-            // A tile: a random central direction and a spread from a pixel's width to wide.
+            // A tile: a random central direction and a spread from a pixel's width to wide (the
+            // widest often straddles an axis: the posed cast then splits it by octant).
             let c = random_dir(&mut rng);
-            let spread = [0.0005, 0.005, 0.05][k % 3];
+            let spread = [0.0005, 0.005, 0.05, 0.3][k % 4];
             let n = 1 + k % MAX_PACKET;
             let dirs: Vec<[f64; 3]> = (0..n)
                 .map(|_| unit([c[0] + spread * rng.range(-1.0, 1.0), c[1] + spread * rng.range(-1.0, 1.0), c[2] + spread * rng.range(-1.0, 1.0)]))
@@ -347,6 +348,7 @@ fn packets_equal_single_rays() {
                     (0..n).map(|_| RigidPose::yawed(x + rng.range(-0.02, 0.02), y + rng.range(-0.02, 0.02), 0.0, yaw + rng.range(-0.01, 0.01))).collect()
                 }
             };
+            mixed_signs += (0..3).any(|a| dirs.iter().any(|d| d[a] > 0.0) && dirs.iter().any(|d| d[a] < 0.0)) as usize;
             // No movers at all (the scene alone).
             rc.cast_packet_posed(&origins, &dirs, tmin, tmax, &RayCaster::new(&[]), &poses, &mut out);
             for i in 0..n {
@@ -361,5 +363,8 @@ fn packets_equal_single_rays() {
             }
         }
     }
-    assert!(packets == 600 && hits > 5_000 && coherent_posed_hits > 25 && posed_hits > 50 && beyond_hits > 1_000, "{hits} hits, {posed_hits} on the posed robot ({coherent_posed_hits} from coherent poses), {beyond_hits} further hits beyond");
+    assert!(
+        packets == 600 && hits > 5_000 && coherent_posed_hits > 25 && posed_hits > 50 && beyond_hits > 1_000 && mixed_signs > 100,
+        "{hits} hits, {posed_hits} on the posed robot ({coherent_posed_hits} from coherent poses), {beyond_hits} further hits beyond, {mixed_signs} packets with directions of both signs on an axis"
+    );
 }

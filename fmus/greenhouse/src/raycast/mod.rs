@@ -149,7 +149,9 @@ impl RayCaster {
     pub fn cast_packet_posed(&self, origins: &[[f64; 3]], dirs: &[[f64; 3]], min: f64, max: f64, movers: &RayCaster, poses: &[RigidPose], out: &mut [Option<Hit>]) {
         assert!(origins.len() == dirs.len() && poses.len() == dirs.len(), "cast_packet_posed: {} origins, {} rays, {} poses", origins.len(), dirs.len(), poses.len());
         let n = dirs.len();
-        let mut best = self.packet_static(origins, dirs, min, max);
+        assert!(n <= MAX_PACKET, "a packet of {n} rays (at most {MAX_PACKET})");
+        let mut best = [Best { t: max, id: u32::MAX, normal: [0.0; 3] }; MAX_PACKET];
+        nearest_in_packets(self, origins, dirs, min, max, &mut best);
         if movers.is_empty() {
             for i in 0..n {
                 out[i] = best[i].hit();
@@ -157,7 +159,7 @@ impl RayCaster {
             return;
         }
         let before: [(f64, u32); MAX_PACKET] = std::array::from_fn(|i| (best[i].t, best[i].id));
-        // The movers with the rays taken into their frame, each by its own pose, as one packet
+        // The movers with the rays taken into their frame, each by its own pose, as packets
         // whose far limits are the static hits.
         let mut lo = [[0.0; 3]; MAX_PACKET];
         let mut ld = [[0.0; 3]; MAX_PACKET];
@@ -165,46 +167,13 @@ impl RayCaster {
             let pose = &poses[i];
             (lo[i], ld[i]) = (pose.local_of(sub(origins[i], pose.translation)), pose.local_of(dirs[i]));
         }
-        match Packet::new(&lo[..n], &ld[..n], max) {
-            Some(mut packet) => {
-                for i in 0..n {
-                    packet.far[i] = far(best[i].t);
-                }
-                let mut v = PacketNearest { caster: movers, origins: &lo[..n], dirs: &ld[..n], tmins: &[min], best: &mut best };
-                traverse_packet(&movers.nodes, &mut packet, min, &mut v);
-            }
-            None => {
-                for i in 0..n {
-                    movers.nearest(lo[i], ld[i], min, &mut best[i], &mut ());
-                }
-            }
-        }
+        nearest_in_packets(movers, &lo[..n], &ld[..n], min, max, &mut best);
         for i in 0..n {
             if (best[i].t, best[i].id) != before[i] {
                 best[i].normal = poses[i].map_of(best[i].normal);
             }
             out[i] = best[i].hit();
         }
-    }
-
-    /// Nearest static hits of a packet (one origin for all rays, or one per ray).
-    fn packet_static(&self, origins: &[[f64; 3]], dirs: &[[f64; 3]], min: f64, max: f64) -> [Best; MAX_PACKET] {
-        assert!(dirs.len() <= MAX_PACKET, "a packet of {} rays (at most {MAX_PACKET})", dirs.len());
-        let mut best = [Best { t: max, id: u32::MAX, normal: [0.0; 3] }; MAX_PACKET];
-        let origin = |i: usize| origins[i.min(origins.len() - 1)];
-        match Packet::new(origins, dirs, max) {
-            Some(mut packet) => {
-                let mut v = PacketNearest { caster: self, origins, dirs, tmins: &[min], best: &mut best };
-                traverse_packet(&self.nodes, &mut packet, min, &mut v);
-            }
-            None => {
-                // Directions of both signs on an axis: the packet bound would cull nothing.
-                for (i, d) in dirs.iter().enumerate() {
-                    self.nearest(origin(i), *d, min, &mut best[i], &mut ());
-                }
-            }
-        }
-        best
     }
 
     /// Nearest hit among this scene and `movers`, whose objects are given in a moving frame
@@ -393,6 +362,59 @@ impl<S: Stats> Visit for Nearest<'_, S> {
     fn node(&mut self) {
         self.stats.node();
     }
+}
+
+/// Nearest hits in `set` of up to [`MAX_PACKET`] rays with their own origins (a run of LiDAR
+/// firings), each ray lowering its `best` (whose distance is its far limit on entry): one
+/// packet when the directions share their signs on every axis, else one packet per octant of
+/// directions (a packet whose directions have both signs on an axis has an interval bound
+/// that culls nothing; a quarter of the LiDAR's packets straddle an axis), a lone ray alone.
+/// Each ray's answer is its single-ray answer whatever packet it goes in.
+fn nearest_in_packets(set: &RayCaster, origins: &[[f64; 3]], dirs: &[[f64; 3]], min: f64, max: f64, best: &mut [Best; MAX_PACKET]) {
+    if packet_nearest(set, origins, dirs, min, max, best) {
+        return;
+    }
+    // The rays of each octant (bit a: the direction's inverse along axis a is positive, as
+    // the packet bound reads it), one bit per ray.
+    let mut octants = [0u64; 8];
+    for (i, d) in dirs.iter().enumerate() {
+        let k = (0..3).fold(0, |k, a| k | ((wide::inverse(d[a]) > 0.0) as usize) << a);
+        octants[k] |= 1 << i;
+    }
+    let mut lanes = [0usize; MAX_PACKET];
+    let mut sub_o = [[0.0; 3]; MAX_PACKET];
+    let mut sub_d = [[0.0; 3]; MAX_PACKET];
+    let mut sub_best = [Best { t: max, id: u32::MAX, normal: [0.0; 3] }; MAX_PACKET];
+    for mut m in octants {
+        let mut k = 0;
+        while m != 0 {
+            let i = m.trailing_zeros() as usize;
+            m &= m - 1;
+            (lanes[k], sub_o[k], sub_d[k], sub_best[k]) = (i, origins[i], dirs[i], best[i]);
+            k += 1;
+        }
+        // A lone ray, or rays whose bound still fails (NaN directions): one at a time.
+        if k < 2 || !packet_nearest(set, &sub_o[..k], &sub_d[..k], min, max, &mut sub_best) {
+            for q in 0..k {
+                set.nearest(sub_o[q], sub_d[q], min, &mut sub_best[q], &mut ());
+            }
+        }
+        for q in 0..k {
+            best[lanes[q]] = sub_best[q];
+        }
+    }
+}
+
+/// [`nearest_in_packets`] as one packet; false (nothing done) when the rays' directions do not
+/// share their signs on some axis.
+fn packet_nearest(set: &RayCaster, origins: &[[f64; 3]], dirs: &[[f64; 3]], min: f64, max: f64, best: &mut [Best; MAX_PACKET]) -> bool {
+    let Some(mut packet) = Packet::new(origins, dirs, max) else { return false };
+    for i in 0..dirs.len() {
+        packet.far[i] = far(best[i].t);
+    }
+    let mut v = PacketNearest { caster: set, origins, dirs, tmins: &[min], best };
+    traverse_packet(&set.nodes, &mut packet, min, &mut v);
+    true
 }
 
 /// Nearest-hit traversal of a packet: each ray keeps its own best hit.
