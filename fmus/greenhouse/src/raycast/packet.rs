@@ -38,15 +38,11 @@ pub(crate) struct Packet {
 }
 
 impl Packet {
-    /// None when some axis has directions of both signs: the interval test would cull nothing.
-    /// `origins` and `dirs` each hold one for all rays or one per ray. Axis by axis over the
-    /// lanes, so the conversions, inverses and bounds run in SIMD; inlined so the packet is
-    /// built where it is used rather than moved there.
+    /// `len` rays at the origin with no extent and no reach (every far limit -inf): lanes
+    /// that [`Packet::new`] then fills.
     #[inline(always)]
-    pub(crate) fn new(origins: &[[f64; 3]], dirs: &[[f64; 3]], tmax: f64) -> Option<Packet> {
-        let n = origins.len().max(dirs.len());
-        debug_assert!(n <= MAX_PACKET && (origins.len() == 1 || origins.len() == n) && (dirs.len() == 1 || dirs.len() == n));
-        let mut p = Packet {
+    fn idle(len: usize) -> Packet {
+        Packet {
             o: [[0.0; MAX_PACKET]; 3],
             o_lo: [0.0; 3],
             o_hi: [0.0; 3],
@@ -55,8 +51,19 @@ impl Packet {
             lo: [0.0; 3],
             hi: [0.0; 3],
             near: [0; 3],
-            len: n,
-        };
+            len,
+        }
+    }
+
+    /// None when some axis has directions of both signs: the interval test would cull nothing.
+    /// `origins` and `dirs` each hold one for all rays or one per ray. Axis by axis over the
+    /// lanes, so the conversions, inverses and bounds run in SIMD; inlined so the packet is
+    /// built where it is used rather than moved there.
+    #[inline(always)]
+    pub(crate) fn new(origins: &[[f64; 3]], dirs: &[[f64; 3]], tmax: f64) -> Option<Packet> {
+        let n = origins.len().max(dirs.len());
+        debug_assert!(n <= MAX_PACKET && (origins.len() == 1 || origins.len() == n) && (dirs.len() == 1 || dirs.len() == n));
+        let mut p = Packet::idle(n);
         for a in 0..3 {
             let o = &mut p.o[a][..n];
             (p.o_lo[a], p.o_hi[a]) = match origins {
@@ -379,17 +386,7 @@ mod tests {
         let mut set = 0u64;
         for case in 0..20_000 {
             let len = 1 + case % MAX_PACKET;
-            let mut p = Packet {
-                o: [[0.0; MAX_PACKET]; 3],
-                o_lo: [0.0; 3],
-                o_hi: [0.0; 3],
-                inv: [[0.0; MAX_PACKET]; 3],
-                far: [f32::NEG_INFINITY; MAX_PACKET],
-                lo: [0.0; 3],
-                hi: [0.0; 3],
-                near: [0; 3],
-                len,
-            };
+            let mut p = Packet::idle(len);
             for i in 0..len {
                 for k in 0..3 {
                     p.o[k][i] = value(&mut rng, 4.0);
