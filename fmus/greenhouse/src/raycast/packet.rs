@@ -126,7 +126,7 @@ impl Packet {
         }
     }
 
-    /// [`Packet::rays_meeting`] one ray at a time: the reference (and the code elsewhere).
+    /// [`Packet::rays_meeting`] one ray at a time: the reference, and the code on other CPUs.
     #[cfg_attr(target_arch = "x86_64", allow(dead_code))]
     #[inline(always)]
     fn rays_meeting_scalar(&self, n: &Node4, lane: usize, tmin: f32) -> u64 {
