@@ -132,16 +132,19 @@ impl SunColumns {
     fn lists(&self, caster: &RayCaster, prims: &[usize], max_entries: usize) -> Option<Lists> {
         let n = self.nx * self.ny;
         let mut count = vec![0u32; n];
-        let mut entries = 0usize;
-        let mut cells = vec![];
+        // Each primitive's cells, found once: `covered[first[i] .. first[i + 1]]`.
+        let mut covered: Vec<u32> = vec![];
+        let mut first = Vec::with_capacity(prims.len() + 1);
+        first.push(0usize);
         for &k in prims {
-            cells.clear();
-            self.cells(&caster.boxes[k], |c| cells.push(c));
-            cells.iter().for_each(|&c| count[c] += 1);
-            entries += cells.len();
-            if entries > max_entries || entries >= u32::MAX as usize {
+            self.cells(&caster.boxes[k], |c| {
+                count[c] += 1;
+                covered.push(c as u32);
+            });
+            if covered.len() > max_entries || covered.len() >= u32::MAX as usize {
                 return None;
             }
+            first.push(covered.len());
         }
         let mut start = Vec::with_capacity(n + 1);
         start.push(0u32);
@@ -153,13 +156,11 @@ impl SunColumns {
         let mut order: Vec<usize> = (0..prims.len()).collect();
         order.sort_by(|&a, &b| tops[b].total_cmp(&tops[a]).then(a.cmp(&b)));
         let mut at = start[..n].to_vec();
-        let mut list = vec![(0f32, 0u32); entries];
+        let mut list = vec![(0f32, 0u32); covered.len()];
         for i in order {
-            cells.clear();
-            self.cells(&caster.boxes[prims[i]], |c| cells.push(c));
-            for &c in &cells {
-                list[at[c] as usize] = (tops[i], prims[i] as u32);
-                at[c] += 1;
+            for &c in &covered[first[i]..first[i + 1]] {
+                list[at[c as usize] as usize] = (tops[i], prims[i] as u32);
+                at[c as usize] += 1;
             }
         }
         Some(Lists { start, entries: list })
