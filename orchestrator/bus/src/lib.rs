@@ -10,13 +10,14 @@ pub mod bus;
 pub mod check;
 pub mod node;
 pub mod policy;
+mod record_queue;
 pub mod recorder;
 
 pub use agrisim_error::{err, Context, Error, Result};
 pub use bus::{Bus, Published, Reader, Sample, Tap};
 pub use node::Node;
 pub use policy::{Profile, RecordPolicy};
-pub use recorder::{part_path, Channel, Chunks, Recorder};
+pub use recorder::{part_path, Channel, Chunks, Payload, Recorder};
 
 /// `crate::error::...` paths inside this crate.
 pub(crate) mod error {

@@ -2,7 +2,9 @@
 //! encoding, `offered_qos_profiles` channel metadata, log time = simulation time. Files made
 //! this way open in Foxglove and decode with mcap-ros2-support and rosbags.
 //!
-//! Chunks are zstd-compressed. The file is written under a temporary name (`NAME.part`)
+//! Chunks are zstd-compressed, on a writer thread of the recorder's: the stepping thread
+//! hands each kept message over (bytes shared with the bus are not copied) and goes on. The
+//! file is written under a temporary name (`NAME.part`)
 //! and renamed to its own name when finished: a file under its own name is always complete,
 //! and a killed process leaves a `.part` whose chunks up to the last one written an MCAP
 //! recovery reader salvages. The writer is finished on drop as well, so a run that stops on
@@ -11,51 +13,90 @@
 
 use crate::error::{Context, Result};
 use crate::policy::{RecordPolicy, TopicFilter};
+use crate::record_queue::{Queue, Weight};
 use agrisim_msgs::Message;
 use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::thread::JoinHandle;
 
 /// QoS rosbag2 records for an ordinary reliable, volatile topic (history/depth unknown).
 const QOS_VOLATILE: &str = "- history: 3\n  depth: 0\n  reliability: 1\n  durability: 2\n  deadline:\n    sec: 2147483647\n    nsec: 4294967295\n  lifespan:\n    sec: 2147483647\n    nsec: 4294967295\n  liveliness: 1\n  liveliness_lease_duration:\n    sec: 2147483647\n    nsec: 4294967295\n  avoid_ros_namespace_conventions: false\n";
+
+/// Most bytes of messages waiting for the writer thread (about three 1280x720 RGB-D frames):
+/// beyond it the stepping thread waits.
+const QUEUE_BYTES: usize = 32 << 20;
 
 /// A channel handle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub struct Channel(u16);
 
-/// One topic: its handle, type, filter and MCAP channel (created at its first kept message).
+/// A message's CDR bytes as handed to the recorder: shared with the bus (no copy) or owned.
+#[derive(Clone, Debug)]
+pub enum Payload {
+    Shared(Arc<[u8]>),
+    Owned(Vec<u8>),
+}
+
+impl Payload {
+    fn as_slice(&self) -> &[u8] {
+        match self {
+            Payload::Shared(b) => b,
+            Payload::Owned(b) => b,
+        }
+    }
+}
+
+impl From<Arc<[u8]>> for Payload {
+    fn from(b: Arc<[u8]>) -> Payload {
+        Payload::Shared(b)
+    }
+}
+
+impl From<Vec<u8>> for Payload {
+    fn from(b: Vec<u8>) -> Payload {
+        Payload::Owned(b)
+    }
+}
+
+impl From<&[u8]> for Payload {
+    fn from(b: &[u8]) -> Payload {
+        Payload::Owned(b.to_vec())
+    }
+}
+
+/// One topic as the stepping thread knows it: its handle, type and filter.
 struct Topic {
-    name: String,
     channel: Channel,
     type_name: String,
     filter: TopicFilter,
-    mcap_id: Option<u16>,
-    sequence: u32,
 }
 
+/// Records ROS 2 messages to an MCAP file. The stepping thread only decides what is kept and
+/// queues it; a writer thread of the recorder frames, compresses and writes, so the
+/// stepping thread never waits for zstd or the disk unless the queue is full.
 pub struct Recorder {
-    writer: Option<mcap::Writer<BufWriter<File>>>,
+    writer: Option<WriterThread>,
     path: PathBuf,
     policy: RecordPolicy,
-    schemas: BTreeMap<String, u16>,
     topics: Vec<Topic>,
     by_name: BTreeMap<String, usize>,
 }
 
 /// How a recording is cut into compressed chunks. A chunk is written when complete, so a
-/// killed run loses at most its last one (a finished or interrupted run loses nothing).
+/// killed run loses at most its last one and the messages queued for the writer thread (a
+/// finished or interrupted run loses nothing).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Chunks {
-    /// 1 MiB, compressed on the stepping thread: what a stream of small messages (poses,
+    /// 1 MiB, compressed on the writer thread: what a stream of small messages (poses,
     /// clouds, joint states) wants; a killed run loses little.
     Small,
     /// 16 MiB (three 1280x720 camera frames), compressed by one zstd worker thread beside the
-    /// stepping thread, which hands each message over and waits only when a chunk ends. In
-    /// 1 MiB chunks every camera image ended one, so the stepping thread waited for its
-    /// compression all the same. zstd's multithreaded output depends on the input and the
-    /// worker count alone, never on timing (zstd issue 2327 and its determinism tests), so
-    /// logs stay byte-identical run after run.
+    /// writer thread. In 1 MiB chunks every camera image ended one. zstd's multithreaded
+    /// output depends on the input and the worker count alone, never on timing (zstd issue
+    /// 2327 and its determinism tests), so logs stay byte-identical run after run.
     Large,
 }
 
@@ -96,12 +137,15 @@ impl Recorder {
             .compression_threads(workers)
             .chunk_size(Some(bytes));
         let writer = options.create(BufWriter::new(file)).context(|| format!("cannot start MCAP file {}", path.display()))?;
-        Ok(Recorder { writer: Some(writer), path: path.to_path_buf(), policy, schemas: BTreeMap::new(), topics: vec![], by_name: BTreeMap::new() })
+        let writer = WriterThread::start(Sink { writer, path: path.display().to_string(), schemas: BTreeMap::new(), topics: vec![] }).context(|| format!("cannot start the writer thread of {}", path.display()))?;
+        Ok(Recorder { writer: Some(writer), path: path.to_path_buf(), policy, topics: vec![], by_name: BTreeMap::new() })
     }
 
-    fn writer(&mut self) -> Result<&mut mcap::Writer<BufWriter<File>>> {
+    /// Queues `cmd` for the writer thread; an error the writer met since is reported here.
+    fn send(&mut self, cmd: Cmd) -> Result<()> {
         let path = self.path.display().to_string();
-        self.writer.as_mut().ok_or_else(|| crate::err!("{path}: recording already finished"))
+        let w = self.writer.as_ref().ok_or_else(|| crate::err!("{path}: recording already finished"))?;
+        w.queue.push(cmd).map_err(|e| crate::err!("{e}"))
     }
 
     /// The channel for `topic` carrying `type_name` (e.g. `nav_msgs/msg/Odometry`), created
@@ -119,56 +163,31 @@ impl Recorder {
         }
         let channel = Channel(self.topics.len() as u16);
         let filter = TopicFilter::new(self.policy.rule(topic, type_name));
+        self.send(Cmd::Topic { name: topic.to_string(), type_name: type_name.to_string() })?;
         self.by_name.insert(topic.to_string(), self.topics.len());
-        self.topics.push(Topic { name: topic.to_string(), channel, type_name: type_name.to_string(), filter, mcap_id: None, sequence: 0 });
+        self.topics.push(Topic { channel, type_name: type_name.to_string(), filter });
         Ok(channel)
     }
 
-    /// The MCAP channel of topic `i`, added to the file now if it is not there yet.
-    fn mcap_channel(&mut self, i: usize) -> Result<u16> {
-        if let Some(id) = self.topics[i].mcap_id {
-            return Ok(id);
-        }
-        let (topic, type_name) = (self.topics[i].name.clone(), self.topics[i].type_name.clone());
-        let schema_id = match self.schemas.get(&type_name) {
-            Some(id) => *id,
-            None => {
-                let text = agrisim_msgs::ros2msg_schema(&type_name).expect("checked when the channel was made");
-                let id = self.writer()?.add_schema(&type_name, "ros2msg", text.as_bytes()).context(|| format!("MCAP schema {type_name}"))?;
-                self.schemas.insert(type_name.clone(), id);
-                id
-            }
-        };
-        let metadata = BTreeMap::from([("offered_qos_profiles".to_string(), QOS_VOLATILE.to_string())]);
-        let id = self.writer()?.add_channel(schema_id, &topic, "cdr", &metadata).context(|| format!("MCAP channel {topic}"))?;
-        self.topics[i].mcap_id = Some(id);
-        Ok(id)
-    }
-
     /// Records CDR bytes on a channel at simulation time `time_ns`, if the policy keeps them.
-    pub fn write(&mut self, channel: Channel, time_ns: i64, cdr: &[u8]) -> Result<()> {
+    /// Bytes shared with the bus ([`Payload::Shared`]) are not copied.
+    pub fn write(&mut self, channel: Channel, time_ns: i64, cdr: impl Into<Payload>) -> Result<()> {
         let i = channel.0 as usize;
         if !self.topics[i].filter.keep(time_ns) {
             return Ok(());
         }
-        let id = self.mcap_channel(i)?;
-        let t = &mut self.topics[i];
-        t.sequence += 1;
-        let header = mcap::records::MessageHeader { channel_id: id, sequence: t.sequence, log_time: time_ns as u64, publish_time: time_ns as u64 };
-        let path = self.path.display().to_string();
-        self.writer()?.write_to_known_channel(&header, cdr).context(|| format!("writing {path}"))
+        self.send(Cmd::Message { topic: channel.0, time_ns, cdr: cdr.into() })
     }
 
     /// Records a message on `topic` (creating the channel if needed).
     pub fn publish<M: Message>(&mut self, topic: &str, time_ns: i64, msg: &M) -> Result<()> {
         let ch = self.channel(topic, M::TYPE_NAME)?;
-        self.write(ch, time_ns, &msg.to_cdr())
+        self.write(ch, time_ns, msg.to_cdr())
     }
 
     /// A metadata record (run settings: scenario, seed, parameters), sorted by key.
     pub fn metadata(&mut self, name: &str, entries: BTreeMap<String, String>) -> Result<()> {
-        let m = mcap::records::Metadata { name: name.to_string(), metadata: entries };
-        self.writer()?.write_metadata(&m).context(|| format!("MCAP metadata {name}"))
+        self.send(Cmd::Metadata(mcap::records::Metadata { name: name.to_string(), metadata: entries }))
     }
 
     /// Writes the summary and footer. Also done on drop; calling it reports errors.
@@ -177,15 +196,19 @@ impl Recorder {
     }
 
     /// [`Recorder::finish`] for a recorder owned by something else; later writes are errors.
-    /// The file gets its own name once complete.
+    /// Waits for the writer thread to write what is queued. The file gets its own name once
+    /// complete.
     pub fn finish_in_place(&mut self) -> Result<()> {
-        if let Some(mut w) = self.writer.take() {
-            w.finish().context(|| format!("finishing {}", self.path.display()))?;
-            drop(w);
+        let Some(w) = self.writer.take() else { return Ok(()) };
+        let (failure, finished) = w.finish();
+        if finished.is_ok() {
             let part = part_path(&self.path);
             std::fs::rename(&part, &self.path).context(|| format!("renaming {} to {}", part.display(), self.path.display()))?;
         }
-        Ok(())
+        match failure {
+            Some(e) => Err(crate::err!("{e}")),
+            None => finished.map_err(|e| crate::err!("{e}")),
+        }
     }
 
     pub fn path(&self) -> &Path {
@@ -198,6 +221,125 @@ impl Drop for Recorder {
     /// file under its own name.
     fn drop(&mut self) {
         let _ = self.finish_in_place();
+    }
+}
+
+/// What the stepping thread asks of the writer thread, in order.
+enum Cmd {
+    /// A topic was named (its MCAP channel is added at its first message).
+    Topic { name: String, type_name: String },
+    Message { topic: u16, time_ns: i64, cdr: Payload },
+    Metadata(mcap::records::Metadata),
+}
+
+impl Weight for Cmd {
+    fn bytes(&self) -> usize {
+        match self {
+            Cmd::Message { cdr, .. } => cdr.as_slice().len(),
+            _ => 0,
+        }
+    }
+}
+
+/// The writer thread and its queue.
+struct WriterThread {
+    queue: Arc<Queue<Cmd>>,
+    thread: JoinHandle<std::result::Result<(), String>>,
+}
+
+impl WriterThread {
+    fn start(mut sink: Sink) -> std::io::Result<WriterThread> {
+        let queue = Arc::new(Queue::new(QUEUE_BYTES));
+        let q = queue.clone();
+        let thread = std::thread::Builder::new().name("mcap-writer".into()).spawn(move || {
+            // After a failure the rest is dropped unwritten; the file is still finished (what
+            // was written stays readable) and the failure reported.
+            while let Some(cmd) = q.pop() {
+                if q.failure().is_none() {
+                    if let Err(e) = sink.apply(cmd) {
+                        q.fail(e);
+                    }
+                }
+            }
+            sink.writer.finish().map(|_| ()).map_err(|e| format!("finishing {}: {}", sink.path, chain(&e)))
+        })?;
+        Ok(WriterThread { queue, thread })
+    }
+
+    /// Closes the queue and waits for the file to be finished: the first failure of the
+    /// writing, and how finishing went.
+    fn finish(self) -> (Option<String>, std::result::Result<(), String>) {
+        self.queue.close();
+        let finished = self.thread.join().unwrap_or_else(|_| Err("the MCAP writer thread panicked".into()));
+        (self.queue.failure(), finished)
+    }
+}
+
+/// An error with its causes ("I/O error ...: No space left on device"): the MCAP writer's
+/// errors name the cause only as their source.
+fn chain(e: &dyn std::error::Error) -> String {
+    let mut s = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        s += &format!(": {c}");
+        cause = c.source();
+    }
+    s
+}
+
+/// The writer thread's side: the MCAP writer and the channels added to it.
+struct Sink {
+    writer: mcap::Writer<BufWriter<File>>,
+    path: String,
+    schemas: BTreeMap<String, u16>,
+    topics: Vec<SinkTopic>,
+}
+
+struct SinkTopic {
+    name: String,
+    type_name: String,
+    mcap_id: Option<u16>,
+    sequence: u32,
+}
+
+impl Sink {
+    fn apply(&mut self, cmd: Cmd) -> std::result::Result<(), String> {
+        match cmd {
+            Cmd::Topic { name, type_name } => {
+                self.topics.push(SinkTopic { name, type_name, mcap_id: None, sequence: 0 });
+                Ok(())
+            }
+            Cmd::Message { topic, time_ns, cdr } => {
+                let i = topic as usize;
+                let id = self.mcap_channel(i)?;
+                let t = &mut self.topics[i];
+                t.sequence += 1;
+                let header = mcap::records::MessageHeader { channel_id: id, sequence: t.sequence, log_time: time_ns as u64, publish_time: time_ns as u64 };
+                self.writer.write_to_known_channel(&header, cdr.as_slice()).map_err(|e| format!("writing {}: {}", self.path, chain(&e)))
+            }
+            Cmd::Metadata(m) => self.writer.write_metadata(&m).map_err(|e| format!("{}: MCAP metadata {}: {}", self.path, m.name, chain(&e))),
+        }
+    }
+
+    /// The MCAP channel of topic `i`, added to the file now if it is not there yet.
+    fn mcap_channel(&mut self, i: usize) -> std::result::Result<u16, String> {
+        if let Some(id) = self.topics[i].mcap_id {
+            return Ok(id);
+        }
+        let (topic, type_name) = (&self.topics[i].name, &self.topics[i].type_name);
+        let schema_id = match self.schemas.get(type_name) {
+            Some(id) => *id,
+            None => {
+                let text = agrisim_msgs::ros2msg_schema(type_name).expect("checked when the channel was made");
+                let id = self.writer.add_schema(type_name, "ros2msg", text.as_bytes()).map_err(|e| format!("{}: MCAP schema {type_name}: {}", self.path, chain(&e)))?;
+                self.schemas.insert(type_name.clone(), id);
+                id
+            }
+        };
+        let metadata = BTreeMap::from([("offered_qos_profiles".to_string(), QOS_VOLATILE.to_string())]);
+        let id = self.writer.add_channel(schema_id, topic, "cdr", &metadata).map_err(|e| format!("{}: MCAP channel {topic}: {}", self.path, chain(&e)))?;
+        self.topics[i].mcap_id = Some(id);
+        Ok(id)
     }
 }
 
@@ -229,6 +371,33 @@ mod tests {
 
     fn messages(file: &[u8]) -> Vec<(u64, Vec<u8>)> {
         mcap::MessageStream::new(file).unwrap().map(|m| m.unwrap()).map(|m| (m.log_time, m.data.into_owned())).collect()
+    }
+
+    /// A disk that fills up mid-run (the `.part` file is /dev/full): the writer thread's
+    /// failure reaches a later write and the finish, naming the file, and nothing panics.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_write_failure_on_the_writer_thread_is_reported() {
+        let dir = std::env::temp_dir().join(format!("agrisim-recorder-full-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("run.mcap");
+        std::os::unix::fs::symlink("/dev/full", part_path(&path)).unwrap();
+        let mut r = Recorder::with_chunks(&path, RecordPolicy::default(), Chunks::Small).unwrap();
+        let msgs = images(1, 4_000_000);
+        let mut failed = None;
+        for k in 0..100 {
+            if let Err(e) = r.publish("/camera/image", k * 100_000_000, &msgs[0]) {
+                failed = Some(e.to_string());
+                break;
+            }
+        }
+        let finished = r.finish().unwrap_err().to_string();
+        std::fs::remove_dir_all(&dir).unwrap();
+        let failed = failed.expect("a write after the failure reports it");
+        for e in [&failed, &finished] {
+            assert!(e.contains("run.mcap") && e.contains("No space left on device"), "{e}");
+        }
+        assert!(!path.exists(), "an unfinished file keeps its temporary name");
     }
 
     /// Large chunks (a zstd worker thread) give the same file every time and the same

@@ -231,7 +231,7 @@ impl Hooks for Link<'_> {
         }
         for m in self.bus.drain() {
             let ch = self.recorder.channel(&m.topic, &m.type_name)?;
-            self.recorder.write(ch, m.time_ns, &m.cdr)?;
+            self.recorder.write(ch, m.time_ns, m.cdr)?;
         }
         self.recorder.publish("/clock", t_ns, &Clock { clock: Time::from_nanos(t_ns) })?;
         let stamp = Header { stamp: Time::from_nanos(t_ns), frame_id: String::new() };
