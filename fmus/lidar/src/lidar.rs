@@ -78,10 +78,10 @@ pub struct Lidar {
 /// One point's ray: direction in the map and in lidar_link, time offset in the frame, hit.
 #[derive(Clone, Copy, Debug, Default)]
 struct Ray {
-    dir: [f64; 3],
     sensor: [f64; 3],
     t: f32,
-    hit: Option<agrisim_greenhouse::Hit>,
+    /// What comes back: range and intensity (none: no hit, or too weak to detect).
+    echo: Option<(f64, f32)>,
 }
 
 fn param(io: &Store, i: usize, ok: impl Fn(f64) -> bool, what: &str) -> Result<f64, String> {
@@ -186,10 +186,10 @@ impl Lidar {
         let stamp_ns = if c.deskewed { end_ns } else { (p.time(n0) * 1e9).round() as i64 };
         // The rays, cast on the threads in runs of whole packets (each thread takes the next
         // run when done with one, so a thread the system holds back does not hold up the
-        // frame), then the points in order (the range noise is drawn in point order, so the
-        // cloud does not depend on the threads).
+        // frame) with what each one's return would be, then the points in order (the range
+        // noise is drawn in point order, so the cloud does not depend on the threads). Every
+        // ray is written anew: the buffer is only sized, not cleared.
         let mut rays = std::mem::take(&mut self.rays);
-        rays.clear();
         rays.resize(c.points_per_frame, Ray::default());
         let this = &*self;
         on_threads(c.threads, rays.chunks_mut(RUN), |j, part| {
@@ -199,14 +199,12 @@ impl Lidar {
         let mut cloud = CloudBuilder::with_capacity(c.points_per_frame);
         let mut returns = 0;
         for ray in &rays {
-            let (d, d_sensor, t) = (ray.dir, ray.sensor, ray.t);
-            match ray.hit.filter(|h| detected(h.distance, c.range.1, c.extinction)) {
-                Some(hit) => {
-                    let rho = reflectivity::of_kind(c.scene.kind(hit.object));
-                    let cos_incidence = -(hit.normal[0] * d[0] + hit.normal[1] * d[1] + hit.normal[2] * d[2]);
-                    let r = hit.distance + self.rng.gauss(c.noise);
+            let (d_sensor, t) = (ray.sensor, ray.t);
+            match ray.echo {
+                Some((distance, intensity)) => {
+                    let r = distance + self.rng.gauss(c.noise);
                     let xyz = [(d_sensor[0] * r) as f32, (d_sensor[1] * r) as f32, (d_sensor[2] * r) as f32];
-                    cloud.push(&Point { xyz, intensity: reflectivity::intensity(rho, cos_incidence), t });
+                    cloud.push(&Point { xyz, intensity, t });
                     returns += 1;
                 }
                 None if c.drop_no_return => {}
@@ -219,7 +217,7 @@ impl Lidar {
 
     /// Casts the rays of points `n0 ..` into `out` (one per point) in packets of consecutive
     /// points (successive firings look close together); each ray's hit is exactly its
-    /// single-ray hit.
+    /// single-ray hit. Each ray's echo is what the hit returns, if strong enough to detect.
     fn cast_run(&self, n0: i64, end_ns: i64, stamp_ns: i64, out: &mut [Ray]) {
         let c = self.config.as_ref().expect("initialized");
         let robot = &self.robot.as_ref().expect("initialized").caster;
@@ -248,16 +246,19 @@ impl Lidar {
                 let d_sensor = p.beam_direction(&fs, p.beam(n));
                 let m = yaw_rotate(sin, cos, c.mount.translation);
                 ray.sensor = d_sensor;
-                ray.dir = yaw_rotate(sin, cos, c.mount.rotate(d_sensor));
                 ray.t = (fs.time - stamp_s) as f32;
-                batch.dirs[i] = ray.dir;
+                batch.dirs[i] = yaw_rotate(sin, cos, c.mount.rotate(d_sensor));
                 batch.origins[i] = [base.translation[0] + m[0], base.translation[1] + m[1], m[2]];
                 batch.poses[i] = base;
             }
             let k = rays.len();
             c.scene.caster.cast_packet_posed(&batch.origins[..k], &batch.dirs[..k], c.range.0, c.range.1, robot, &batch.poses[..k], &mut batch.hits[..k]);
-            for (ray, hit) in rays.iter_mut().zip(&batch.hits[..k]) {
-                ray.hit = *hit;
+            for ((ray, hit), d) in rays.iter_mut().zip(&batch.hits[..k]).zip(&batch.dirs[..k]) {
+                ray.echo = hit.filter(|h| detected(h.distance, c.range.1, c.extinction)).map(|h| {
+                    let rho = reflectivity::of_kind(c.scene.kind(h.object));
+                    let cos_incidence = -(h.normal[0] * d[0] + h.normal[1] * d[1] + h.normal[2] * d[2]);
+                    (h.distance, reflectivity::intensity(rho, cos_incidence))
+                });
             }
         }
     }
