@@ -4,7 +4,7 @@
 //! most what was queued besides the chunk being written.
 
 use std::collections::VecDeque;
-use std::sync::{Condvar, Mutex, MutexGuard};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 
 /// What a queued item counts for against the limit.
 pub(crate) trait Weight {
@@ -92,10 +92,31 @@ impl<T: Weight> Queue<T> {
     }
 }
 
+/// A consumer's guard: if the consumer's thread panics, the queue is marked failed, so that a
+/// producer waiting on a full queue gets an error instead of waiting for a consumer that is
+/// gone.
+pub(crate) struct FailOnPanic<T: Weight> {
+    queue: Arc<Queue<T>>,
+    why: &'static str,
+}
+
+impl<T: Weight> FailOnPanic<T> {
+    pub fn new(queue: Arc<Queue<T>>, why: &'static str) -> FailOnPanic<T> {
+        FailOnPanic { queue, why }
+    }
+}
+
+impl<T: Weight> Drop for FailOnPanic<T> {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            self.queue.fail(self.why.into());
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::sync::Arc;
 
     impl Weight for Vec<u8> {
         fn bytes(&self) -> usize {
@@ -111,9 +132,12 @@ mod tests {
         let consumer = {
             let q = q.clone();
             std::thread::spawn(move || {
+                let _unblock = FailOnPanic::new(q.clone(), "consumer panicked");
                 let mut got = vec![];
                 while let Some(item) = q.pop() {
-                    assert!(q.lock().bytes <= 1000, "queue over its limit");
+                    let s = q.lock();
+                    assert!(s.bytes <= 1000 || s.items.len() == 1, "queue over its limit: {} bytes in {} items", s.bytes, s.items.len());
+                    drop(s);
                     got.push(item);
                     std::thread::yield_now();
                 }
@@ -130,6 +154,24 @@ mod tests {
         for (i, (item, &n)) in got.iter().zip(&sizes).enumerate() {
             assert_eq!((item.len(), item.first().copied().unwrap_or(i as u8)), (n, i as u8));
         }
+    }
+
+    /// A consumer that panics (its guard marks the queue failed) does not leave the producer
+    /// waiting on a full queue for ever.
+    #[test]
+    fn a_panicking_consumer_unblocks_the_producer() {
+        let q = Arc::new(Queue::<Vec<u8>>::new(10));
+        let consumer = {
+            let q = q.clone();
+            std::thread::spawn(move || {
+                let _unblock = FailOnPanic::new(q.clone(), "consumer panicked");
+                std::thread::sleep(std::time::Duration::from_millis(20));
+                panic!("consumer gone");
+            })
+        };
+        q.push(vec![0; 10]).unwrap();
+        assert_eq!(q.push(vec![0; 10]), Err("consumer panicked".into()));
+        assert!(consumer.join().is_err());
     }
 
     /// A consumer's failure reaches the producer, even one waiting on a full queue.

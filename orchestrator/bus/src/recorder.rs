@@ -13,7 +13,7 @@
 
 use crate::error::{Context, Result};
 use crate::policy::{RecordPolicy, TopicFilter};
-use crate::record_queue::{Queue, Weight};
+use crate::record_queue::{FailOnPanic, Queue, Weight};
 use agrisim_msgs::Message;
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -252,6 +252,7 @@ impl WriterThread {
         let queue = Arc::new(Queue::new(QUEUE_BYTES));
         let q = queue.clone();
         let thread = std::thread::Builder::new().name("mcap-writer".into()).spawn(move || {
+            let _unblock = FailOnPanic::new(q.clone(), "the MCAP writer thread panicked");
             // After a failure the rest is dropped unwritten; the file is still finished (what
             // was written stays readable) and the failure reported.
             while let Some(cmd) = q.pop() {
