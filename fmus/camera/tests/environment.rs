@@ -1,6 +1,7 @@
 //! Images under sun and weather: darker at dusk and under cloud, shadows opposite the sun's
 //! azimuth, geometry (depth, labels) untouched by light and weather, fog removing far depth
-//! only, and frames independent of the number of render threads.
+//! only, render quality changing colours only, and frames independent of the number of
+//! render threads.
 
 use agrisim_fmi::{Model, Quiet, Store, Value};
 use agrisim_fmu_camera::lighting::Lighting;
@@ -139,6 +140,19 @@ fn frames_do_not_depend_on_the_thread_count() {
     assert!(one.rgb == three.rgb && one.depth == three.depth);
     let d = image::read_32fc1(&Image { encoding: "32FC1".into(), width: 160, height: 90, step: 640, data: one.depth.clone(), ..Default::default() }).unwrap();
     assert!(d.iter().filter(|&&z| z > 0.0).count() > 160 * 90 / 3);
+}
+
+/// Render quality (no shadows, hard, soft) changes colours only: depth (noise included) and
+/// labels stay byte for byte.
+#[test]
+fn render_quality_changes_the_image_not_depth_or_labels() {
+    let [low, medium, high] = ["low", "medium", "high"].map(|q| shot(&format!("{NOON}\nrender_quality = \"{q}\""), 2));
+    for other in [&medium, &high] {
+        assert_eq!(other.depth, low.depth);
+        assert_eq!(other.labels, low.labels);
+    }
+    assert_ne!(medium.rgb, low.rgb, "shadows change the image");
+    assert_ne!(high.rgb, medium.rgb, "soft shadows change the image");
 }
 
 /// Floor and a tall post at the origin; the camera 8 m above it looking straight down.
