@@ -124,26 +124,32 @@ mod tests {
         }
     }
 
+    /// Runs `body` as the consumer of `q` on a thread of its own, guarded as the recorder's
+    /// writer thread is.
+    fn consumer<R: Send + 'static>(q: &Arc<Queue<Vec<u8>>>, body: impl FnOnce(&Queue<Vec<u8>>) -> R + Send + 'static) -> std::thread::JoinHandle<R> {
+        let q = q.clone();
+        std::thread::spawn(move || {
+            let _unblock = FailOnPanic::new(q.clone(), "consumer panicked");
+            body(&q)
+        })
+    }
+
     /// Everything pushed comes out once, in order, and the queue never holds more than its
     /// limit (plus one item that is larger alone).
     #[test]
     fn order_kept_and_bytes_bounded() {
         let q = Arc::new(Queue::<Vec<u8>>::new(1000));
-        let consumer = {
-            let q = q.clone();
-            std::thread::spawn(move || {
-                let _unblock = FailOnPanic::new(q.clone(), "consumer panicked");
-                let mut got = vec![];
-                while let Some(item) = q.pop() {
-                    let s = q.lock();
-                    assert!(s.bytes <= 1000 || s.items.len() == 1, "queue over its limit: {} bytes in {} items", s.bytes, s.items.len());
-                    drop(s);
-                    got.push(item);
-                    std::thread::yield_now();
-                }
-                got
-            })
-        };
+        let consumer = consumer(&q, |q| {
+            let mut got = vec![];
+            while let Some(item) = q.pop() {
+                let s = q.lock();
+                assert!(s.bytes <= 1000 || s.items.len() == 1, "queue over its limit: {} bytes in {} items", s.bytes, s.items.len());
+                drop(s);
+                got.push(item);
+                std::thread::yield_now();
+            }
+            got
+        });
         let sizes: Vec<usize> = (0..500).map(|i| (i * 37) % 400 + usize::from(i == 250) * 5000).collect();
         for (i, &n) in sizes.iter().enumerate() {
             q.push(vec![i as u8; n]).unwrap();
@@ -161,14 +167,10 @@ mod tests {
     #[test]
     fn a_panicking_consumer_unblocks_the_producer() {
         let q = Arc::new(Queue::<Vec<u8>>::new(10));
-        let consumer = {
-            let q = q.clone();
-            std::thread::spawn(move || {
-                let _unblock = FailOnPanic::new(q.clone(), "consumer panicked");
-                std::thread::sleep(std::time::Duration::from_millis(20));
-                panic!("consumer gone");
-            })
-        };
+        let consumer = consumer(&q, |_| {
+            std::thread::sleep(std::time::Duration::from_millis(20));
+            panic!("consumer gone");
+        });
         q.push(vec![0; 10]).unwrap();
         assert_eq!(q.push(vec![0; 10]), Err("consumer panicked".into()));
         assert!(consumer.join().is_err());
