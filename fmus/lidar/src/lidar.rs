@@ -75,7 +75,7 @@ pub struct Lidar {
     rays: Vec<Ray>,
 }
 
-/// One point's ray: direction in the map and in lidar_link, time offset in the frame, hit.
+/// One point's ray: direction in lidar_link, time offset in the frame, echo.
 #[derive(Clone, Copy, Debug, Default)]
 struct Ray {
     sensor: [f64; 3],

@@ -143,8 +143,7 @@ impl Recorder {
 
     /// Queues `cmd` for the writer thread; an error the writer met since is reported here.
     fn send(&mut self, cmd: Cmd) -> Result<()> {
-        let path = self.path.display().to_string();
-        let w = self.writer.as_ref().ok_or_else(|| crate::err!("{path}: recording already finished"))?;
+        let w = self.writer.as_ref().ok_or_else(|| crate::err!("{}: recording already finished", self.path.display()))?;
         w.queue.push(cmd).map_err(|e| crate::err!("{e}"))
     }
 
