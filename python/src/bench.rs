@@ -46,7 +46,15 @@ struct Job {
     out: PathBuf,
 }
 
-fn job(kind: Kind, scenario: Option<PathBuf>, trials: u64, seed: u64, scenes: u64, record: Option<String>, out: PathBuf) -> PyResult<Job> {
+fn job(
+    kind: Kind,
+    scenario: Option<PathBuf>,
+    trials: u64,
+    seed: u64,
+    scenes: u64,
+    record: Option<String>,
+    out: PathBuf,
+) -> PyResult<Job> {
     if scenes == 0 {
         return Err(py_err("scenes must be at least 1"));
     }
@@ -54,7 +62,16 @@ fn job(kind: Kind, scenario: Option<PathBuf>, trials: u64, seed: u64, scenes: u6
     let scenario = Scenario::load(&path).map_err(py_err)?;
     let (fmu_dir, cache_dir) = fmu_dirs();
     let record = record.map(|r| r.parse::<Profile>().map_err(py_err)).transpose()?;
-    let options = RunOptions { fmu_dir, cache_dir, seed: None, duration: None, fmu_overrides: Default::default(), fmu_log: None, record, nodes: Default::default() };
+    let options = RunOptions {
+        fmu_dir,
+        cache_dir,
+        seed: None,
+        duration: None,
+        fmu_overrides: Default::default(),
+        fmu_log: None,
+        record,
+        nodes: Default::default(),
+    };
     Ok(Job { kind, scenario, options, plan: TrialPlan { trials, seed, scenes }, out })
 }
 
@@ -62,7 +79,14 @@ fn job(kind: Kind, scenario: Option<PathBuf>, trials: u64, seed: u64, scenes: u6
 fn worker(j: &Job, i: u64) -> std::process::Command {
     let mut c = std::process::Command::new(agrisim_bin());
     c.args(["bench", j.kind.name(), "--scenario"]).arg(&j.scenario.path);
-    c.args(["--trials", &j.plan.trials.to_string(), "--seed", &j.plan.seed.to_string(), "--scenes", &j.plan.scenes.to_string()]);
+    c.args([
+        "--trials",
+        &j.plan.trials.to_string(),
+        "--seed",
+        &j.plan.seed.to_string(),
+        "--scenes",
+        &j.plan.scenes.to_string(),
+    ]);
     c.arg("--fmu-dir").arg(&j.options.fmu_dir).arg("--cache-dir").arg(&j.options.cache_dir);
     if let Some(p) = j.options.record {
         c.args(["--record", p.name()]);
@@ -79,8 +103,14 @@ fn run_bench(py: Python<'_>, j: Job, jobs: usize, resume: bool) -> PyResult<Stri
         let command = |i: u64| worker(j, i);
         let exec = if jobs == 0 { Exec::InProcess } else { Exec::Workers { jobs, command: &command } };
         let json = match j.kind {
-            Kind::Nav => agrisim_bench::nav::bench_nav(&j.scenario, &j.options, j.plan, &j.out, resume, exec, |_, _| {}).map(|s| serde_json::to_string(&s)),
-            Kind::Harvest => agrisim_bench::harvest::bench_harvest(&j.scenario, &j.options, j.plan, &j.out, resume, exec, |_, _| {}).map(|s| serde_json::to_string(&s)),
+            Kind::Nav => {
+                agrisim_bench::nav::bench_nav(&j.scenario, &j.options, j.plan, &j.out, resume, exec, |_, _| {})
+                    .map(|s| serde_json::to_string(&s))
+            }
+            Kind::Harvest => {
+                agrisim_bench::harvest::bench_harvest(&j.scenario, &j.options, j.plan, &j.out, resume, exec, |_, _| {})
+                    .map(|s| serde_json::to_string(&s))
+            }
         };
         json.map(|r| r.expect("plain struct serializes"))
     })
@@ -92,7 +122,17 @@ fn run_bench(py: Python<'_>, j: Job, jobs: usize, resume: bool) -> PyResult<Stri
 #[pyfunction]
 #[pyo3(signature = (out, scenario=None, trials=50, seed=1, scenes=1, record=None, jobs=0, resume=false))]
 #[allow(clippy::too_many_arguments)]
-pub fn bench_nav(py: Python<'_>, out: PathBuf, scenario: Option<PathBuf>, trials: u64, seed: u64, scenes: u64, record: Option<String>, jobs: usize, resume: bool) -> PyResult<String> {
+pub fn bench_nav(
+    py: Python<'_>,
+    out: PathBuf,
+    scenario: Option<PathBuf>,
+    trials: u64,
+    seed: u64,
+    scenes: u64,
+    record: Option<String>,
+    jobs: usize,
+    resume: bool,
+) -> PyResult<String> {
     run_bench(py, job(Kind::Nav, scenario, trials, seed, scenes, record, out)?, jobs, resume)
 }
 
@@ -100,7 +140,17 @@ pub fn bench_nav(py: Python<'_>, out: PathBuf, scenario: Option<PathBuf>, trials
 #[pyfunction]
 #[pyo3(signature = (out, scenario=None, trials=50, seed=1, scenes=1, record=None, jobs=0, resume=false))]
 #[allow(clippy::too_many_arguments)]
-pub fn bench_harvest(py: Python<'_>, out: PathBuf, scenario: Option<PathBuf>, trials: u64, seed: u64, scenes: u64, record: Option<String>, jobs: usize, resume: bool) -> PyResult<String> {
+pub fn bench_harvest(
+    py: Python<'_>,
+    out: PathBuf,
+    scenario: Option<PathBuf>,
+    trials: u64,
+    seed: u64,
+    scenes: u64,
+    record: Option<String>,
+    jobs: usize,
+    resume: bool,
+) -> PyResult<String> {
     run_bench(py, job(Kind::Harvest, scenario, trials, seed, scenes, record, out)?, jobs, resume)
 }
 
@@ -109,7 +159,17 @@ pub fn bench_harvest(py: Python<'_>, out: PathBuf, scenario: Option<PathBuf>, tr
 #[pyfunction]
 #[pyo3(signature = (benchmark, out, index, scenario=None, trials=50, seed=1, scenes=1, record=None))]
 #[allow(clippy::too_many_arguments)]
-pub fn run_trial(py: Python<'_>, benchmark: &str, out: PathBuf, index: u64, scenario: Option<PathBuf>, trials: u64, seed: u64, scenes: u64, record: Option<String>) -> PyResult<()> {
+pub fn run_trial(
+    py: Python<'_>,
+    benchmark: &str,
+    out: PathBuf,
+    index: u64,
+    scenario: Option<PathBuf>,
+    trials: u64,
+    seed: u64,
+    scenes: u64,
+    record: Option<String>,
+) -> PyResult<()> {
     let j = job(Kind::parse(benchmark)?, scenario, trials, seed, scenes, record, out)?;
     if index >= j.plan.trials {
         return Err(py_err(format!("trial {index} is not among the {} trials", j.plan.trials)));

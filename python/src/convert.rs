@@ -34,7 +34,9 @@ pub fn from_py(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<Value> {
     if obj.is_instance_of::<PyInt>() {
         return match obj.extract::<i64>() {
             Ok(i) => Ok(Value::Int(i)),
-            Err(_) => Ok(Value::UInt(obj.extract::<u64>().map_err(|_| py_err(format!("field {path}: integer out of range")))?)),
+            Err(_) => Ok(Value::UInt(
+                obj.extract::<u64>().map_err(|_| py_err(format!("field {path}: integer out of range")))?,
+            )),
         };
     }
     if obj.is_instance_of::<PyFloat>() {
@@ -49,7 +51,8 @@ pub fn from_py(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<Value> {
     if let Ok(d) = obj.cast::<PyDict>() {
         let mut fields = Vec::with_capacity(d.len());
         for (k, v) in d.iter() {
-            let k: String = k.extract().map_err(|_| py_err(format!("field {path}: keys must be field names (strings)")))?;
+            let k: String =
+                k.extract().map_err(|_| py_err(format!("field {path}: keys must be field names (strings)")))?;
             let p = if path.is_empty() { k.clone() } else { format!("{path}.{k}") };
             fields.push((k, from_py(&v, &p)?));
         }
@@ -69,7 +72,11 @@ pub fn from_py(obj: &Bound<'_, PyAny>, path: &str) -> PyResult<Value> {
     if let Ok(b) = obj.extract::<Vec<u8>>() {
         return Ok(Value::Bytes(b));
     }
-    Err(py_err(format!("field {}: cannot encode a {}", if path.is_empty() { "(message)" } else { path }, obj.get_type().name()?)))
+    Err(py_err(format!(
+        "field {}: cannot encode a {}",
+        if path.is_empty() { "(message)" } else { path },
+        obj.get_type().name()?
+    )))
 }
 
 /// Decodes CDR bytes (header included) of ROS 2 type `type_name` into a dict.

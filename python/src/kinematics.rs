@@ -28,7 +28,12 @@ impl ArmModel {
         }
         let robot = Robot::from_urdf_str(URDF).map_err(|e| py_err(format!("models/robot/agrisim_robot.urdf: {e}")))?;
         let chain = robot.chain(&robot.root, &format!("{side}_hand_tcp")).map_err(py_err)?;
-        let arm = chain.iter().enumerate().filter(|(_, j)| j.kind.is_movable() && j.name != "lift_joint").map(|(i, _)| i).collect();
+        let arm = chain
+            .iter()
+            .enumerate()
+            .filter(|(_, j)| j.kind.is_movable() && j.name != "lift_joint")
+            .map(|(i, _)| i)
+            .collect();
         Ok(ArmModel { chain, arm, lift })
     }
 
@@ -41,7 +46,10 @@ impl ArmModel {
     /// Lower and upper position limits [rad] of the arm's joints.
     #[getter]
     fn limits(&self) -> (Vec<f64>, Vec<f64>) {
-        self.arm.iter().map(|&i| self.chain[i].limits.map_or((f64::NEG_INFINITY, f64::INFINITY), |l| (l.lower, l.upper))).unzip()
+        self.arm
+            .iter()
+            .map(|&i| self.chain[i].limits.map_or((f64::NEG_INFINITY, f64::INFINITY), |l| (l.lower, l.upper)))
+            .unzip()
     }
 
     /// The tool centre point for joint positions `q` (one per arm joint): its position [m]
@@ -51,7 +59,12 @@ impl ArmModel {
             return Err(py_err(format!("fk: {} joint values for {} arm joints", q.len(), self.arm.len())));
         }
         let mut it = q.iter();
-        let values: Vec<f64> = self.chain.iter().filter(|j| j.kind.is_movable()).map(|j| if j.name == "lift_joint" { self.lift } else { *it.next().expect("counted") }).collect();
+        let values: Vec<f64> = self
+            .chain
+            .iter()
+            .filter(|j| j.kind.is_movable())
+            .map(|j| if j.name == "lift_joint" { self.lift } else { *it.next().expect("counted") })
+            .collect();
         let p = Robot::chain_fk(&self.chain, &values).map_err(py_err)?;
         Ok((p.trans, p.rot))
     }

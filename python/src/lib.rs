@@ -14,7 +14,12 @@ mod task;
 
 use pyo3::prelude::*;
 
-pyo3::create_exception!(agrisim, AgrisimError, pyo3::exceptions::PyRuntimeError, "An error from the agrisim engine; the message names what was wrong.");
+pyo3::create_exception!(
+    agrisim,
+    AgrisimError,
+    pyo3::exceptions::PyRuntimeError,
+    "An error from the agrisim engine; the message names what was wrong."
+);
 
 /// An engine error as the Python exception.
 pub(crate) fn py_err(e: impl std::fmt::Display) -> PyErr {

@@ -5,10 +5,10 @@
 
 use crate::py_err;
 use agrisim_bus::Bus;
-use std::collections::BTreeSet;
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use std::collections::BTreeMap;
+use std::collections::BTreeSet;
 
 #[pyclass(unsendable, module = "agrisim._agrisim")]
 pub struct Node {
@@ -44,7 +44,13 @@ impl Node {
     /// One step at simulated time `t_ns`: `messages` (topic, ROS 2 type, CDR bytes) and
     /// `scalars` arrived since the last step; returns what the node published and the scalars
     /// it has set (all of them, each step: they are its standing set-points).
-    fn step<'py>(&mut self, py: Python<'py>, t_ns: i64, messages: Vec<(String, String, Vec<u8>)>, scalars: BTreeMap<String, f64>) -> PyResult<Outputs<'py>> {
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        t_ns: i64,
+        messages: Vec<(String, String, Vec<u8>)>,
+        scalars: BTreeMap<String, f64>,
+    ) -> PyResult<Outputs<'py>> {
         for (topic, ty, cdr) in messages {
             self.bus.publish_raw(&topic, &ty, t_ns, cdr);
         }
@@ -53,9 +59,17 @@ impl Node {
             self.inputs.insert(k.clone());
         }
         self.bus.drain();
-        self.node.step(t_ns, &mut self.bus).map_err(|e| py_err(format!("node {} at t={} s: {e}", self.node.name(), t_ns as f64 * 1e-9)))?;
+        self.node
+            .step(t_ns, &mut self.bus)
+            .map_err(|e| py_err(format!("node {} at t={} s: {e}", self.node.name(), t_ns as f64 * 1e-9)))?;
         let out = self.bus.drain().into_iter().map(|m| (m.topic, m.type_name, PyBytes::new(py, &m.cdr))).collect();
-        let set = self.bus.scalars().iter().filter(|(k, _)| !self.inputs.contains(*k)).map(|(k, v)| (k.clone(), *v)).collect();
+        let set = self
+            .bus
+            .scalars()
+            .iter()
+            .filter(|(k, _)| !self.inputs.contains(*k))
+            .map(|(k, v)| (k.clone(), *v))
+            .collect();
         for r in self.bus.take_rejected() {
             eprintln!("agrisim.Node: {r}");
         }

@@ -8,7 +8,9 @@ use std::path::{Path, PathBuf};
 /// The agrisim checkout: `AGRISIM_ROOT` or the one this module was built from.
 #[pyfunction]
 pub fn root() -> PathBuf {
-    std::env::var_os("AGRISIM_ROOT").map(PathBuf::from).unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("python/ has a parent").to_path_buf())
+    std::env::var_os("AGRISIM_ROOT")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("python/ has a parent").to_path_buf())
 }
 
 /// A scenario file: an existing path as given, else `models/scenarios/NAME.toml` of the root.

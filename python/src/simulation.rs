@@ -64,11 +64,20 @@ impl Simulation {
         self.session.as_mut().ok_or_else(|| py_err("the simulation is closed"))
     }
 
-    fn variable(&mut self, component: &str, name: &str) -> PyResult<(usize, agrisim_cosim::model_description::ModelVariable)> {
+    fn variable(
+        &mut self,
+        component: &str,
+        name: &str,
+    ) -> PyResult<(usize, agrisim_cosim::model_description::ModelVariable)> {
         let s = self.session()?;
         let comp = s.component(component, "Simulation").map_err(py_err)?;
         let c = &s.master.system.components[comp];
-        let v = c.archive.md.variable(name).cloned().ok_or_else(|| py_err(format!("FMU '{component}' has no variable '{name}'")))?;
+        let v = c
+            .archive
+            .md
+            .variable(name)
+            .cloned()
+            .ok_or_else(|| py_err(format!("FMU '{component}' has no variable '{name}'")))?;
         Ok((comp, v))
     }
 }
@@ -97,7 +106,9 @@ impl Simulation {
         if let Some(params) = parameters {
             for (comp, table) in params.iter() {
                 let comp: String = comp.extract()?;
-                let table = table.cast::<PyDict>().map_err(|_| py_err(format!("parameters['{comp}']: expected a dict of parameter values")))?;
+                let table = table
+                    .cast::<PyDict>()
+                    .map_err(|_| py_err(format!("parameters['{comp}']: expected a dict of parameter values")))?;
                 for (name, v) in table.iter() {
                     let name: String = name.extract()?;
                     let value = toml_of(&v, &format!("{comp}.{name}"))?;
@@ -120,7 +131,16 @@ impl Simulation {
         };
         let nodes = nodes.unwrap_or_default().iter().map(|n| node_of(n, &s)).collect::<PyResult<Vec<_>>>()?;
         let (fmu_dir, cache_dir) = fmu_dirs();
-        let o = RunOptions { fmu_dir, cache_dir, seed, duration: None, fmu_overrides: fmu.unwrap_or_default(), fmu_log: None, record: profile, nodes: Default::default() };
+        let o = RunOptions {
+            fmu_dir,
+            cache_dir,
+            seed,
+            duration: None,
+            fmu_overrides: fmu.unwrap_or_default(),
+            fmu_log: None,
+            record: profile,
+            nodes: Default::default(),
+        };
         let mut task = OnThisThread((s.clone(), o, mcap.clone(), Some(nodes)));
         let session = py
             .detach(move || {
@@ -137,7 +157,14 @@ impl Simulation {
                 types.insert(r.topic.clone(), ty);
             }
         }
-        Ok(Simulation { session: Some(session), scenario: s, readers: BTreeMap::new(), types, mcap: record, _scratch: scratch })
+        Ok(Simulation {
+            session: Some(session),
+            scenario: s,
+            readers: BTreeMap::new(),
+            types,
+            mcap: record,
+            _scratch: scratch,
+        })
     }
 
     /// Simulated time [s].
@@ -187,7 +214,11 @@ impl Simulation {
     fn publish(&mut self, topic: &str, msg: &Bound<'_, PyAny>, type_name: Option<String>) -> PyResult<()> {
         let ty = match type_name.or_else(|| self.types.get(topic).cloned()) {
             Some(t) => t,
-            None => return Err(py_err(format!("topic {topic}: not a topic of this system; pass type_name='pkg/msg/Type' to publish on it"))),
+            None => {
+                return Err(py_err(format!(
+                    "topic {topic}: not a topic of this system; pass type_name='pkg/msg/Type' to publish on it"
+                )))
+            }
         };
         let cdr = if let Ok(b) = msg.cast::<PyBytes>() {
             let b = b.as_bytes().to_vec();
@@ -234,7 +265,16 @@ impl Simulation {
 
     /// The system's component names.
     fn components(&self) -> PyResult<Vec<String>> {
-        Ok(self.session.as_ref().ok_or_else(|| py_err("the simulation is closed"))?.master.system.components.iter().map(|c| c.name.clone()).collect())
+        Ok(self
+            .session
+            .as_ref()
+            .ok_or_else(|| py_err("the simulation is closed"))?
+            .master
+            .system
+            .components
+            .iter()
+            .map(|c| c.name.clone())
+            .collect())
     }
 
     /// An FMU variable's current value (float, int, bool, str or bytes).
@@ -257,7 +297,8 @@ impl Simulation {
         let (comp, v) = self.variable(component, name)?;
         let x = match value.cast::<PyBytes>() {
             Ok(b) => value::Value::Bin(b.as_bytes().to_vec()),
-            Err(_) => value::from_toml(&v, &toml_of(value, &format!("{component}.{name}"))?).map_err(|e| py_err(format!("FMU '{component}': {e}")))?,
+            Err(_) => value::from_toml(&v, &toml_of(value, &format!("{component}.{name}"))?)
+                .map_err(|e| py_err(format!("FMU '{component}': {e}")))?,
         };
         let inst = &mut self.session()?.master.system.components[comp].instance;
         value::set(inst, &v, &x).map_err(|e| py_err(format!("FMU '{component}', variable '{name}': {e}")))
@@ -295,7 +336,12 @@ impl Simulation {
     }
 
     /// Closes the simulation; an exception in the `with` block goes on.
-    fn __exit__(&mut self, exc_type: Option<Bound<'_, PyAny>>, exc_value: Option<Bound<'_, PyAny>>, traceback: Option<Bound<'_, PyAny>>) -> PyResult<bool> {
+    fn __exit__(
+        &mut self,
+        exc_type: Option<Bound<'_, PyAny>>,
+        exc_value: Option<Bound<'_, PyAny>>,
+        traceback: Option<Bound<'_, PyAny>>,
+    ) -> PyResult<bool> {
         let _ = (exc_type, exc_value, traceback);
         self.close()?;
         Ok(false)
@@ -306,6 +352,7 @@ fn sample_to_py<'py>(py: Python<'py>, topic: &str, ty: &str, cdr: &[u8], raw: bo
     if raw {
         return Ok(PyBytes::new(py, cdr).into_any());
     }
-    let v = agrisim_msgs::dynamic::decode(ty, cdr).map_err(|e| py_err(format!("topic {topic}: message is not a valid {ty}: {e}")))?;
+    let v = agrisim_msgs::dynamic::decode(ty, cdr)
+        .map_err(|e| py_err(format!("topic {topic}: message is not a valid {ty}: {e}")))?;
     to_py(py, &v)
 }

@@ -32,9 +32,18 @@ impl NavTask {
     /// The goal (x, y, yaw) [m, m, rad] in the map frame of a nav trial seeded `seed`.
     fn goal(&self, seed: u64) -> PyResult<(f64, f64, f64)> {
         let nav = &self.scenario.nav;
-        draw_target(&self.setup.layout, &self.setup.truth, &mut Rng::new(seed), nav.targets_in_headland, nav.aisle_margin, 0.7)
-            .map(|[x, y, yaw]| (x, y, yaw))
-            .ok_or_else(|| py_err(format!("scenario {}: no free navigation target could be drawn", self.scenario.path.display())))
+        draw_target(
+            &self.setup.layout,
+            &self.setup.truth,
+            &mut Rng::new(seed),
+            nav.targets_in_headland,
+            nav.aisle_margin,
+            0.7,
+        )
+        .map(|[x, y, yaw]| (x, y, yaw))
+        .ok_or_else(|| {
+            py_err(format!("scenario {}: no free navigation target could be drawn", self.scenario.path.display()))
+        })
     }
 
     /// The start pose (x, y, yaw) of the scenario's layout, in the map frame.

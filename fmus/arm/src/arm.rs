@@ -212,7 +212,12 @@ impl Arm {
             Err(reason) => {
                 self.rejected += 1;
                 self.rejected_last = true;
-                log.warning(format_args!("{} arm: trajectory {} rejected at t={} s: {reason}", self.description().side, self.accepted + self.rejected, t_ns as f64 * 1e-9));
+                log.warning(format_args!(
+                    "{} arm: trajectory {} rejected at t={} s: {reason}",
+                    self.description().side,
+                    self.accepted + self.rejected,
+                    t_ns as f64 * 1e-9
+                ));
                 self.reason = reason;
             }
         }
@@ -225,7 +230,11 @@ impl Arm {
                 .map_err(|e| format!("not a valid control_msgs/msg/GripperCommand CDR message: {e}"))
                 .and_then(|c| self.gripper.command(c.position, c.max_effort));
             if let Err(e) = res {
-                log.warning(format_args!("{} gripper: command refused at t={} s: {e}", self.description().side, t_ns as f64 * 1e-9));
+                log.warning(format_args!(
+                    "{} gripper: command refused at t={} s: {e}",
+                    self.description().side,
+                    t_ns as f64 * 1e-9
+                ));
             }
         }
         Ok(())
@@ -311,7 +320,13 @@ impl Arm {
         }
         io.set_f64(FINGER_WIDTH, self.gripper.width);
         io.set_f64(TRACKING_ERROR_RMS, self.errors.rms());
-        let status = if self.rejected_last { 2 } else if self.exec == Exec::Executing { 1 } else { 0 };
+        let status = if self.rejected_last {
+            2
+        } else if self.exec == Exec::Executing {
+            1
+        } else {
+            0
+        };
         io.set_i32(STATUS, status);
         if let Some(s) = self.snapshot.take() {
             let js = self.joint_state_message(&s).to_cdr();
@@ -382,7 +397,10 @@ impl Model for Arm {
         let q0 = parse_list(io.string(Q_INIT), READY_POSE, "q_init")?;
         for i in 0..N {
             if !d.limits[i].contains(q0[i]) {
-                return Err(format!("q_init: {} = {} outside [{}, {}]", d.joint_names[i], q0[i], d.limits[i].lower, d.limits[i].upper));
+                return Err(format!(
+                    "q_init: {} = {} outside [{}, {}]",
+                    d.joint_names[i], q0[i], d.limits[i].lower, d.limits[i].upper
+                ));
             }
         }
         let kp = positive_list(io, KP, DEFAULT_KP)?;
@@ -442,4 +460,3 @@ impl Model for Arm {
         Ok(())
     }
 }
-

@@ -84,7 +84,12 @@ fn body_of(urdf: &urdf_rs::Robot, link: &str) -> Result<Option<Body>, String> {
     let o = Pose::from_xyz_rpy(inr.origin.xyz.0, inr.origin.rpy.0);
     let t = &inr.inertia;
     let local = [[t.ixx, t.ixy, t.ixz], [t.ixy, t.iyy, t.iyz], [t.ixz, t.iyz, t.izz]];
-    Ok(Some(Body { link: link.to_string(), mass: inr.mass.value, com: o.trans, inertia: rotate_inertia(&o.rot, &local) }))
+    Ok(Some(Body {
+        link: link.to_string(),
+        mass: inr.mass.value,
+        com: o.trans,
+        inertia: rotate_inertia(&o.rot, &local),
+    }))
 }
 
 impl ArmDescription {
@@ -104,7 +109,8 @@ impl ArmDescription {
         if revolute.len() != N || revolute.iter().any(|j| j.kind != JointKind::Revolute) {
             return Err(format!("{side} arm: expected {N} revolute joints from {side}_link0 to {side}_hand"));
         }
-        let mut limits = [revolute[0].limits.unwrap_or(Limits { lower: 0.0, upper: 0.0, velocity: 0.0, effort: 0.0 }); N];
+        let mut limits =
+            [revolute[0].limits.unwrap_or(Limits { lower: 0.0, upper: 0.0, velocity: 0.0, effort: 0.0 }); N];
         let joint_names: [String; N] = std::array::from_fn(|i| revolute[i].name.clone());
         for (i, j) in revolute.iter().enumerate() {
             if j.name != format!("{side}_joint{}", i + 1) {
@@ -116,7 +122,9 @@ impl ArmDescription {
         let fj = |n: &str| robot.joint(n).cloned().ok_or_else(|| format!("URDF has no joint {n}"));
         let finger_joints = [fj(&finger_names[0])?, fj(&finger_names[1])?];
         let finger_limits = limits_of(&finger_joints[0])?;
-        if limits_of(&finger_joints[1])? != finger_limits || finger_joints.iter().any(|j| j.kind != JointKind::Prismatic) {
+        if limits_of(&finger_joints[1])? != finger_limits
+            || finger_joints.iter().any(|j| j.kind != JointKind::Prismatic)
+        {
             return Err(format!("{side} gripper: finger joints must be prismatic with equal limits"));
         }
         let mut chain_bodies = Vec::new();

@@ -83,7 +83,13 @@ fn sign(x: f64) -> f64 {
 
 /// Controller torque for one joint (saturated).
 /// `actual` = (q, qd); `desired` = (q_d, qd_d, qdd_d).
-pub fn control_torque(p: &JointParams, mm: &ModelMismatch, inertia: f64, actual: (f64, f64), desired: (f64, f64, f64)) -> f64 {
+pub fn control_torque(
+    p: &JointParams,
+    mm: &ModelMismatch,
+    inertia: f64,
+    actual: (f64, f64),
+    desired: (f64, f64, f64),
+) -> f64 {
     let ((q, qd), (q_d, qd_d, qdd_d)) = (actual, desired);
     let ff = mm.inertia * inertia * qdd_d + mm.viscous * p.viscous * qd_d + mm.coulomb * p.coulomb * sign(qd_d);
     let tau = ff + p.kp * (q_d - q) + p.kd * (qd_d - qd);
@@ -107,7 +113,14 @@ pub fn integrate(p: &JointParams, inertia: f64, q: f64, qd: f64, tau: f64, dt: f
 }
 
 /// One control period for all joints: torque from the setpoint and the state, then the plant.
-pub fn step(params: &[JointParams; N], mm: &ModelMismatch, inertia: &[f64; N], s: &mut JointState, sp: &Setpoint, dt: f64) {
+pub fn step(
+    params: &[JointParams; N],
+    mm: &ModelMismatch,
+    inertia: &[f64; N],
+    s: &mut JointState,
+    sp: &Setpoint,
+    dt: f64,
+) {
     for i in 0..N {
         let tau = control_torque(&params[i], mm, inertia[i], (s.q[i], s.qd[i]), (sp.q[i], sp.qd[i], sp.qdd[i]));
         let (q, v) = integrate(&params[i], inertia[i], s.q[i], s.qd[i], tau, dt);

@@ -64,7 +64,11 @@ impl Gripper {
     pub fn update(&mut self, dt: f64, grasp_width: f64) {
         let before = self.width;
         let step = self.speed * dt;
-        let mut w = if self.target < self.width { (self.width - step).max(self.target) } else { (self.width + step).min(self.target) };
+        let mut w = if self.target < self.width {
+            (self.width - step).max(self.target)
+        } else {
+            (self.width + step).min(self.target)
+        };
         let object = grasp_width > 0.0 && grasp_width.is_finite();
         // The fingers stop on an object they close onto (never pushed open by one).
         let stop = if object { grasp_width.min(before) } else { 0.0 };

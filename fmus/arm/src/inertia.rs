@@ -15,7 +15,8 @@ use agrisim_robot::Pose;
 /// Reflected rotor (motor + gear) inertia per joint [kg m^2], as Franka gives it for the FR3
 /// (quoted in Drake's franka_description README, "Rotor Inertia and Gear Ratio"). The Panda's
 /// values are not published; the FR3's are used as the closest available figure.
-pub const ROTOR_INERTIA: [f64; N] = [0.605721456, 0.605721456, 0.462474144, 0.462474144, 0.205544064, 0.205544064, 0.205544064];
+pub const ROTOR_INERTIA: [f64; N] =
+    [0.605721456, 0.605721456, 0.462474144, 0.462474144, 0.205544064, 0.205544064, 0.205544064];
 
 fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
@@ -109,7 +110,12 @@ mod tests {
                     let mut pose = Pose::IDENTITY;
                     let mut mv = 0;
                     for (k, j) in d.chain.iter().enumerate() {
-                        let qj = if j.kind.is_movable() { mv += 1; q[mv - 1] } else { 0.0 };
+                        let qj = if j.kind.is_movable() {
+                            mv += 1;
+                            q[mv - 1]
+                        } else {
+                            0.0
+                        };
                         pose = pose.mul(&j.transform(qj));
                         for (kk, b) in &d.chain_bodies {
                             if *kk == k {

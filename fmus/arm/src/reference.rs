@@ -96,7 +96,8 @@ impl Reference {
                 (Some(_), None) => Degree::Cubic,
                 _ => Degree::Linear,
             };
-            let end: [(f64, f64, f64); N] = std::array::from_fn(|i| (w.q[i], w.qd.map_or(0.0, |v| v[i]), w.qdd.map_or(0.0, |a| a[i])));
+            let end: [(f64, f64, f64); N] =
+                std::array::from_fn(|i| (w.q[i], w.qd.map_or(0.0, |v| v[i]), w.qdd.map_or(0.0, |a| a[i])));
             if w.t_ns > prev_t {
                 let t = (w.t_ns - prev_t) as f64 * 1e-9;
                 let c = std::array::from_fn(|i| coefficients(deg, prev[i], end[i], t));
@@ -190,7 +191,8 @@ mod tests {
     fn a_later_start_keeps_the_old_trajectory_until_then() {
         let old = Reference::new(0, &Setpoint::hold([0.0; N]), &[wp(1_000_000_000, 1.0, Some(0.0), Some(0.0))]);
         let at = old.sample(1_500_000_000);
-        let mut new = Reference::new(2_000_000_000, &at, &[wp(1_000_000_000, 2.0, Some(0.0), Some(0.0))]).after(old.clone(), 500_000_000);
+        let mut new = Reference::new(2_000_000_000, &at, &[wp(1_000_000_000, 2.0, Some(0.0), Some(0.0))])
+            .after(old.clone(), 500_000_000);
         assert_eq!(new.sample(600_000_000), old.sample(600_000_000), "the old one still runs");
         assert_eq!(new.sample(1_900_000_000), Setpoint::hold([1.0; N]), "then holds its end");
         assert!((new.sample(2_000_000_000).q[0] - 1.0).abs() < 1e-12);
@@ -209,7 +211,11 @@ mod tests {
     #[test]
     fn derivatives_are_consistent() {
         let from = Setpoint::hold([0.0; N]);
-        let r = Reference::new(0, &from, &[wp(500_000_000, 0.3, Some(0.4), Some(0.0)), wp(1_500_000_000, -0.2, Some(0.0), Some(0.0))]);
+        let r = Reference::new(
+            0,
+            &from,
+            &[wp(500_000_000, 0.3, Some(0.4), Some(0.0)), wp(1_500_000_000, -0.2, Some(0.0), Some(0.0))],
+        );
         for k in 1..1400 {
             let t = k * 1_000_000;
             let (a, b, m) = (r.sample(t - 1000), r.sample(t + 1000), r.sample(t));

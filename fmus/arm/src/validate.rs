@@ -45,7 +45,9 @@ pub fn validate(bytes: &[u8], arm: &ArmDescription, q_cmd: &[f64; N]) -> Result<
 
 /// The trajectory message in `bytes`.
 pub fn decode(bytes: &[u8]) -> Result<JointTrajectory, String> {
-    JointTrajectory::from_cdr(bytes).map_err(|e| format!("not a valid trajectory_msgs/msg/JointTrajectory CDR message ({} bytes): {e}", bytes.len()))
+    JointTrajectory::from_cdr(bytes).map_err(|e| {
+        format!("not a valid trajectory_msgs/msg/JointTrajectory CDR message ({} bytes): {e}", bytes.len())
+    })
 }
 
 /// Validates a decoded trajectory.
@@ -64,7 +66,11 @@ pub fn check(msg: &JointTrajectory, arm: &ArmDescription, q_cmd: &[f64; N]) -> R
         col.push(i);
     }
     if let Some(i) = seen.iter().position(|s| !s) {
-        return Err(format!("joint {} missing from joint_names ({} of {N} given)", arm.joint_names[i], msg.joint_names.len()));
+        return Err(format!(
+            "joint {} missing from joint_names ({} of {N} given)",
+            arm.joint_names[i],
+            msg.joint_names.len()
+        ));
     }
     // 3.
     if msg.points.is_empty() {
@@ -92,9 +98,14 @@ pub fn check(msg: &JointTrajectory, arm: &ArmDescription, q_cmd: &[f64; N]) -> R
             return Err(format!("point {p}: accelerations given without velocities"));
         }
         if !pt.effort.is_empty() {
-            return Err(format!("point {p}: {} effort values; effort commands are not supported (position-controlled arm)", pt.effort.len()));
+            return Err(format!(
+                "point {p}: {} effort values; effort commands are not supported (position-controlled arm)",
+                pt.effort.len()
+            ));
         }
-        for (field, v) in [("positions", &pt.positions), ("velocities", &pt.velocities), ("accelerations", &pt.accelerations)] {
+        for (field, v) in
+            [("positions", &pt.positions), ("velocities", &pt.velocities), ("accelerations", &pt.accelerations)]
+        {
             if let Some(k) = v.iter().position(|x| !x.is_finite()) {
                 return Err(format!("point {p}: {field}[{k}] ({}) is {}", msg.joint_names[k], v[k]));
             }
@@ -110,7 +121,12 @@ pub fn check(msg: &JointTrajectory, arm: &ArmDescription, q_cmd: &[f64; N]) -> R
         }
         if let Some(prev) = out.last() {
             if t_ns <= prev.t_ns {
-                return Err(format!("point {p}: time_from_start {} not after point {} ({})", fmt_t(t_ns), p - 1, fmt_t(prev.t_ns)));
+                return Err(format!(
+                    "point {p}: time_from_start {} not after point {} ({})",
+                    fmt_t(t_ns),
+                    p - 1,
+                    fmt_t(prev.t_ns)
+                ));
             }
         }
         // 6. limits.
@@ -118,14 +134,20 @@ pub fn check(msg: &JointTrajectory, arm: &ArmDescription, q_cmd: &[f64; N]) -> R
         for i in 0..N {
             let l = arm.limits[i];
             if !l.contains(q[i]) {
-                return Err(format!("point {p}: {} position {} rad outside limits [{}, {}]", arm.joint_names[i], q[i], l.lower, l.upper));
+                return Err(format!(
+                    "point {p}: {} position {} rad outside limits [{}, {}]",
+                    arm.joint_names[i], q[i], l.lower, l.upper
+                ));
             }
         }
         let qd = (!pt.velocities.is_empty()).then(|| reorder(&pt.velocities));
         if let Some(v) = qd {
             for i in 0..N {
                 if v[i].abs() > arm.limits[i].velocity {
-                    return Err(format!("point {p}: {} velocity {} rad/s beyond limit {}", arm.joint_names[i], v[i], arm.limits[i].velocity));
+                    return Err(format!(
+                        "point {p}: {} velocity {} rad/s beyond limit {}",
+                        arm.joint_names[i], v[i], arm.limits[i].velocity
+                    ));
                 }
             }
         }
@@ -139,11 +161,19 @@ pub fn check(msg: &JointTrajectory, arm: &ArmDescription, q_cmd: &[f64; N]) -> R
             let dq = (q[i] - q_prev[i]).abs();
             if dt == 0.0 {
                 if dq > START_TOLERANCE {
-                    return Err(format!("point 0 at time 0: {} is {} rad from the current commanded position {} (a jump)", arm.joint_names[i], q[i], q_prev[i]));
+                    return Err(format!(
+                        "point 0 at time 0: {} is {} rad from the current commanded position {} (a jump)",
+                        arm.joint_names[i], q[i], q_prev[i]
+                    ));
                 }
             } else if dq / dt > arm.limits[i].velocity {
                 let from = if p == 0 { "current position".to_string() } else { format!("point {}", p - 1) };
-                return Err(format!("point {p}: {} moves {dq} rad in {dt} s from {from} ({} rad/s beyond limit {})", arm.joint_names[i], dq / dt, arm.limits[i].velocity));
+                return Err(format!(
+                    "point {p}: {} moves {dq} rad in {dt} s from {from} ({} rad/s beyond limit {})",
+                    arm.joint_names[i],
+                    dq / dt,
+                    arm.limits[i].velocity
+                ));
             }
         }
         let qdd = (!pt.accelerations.is_empty()).then(|| reorder(&pt.accelerations));

@@ -129,40 +129,84 @@ fn corpus_with_reasons() -> Vec<(&'static str, &'static str, Vec<u8>)> {
         ("truncated CDR", "CDR sequence count", good.to_cdr()[..40].to_vec()),
         ("unknown joint name", "unknown joint name \"left_joint8\"", m(&|t| t.joint_names[6] = "left_joint8".into())),
         ("other arm's names", "unknown joint name \"right_joint1\"", m(&|t| t.joint_names = names("right"))),
-        ("missing joint", "left_joint7 missing", m(&|t| {
-            t.joint_names.pop();
-            for p in &mut t.points {
-                p.positions.pop();
-            }
-        })),
+        (
+            "missing joint",
+            "left_joint7 missing",
+            m(&|t| {
+                t.joint_names.pop();
+                for p in &mut t.points {
+                    p.positions.pop();
+                }
+            }),
+        ),
         ("duplicate joint", "duplicate joint name", m(&|t| t.joint_names[1] = "left_joint1".into())),
         ("no joint names", "(0 of 7 given)", m(&|t| t.joint_names.clear())),
         ("no points", "no points", m(&|t| t.points.clear())),
-        ("6 positions", "point 1: 6 positions", m(&|t| {
-            t.points[1].positions.pop();
-        })),
+        (
+            "6 positions",
+            "point 1: 6 positions",
+            m(&|t| {
+                t.points[1].positions.pop();
+            }),
+        ),
         ("8 positions", "point 0: 8 positions", m(&|t| t.points[0].positions.push(0.0))),
         ("3 velocities", "3 velocities", m(&|t| t.points[0].velocities = vec![0.0; 3])),
-        ("accelerations without velocities", "accelerations given without velocities", m(&|t| t.points[0].accelerations = vec![0.0; 7])),
+        (
+            "accelerations without velocities",
+            "accelerations given without velocities",
+            m(&|t| t.points[0].accelerations = vec![0.0; 7]),
+        ),
         ("effort given", "effort", m(&|t| t.points[1].effort = vec![1.0; 7])),
         ("NaN position", "positions[2] (left_joint3) is NaN", m(&|t| t.points[1].positions[2] = nan)),
         ("+inf position", "positions[0] (left_joint1) is inf", m(&|t| t.points[0].positions[0] = f64::INFINITY)),
-        ("NaN velocity", "velocities[3] (left_joint4) is NaN", m(&|t| t.points[0].velocities = vec![0.0, 0.0, 0.0, nan, 0.0, 0.0, 0.0])),
-        ("-inf acceleration", "accelerations[4] (left_joint5) is -inf", m(&|t| {
-            t.points[0].velocities = vec![0.0; 7];
-            t.points[0].accelerations = vec![0.0, 0.0, 0.0, 0.0, f64::NEG_INFINITY, 0.0, 0.0];
-        })),
+        (
+            "NaN velocity",
+            "velocities[3] (left_joint4) is NaN",
+            m(&|t| t.points[0].velocities = vec![0.0, 0.0, 0.0, nan, 0.0, 0.0, 0.0]),
+        ),
+        (
+            "-inf acceleration",
+            "accelerations[4] (left_joint5) is -inf",
+            m(&|t| {
+                t.points[0].velocities = vec![0.0; 7];
+                t.points[0].accelerations = vec![0.0, 0.0, 0.0, 0.0, f64::NEG_INFINITY, 0.0, 0.0];
+            }),
+        ),
         ("nanosec >= 1e9", "nanosec 1000000000", m(&|t| t.points[1].time_from_start = Duration::new(1, 1_000_000_000))),
-        ("negative time", "negative time_from_start", m(&|t| t.points[0].time_from_start = Duration::new(-1, 500_000_000))),
+        (
+            "negative time",
+            "negative time_from_start",
+            m(&|t| t.points[0].time_from_start = Duration::new(-1, 500_000_000)),
+        ),
         ("equal times", "not after point 0", m(&|t| t.points[1].time_from_start = Duration::new(1, 0))),
-        ("decreasing times", "0.5 s not after point 0", m(&|t| t.points[1].time_from_start = Duration::new(0, 500_000_000))),
+        (
+            "decreasing times",
+            "0.5 s not after point 0",
+            m(&|t| t.points[1].time_from_start = Duration::new(0, 500_000_000)),
+        ),
         ("above upper limit", "left_joint4 position 0 rad outside limits", m(&|t| t.points[1].positions[3] = 0.0)),
         ("below lower limit", "left_joint1 position -3 rad outside limits", m(&|t| t.points[1].positions[0] = -3.0)),
-        ("velocity beyond limit", "left_joint2 velocity 3 rad/s beyond limit", m(&|t| t.points[0].velocities = vec![0.0, 3.0, 0.0, 0.0, 0.0, 0.0, 0.0])),
-        ("implied velocity beyond limit", "point 1: left_joint1 moves", m(&|t| t.points[1].positions[0] = READY_POSE[0] + 2.5)),
-        ("too fast from current state", "from current position", m(&|t| t.points[0].time_from_start = Duration::new(0, 10_000_000))),
+        (
+            "velocity beyond limit",
+            "left_joint2 velocity 3 rad/s beyond limit",
+            m(&|t| t.points[0].velocities = vec![0.0, 3.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+        ),
+        (
+            "implied velocity beyond limit",
+            "point 1: left_joint1 moves",
+            m(&|t| t.points[1].positions[0] = READY_POSE[0] + 2.5),
+        ),
+        (
+            "too fast from current state",
+            "from current position",
+            m(&|t| t.points[0].time_from_start = Duration::new(0, 10_000_000)),
+        ),
         ("jump at time 0", "a jump", m(&|t| t.points[0].time_from_start = Duration::new(0, 0))),
-        ("reordered names, positions not", "left_joint4 position 0.1 rad outside limits", m(&|t| t.joint_names.swap(0, 3))),
+        (
+            "reordered names, positions not",
+            "left_joint4 position 0.1 rad outside limits",
+            m(&|t| t.joint_names.swap(0, 3)),
+        ),
     ]
 }
 
@@ -246,7 +290,10 @@ fn valid_trajectory_is_tracked_with_small_nonzero_error() {
     assert_eq!(st.trajectory_count, 1);
     assert_eq!(sim.io.i32(STATUS), 0);
     let rms = sim.io.f64(TRACKING_ERROR_RMS);
-    println!("sample trajectory (5 s, cubic, 3 points): RMS tracking error {rms:.6} rad, max {:.6} rad", st.max_tracking_error);
+    println!(
+        "sample trajectory (5 s, cubic, 3 points): RMS tracking error {rms:.6} rad, max {:.6} rad",
+        st.max_tracking_error
+    );
     assert_eq!(rms, st.rms_tracking_error);
     assert!(rms > 1e-5, "tracking error unrealistically small: {rms}");
     assert!(rms < 5e-3, "tracking error too large: {rms}");
@@ -402,6 +449,10 @@ fn a_rejection_quoting_a_huge_joint_name_fits_the_status_port() {
     a.send(&t.to_cdr());
     a.step(1);
     let reason = a.status().reason;
-    assert!(reason.starts_with("unknown joint name \"xxx") && reason.ends_with("...") && reason.len() <= 1024, "{}", reason.len());
+    assert!(
+        reason.starts_with("unknown joint name \"xxx") && reason.ends_with("...") && reason.len() <= 1024,
+        "{}",
+        reason.len()
+    );
     assert!(a.io.binary(TRAJECTORY_STATUS).len() <= Arm::VARIABLES[TRAJECTORY_STATUS].max_size);
 }

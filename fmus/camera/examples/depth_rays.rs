@@ -80,7 +80,11 @@ fn main() {
     let n = rays.len();
     let hits = dist.iter().filter(|d| d.is_finite()).count();
     println!("camera depth rays  {n} ({poses} frames of 1280x720), hits {:.1} %", 100.0 * hits as f64 / n as f64);
-    println!("rays/s             {:.3e} in 8x8 packets, {:.3e} as single rays (single thread, best of 3; identical hits)", n as f64 / secs, n as f64 / secs_single);
+    println!(
+        "rays/s             {:.3e} in 8x8 packets, {:.3e} as single rays (single thread, best of 3; identical hits)",
+        n as f64 / secs,
+        n as f64 / secs_single
+    );
     if let Some(dir) = common::arg("--out") {
         let dir = std::path::PathBuf::from(dir);
         std::fs::create_dir_all(&dir).expect("out dir");

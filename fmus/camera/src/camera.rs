@@ -12,7 +12,6 @@ use crate::optics::{CameraPose, Intrinsics, Mount};
 use crate::ports::*;
 use crate::render::{self, DepthModel, DepthNoise, Frame, Shot};
 use crate::scene::Scene;
-use agrisim_sensor_ports::robot::{Coords, RobotBody};
 use agrisim_fmi::{Log, Model, OutPort, Store, Var};
 use agrisim_fmu_util::{to_ns, Schedule};
 use agrisim_greenhouse::environment::Environment;
@@ -20,6 +19,7 @@ use agrisim_greenhouse::raycast::SunColumns;
 use agrisim_greenhouse::weather::Conditions;
 use agrisim_math::Rng;
 use agrisim_msgs::Message;
+use agrisim_sensor_ports::robot::{Coords, RobotBody};
 use std::sync::Arc;
 
 pub use crate::ports::MAX_SIDE;
@@ -61,7 +61,12 @@ pub struct Camera {
 }
 
 fn new_ports() -> [OutPort; 4] {
-    [OutPort::new(IMAGE, IMAGE_SEQ), OutPort::new(DEPTH, DEPTH_SEQ), OutPort::new(CAMERA_INFO, CAMERA_INFO_SEQ), OutPort::new(LABELS_IMAGE, LABELS_SEQ)]
+    [
+        OutPort::new(IMAGE, IMAGE_SEQ),
+        OutPort::new(DEPTH, DEPTH_SEQ),
+        OutPort::new(CAMERA_INFO, CAMERA_INFO_SEQ),
+        OutPort::new(LABELS_IMAGE, LABELS_SEQ),
+    ]
 }
 
 fn param(io: &Store, i: usize, ok: impl Fn(f64) -> bool, what: &str) -> Result<f64, String> {
@@ -73,10 +78,7 @@ fn side(io: &Store, i: usize) -> Result<u32, String> {
     if (1..=MAX_SIDE).contains(&v) {
         Ok(v as u32)
     } else {
-        Err(format!(
-            "parameter {} must be in [1, {MAX_SIDE}], got {v}",
-            VARIABLES[i].name
-        ))
+        Err(format!("parameter {} must be in [1, {MAX_SIDE}], got {v}", VARIABLES[i].name))
     }
 }
 
@@ -87,38 +89,18 @@ impl Config {
         let width = side(io, WIDTH)?;
         let height = side(io, HEIGHT)?;
         let fov_v = param(io, FOV_V, fov, "in (0, 180) deg")?;
-        let fov_h = match param(
-            io,
-            FOV_H,
-            |v| v == 0.0 || fov(v),
-            "0 (square pixels) or in (0, 180) deg",
-        )? {
-            0.0 => {
-                2.0 * (width as f64 / height as f64 * (0.5 * fov_v.to_radians()).tan())
-                    .atan()
-                    .to_degrees()
-            }
+        let fov_h = match param(io, FOV_H, |v| v == 0.0 || fov(v), "0 (square pixels) or in (0, 180) deg")? {
+            0.0 => 2.0 * (width as f64 / height as f64 * (0.5 * fov_v.to_radians()).tan()).atan().to_degrees(),
             v => v,
         };
-        let rate = param(
-            io,
-            FRAME_RATE,
-            |v| v > 0.0 && v <= 1000.0,
-            "in (0, 1000] Hz",
-        )?;
+        let rate = param(io, FRAME_RATE, |v| v > 0.0 && v <= 1000.0, "in (0, 1000] Hz")?;
         let range_min = param(io, RANGE_MIN, |v| v >= 0.0, ">= 0")?;
         let range_max = param(io, RANGE_MAX, |v| v > range_min, "above range_min")?;
         let noise = match io.i32(DEPTH_NOISE_MODEL) {
             0 => DepthNoise::None,
-            1 => DepthNoise::Fixed {
-                sigma: param(io, DEPTH_NOISE_SIGMA, |v| v >= 0.0, ">= 0")?,
-            },
-            2 => DepthNoise::Stereo {
-                subpixel: param(io, SUBPIXEL, |v| v >= 0.0, ">= 0")?,
-            },
-            m => return Err(format!(
-                "parameter depth_noise_model must be 0 (none), 1 (fixed) or 2 (stereo), got {m}"
-            )),
+            1 => DepthNoise::Fixed { sigma: param(io, DEPTH_NOISE_SIGMA, |v| v >= 0.0, ">= 0")? },
+            2 => DepthNoise::Stereo { subpixel: param(io, SUBPIXEL, |v| v >= 0.0, ">= 0")? },
+            m => return Err(format!("parameter depth_noise_model must be 0 (none), 1 (fixed) or 2 (stereo), got {m}")),
         };
         let mount = SENSOR_PORTS.mount(io)?;
         let conditions = match io.string(ENVIRONMENT).trim() {
@@ -192,7 +174,15 @@ impl Camera {
         let mut mount = c.mount;
         mount.translation[2] += lift;
         let pose = CameraPose::new(&mount, x, y, yaw);
-        let shot = Shot { scene: &c.scene, dynamic: &robot, k: &c.intrinsics, pose: &pose, light: &c.light, columns: &c.columns, depth: &c.depth };
+        let shot = Shot {
+            scene: &c.scene,
+            dynamic: &robot,
+            k: &c.intrinsics,
+            pose: &pose,
+            light: &c.light,
+            columns: &c.columns,
+            depth: &c.depth,
+        };
         render::render_into(frame, &shot, &mut self.rng, c.threads);
     }
 
@@ -218,12 +208,7 @@ impl Model for Camera {
         Self::default()
     }
 
-    fn initialize(
-        &mut self,
-        io: &mut Store,
-        start_time: f64,
-        _log: &mut dyn Log,
-    ) -> Result<(), String> {
+    fn initialize(&mut self, io: &mut Store, start_time: f64, _log: &mut dyn Log) -> Result<(), String> {
         let config = Config::from_params(io)?;
         SENSOR_PORTS.base_pose(io)?;
         self.schedule = Schedule::new(1.0 / config.period, start_time)?;
@@ -242,13 +227,7 @@ impl Model for Camera {
         Ok(())
     }
 
-    fn do_step(
-        &mut self,
-        io: &mut Store,
-        t: f64,
-        h: f64,
-        _log: &mut dyn Log,
-    ) -> Result<(), String> {
+    fn do_step(&mut self, io: &mut Store, t: f64, h: f64, _log: &mut dyn Log) -> Result<(), String> {
         let (x, y, yaw) = SENSOR_PORTS.base_pose(io)?;
         let lift = io.f64(LIFT_POSITION);
         if !(lift.is_finite() && lift.abs() < 100.0) {
@@ -272,7 +251,16 @@ impl Camera {
     }
 
     #[allow(clippy::too_many_arguments)]
-    fn capture_and_publish(&mut self, io: &mut Store, stamp: i64, x: f64, y: f64, yaw: f64, lift: f64, coords: Option<&Coords>) {
+    fn capture_and_publish(
+        &mut self,
+        io: &mut Store,
+        stamp: i64,
+        x: f64,
+        y: f64,
+        yaw: f64,
+        lift: f64,
+        coords: Option<&Coords>,
+    ) {
         let mut frame = std::mem::take(&mut self.frame);
         self.render_posed(&mut frame, x, y, yaw, lift, coords);
         let c = self.config.as_ref().expect("initialized");
@@ -280,9 +268,7 @@ impl Camera {
         let info = c.intrinsics.camera_info(stamp, id).to_cdr();
         let rgb = image::rgb8_cdr(stamp, id, w, hh, &frame.rgb);
         let depth = image::depth_32fc1_cdr(stamp, id, w, hh, &frame.depth);
-        let labels = c
-            .labels
-            .then(|| image::labels_32sc1_cdr(stamp, id, w, hh, &frame.labels));
+        let labels = c.labels.then(|| image::labels_32sc1_cdr(stamp, id, w, hh, &frame.labels));
         let ports = self.ports.get_or_insert_with(new_ports);
         ports[0].publish(stamp, rgb);
         ports[1].publish(stamp, depth);

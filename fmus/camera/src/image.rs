@@ -30,33 +30,11 @@ pub fn rgb8(stamp_ns: i64, frame_id: &str, width: u32, height: u32, rgb: &[u8]) 
 }
 
 pub fn depth_32fc1(stamp_ns: i64, frame_id: &str, width: u32, height: u32, depth: &[f32]) -> Image {
-    image(
-        stamp_ns,
-        frame_id,
-        width,
-        height,
-        "32FC1",
-        4,
-        depth.iter().flat_map(|z| z.to_le_bytes()).collect(),
-    )
+    image(stamp_ns, frame_id, width, height, "32FC1", 4, depth.iter().flat_map(|z| z.to_le_bytes()).collect())
 }
 
-pub fn labels_32sc1(
-    stamp_ns: i64,
-    frame_id: &str,
-    width: u32,
-    height: u32,
-    labels: &[i32],
-) -> Image {
-    image(
-        stamp_ns,
-        frame_id,
-        width,
-        height,
-        "32SC1",
-        4,
-        labels.iter().flat_map(|l| l.to_le_bytes()).collect(),
-    )
+pub fn labels_32sc1(stamp_ns: i64, frame_id: &str, width: u32, height: u32, labels: &[i32]) -> Image {
+    image(stamp_ns, frame_id, width, height, "32SC1", 4, labels.iter().flat_map(|l| l.to_le_bytes()).collect())
 }
 
 /// CDR of an rgb8 image: [`rgb8`]`(..).to_cdr()` with the pixels copied once, straight
@@ -98,10 +76,7 @@ fn le_words<T: bytemuck::Pod>(px: &[T], le: impl Fn(&T) -> [u8; 4]) -> std::borr
 
 /// Pixels of a 32FC1 / 32SC1 image as 4-byte little-endian words (for tests and tools).
 pub fn words(img: &Image) -> Result<Vec<[u8; 4]>, String> {
-    if img.is_bigendian != 0
-        || img.step != 4 * img.width
-        || img.data.len() != (img.step * img.height) as usize
-    {
+    if img.is_bigendian != 0 || img.step != 4 * img.width || img.data.len() != (img.step * img.height) as usize {
         return Err(format!(
             "{} image {}x{} step {} with {} bytes",
             img.encoding,
@@ -111,11 +86,7 @@ pub fn words(img: &Image) -> Result<Vec<[u8; 4]>, String> {
             img.data.len()
         ));
     }
-    Ok(img
-        .data
-        .chunks_exact(4)
-        .map(|c| [c[0], c[1], c[2], c[3]])
-        .collect())
+    Ok(img.data.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect())
 }
 
 pub fn read_32fc1(img: &Image) -> Result<Vec<f32>, String> {

@@ -26,14 +26,7 @@ impl Intrinsics {
     pub fn from_fov(width: u32, height: u32, fov_h_deg: f64, fov_v_deg: f64) -> Intrinsics {
         let fx = 0.5 * width as f64 / (0.5 * fov_h_deg.to_radians()).tan();
         let fy = 0.5 * height as f64 / (0.5 * fov_v_deg.to_radians()).tan();
-        Intrinsics {
-            width,
-            height,
-            fx,
-            fy,
-            cx: 0.5 * (width as f64 - 1.0),
-            cy: 0.5 * (height as f64 - 1.0),
-        }
+        Intrinsics { width, height, fx, fy, cx: 0.5 * (width as f64 - 1.0), cy: 0.5 * (height as f64 - 1.0) }
     }
 
     /// Row-major K.
@@ -72,9 +65,7 @@ impl Intrinsics {
             d: vec![0.0; 5],
             k,
             r: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0],
-            p: [
-                k[0], 0.0, k[2], 0.0, 0.0, k[4], k[5], 0.0, 0.0, 0.0, 1.0, 0.0,
-            ],
+            p: [k[0], 0.0, k[2], 0.0, 0.0, k[4], k[5], 0.0, 0.0, 0.0, 1.0, 0.0],
             binning_x: 0,
             binning_y: 0,
             roi: RegionOfInterest::default(),
@@ -131,20 +122,13 @@ impl CameraPose {
         let base = rpy(0.0, 0.0, base_yaw);
         let body = mat_mul(&base, &rpy(mount.roll, mount.pitch, mount.yaw));
         let t = mat_vec(&base, mount.translation);
-        CameraPose {
-            origin: [x + t[0], y + t[1], t[2]],
-            rotation: mat_mul(&body, &OPTICAL_IN_BODY),
-        }
+        CameraPose { origin: [x + t[0], y + t[1], t[2]], rotation: mat_mul(&body, &OPTICAL_IN_BODY) }
     }
 
     /// An optical-frame point in the map.
     pub fn to_map(&self, p: Vec3) -> Vec3 {
         let r = mat_vec(&self.rotation, p);
-        [
-            r[0] + self.origin[0],
-            r[1] + self.origin[1],
-            r[2] + self.origin[2],
-        ]
+        [r[0] + self.origin[0], r[1] + self.origin[1], r[2] + self.origin[2]]
     }
 }
 
@@ -155,25 +139,13 @@ mod tests {
     #[test]
     fn d435i_intrinsics_and_axes() {
         let k = Intrinsics::from_fov(1280, 720, 87.0, 58.0);
-        assert!(
-            (k.fx - 674.4).abs() < 0.1 && (k.fy - 649.4).abs() < 0.1,
-            "{k:?}"
-        );
+        assert!((k.fx - 674.4).abs() < 0.1 && (k.fy - 649.4).abs() < 0.1, "{k:?}");
         assert_eq!((k.cx, k.cy), (639.5, 359.5));
         // Edge pixels see half the field of view (at their outer boundary).
         let r = k.ray(-0.5, k.cy);
         assert!(((-r[0] / r[2]).atan().to_degrees() - 43.5).abs() < 1e-9);
-        let pose = CameraPose::new(
-            &Mount {
-                translation: [0.6, 0.0, 1.2],
-                roll: 0.0,
-                pitch: 0.0,
-                yaw: 0.0,
-            },
-            1.0,
-            2.0,
-            0.0,
-        );
+        let pose =
+            CameraPose::new(&Mount { translation: [0.6, 0.0, 1.2], roll: 0.0, pitch: 0.0, yaw: 0.0 }, 1.0, 2.0, 0.0);
         let near = |a: Vec3, b: Vec3| (0..3).all(|i| (a[i] - b[i]).abs() < 1e-12);
         assert!(near(pose.to_map([0.0, 0.0, 1.0]), [2.6, 2.0, 1.2])); // z forward = map +x
         assert!(near(pose.to_map([1.0, 0.0, 0.0]), [1.6, 1.0, 1.2])); // x right = map -y

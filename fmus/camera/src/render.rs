@@ -7,9 +7,9 @@ use crate::lighting::{self, Lighting};
 use crate::optics::{mat_vec, ray_through, CameraPose, Intrinsics, Vec3};
 use crate::scene::Scene;
 use crate::shading::{self, Palette};
+use agrisim_fmu_util::on_threads;
 use agrisim_greenhouse::raycast::{Occluders, Shadow, SunColumns, MAX_PACKET};
 use agrisim_greenhouse::{Hit, Object, RayCaster};
-use agrisim_fmu_util::on_threads;
 use agrisim_math::Rng;
 
 /// Depth noise (issue 5 item 2).
@@ -119,7 +119,11 @@ pub fn render_into(f: &mut Frame, shot: &Shot, rng: &mut Rng, threads: usize) {
     let cover_pow = std::array::from_fn(|n| light.cover_tau.powi(n as i32));
     let ctx = Ctx { scene, movers: &movers, k, pose, light, columns, cover_pow, palette: Palette::default(), xs: &xs };
     let threads = threads.clamp(1, h.div_ceil(CHUNK_ROWS).max(1));
-    let chunks = f.rgb.chunks_mut(3 * w * CHUNK_ROWS).zip(f.true_depth.chunks_mut(w * CHUNK_ROWS)).zip(f.labels.chunks_mut(w * CHUNK_ROWS));
+    let chunks = f
+        .rgb
+        .chunks_mut(3 * w * CHUNK_ROWS)
+        .zip(f.true_depth.chunks_mut(w * CHUNK_ROWS))
+        .zip(f.labels.chunks_mut(w * CHUNK_ROWS));
     let ctx = &ctx;
     on_threads(threads, chunks, |c, ((rgb, z), l)| {
         ctx.rows(c * CHUNK_ROWS, rgb, z, l);
@@ -270,7 +274,8 @@ impl Ctx<'_> {
         for (i, s) in surfaces.iter().enumerate() {
             if let Surface::Lit { p, cos_sun, .. } = *s {
                 if l.sun_up && cos_sun > 0.0 {
-                    let d2 = (p[0] - o[0]) * (p[0] - o[0]) + (p[1] - o[1]) * (p[1] - o[1]) + (p[2] - o[2]) * (p[2] - o[2]);
+                    let d2 =
+                        (p[0] - o[0]) * (p[0] - o[0]) + (p[1] - o[1]) * (p[1] - o[1]) + (p[2] - o[2]) * (p[2] - o[2]);
                     lit[m] = ((d2 as f32).to_bits() as u64) << 32 | i as u64;
                     at[i] = p;
                     m += 1;
@@ -319,7 +324,15 @@ impl Ctx<'_> {
     /// Adds the transmittance toward `s` at the lit points `keys` (see [`Ctx::beams`]) to
     /// their beams, cast against `caster` (the scene, or its glass and film alone) and the
     /// movers, in packets of [`SHADOW_PACKET`] points close together.
-    fn shadow_packets(&self, keys: &mut [u64], at: &[Vec3; MAX_PACKET], s: Vec3, caster: &RayCaster, recent: &mut Occluders, beams: &mut [f64; MAX_PACKET]) {
+    fn shadow_packets(
+        &self,
+        keys: &mut [u64],
+        at: &[Vec3; MAX_PACKET],
+        s: Vec3,
+        caster: &RayCaster,
+        recent: &mut Occluders,
+        beams: &mut [f64; MAX_PACKET],
+    ) {
         // Nearest the camera first: a tile across an edge holds a near leaf and the far
         // background, and one packet spanning both culls almost nothing. Each ray's answer
         // is exact whatever rays share its packet, so only the groups matter, not the order
@@ -363,7 +376,9 @@ impl Ctx<'_> {
         if let Some(tau) = self.light.cover_see_through {
             for _ in 0..SEE_THROUGH {
                 match layers.pane(&kind, tau) {
-                    Some(beyond) => layers.hit = self.scene.caster.cast_among(self.pose.origin, d, beyond, FAR, self.movers),
+                    Some(beyond) => {
+                        layers.hit = self.scene.caster.cast_among(self.pose.origin, d, beyond, FAR, self.movers)
+                    }
                     None => break,
                 }
             }
@@ -391,7 +406,14 @@ impl Ctx<'_> {
             if m == 0 {
                 return;
             }
-            self.scene.caster.cast_packet_beyond(self.pose.origin, &sub[..m], &mins[..m], FAR, self.movers, &mut out[..m]);
+            self.scene.caster.cast_packet_beyond(
+                self.pose.origin,
+                &sub[..m],
+                &mins[..m],
+                FAR,
+                self.movers,
+                &mut out[..m],
+            );
             for q in 0..m {
                 layers[which[q]].hit = out[q];
             }
@@ -449,7 +471,18 @@ impl Ctx<'_> {
     fn beam(&self, p: Vec3) -> f64 {
         let l = self.light;
         let Some(n) = self.light.sun_samples() else { return l.cover_tau };
-        let sum: f64 = (0..n).map(|k| transmitted(self.scene, self.columns.get(k as usize), self.movers, p, sun_disc_sample(l.sun, k, n), &self.cover_pow)).sum();
+        let sum: f64 = (0..n)
+            .map(|k| {
+                transmitted(
+                    self.scene,
+                    self.columns.get(k as usize),
+                    self.movers,
+                    p,
+                    sun_disc_sample(l.sun, k, n),
+                    &self.cover_pow,
+                )
+            })
+            .sum();
         sum / n as f64
     }
 }
@@ -467,7 +500,11 @@ const MAX_COLUMN_CELLS: usize = 1 << 22;
 pub fn sun_columns(scene: &Scene, light: &Lighting) -> Vec<SunColumns> {
     let Some(n) = light.sun_samples().filter(|_| light.sun_up) else { return vec![] };
     let opaque = opaque(scene);
-    let columns: Option<Vec<_>> = (0..n).map(|k| SunColumns::new(&scene.caster, sun_disc_sample(light.sun, k, n), opaque, COLUMN_CELL, MAX_COLUMN_CELLS)).collect();
+    let columns: Option<Vec<_>> = (0..n)
+        .map(|k| {
+            SunColumns::new(&scene.caster, sun_disc_sample(light.sun, k, n), opaque, COLUMN_CELL, MAX_COLUMN_CELLS)
+        })
+        .collect();
     columns.unwrap_or_default()
 }
 
@@ -508,7 +545,14 @@ fn normalize(v: Vec3) -> Vec3 {
 /// The shadow ray: 0 if something opaque lies between `p` and the sun, else `tau` per glass
 /// or film surface crossed (16 or more: 0, as deep as anyone renders). With the sample's
 /// columns, a ray they clear goes through the glass and film alone.
-fn transmitted(scene: &Scene, columns: Option<&SunColumns>, movers: &RayCaster, p: Vec3, s: Vec3, cover_pow: &[f64; 16]) -> f64 {
+fn transmitted(
+    scene: &Scene,
+    columns: Option<&SunColumns>,
+    movers: &RayCaster,
+    p: Vec3,
+    s: Vec3,
+    cover_pow: &[f64; 16],
+) -> f64 {
     let caster = match columns.map(|c| (c, c.occluder(&scene.caster, p, EPS, FAR, None))) {
         Some((_, Shadow::Blocked(_))) => return 0.0,
         Some((c, Shadow::Clear)) => c.translucent(),
@@ -554,7 +598,14 @@ fn mix64(mut z: u64) -> u64 {
 /// Range clip, fog limit (along the ray), discontinuities, left band, noise: true_depth ->
 /// depth, rows in chunks on `threads` threads. Pixel i's noise is drawn from a generator
 /// seeded by mix(key, i), so the result does not depend on the threads.
-pub fn apply_depth_model(f: &mut Frame, k: &Intrinsics, m: &DepthModel, fog_limit: Option<f64>, key: u64, threads: usize) {
+pub fn apply_depth_model(
+    f: &mut Frame,
+    k: &Intrinsics,
+    m: &DepthModel,
+    fog_limit: Option<f64>,
+    key: u64,
+    threads: usize,
+) {
     let w = k.width as usize;
     let zt = &f.true_depth;
     // No pixel in range lies beyond a fog limit past the range's end along the frame's most
@@ -569,12 +620,23 @@ pub fn apply_depth_model(f: &mut Frame, k: &Intrinsics, m: &DepthModel, fog_limi
         Some(_) => (0..w).map(|u| k.plane_x(u as f64)).collect(),
         None => vec![],
     };
-    f.valid = on_threads(threads, f.depth.chunks_mut(w * CHUNK_ROWS), |c, out| depth_rows(c * CHUNK_ROWS, out, zt, &xs, k, m, fog_limit, key));
+    f.valid = on_threads(threads, f.depth.chunks_mut(w * CHUNK_ROWS), |c, out| {
+        depth_rows(c * CHUNK_ROWS, out, zt, &xs, k, m, fog_limit, key)
+    });
 }
 
 /// [`apply_depth_model`] for the rows from `v0` that `out` holds; returns how many are valid.
 #[allow(clippy::too_many_arguments)]
-fn depth_rows(v0: usize, out: &mut [f32], zt: &[f32], xs: &[f64], k: &Intrinsics, m: &DepthModel, fog_limit: Option<f64>, key: u64) -> usize {
+fn depth_rows(
+    v0: usize,
+    out: &mut [f32],
+    zt: &[f32],
+    xs: &[f64],
+    k: &Intrinsics,
+    m: &DepthModel,
+    fog_limit: Option<f64>,
+    key: u64,
+) -> usize {
     let (w, h) = (k.width as usize, k.height as usize);
     let mut valid = 0;
     for v in v0..v0 + out.len() / w {
@@ -605,7 +667,8 @@ fn depth_rows(v0: usize, out: &mut [f32], zt: &[f32], xs: &[f64], k: &Intrinsics
             }
             out[i - v0 * w] = if ok {
                 let sigma = m.noise.sigma(z, k.fx, m.baseline);
-                let zm = if sigma == 0.0 { z } else { z + sigma * Rng::new(mix64(key ^ mix64(i as u64))).normal_ziggurat() };
+                let zm =
+                    if sigma == 0.0 { z } else { z + sigma * Rng::new(mix64(key ^ mix64(i as u64))).normal_ziggurat() };
                 if zm > 0.0 {
                     valid += 1;
                     zm as f32

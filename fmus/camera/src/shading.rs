@@ -59,11 +59,7 @@ pub fn srgb_to_linear(c: u8) -> f64 {
 
 pub fn linear_to_srgb(l: f64) -> u8 {
     let l = l.clamp(0.0, 1.0);
-    let c = if l <= 0.0031308 {
-        12.92 * l
-    } else {
-        1.055 * l.powf(1.0 / 2.4) - 0.055
-    };
+    let c = if l <= 0.0031308 { 12.92 * l } else { 1.055 * l.powf(1.0 / 2.4) - 0.055 };
     (c * 255.0).round() as u8
 }
 
@@ -160,11 +156,7 @@ impl Palette {
 
     pub fn albedo(&self, kind: Kind) -> [f64; 3] {
         let c = albedo_srgb(kind);
-        [
-            self.lut[c[0] as usize],
-            self.lut[c[1] as usize],
-            self.lut[c[2] as usize],
-        ]
+        [self.lut[c[0] as usize], self.lut[c[1] as usize], self.lut[c[2] as usize]]
     }
 }
 

@@ -56,7 +56,8 @@ fn shot_with(environment: &str, threads: i32, set: impl FnOnce(&mut Store)) -> S
 /// Mean Rec. 709 luma of an rgb8 image (on the sRGB codes).
 fn luma(rgb: &[u8]) -> f64 {
     let n = rgb.len() / 3;
-    rgb.chunks_exact(3).map(|p| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64).sum::<f64>() / n as f64
+    rgb.chunks_exact(3).map(|p| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64).sum::<f64>()
+        / n as f64
 }
 
 #[test]
@@ -70,10 +71,8 @@ fn darker_at_dusk_and_under_cloud_with_the_same_geometry() {
     let cfg = GreenhouseConfig::from_toml_str("").unwrap();
     let kinds: Vec<Kind> = generate(&cfg, cfg.seed).objects.iter().map(|o| o.kind).collect();
     let ids: Vec<i32> = noon.labels.chunks_exact(4).map(|c| i32::from_le_bytes(c.try_into().unwrap())).collect();
-    let surface: Vec<bool> = ids
-        .iter()
-        .map(|&l| l > 0 && !matches!(kinds.get(l as usize - 1), Some(Kind::Wall | Kind::Roof)))
-        .collect();
+    let surface: Vec<bool> =
+        ids.iter().map(|&l| l > 0 && !matches!(kinds.get(l as usize - 1), Some(Kind::Wall | Kind::Roof))).collect();
     assert!(surface.iter().filter(|&&b| b).count() > 160 * 90 / 2);
     let luma = |rgb: &[u8]| {
         let px: Vec<u8> = rgb.chunks_exact(3).zip(&surface).filter(|(_, &s)| s).flat_map(|(p, _)| p.to_vec()).collect();
@@ -138,7 +137,15 @@ fn frames_do_not_depend_on_the_thread_count() {
     let three = shot(&env, 3);
     assert!(one.rgb == two.rgb && one.depth == two.depth && one.labels == two.labels);
     assert!(one.rgb == three.rgb && one.depth == three.depth);
-    let d = image::read_32fc1(&Image { encoding: "32FC1".into(), width: 160, height: 90, step: 640, data: one.depth.clone(), ..Default::default() }).unwrap();
+    let d = image::read_32fc1(&Image {
+        encoding: "32FC1".into(),
+        width: 160,
+        height: 90,
+        step: 640,
+        data: one.depth.clone(),
+        ..Default::default()
+    })
+    .unwrap();
     assert!(d.iter().filter(|&&z| z > 0.0).count() > 160 * 90 / 3);
 }
 
@@ -158,8 +165,20 @@ fn render_quality_changes_the_image_not_depth_or_labels() {
 /// Floor and a tall post at the origin; the camera 8 m above it looking straight down.
 fn post_scene() -> (Scene, Intrinsics, CameraPose) {
     let objects = vec![
-        Object { id: 0, name: "floor".into(), kind: Kind::Floor, shape: Shape::Box { half: [50.0, 50.0, 0.05] }, placement: Placement::at(0.0, 0.0, -0.05) },
-        Object { id: 1, name: "post".into(), kind: Kind::Obstacle, shape: Shape::Box { half: [0.1, 0.1, 1.0] }, placement: Placement::at(0.0, 0.0, 1.0) },
+        Object {
+            id: 0,
+            name: "floor".into(),
+            kind: Kind::Floor,
+            shape: Shape::Box { half: [50.0, 50.0, 0.05] },
+            placement: Placement::at(0.0, 0.0, -0.05),
+        },
+        Object {
+            id: 1,
+            name: "post".into(),
+            kind: Kind::Obstacle,
+            shape: Shape::Box { half: [0.1, 0.1, 1.0] },
+            placement: Placement::at(0.0, 0.0, 1.0),
+        },
     ];
     let k = Intrinsics::from_fov(200, 200, 90.0, 90.0);
     let mount = Mount { translation: [0.0, 0.0, 8.0], roll: 0.0, pitch: std::f64::consts::FRAC_PI_2, yaw: 0.0 };
@@ -171,8 +190,18 @@ fn shadow_centroid(environment: &str) -> ([f64; 2], f64) {
     let (scene, k, pose) = post_scene();
     let c = Conditions::of(&Environment::from_toml_str(environment).unwrap());
     let light = Lighting::from_conditions(&c);
-    let model = DepthModel { range: (0.1, 20.0), noise: DepthNoise::None, baseline: 0.05, invalid_band: false, edge_ratio: 0.0 };
-    let f = render::render(&render::Shot { scene: &scene, dynamic: &[], k: &k, pose: &pose, light: &light, columns: &[], depth: &model }, &mut Rng::new(1), 2);
+    let model = DepthModel {
+        range: (0.1, 20.0),
+        noise: DepthNoise::None,
+        baseline: 0.05,
+        invalid_band: false,
+        edge_ratio: 0.0,
+    };
+    let f = render::render(
+        &render::Shot { scene: &scene, dynamic: &[], k: &k, pose: &pose, light: &light, columns: &[], depth: &model },
+        &mut Rng::new(1),
+        2,
+    );
     // Sunlit floor is far brighter than the floor lit by the sky alone.
     let floor: Vec<usize> = (0..f.labels.len()).filter(|&i| f.labels[i] == 1).collect();
     let max = floor.iter().map(|&i| f.rgb[3 * i] as u32).max().unwrap();
@@ -207,9 +236,29 @@ fn shadows_point_away_from_the_sun() {
     assert!(turn > 90.0 && turn < 270.0, "the shadow swings with the sun: {directions:?}");
     // No shadows at low quality.
     let (scene, k, pose) = post_scene();
-    let c = Conditions::of(&Environment::from_toml_str("date = \"2025-06-21\"\ntime = \"09:00\"\nrender_quality = \"low\"").unwrap());
-    let model = DepthModel { range: (0.1, 20.0), noise: DepthNoise::None, baseline: 0.05, invalid_band: false, edge_ratio: 0.0 };
-    let f = render::render(&render::Shot { scene: &scene, dynamic: &[], k: &k, pose: &pose, light: &Lighting::from_conditions(&c), columns: &[], depth: &model }, &mut Rng::new(1), 1);
+    let c = Conditions::of(
+        &Environment::from_toml_str("date = \"2025-06-21\"\ntime = \"09:00\"\nrender_quality = \"low\"").unwrap(),
+    );
+    let model = DepthModel {
+        range: (0.1, 20.0),
+        noise: DepthNoise::None,
+        baseline: 0.05,
+        invalid_band: false,
+        edge_ratio: 0.0,
+    };
+    let f = render::render(
+        &render::Shot {
+            scene: &scene,
+            dynamic: &[],
+            k: &k,
+            pose: &pose,
+            light: &Lighting::from_conditions(&c),
+            columns: &[],
+            depth: &model,
+        },
+        &mut Rng::new(1),
+        1,
+    );
     let floor: Vec<u8> = (0..f.labels.len()).filter(|&i| f.labels[i] == 1).map(|i| f.rgb[3 * i]).collect();
     assert_eq!(floor.iter().min(), floor.iter().max(), "flat floor, one colour");
 }
@@ -238,10 +287,23 @@ fn sun_columns_change_no_pixel() {
     let scene = Scene::from_objects(&gh.objects);
     let a = &gh.layout.aisles[1];
     let (x, y) = (0.5 * (a.x_start + a.x_end), a.y);
-    let base = Object { id: gh.objects.len() as u32, name: "base".into(), kind: Kind::Robot, shape: Shape::Box { half: [0.6, 0.45, 0.3] }, placement: Placement::yawed([x + 1.5, y, 0.35], 0.2) };
-    let model = DepthModel { range: (0.1, 10.0), noise: DepthNoise::None, baseline: 0.05, invalid_band: false, edge_ratio: 0.0 };
+    let base = Object {
+        id: gh.objects.len() as u32,
+        name: "base".into(),
+        kind: Kind::Robot,
+        shape: Shape::Box { half: [0.6, 0.45, 0.3] },
+        placement: Placement::yawed([x + 1.5, y, 0.35], 0.2),
+    };
+    let model = DepthModel {
+        range: (0.1, 10.0),
+        noise: DepthNoise::None,
+        baseline: 0.05,
+        invalid_band: false,
+        edge_ratio: 0.0,
+    };
     for (quality, w, h) in [("medium", 320, 180), ("high", 96, 54)] {
-        let c = Conditions::of(&Environment::from_toml_str(&format!("{NOON}\nrender_quality = \"{quality}\"")).unwrap());
+        let c =
+            Conditions::of(&Environment::from_toml_str(&format!("{NOON}\nrender_quality = \"{quality}\"")).unwrap());
         let light = Lighting::from_conditions(&c);
         let columns = render::sun_columns(&scene, &light);
         assert_eq!(columns.len(), light.sun_samples().unwrap() as usize, "{quality}: a grid per sun sample");
@@ -249,11 +311,36 @@ fn sun_columns_change_no_pixel() {
         for yaw in [0.3, 1.9] {
             let mount = Mount { translation: [0.0, 0.0, 1.2], roll: 0.0, pitch: 0.2, yaw: 0.0 };
             let pose = CameraPose::new(&mount, x, y, yaw);
-            let frame = |columns: &[_]| render::render(&render::Shot { scene: &scene, dynamic: std::slice::from_ref(&base), k: &k, pose: &pose, light: &light, columns, depth: &model }, &mut Rng::new(1), 2);
+            let frame = |columns: &[_]| {
+                render::render(
+                    &render::Shot {
+                        scene: &scene,
+                        dynamic: std::slice::from_ref(&base),
+                        k: &k,
+                        pose: &pose,
+                        light: &light,
+                        columns,
+                        depth: &model,
+                    },
+                    &mut Rng::new(1),
+                    2,
+                )
+            };
             let (with, without) = (frame(&columns), frame(&[]));
-            assert!(with.rgb == without.rgb && with.depth == without.depth && with.labels == without.labels, "{quality}, yaw {yaw}");
+            assert!(
+                with.rgb == without.rgb && with.depth == without.depth && with.labels == without.labels,
+                "{quality}, yaw {yaw}"
+            );
             // A grid for another sun is not used.
-            let other = render::sun_columns(&scene, &Lighting::from_conditions(&Conditions::of(&Environment::from_toml_str(&format!("{DUSK}\nrender_quality = \"{quality}\"").replace("21:15", "16:00")).unwrap())));
+            let other = render::sun_columns(
+                &scene,
+                &Lighting::from_conditions(&Conditions::of(
+                    &Environment::from_toml_str(
+                        &format!("{DUSK}\nrender_quality = \"{quality}\"").replace("21:15", "16:00"),
+                    )
+                    .unwrap(),
+                )),
+            );
             assert!(frame(&other).rgb == without.rgb, "{quality}, yaw {yaw}: another sun's grid");
         }
     }

@@ -8,5 +8,8 @@ agrisim_fmi::fmu_conformance_tests!(agrisim_fmu_camera::Camera, seeds = 4, cases
 #[test]
 fn initial_dependencies_hold_in_fog() {
     let fog = agrisim_fmi::Value::String("weather = \"fog\"\nvisibility = 30.0".into());
-    agrisim_fmi::testing::assert_initial_dependencies::<agrisim_fmu_camera::Camera>(&[(agrisim_fmu_camera::ports::ENVIRONMENT, fog)]);
+    agrisim_fmi::testing::assert_initial_dependencies::<agrisim_fmu_camera::Camera>(&[(
+        agrisim_fmu_camera::ports::ENVIRONMENT,
+        fog,
+    )]);
 }

@@ -13,12 +13,7 @@ use agrisim_math::Rng;
 use agrisim_msgs::sensor_msgs::{CameraInfo, Image};
 use agrisim_msgs::Message;
 
-const MOUNT: Mount = Mount {
-    translation: [0.6, 0.0, 1.2],
-    roll: 0.0,
-    pitch: 0.0,
-    yaw: 0.0,
-};
+const MOUNT: Mount = Mount { translation: [0.6, 0.0, 1.2], roll: 0.0, pitch: 0.0, yaw: 0.0 };
 
 /// A large wall (box) facing the camera, its front face `z` metres ahead of the optical centre
 /// of a camera on a base at the origin looking along +x.
@@ -28,21 +23,13 @@ fn wall_scene(z: f64) -> Scene {
         id: 0,
         name: "wall".into(),
         kind: Kind::Obstacle,
-        shape: Shape::Box {
-            half: [0.5, 100.0, 100.0],
-        },
+        shape: Shape::Box { half: [0.5, 100.0, 100.0] },
         placement: Placement::at(face + 0.5, 0.0, 0.0),
     }])
 }
 
 fn model(noise: DepthNoise, band: bool, edge: f64) -> DepthModel {
-    DepthModel {
-        range: (0.105, 10.0),
-        noise,
-        baseline: 0.05,
-        invalid_band: band,
-        edge_ratio: edge,
-    }
+    DepthModel { range: (0.105, 10.0), noise, baseline: 0.05, invalid_band: band, edge_ratio: edge }
 }
 
 fn light() -> Lighting {
@@ -50,7 +37,14 @@ fn light() -> Lighting {
 }
 
 /// A frame of `scene` alone (no robot objects), noise seeded with `seed`, on 2 threads.
-fn shoot(scene: &Scene, k: &Intrinsics, pose: &CameraPose, light: &Lighting, depth: DepthModel, seed: u64) -> render::Frame {
+fn shoot(
+    scene: &Scene,
+    k: &Intrinsics,
+    pose: &CameraPose,
+    light: &Lighting,
+    depth: DepthModel,
+    seed: u64,
+) -> render::Frame {
     render::render(&Shot { scene, dynamic: &[], k, pose, light, columns: &[], depth: &depth }, &mut Rng::new(seed), 2)
 }
 
@@ -67,10 +61,7 @@ fn depth_reprojects_onto_the_wall() {
             for u in (0..320).step_by(5) {
                 let d = f.depth[v * 320 + u] as f64;
                 let p = pose.to_map(k.reproject(u as f64, v as f64, d));
-                assert!(
-                    (p[0] - (0.6 + z)).abs() < 1e-5 * z,
-                    "z {z} pixel ({u}, {v}) -> {p:?}"
-                );
+                assert!((p[0] - (0.6 + z)).abs() < 1e-5 * z, "z {z} pixel ({u}, {v}) -> {p:?}");
                 assert_eq!(f.labels[v * 320 + u], 1);
             }
         }
@@ -81,10 +72,7 @@ fn depth_reprojects_onto_the_wall() {
         for (i, &d) in f.depth.iter().enumerate() {
             if d > 0.0 {
                 let p = pose.to_map(k.reproject((i % 320) as f64, (i / 320) as f64, d as f64));
-                assert!(
-                    (p[0] - (0.6 + z)).abs() < 5.5 * sigma,
-                    "{p:?} sigma {sigma}"
-                );
+                assert!((p[0] - (0.6 + z)).abs() < 5.5 * sigma, "{p:?} sigma {sigma}");
                 checked += 1;
             }
         }
@@ -100,30 +88,19 @@ fn out_of_range_is_zero() {
         let f = shoot(&wall_scene(z), &k, &pose, &light(), model(DepthNoise::None, false, 0.0), 1);
         assert_eq!(f.valid, 0, "z {z}");
         assert!(f.depth.iter().all(|&d| d == 0.0));
-        assert!(
-            f.labels.iter().all(|&l| l == 1),
-            "still seen in colour and labels"
-        );
+        assert!(f.labels.iter().all(|&l| l == 1), "still seen in colour and labels");
     }
 }
 
 fn measured_sigma(noise: DepthNoise, z: f64, k: &Intrinsics) -> f64 {
     let pose = CameraPose::new(&MOUNT, 0.0, 0.0, 0.0);
     let f = shoot(&wall_scene(z), k, &pose, &light(), model(noise, false, 0.0), 99);
-    let errs: Vec<f64> = f
-        .depth
-        .iter()
-        .zip(&f.true_depth)
-        .filter(|(d, _)| **d > 0.0)
-        .map(|(d, t)| *d as f64 - *t as f64)
-        .collect();
+    let errs: Vec<f64> =
+        f.depth.iter().zip(&f.true_depth).filter(|(d, _)| **d > 0.0).map(|(d, t)| *d as f64 - *t as f64).collect();
     assert!(errs.len() > 200_000);
     let n = errs.len() as f64;
     let mean = errs.iter().sum::<f64>() / n;
-    assert!(
-        mean.abs() < 0.05 * noise.sigma(z, k.fx, 0.05) + 1e-6,
-        "bias {mean}"
-    );
+    assert!(mean.abs() < 0.05 * noise.sigma(z, k.fx, 0.05) + 1e-6, "bias {mean}");
     (errs.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / n).sqrt()
 }
 
@@ -151,11 +128,7 @@ fn left_invalid_band_matches_the_formula() {
         for v in [0, 100, 359] {
             let row = &f.depth[v * 640..(v + 1) * 640];
             let band = row.iter().take_while(|&&d| d == 0.0).count();
-            assert_eq!(
-                band,
-                want.ceil() as usize,
-                "z {z} row {v}: band {band} px, formula {want:.2} px"
-            );
+            assert_eq!(band, want.ceil() as usize, "z {z} row {v}: band {band} px, formula {want:.2} px");
             assert!(row[band..].iter().all(|&d| d > 0.0));
         }
     }
@@ -168,18 +141,14 @@ fn depth_discontinuities_are_invalid() {
         id: 0,
         name: "wall".into(),
         kind: Kind::Obstacle,
-        shape: Shape::Box {
-            half: [0.5, 100.0, 100.0],
-        },
+        shape: Shape::Box { half: [0.5, 100.0, 100.0] },
         placement: Placement::at(0.6 + 3.0 + 0.5, 0.0, 0.0),
     }];
     objects.push(Object {
         id: 1,
         name: "post".into(),
         kind: Kind::Post,
-        shape: Shape::Box {
-            half: [0.05, 0.1, 5.0],
-        },
+        shape: Shape::Box { half: [0.05, 0.1, 5.0] },
         placement: Placement::at(0.6 + 1.05, 0.0, 0.0),
     });
     let scene = Scene::from_objects(&objects);
@@ -189,10 +158,7 @@ fn depth_discontinuities_are_invalid() {
     let row = 90 * 320;
     let post: Vec<usize> = (0..320).filter(|&u| f.labels[row + u] == 2).collect();
     let (first, last) = (post[0], *post.last().unwrap());
-    assert!(
-        f.depth[row + first] > 0.0 && f.depth[row + last] > 0.0,
-        "the near side stays"
-    );
+    assert!(f.depth[row + first] > 0.0 && f.depth[row + last] > 0.0, "the near side stays");
     assert_eq!(f.depth[row + first - 1], 0.0);
     assert_eq!(f.depth[row + last + 1], 0.0);
     assert!(f.depth[row + first - 3] > 2.9);
@@ -202,14 +168,7 @@ fn greenhouse() -> (Vec<Object>, [f64; 3]) {
     let cfg = GreenhouseConfig::from_toml_str("").unwrap();
     let gh = generate(&cfg, cfg.seed);
     let a = &gh.layout.aisles[0];
-    (
-        gh.objects.clone(),
-        [
-            0.5 * (a.x_start + a.x_end),
-            a.y,
-            std::f64::consts::FRAC_PI_2,
-        ],
-    )
+    (gh.objects.clone(), [0.5 * (a.x_start + a.x_end), a.y, std::f64::consts::FRAC_PI_2])
 }
 
 #[test]
@@ -237,16 +196,10 @@ fn labels_name_fruit_and_ripe_fruit_is_red() {
                 if f.depth[i] == 0.0 {
                     continue;
                 }
-                let p =
-                    pose.to_map(k.reproject((i % 320) as f64, (i / 320) as f64, f.depth[i] as f64));
+                let p = pose.to_map(k.reproject((i % 320) as f64, (i / 320) as f64, f.depth[i] as f64));
                 let c = o.placement.translation;
-                let r =
-                    ((p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2)).sqrt();
-                assert!(
-                    (r - radius).abs() < 1e-4,
-                    "{} at {r} from its centre, radius {radius}",
-                    o.name
-                );
+                let r = ((p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2)).sqrt();
+                assert!((r - radius).abs() < 1e-4, "{} at {r} from its centre, radius {radius}", o.name);
                 let px = &f.rgb[3 * i..3 * i + 3];
                 let acc = |a: &mut [f64; 3]| (0..3).for_each(|j| a[j] += px[j] as f64);
                 if ripeness == 6 {
@@ -259,21 +212,12 @@ fn labels_name_fruit_and_ripe_fruit_is_red() {
             }
         }
     }
-    assert!(
-        fruit_px > 100 && ripe_n > 10 && green_n > 10,
-        "{fruit_px} {ripe_n} {green_n}"
-    );
+    assert!(fruit_px > 100 && ripe_n > 10 && green_n > 10, "{fruit_px} {ripe_n} {green_n}");
     let ripe = ripe.map(|c| c / ripe_n as f64);
     let green = green.map(|c| c / green_n as f64);
     println!("mean colour of ripe (stage 6) fruit pixels {ripe:?}, green (stage 1) {green:?}");
-    assert!(
-        ripe[0] > 2.0 * ripe[1] && ripe[0] > 2.0 * ripe[2],
-        "ripe {ripe:?}"
-    );
-    assert!(
-        green[1] > green[0] && green[1] > green[2],
-        "green {green:?}"
-    );
+    assert!(ripe[0] > 2.0 * ripe[1] && ripe[0] > 2.0 * ripe[2], "ripe {ripe:?}");
+    assert!(green[1] > green[0] && green[1] > green[2], "green {green:?}");
 }
 
 #[test]
@@ -285,56 +229,34 @@ fn shadows_follow_the_sun() {
             id: 0,
             name: "floor".into(),
             kind: Kind::Floor,
-            shape: Shape::Box {
-                half: [50.0, 50.0, 0.05],
-            },
+            shape: Shape::Box { half: [50.0, 50.0, 0.05] },
             placement: Placement::at(0.0, 0.0, -0.05),
         },
         Object {
             id: 1,
             name: "block".into(),
             kind: Kind::Obstacle,
-            shape: Shape::Box {
-                half: [0.2, 0.2, 0.5],
-            },
+            shape: Shape::Box { half: [0.2, 0.2, 0.5] },
             placement: Placement::at(3.0, 0.0, 0.5),
         },
     ];
     let scene = Scene::from_objects(&objects);
     let k = Intrinsics::from_fov(320, 240, 87.0, 58.0);
-    let mount = Mount {
-        translation: [0.0, 0.0, 6.0],
-        roll: 0.0,
-        pitch: std::f64::consts::FRAC_PI_2,
-        yaw: 0.0,
-    };
+    let mount = Mount { translation: [0.0, 0.0, 6.0], roll: 0.0, pitch: std::f64::consts::FRAC_PI_2, yaw: 0.0 };
     let pose = CameraPose::new(&mount, 3.0, 0.0, 0.0); // straight down onto the block
     let px = |az: f64, p: [f64; 3]| {
         let f = shoot(&scene, &k, &pose, &Lighting::new(az, 30.0, 0.35), model(DepthNoise::None, false, 0.0), 1);
         // Project the floor point into the image.
-        let rel = [
-            p[0] - pose.origin[0],
-            p[1] - pose.origin[1],
-            p[2] - pose.origin[2],
-        ];
+        let rel = [p[0] - pose.origin[0], p[1] - pose.origin[1], p[2] - pose.origin[2]];
         let r = pose.rotation;
         let o = [0, 1, 2].map(|j| r[0][j] * rel[0] + r[1][j] * rel[1] + r[2][j] * rel[2]);
-        let (u, v) = (
-            (k.fx * o[0] / o[2] + k.cx).round() as usize,
-            (k.fy * o[1] / o[2] + k.cy).round() as usize,
-        );
+        let (u, v) = ((k.fx * o[0] / o[2] + k.cx).round() as usize, (k.fy * o[1] / o[2] + k.cy).round() as usize);
         f.rgb[3 * (v * 320 + u)]
     };
     let behind = [3.0 - 1.0, 0.0, 0.0];
     let front = [3.0 + 1.0, 0.0, 0.0];
-    assert!(
-        px(0.0, behind) < px(0.0, front),
-        "sun in +x: shadow toward -x"
-    );
-    assert!(
-        px(180.0, behind) > px(180.0, front),
-        "sun in -x: shadow toward +x"
-    );
+    assert!(px(0.0, behind) < px(0.0, front), "sun in +x: shadow toward -x");
+    assert!(px(180.0, behind) > px(180.0, front), "sun in -x: shadow toward +x");
 }
 
 fn store(w: i32, h: i32, seed: i32) -> Store {
@@ -365,8 +287,7 @@ fn fmu_publishes_decodable_messages_at_10_hz() {
     m.initialize(&mut io, 0.0, &mut Quiet).unwrap();
     let mut seqs = vec![];
     for k in 0..11 {
-        m.do_step(&mut io, k as f64 * 0.02, 0.02, &mut Quiet)
-            .unwrap();
+        m.do_step(&mut io, k as f64 * 0.02, 0.02, &mut Quiet).unwrap();
         seqs.push(io.i64(IMAGE_SEQ));
     }
     // Frames at 0, 0.1, 0.2 s, each published by the step that reaches its instant.
@@ -375,47 +296,24 @@ fn fmu_publishes_decodable_messages_at_10_hz() {
     let k = Intrinsics::from_fov(160, 120, 87.0, 58.0);
     assert_eq!(info.k, k.k());
     assert_eq!(
-        (
-            info.width,
-            info.height,
-            info.distortion_model.as_str(),
-            info.d.clone()
-        ),
+        (info.width, info.height, info.distortion_model.as_str(), info.d.clone()),
         (160, 120, "plumb_bob", vec![0.0; 5])
     );
-    assert_eq!(
-        info.header.stamp.sec * 1_000_000_000 + info.header.stamp.nanosec as i32,
-        200_000_000
-    );
+    assert_eq!(info.header.stamp.sec * 1_000_000_000 + info.header.stamp.nanosec as i32, 200_000_000);
     assert_eq!(info.header.frame_id, "camera_color_optical_frame");
     let rgb = Image::from_cdr(agrisim_fmi::port::latest(&io, IMAGE)).unwrap();
     assert_eq!(
-        (
-            rgb.encoding.as_str(),
-            rgb.width,
-            rgb.height,
-            rgb.step,
-            rgb.data.len()
-        ),
+        (rgb.encoding.as_str(), rgb.width, rgb.height, rgb.step, rgb.data.len()),
         ("rgb8", 160, 120, 480, 160 * 120 * 3)
     );
     let depth = image::read_32fc1(&Image::from_cdr(agrisim_fmi::port::latest(&io, DEPTH)).unwrap()).unwrap();
     assert_eq!(depth.len(), 160 * 120);
-    assert_eq!(
-        depth.iter().filter(|&&d| d > 0.0).count(),
-        io.i32(VALID_DEPTH) as usize
-    );
-    println!(
-        "valid depth pixels {} of {}",
-        io.i32(VALID_DEPTH),
-        160 * 120
-    );
+    assert_eq!(depth.iter().filter(|&&d| d > 0.0).count(), io.i32(VALID_DEPTH) as usize);
+    println!("valid depth pixels {} of {}", io.i32(VALID_DEPTH), 160 * 120);
     assert!(io.i32(VALID_DEPTH) > 160 * 120 / 3);
     // In range up to the noise (sigma at 10 m is 1.9 m at this low resolution: fx = 84 px).
     let sigma_max = 100.0 * 0.08 / (k.fx * 0.05);
-    assert!(depth
-        .iter()
-        .all(|&d| d == 0.0 || (d > 0.0 && (d as f64) < 10.0 + 6.0 * sigma_max)));
+    assert!(depth.iter().all(|&d| d == 0.0 || (d > 0.0 && (d as f64) < 10.0 + 6.0 * sigma_max)));
     let labels = image::read_32sc1(&Image::from_cdr(agrisim_fmi::port::latest(&io, LABELS_IMAGE)).unwrap()).unwrap();
     assert_eq!(labels.len(), 160 * 120);
     assert_eq!(io.i64(LABELS_SEQ), 3);
@@ -431,10 +329,7 @@ fn square_pixels_when_fov_horizontal_is_zero() {
     *io.value_mut(FOV_H) = Value::Float64(0.0);
     let m = run(&mut io, 1);
     let k = m.config().unwrap().intrinsics;
-    assert!(
-        (k.fx - k.fy).abs() < 1e-9 && (k.fy - 240.0 / 29f64.to_radians().tan()).abs() < 1e-9,
-        "{k:?}"
-    );
+    assert!((k.fx - k.fy).abs() < 1e-9 && (k.fy - 240.0 / 29f64.to_radians().tan()).abs() < 1e-9, "{k:?}");
     let info = CameraInfo::from_cdr(agrisim_fmi::port::latest(&io, CAMERA_INFO)).unwrap();
     assert_eq!(info.k, k.k());
 }
@@ -453,11 +348,7 @@ fn deterministic_per_seed() {
     let outputs = |seed| {
         let mut io = store(96, 64, seed);
         run(&mut io, 11);
-        (
-            io.binary(IMAGE).to_vec(),
-            io.binary(DEPTH).to_vec(),
-            io.binary(LABELS_IMAGE).to_vec(),
-        )
+        (io.binary(IMAGE).to_vec(), io.binary(DEPTH).to_vec(), io.binary(LABELS_IMAGE).to_vec())
     };
     let a = outputs(5);
     assert_eq!(a, outputs(5));
@@ -478,11 +369,7 @@ fn bad_parameters_fail_initialization() {
     ] {
         let mut io = Store::new(Camera::VARIABLES);
         *io.value_mut(i) = v;
-        assert!(
-            Camera::new().initialize(&mut io, 0.0, &mut Quiet).is_err(),
-            "{}",
-            VARIABLES[i].name
-        );
+        assert!(Camera::new().initialize(&mut io, 0.0, &mut Quiet).is_err(), "{}", VARIABLES[i].name);
     }
 }
 
@@ -495,9 +382,19 @@ fn keyed_pixel_noise_is_uncorrelated_and_new_every_frame() {
     let scene = wall_scene(3.0);
     let m = model(DepthNoise::Stereo { subpixel: 0.08 }, false, 0.0);
     let mut rng = Rng::new(5);
-    let f1 = render::render(&Shot { scene: &scene, dynamic: &[], k: &k, pose: &pose, light: &light(), columns: &[], depth: &m }, &mut rng, 2);
-    let f2 = render::render(&Shot { scene: &scene, dynamic: &[], k: &k, pose: &pose, light: &light(), columns: &[], depth: &m }, &mut rng, 2);
-    let err = |f: &render::Frame| -> Vec<f64> { f.depth.iter().zip(&f.true_depth).map(|(d, t)| *d as f64 - *t as f64).collect() };
+    let f1 = render::render(
+        &Shot { scene: &scene, dynamic: &[], k: &k, pose: &pose, light: &light(), columns: &[], depth: &m },
+        &mut rng,
+        2,
+    );
+    let f2 = render::render(
+        &Shot { scene: &scene, dynamic: &[], k: &k, pose: &pose, light: &light(), columns: &[], depth: &m },
+        &mut rng,
+        2,
+    );
+    let err = |f: &render::Frame| -> Vec<f64> {
+        f.depth.iter().zip(&f.true_depth).map(|(d, t)| *d as f64 - *t as f64).collect()
+    };
     let (e1, e2) = (err(&f1), err(&f2));
     let corr = |a: &[f64], b: &[f64]| {
         let n = a.len() as f64;
@@ -565,6 +462,10 @@ fn the_camera_sees_the_arms_where_the_joints_put_them() {
         set_arms(io, WORKING, [0.0, 0.0]);
         io.set_f64(LIFT_POSITION, 0.3);
     });
-    let diff: usize = working.keys().chain(raised.keys()).map(|k| working.get(k).unwrap_or(&0).abs_diff(*raised.get(k).unwrap_or(&0))).sum();
+    let diff: usize = working
+        .keys()
+        .chain(raised.keys())
+        .map(|k| working.get(k).unwrap_or(&0).abs_diff(*raised.get(k).unwrap_or(&0)))
+        .sum();
     assert!(diff < seen / 20, "{raised:?} vs {working:?}");
 }

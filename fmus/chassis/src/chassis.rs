@@ -6,10 +6,10 @@ use crate::command::CommandIntake;
 use crate::odometry::WheelOdometry;
 use crate::ports::*;
 use crate::schedule::Schedule;
-use agrisim_fmu_util::to_ns;
 use crate::se2::{integrate, Twist2};
 use crate::wheels::{approach, WheelLayout, WheelState};
 use agrisim_fmi::{Log, Model, OutPort, Store, Var};
+use agrisim_fmu_util::to_ns;
 use agrisim_math::{Pose2, Rng};
 use agrisim_msgs::Message;
 
@@ -59,7 +59,12 @@ pub struct StepOutput {
 
 /// Mean contact velocity of each wheel over a step whose set-point ramp took `ramp[i]` of the
 /// step and then held: exact for an instant change (0) and for a full-step linear ramp (1).
-pub fn mean_contact_velocities(layout: &WheelLayout, start: &[WheelState; 4], end: &[WheelState; 4], ramp: &[f64; 4]) -> [(f64, f64); 4] {
+pub fn mean_contact_velocities(
+    layout: &WheelLayout,
+    start: &[WheelState; 4],
+    end: &[WheelState; 4],
+    ramp: &[f64; 4],
+) -> [(f64, f64); 4] {
     let (va, vb) = (layout.wheel_velocities(start), layout.wheel_velocities(end));
     std::array::from_fn(|i| {
         let f = ramp[i];
@@ -151,7 +156,11 @@ impl<D: Drive> Model for Chassis<D> {
     }
 
     fn initialize(&mut self, io: &mut Store, start_time: f64, log: &mut dyn Log) -> Result<(), String> {
-        self.layout = Some(WheelLayout::rectangular(positive(io, WHEEL_BASE)?, positive(io, TRACK)?, positive(io, WHEEL_RADIUS)?));
+        self.layout = Some(WheelLayout::rectangular(
+            positive(io, WHEEL_BASE)?,
+            positive(io, TRACK)?,
+            positive(io, WHEEL_RADIUS)?,
+        ));
         self.limits = Limits {
             steer_max: non_negative(io, STEER_MAX)?,
             steer_rate_max: non_negative(io, STEER_RATE_MAX)?,
@@ -187,13 +196,15 @@ impl<D: Drive> Model for Chassis<D> {
         let mut reference = [WheelState::default(); 4];
         let mut ramp = [0.0; 4];
         for i in 0..4 {
-            let steer = approach(start[i].steer, target[i].steer, l.steer_rate_max * h).clamp(-l.steer_max, l.steer_max);
+            let steer =
+                approach(start[i].steer, target[i].steer, l.steer_rate_max * h).clamp(-l.steer_max, l.steer_max);
             // Drive a wheel only as far as it points the right way: no sideways scrubbing
             // while the steering servo is still turning.
             let aligned = (target[i].steer - steer).cos().max(0.0);
             let spin_target = (target[i].spin * aligned).clamp(-l.spin_max, l.spin_max);
             let spin = approach(self.spin_ref[i], spin_target, l.spin_accel_max * h);
-            let duration = ((spin - self.spin_ref[i]).abs() / l.spin_accel_max).max((steer - start[i].steer).abs() / l.steer_rate_max);
+            let duration = ((spin - self.spin_ref[i]).abs() / l.spin_accel_max)
+                .max((steer - start[i].steer).abs() / l.steer_rate_max);
             ramp[i] = if duration.is_finite() { (duration / h).min(1.0) } else { 1.0 };
             self.spin_ref[i] = spin;
             reference[i] = WheelState { steer, spin };

@@ -21,7 +21,12 @@ pub struct CommandIntake {
 
 impl Default for CommandIntake {
     fn default() -> Self {
-        CommandIntake { cmd_seq: 0, cmd_vel: InPort::new(CMD_VEL, CMD_VEL_SEQ), latest: Twist2::default(), received_at: 0.0 }
+        CommandIntake {
+            cmd_seq: 0,
+            cmd_vel: InPort::new(CMD_VEL, CMD_VEL_SEQ),
+            latest: Twist2::default(),
+            received_at: 0.0,
+        }
     }
 }
 
@@ -95,6 +100,8 @@ fn scalar_command(io: &Store) -> Result<Twist2, String> {
 }
 
 fn decode_twist(bytes: &[u8]) -> Result<Twist2, String> {
-    let m = Twist::from_cdr(bytes).map_err(|e| format!("cmd_vel: not a valid geometry_msgs/msg/Twist CDR message ({} bytes): {e}", bytes.len()))?;
+    let m = Twist::from_cdr(bytes).map_err(|e| {
+        format!("cmd_vel: not a valid geometry_msgs/msg/Twist CDR message ({} bytes): {e}", bytes.len())
+    })?;
     checked(Twist2 { vx: m.linear.x, vy: m.linear.y, wz: m.angular.z }, "cmd_vel")
 }

@@ -32,7 +32,11 @@ pub struct DynamicDrive {
 
 fn finite_positive(io: &Store, i: usize) -> Result<f64, String> {
     let v = io.f64(i);
-    if v.is_finite() && v > 0.0 { Ok(v) } else { Err(format!("parameter {} must be positive and finite, got {v}", VARIABLES[i].name)) }
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("parameter {} must be positive and finite, got {v}", VARIABLES[i].name))
+    }
 }
 
 impl Drive for DynamicDrive {
@@ -117,7 +121,11 @@ impl Drive for DynamicDrive {
             sum.wz += v.wz;
         }
         let k = n as f64;
-        StepOutput { mean: Twist2 { vx: sum.vx / k, vy: sum.vy / k, wz: sum.wz / k }, end: v, wheel_travel: travel.map(|(x, y)| (x / k, y / k)) }
+        StepOutput {
+            mean: Twist2 { vx: sum.vx / k, vy: sum.vy / k, wz: sum.wz / k },
+            end: v,
+            wheel_travel: travel.map(|(x, y)| (x / k, y / k)),
+        }
     }
 }
 

@@ -19,7 +19,15 @@ pub struct WheelOdometry {
 impl WheelOdometry {
     /// Integrates one step from the wheels' travel over it (mean contact velocities, what
     /// tick-counting encoders measure), read with encoder and steering-sensor noise.
-    pub fn update(&mut self, layout: &WheelLayout, travel: &[(f64, f64); 4], enc_noise: f64, steer_noise: f64, rng: &mut Rng, h: f64) {
+    pub fn update(
+        &mut self,
+        layout: &WheelLayout,
+        travel: &[(f64, f64); 4],
+        enc_noise: f64,
+        steer_noise: f64,
+        rng: &mut Rng,
+        h: f64,
+    ) {
         let read: [(f64, f64); 4] = std::array::from_fn(|i| {
             let (vx, vy) = travel[i];
             let speed = vx.hypot(vy) + layout.radius * rng.gauss(enc_noise);
@@ -36,11 +44,17 @@ impl WheelOdometry {
             header: Header { stamp: Time::from_nanos(stamp_ns), frame_id: "odom".into() },
             child_frame_id: "base_link".into(),
             pose: PoseWithCovariance {
-                pose: Pose { position: Point { x: self.pose.x, y: self.pose.y, z: 0.0 }, orientation: Quaternion { x: 0.0, y: 0.0, z: s, w: c } },
+                pose: Pose {
+                    position: Point { x: self.pose.x, y: self.pose.y, z: 0.0 },
+                    orientation: Quaternion { x: 0.0, y: 0.0, z: s, w: c },
+                },
                 covariance: [0.0; 36],
             },
             twist: TwistWithCovariance {
-                twist: Twist { linear: Vector3 { x: self.twist.vx, y: self.twist.vy, z: 0.0 }, angular: Vector3 { x: 0.0, y: 0.0, z: self.twist.wz } },
+                twist: Twist {
+                    linear: Vector3 { x: self.twist.vx, y: self.twist.vy, z: 0.0 },
+                    angular: Vector3 { x: 0.0, y: 0.0, z: self.twist.wz },
+                },
                 covariance: [0.0; 36],
             },
         }

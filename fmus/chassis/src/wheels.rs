@@ -133,13 +133,17 @@ mod tests {
         let mut rng = agrisim_math::Rng::new(3);
         for _ in 0..10_000 {
             let t = Twist2 { vx: rng.normal(), vy: rng.normal(), wz: rng.normal() };
-            let cur: [WheelState; 4] = std::array::from_fn(|_| WheelState { steer: (rng.uniform() - 0.5) * PI, spin: 0.0 });
+            let cur: [WheelState; 4] =
+                std::array::from_fn(|_| WheelState { steer: (rng.uniform() - 0.5) * PI, spin: 0.0 });
             let w = l.inverse(t, &cur, PI / 2.0);
             for s in &w {
                 assert!(s.steer.abs() <= PI / 2.0 + 1e-9);
             }
             let back = l.forward(&w);
-            assert!((back.vx - t.vx).abs() < 1e-9 && (back.vy - t.vy).abs() < 1e-9 && (back.wz - t.wz).abs() < 1e-9, "{t:?} -> {back:?}");
+            assert!(
+                (back.vx - t.vx).abs() < 1e-9 && (back.vy - t.vy).abs() < 1e-9 && (back.wz - t.wz).abs() < 1e-9,
+                "{t:?} -> {back:?}"
+            );
         }
     }
 

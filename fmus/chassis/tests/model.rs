@@ -64,7 +64,12 @@ fn circle_matches_analytic_pose() {
         let (bx, by) = ((s * v - (1.0 - c) * vy) / w, ((1.0 - c) * v + s * vy) / w);
         let (s0, c0) = 0.5f64.sin_cos();
         let (xa, ya) = (1.0 + c0 * bx - s0 * by, s0 * bx + c0 * by);
-        assert!((io.f64(X) - xa).abs() < 1e-6 && (io.f64(Y) - ya).abs() < 1e-6, "t={t}: ({}, {}) vs ({xa}, {ya})", io.f64(X), io.f64(Y));
+        assert!(
+            (io.f64(X) - xa).abs() < 1e-6 && (io.f64(Y) - ya).abs() < 1e-6,
+            "t={t}: ({}, {}) vs ({xa}, {ya})",
+            io.f64(X),
+            io.f64(Y)
+        );
         // Without noise, odometry equals ground truth (in its own frame, which starts at the initial pose).
         assert!((io.f64(ODOM_X) - io.f64(X)).abs() < 1e-9);
     }
@@ -147,7 +152,11 @@ fn garbage_twist_is_refused_with_a_warning_and_the_last_valid_command_stays() {
     io.set_i64(CMD_VEL_SEQ, 2);
     m.do_step(&mut io, H, H, &mut log).unwrap();
     assert_eq!(log.0.len(), 1, "{:?}", log.0);
-    assert!(log.0[0].contains("cmd_vel") && log.0[0].contains("refused") && log.0[0].contains("t=0.02"), "{}", log.0[0]);
+    assert!(
+        log.0[0].contains("cmd_vel") && log.0[0].contains("refused") && log.0[0].contains("t=0.02"),
+        "{}",
+        log.0[0]
+    );
     assert!(io.bool(CMD_ACTIVE) && (io.f64(VX) - 0.3).abs() < 1e-9, "the last valid command stays in force");
     // ... until the watchdog: the refused message does not count as a command.
     for k in 2..30 {

@@ -186,7 +186,13 @@ pub unsafe fn reset<M: Model>(c: *mut c_void) -> Status {
 ///
 /// # Safety
 /// `vr` must hold `nvr` values and `value` room for `nvr` (or be NULL when 0).
-pub unsafe fn get<M: Model, T: CType>(c: *mut c_void, function: &str, vr: *const u32, nvr: usize, value: *mut T::C) -> Status {
+pub unsafe fn get<M: Model, T: CType>(
+    c: *mut c_void,
+    function: &str,
+    vr: *const u32,
+    nvr: usize,
+    value: *mut T::C,
+) -> Status {
     with_instance::<M>(API, c, function, mask::GET, |inst| {
         let vrs = slice(vr, nvr, "vr")?;
         let values = slice_mut(value, nvr, "value")?;
@@ -199,7 +205,13 @@ pub unsafe fn get<M: Model, T: CType>(c: *mut c_void, function: &str, vr: *const
 ///
 /// # Safety
 /// `vr` and `value` must hold `nvr` values (or be NULL when 0).
-pub unsafe fn set<M: Model, T: CType>(c: *mut c_void, function: &str, vr: *const u32, nvr: usize, value: *const T::C) -> Status {
+pub unsafe fn set<M: Model, T: CType>(
+    c: *mut c_void,
+    function: &str,
+    vr: *const u32,
+    nvr: usize,
+    value: *const T::C,
+) -> Status {
     with_instance::<M>(API, c, function, mask::SET, |inst| {
         let vrs = slice(vr, nvr, "vr")?;
         let values = slice(value, nvr, "value")?;
@@ -256,16 +268,42 @@ pub unsafe fn serialized_fmu_state_size<M: Model>(c: *mut c_void, state: *mut c_
 ///
 /// # Safety
 /// `serialized` must be NULL or point to `size` writable bytes.
-pub unsafe fn serialize_fmu_state<M: Model>(c: *mut c_void, state: *mut c_void, serialized: *mut c_char, size: usize) -> Status {
-    crate::fmi3::serialize_impl::<M>(API, c, "fmi2SerializeFMUstate", mask::SERIALIZE_FMU_STATE, state, serialized.cast(), size)
+pub unsafe fn serialize_fmu_state<M: Model>(
+    c: *mut c_void,
+    state: *mut c_void,
+    serialized: *mut c_char,
+    size: usize,
+) -> Status {
+    crate::fmi3::serialize_impl::<M>(
+        API,
+        c,
+        "fmi2SerializeFMUstate",
+        mask::SERIALIZE_FMU_STATE,
+        state,
+        serialized.cast(),
+        size,
+    )
 }
 
 /// `fmi2DeSerializeFMUstate`.
 ///
 /// # Safety
 /// `serialized` must be NULL or point to `size` readable bytes; `state` NULL or writable.
-pub unsafe fn deserialize_fmu_state<M: Model>(c: *mut c_void, serialized: *const c_char, size: usize, state: *mut *mut c_void) -> Status {
-    crate::fmi3::deserialize_impl::<M>(API, c, "fmi2DeSerializeFMUstate", mask::DESERIALIZE_FMU_STATE, serialized.cast(), size, state)
+pub unsafe fn deserialize_fmu_state<M: Model>(
+    c: *mut c_void,
+    serialized: *const c_char,
+    size: usize,
+    state: *mut *mut c_void,
+) -> Status {
+    crate::fmi3::deserialize_impl::<M>(
+        API,
+        c,
+        "fmi2DeSerializeFMUstate",
+        mask::DESERIALIZE_FMU_STATE,
+        serialized.cast(),
+        size,
+        state,
+    )
 }
 
 /// `fmi2SetFMUstate`.

@@ -322,14 +322,26 @@ macro_rules! typed {
         ///
         /// # Safety
         /// As [`get`].
-        pub unsafe fn $get<M: Model>(i: *mut c_void, vrs: *const u32, n_vr: usize, values: *mut $c, n_values: usize) -> Status {
+        pub unsafe fn $get<M: Model>(
+            i: *mut c_void,
+            vrs: *const u32,
+            n_vr: usize,
+            values: *mut $c,
+            n_values: usize,
+        ) -> Status {
             get::<M, ctype::$marker>(i, $gname, vrs, n_vr, values, n_values)
         }
         #[doc = concat!("`", $sname, "`.")]
         ///
         /// # Safety
         /// As [`set`].
-        pub unsafe fn $set<M: Model>(i: *mut c_void, vrs: *const u32, n_vr: usize, values: *const $c, n_values: usize) -> Status {
+        pub unsafe fn $set<M: Model>(
+            i: *mut c_void,
+            vrs: *const u32,
+            n_vr: usize,
+            values: *const $c,
+            n_values: usize,
+        ) -> Status {
             set::<M, ctype::$marker>(i, $sname, vrs, n_vr, values, n_values)
         }
     };
@@ -439,7 +451,11 @@ pub unsafe fn free_fmu_state<M: Model>(instance: *mut c_void, state: *mut *mut c
 ///
 /// # Safety
 /// `size` must be NULL or writable.
-pub unsafe fn serialized_fmu_state_size<M: Model>(instance: *mut c_void, state: *mut c_void, size: *mut usize) -> Status {
+pub unsafe fn serialized_fmu_state_size<M: Model>(
+    instance: *mut c_void,
+    state: *mut c_void,
+    size: *mut usize,
+) -> Status {
     serialized_size_impl::<M>(API, instance, "fmi3SerializedFMUStateSize", mask::SERIALIZE_FMU_STATE, state, size)
 }
 
@@ -447,7 +463,12 @@ pub unsafe fn serialized_fmu_state_size<M: Model>(instance: *mut c_void, state: 
 ///
 /// # Safety
 /// `serialized` must be NULL or point to `size` writable bytes.
-pub unsafe fn serialize_fmu_state<M: Model>(instance: *mut c_void, state: *mut c_void, serialized: *mut u8, size: usize) -> Status {
+pub unsafe fn serialize_fmu_state<M: Model>(
+    instance: *mut c_void,
+    state: *mut c_void,
+    serialized: *mut u8,
+    size: usize,
+) -> Status {
     serialize_impl::<M>(API, instance, "fmi3SerializeFMUState", mask::SERIALIZE_FMU_STATE, state, serialized, size)
 }
 
@@ -455,8 +476,21 @@ pub unsafe fn serialize_fmu_state<M: Model>(instance: *mut c_void, state: *mut c
 ///
 /// # Safety
 /// `serialized` must be NULL or point to `size` readable bytes; `state` NULL or writable.
-pub unsafe fn deserialize_fmu_state<M: Model>(instance: *mut c_void, serialized: *const u8, size: usize, state: *mut *mut c_void) -> Status {
-    deserialize_impl::<M>(API, instance, "fmi3DeserializeFMUState", mask::DESERIALIZE_FMU_STATE, serialized, size, state)
+pub unsafe fn deserialize_fmu_state<M: Model>(
+    instance: *mut c_void,
+    serialized: *const u8,
+    size: usize,
+    state: *mut *mut c_void,
+) -> Status {
+    deserialize_impl::<M>(
+        API,
+        instance,
+        "fmi3DeserializeFMUState",
+        mask::DESERIALIZE_FMU_STATE,
+        serialized,
+        size,
+        state,
+    )
 }
 
 /// Shared by the FMI 3 and FMI 2 size functions.
@@ -555,9 +589,16 @@ pub fn unsupported_reason(function: &str) -> &'static str {
         "fmi3EnterEventMode" | "fmi3UpdateDiscreteStates" | "fmi3EvaluateDiscreteStates" | "fmi3EnterStepMode" => {
             "this FMU has no event mode (hasEventMode=false); ExitInitializationMode enters Step Mode directly"
         }
-        "fmi3GetClock" | "fmi3SetClock" | "fmi3GetIntervalDecimal" | "fmi3GetIntervalFraction"
-        | "fmi3GetShiftDecimal" | "fmi3GetShiftFraction" | "fmi3SetIntervalDecimal"
-        | "fmi3SetIntervalFraction" | "fmi3SetShiftDecimal" | "fmi3SetShiftFraction"
+        "fmi3GetClock"
+        | "fmi3SetClock"
+        | "fmi3GetIntervalDecimal"
+        | "fmi3GetIntervalFraction"
+        | "fmi3GetShiftDecimal"
+        | "fmi3GetShiftFraction"
+        | "fmi3SetIntervalDecimal"
+        | "fmi3SetIntervalFraction"
+        | "fmi3SetShiftDecimal"
+        | "fmi3SetShiftFraction"
         | "fmi3ActivateModelPartition" => "this FMU has no clocks",
         "fmi3EnterConfigurationMode" | "fmi3ExitConfigurationMode" => "this FMU has no structural parameters",
         "fmi3GetDirectionalDerivative" | "fmi3GetAdjointDerivative" => {

@@ -102,7 +102,9 @@ pub unsafe fn with_instance<M: Model>(
 /// # Safety
 /// As [`with_instance`].
 pub unsafe fn unsupported<M: Model>(api: Api, ptr: *mut c_void, function: &str, why: &str) -> Status {
-    with_instance::<M>(api, ptr, function, Mask::MAX, |_| Err(Failure::from(format!("not supported by this FMU: {why}"))))
+    with_instance::<M>(api, ptr, function, Mask::MAX, |_| {
+        Err(Failure::from(format!("not supported by this FMU: {why}")))
+    })
 }
 
 /// `ptr[..n]` as a slice; NULL is accepted only for `n == 0`.

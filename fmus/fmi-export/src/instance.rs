@@ -11,9 +11,9 @@ use crate::ctype::CType;
 use crate::logger::Logger;
 use crate::model::Model;
 use crate::registry::Api;
+use crate::serial;
 use crate::state::{settable, Mode};
 use crate::store::{Store, Value};
-use crate::serial;
 use crate::var::{Causality, Var};
 
 /// Where a value reference points.
@@ -75,7 +75,8 @@ fn initialized(mode: Mode) -> bool {
 /// Parameters (and everything else fixed before the run) bit for bit equal.
 fn same_parameters<M: Model>(a: &Store, b: &Store) -> bool {
     M::VARIABLES.iter().enumerate().all(|(i, v)| {
-        !matches!(v.causality, Causality::Parameter | Causality::CalculatedParameter) || a.value(i).identical(b.value(i))
+        !matches!(v.causality, Causality::Parameter | Causality::CalculatedParameter)
+            || a.value(i).identical(b.value(i))
     })
 }
 
@@ -126,7 +127,8 @@ impl<M: Model> Instance<M> {
     pub fn reset(&mut self) -> Result<(), String> {
         self.preview = None;
         self.strings.clear();
-        self.model = catch_unwind(M::new).map_err(|p| format!("the model panicked in new(): {}", panic_message(&*p)))?;
+        self.model =
+            catch_unwind(M::new).map_err(|p| format!("the model panicked in new(): {}", panic_message(&*p)))?;
         self.store = Store::new(M::VARIABLES);
         self.time = 0.0;
         self.start_time = 0.0;
@@ -455,7 +457,8 @@ impl<M: Model> Instance<M> {
             let mut model = if initialized(self.mode) && same_parameters::<M>(&self.store, &h.store) {
                 self.model.clone()
             } else {
-                let mut model = catch_unwind(M::new).map_err(|p| format!("the model panicked in new(): {}", panic_message(&*p)))?;
+                let mut model =
+                    catch_unwind(M::new).map_err(|p| format!("the model panicked in new(): {}", panic_message(&*p)))?;
                 model
                     .initialize(&mut h.store.clone(), h.start_time, &mut self.logger)
                     .map_err(|e| format!("the model failed to initialize (rebuilding a deserialized state): {e}"))?;

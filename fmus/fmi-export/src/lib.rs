@@ -26,8 +26,8 @@ mod units;
 mod var;
 pub mod xml;
 
-pub use port::{port_window, InPort, OutPort};
 pub use model::{Log, Model, ModelError, Quiet};
+pub use port::{port_window, InPort, OutPort};
 pub use state::{Mode, Status};
 pub use store::{checked_f64, Store, Value};
 pub use var::{concat, Causality, Start, Var, Variability, DEFAULT_MAX_SIZE};

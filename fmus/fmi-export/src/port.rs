@@ -96,7 +96,11 @@ impl InPort {
 /// The messages (CDR) in output port `bin` of `io`, oldest first: for tests and tools that
 /// drive a model directly. Panics on a malformed list (a bug in the model).
 pub fn messages(io: &Store, bin: usize) -> Vec<&[u8]> {
-    agrisim_frames::decode(io.binary(bin)).expect("a model's output port holds a valid frame list").into_iter().map(|f| f.payload).collect()
+    agrisim_frames::decode(io.binary(bin))
+        .expect("a model's output port holds a valid frame list")
+        .into_iter()
+        .map(|f| f.payload)
+        .collect()
 }
 
 /// The newest message in output port `bin` of `io` (empty when the port is empty).

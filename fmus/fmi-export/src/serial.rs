@@ -41,7 +41,8 @@ pub fn write<T: Serialize + ?Sized>(value: &T, out: &mut Vec<u8>) -> Result<(), 
 
 /// Decodes a value written by [`write`]; every byte must be used.
 pub fn read<T: DeserializeOwned>(bytes: &[u8]) -> Result<T, String> {
-    let (value, rest) = postcard::take_from_bytes(bytes).map_err(|e| format!("corrupt model state ({} bytes): {e}", bytes.len()))?;
+    let (value, rest) =
+        postcard::take_from_bytes(bytes).map_err(|e| format!("corrupt model state ({} bytes): {e}", bytes.len()))?;
     if !rest.is_empty() {
         return Err(format!("corrupt model state: {} bytes left over", rest.len()));
     }
@@ -57,10 +58,11 @@ pub(crate) fn encode(header: &Header, model: &[u8]) -> Result<Vec<u8>, String> {
 
 /// Splits a serialized state into its header and the model's bytes.
 pub(crate) fn decode(bytes: &[u8]) -> Result<(Header, &[u8]), String> {
-    let body = bytes
-        .strip_prefix(MAGIC.as_slice())
-        .ok_or_else(|| format!("not a serialized agrisim FMU state ({} bytes; expected the prefix \"AGS\\x01\")", bytes.len()))?;
-    let (header, rest): (Header, &[u8]) = postcard::take_from_bytes(body).map_err(|e| format!("corrupt FMU state header: {e}"))?;
+    let body = bytes.strip_prefix(MAGIC.as_slice()).ok_or_else(|| {
+        format!("not a serialized agrisim FMU state ({} bytes; expected the prefix \"AGS\\x01\")", bytes.len())
+    })?;
+    let (header, rest): (Header, &[u8]) =
+        postcard::take_from_bytes(body).map_err(|e| format!("corrupt FMU state header: {e}"))?;
     if rest.len() as u64 != header.model_len {
         return Err(format!(
             "corrupt FMU state: {} bytes of model state, the header says {} (truncated or padded)",
@@ -74,7 +76,11 @@ pub(crate) fn decode(bytes: &[u8]) -> Result<(Header, &[u8]), String> {
 /// [`Model::load_state`](crate::Model::load_state) for a model serialized whole with serde,
 /// its derived parts `#[serde(skip)]`ped: decodes `bytes`, lets `keep` move the derived parts
 /// over from the current model, and replaces it.
-pub fn load_keeping<T: DeserializeOwned>(model: &mut T, bytes: &[u8], keep: impl FnOnce(&mut T, &mut T)) -> Result<(), String> {
+pub fn load_keeping<T: DeserializeOwned>(
+    model: &mut T,
+    bytes: &[u8],
+    keep: impl FnOnce(&mut T, &mut T),
+) -> Result<(), String> {
     let mut loaded: T = read(bytes)?;
     keep(&mut loaded, model);
     *model = loaded;

@@ -68,7 +68,9 @@ impl Mode {
             Mode::InitializationMode => "Initialization Mode",
             Mode::StepMode => "Step Mode",
             Mode::Terminated => "Terminated",
-            Mode::Error => "Error (after a call returned Error; only Reset, FreeInstance or restoring an FMU state help)",
+            Mode::Error => {
+                "Error (after a call returned Error; only Reset, FreeInstance or restoring an FMU state help)"
+            }
             Mode::Fatal => "Fatal",
         }
     }
@@ -76,14 +78,8 @@ impl Mode {
 
 /// Human-readable list of the modes in `mask`, for log messages.
 pub fn mask_names(mask: Mask) -> String {
-    let all = [
-        Mode::Instantiated,
-        Mode::InitializationMode,
-        Mode::StepMode,
-        Mode::Terminated,
-        Mode::Error,
-        Mode::Fatal,
-    ];
+    let all =
+        [Mode::Instantiated, Mode::InitializationMode, Mode::StepMode, Mode::Terminated, Mode::Error, Mode::Fatal];
     let names: Vec<&str> = all
         .iter()
         .filter(|m| mask & m.bit() != 0)

@@ -117,7 +117,12 @@ unsafe fn access<M: Model, T: CType>(inst: *mut c_void, i: usize, value: Option<
         assert_eq!(fmi3::set::<M, T>(inst, "set", vr.as_ptr(), 1, &x, 1), Status::Ok, "{}: setting '{name}'", M::NAME);
     }
     let mut x = zeroed::<T::C>(1);
-    assert_eq!(fmi3::get::<M, T>(inst, "get", vr.as_ptr(), 1, x.as_mut_ptr(), 1), Status::Ok, "{}: getting '{name}'", M::NAME);
+    assert_eq!(
+        fmi3::get::<M, T>(inst, "get", vr.as_ptr(), 1, x.as_mut_ptr(), 1),
+        Status::Ok,
+        "{}: getting '{name}'",
+        M::NAME
+    );
     T::decode(x[0]).unwrap_or_else(|e| panic!("{}: '{name}' read back: {e}", M::NAME))
 }
 
@@ -140,8 +145,18 @@ pub fn assert_no_direct_feedthrough<M: Model>() {
     unsafe {
         let token = CString::new(M::TOKEN).unwrap_or_default();
         let inst = fmi3::instantiate_co_simulation::<M>(
-            c"feedthrough".as_ptr(), token.as_ptr(), std::ptr::null(), 0, 0, 0, 0, std::ptr::null(), 0,
-            std::ptr::null_mut(), None, None,
+            c"feedthrough".as_ptr(),
+            token.as_ptr(),
+            std::ptr::null(),
+            0,
+            0,
+            0,
+            0,
+            std::ptr::null(),
+            0,
+            std::ptr::null_mut(),
+            None,
+            None,
         );
         assert!(!inst.is_null(), "{}: instantiation failed", M::NAME);
         assert_eq!(fmi3::enter_initialization_mode::<M>(inst, 0, 0.0, 0.0, 0, 0.0), Status::Ok);
@@ -153,7 +168,10 @@ pub fn assert_no_direct_feedthrough<M: Model>() {
         for round in 0..2 {
             if round == 1 {
                 let (mut ev, mut term, mut early, mut last) = (0, 0, 0, 0.0);
-                assert_eq!(fmi3::do_step::<M>(inst, 0.0, 0.02, 0, &mut ev, &mut term, &mut early, &mut last), Status::Ok);
+                assert_eq!(
+                    fmi3::do_step::<M>(inst, 0.0, 0.02, 0, &mut ev, &mut term, &mut early, &mut last),
+                    Status::Ok
+                );
             }
             let before = outputs();
             for i in knowns() {
@@ -164,7 +182,12 @@ pub fn assert_no_direct_feedthrough<M: Model>() {
             }
             let after = outputs();
             for ((i, a), b) in with(Causality::Output).zip(&before).zip(&after) {
-                assert!(same(a, b), "{}: output '{}' changed when inputs were set without a step", M::NAME, M::VARIABLES[i].name);
+                assert!(
+                    same(a, b),
+                    "{}: output '{}' changed when inputs were set without a step",
+                    M::NAME,
+                    M::VARIABLES[i].name
+                );
             }
             // Back to the start values, which the model steps with.
             for i in knowns() {
@@ -275,9 +298,10 @@ unsafe extern "C" fn log2_fixed(
 fn log2() -> Fmi2Logger {
     // SAFETY: identical fixed arguments; the FMU passes no variadic arguments.
     unsafe {
-        std::mem::transmute::<unsafe extern "C" fn(*mut c_void, *const c_char, Status, *const c_char, *const c_char), Fmi2Logger>(
-            log2_fixed,
-        )
+        std::mem::transmute::<
+            unsafe extern "C" fn(*mut c_void, *const c_char, Status, *const c_char, *const c_char),
+            Fmi2Logger,
+        >(log2_fixed)
     }
 }
 
@@ -445,14 +469,25 @@ fn zeroed<T>(n: usize) -> Vec<T> {
     (0..n).map(|_| unsafe { std::mem::zeroed() }).collect()
 }
 
-unsafe fn get3<M: Model, T: CType>(rng: &mut FuzzRng, inst: *mut c_void, function: &'static str, mode: Mode) -> Outcome {
+unsafe fn get3<M: Model, T: CType>(
+    rng: &mut FuzzRng,
+    inst: *mut c_void,
+    function: &'static str,
+    mode: Mode,
+) -> Outcome {
     let vrs = pick_vrs::<M, T>(rng, false);
     let (n_values, null_values, right) = sizes(rng, vrs.len());
     let mut values: Vec<T::C> = zeroed(n_values.max(vrs.len()) + 1);
     let vp = if null_values { std::ptr::null_mut() } else { values.as_mut_ptr() };
     let status = fmi3::get::<M, T>(inst, function, vrs.as_ptr(), vrs.len(), vp, n_values);
     let ok = right && all_match::<M, T>(&vrs, false);
-    let must = if !ok { Must::Fail } else if mode == Mode::InitializationMode { Must::Any } else { Must::Succeed };
+    let must = if !ok {
+        Must::Fail
+    } else if mode == Mode::InitializationMode {
+        Must::Any
+    } else {
+        Must::Succeed
+    };
     Outcome { function, mask: spec3::GET, status, must, then: Then::Nothing }
 }
 
@@ -492,7 +527,13 @@ unsafe fn random_call3<M: Model>(rng: &mut FuzzRng, inst: *mut c_void, sh: &Shad
             let null = rng.chance(10) && n > 0;
             let p = if null { std::ptr::null() } else { cats.as_ptr() };
             let s = fmi3::set_debug_logging::<M>(inst, rng.below(2) as u8, n, p);
-            o("fmi3SetDebugLogging", m::SET_DEBUG_LOGGING, s, if null { Must::Fail } else { Must::Succeed }, Then::Nothing)
+            o(
+                "fmi3SetDebugLogging",
+                m::SET_DEBUG_LOGGING,
+                s,
+                if null { Must::Fail } else { Must::Succeed },
+                Then::Nothing,
+            )
         }
         1 | 2 => {
             let start = if rng.chance(85) { 0.0 } else { rng.f64() };
@@ -501,7 +542,13 @@ unsafe fn random_call3<M: Model>(rng: &mut FuzzRng, inst: *mut c_void, sh: &Shad
             let s = fmi3::enter_initialization_mode::<M>(inst, 0, 0.0, start, stop_defined as u8, stop);
             let good = start.is_finite() && (!stop_defined || stop >= start);
             let must = if good { Must::Succeed } else { Must::Fail };
-            o("fmi3EnterInitializationMode", m::ENTER_INITIALIZATION_MODE, s, must, Then::Mode(Mode::InitializationMode))
+            o(
+                "fmi3EnterInitializationMode",
+                m::ENTER_INITIALIZATION_MODE,
+                s,
+                must,
+                Then::Mode(Mode::InitializationMode),
+            )
         }
         3 | 4 => {
             let s = fmi3::exit_initialization_mode::<M>(inst);
@@ -536,7 +583,10 @@ unsafe fn random_call3<M: Model>(rng: &mut FuzzRng, inst: *mut c_void, sh: &Shad
                 Must::Any
             };
             if s == Status::Ok {
-                assert!(ev == 0 && term == 0 && early == 0 && last == tc + h, "fmi3DoStep outputs wrong: {ev} {term} {early} {last}");
+                assert!(
+                    ev == 0 && term == 0 && early == 0 && last == tc + h,
+                    "fmi3DoStep outputs wrong: {ev} {term} {early} {last}"
+                );
             }
             o("fmi3DoStep", m::DO_STEP, s, must, Then::Stepped(tc + h))
         }
@@ -565,7 +615,13 @@ unsafe fn random_call3<M: Model>(rng: &mut FuzzRng, inst: *mut c_void, sh: &Shad
                     }
                 }
                 let ok = right && all_match::<M, ctype::Bin>(&vrs, false);
-                let must = if !ok { Must::Fail } else if sh.mode == Mode::InitializationMode { Must::Any } else { Must::Succeed };
+                let must = if !ok {
+                    Must::Fail
+                } else if sh.mode == Mode::InitializationMode {
+                    Must::Any
+                } else {
+                    Must::Succeed
+                };
                 o("fmi3GetBinary", m::GET, s, must, Then::Nothing)
             }
             _ => get3::<M, ctype::Float64>(rng, inst, "fmi3GetFloat64", sh.mode),
@@ -581,7 +637,8 @@ unsafe fn random_call3<M: Model>(rng: &mut FuzzRng, inst: *mut c_void, sh: &Shad
                 let vrs = pick_vrs::<M, ctype::Bin>(rng, false);
                 let (n, null, right) = sizes(rng, vrs.len());
                 let mut keep = Keep::default();
-                let vals: Vec<(usize, *const u8)> = (0..n + 1).map(|_| <ctype::Bin as Gen>::gen(rng, &mut keep)).collect();
+                let vals: Vec<(usize, *const u8)> =
+                    (0..n + 1).map(|_| <ctype::Bin as Gen>::gen(rng, &mut keep)).collect();
                 let sz: Vec<usize> = vals.iter().map(|v| v.0).collect();
                 let ptrs: Vec<*const u8> = vals.iter().map(|v| v.1).collect();
                 let pp = if null { std::ptr::null() } else { ptrs.as_ptr() };
@@ -674,7 +731,10 @@ unsafe fn round_trip(
         return (Must::Succeed, Then::Nothing, s);
     }
     let mut again = 0usize;
-    assert!(size(p, &mut again) <= Status::Warning && again == n, "a deserialized state must serialize to the same size");
+    assert!(
+        size(p, &mut again) <= Status::Warning && again == n,
+        "a deserialized state must serialize to the same size"
+    );
     let mut copy = vec![0u8; again];
     assert!(serialize(p, copy.as_mut_ptr(), again) <= Status::Warning);
     assert!(copy == bytes, "a deserialized state must serialize to the same bytes");
@@ -741,12 +801,14 @@ unsafe fn check<M: Model>(o: &Outcome, sh: &mut Shadow, inst: *mut c_void, logs:
                 sh.states.push((p, sh.mode, sh.time));
             }
             Then::Restore(p) => {
-                let (_, m, t) = *sh.states.iter().find(|s| s.0 == p).expect("restored a state the shadow does not know");
+                let (_, m, t) =
+                    *sh.states.iter().find(|s| s.0 == p).expect("restored a state the shadow does not know");
                 sh.mode = m;
                 sh.time = t;
             }
             Then::Copied(src, p) => {
-                let (_, m, t) = *sh.states.iter().find(|s| s.0 == src).expect("copied a state the shadow does not know");
+                let (_, m, t) =
+                    *sh.states.iter().find(|s| s.0 == src).expect("copied a state the shadow does not know");
                 sh.freed.retain(|&q| q != p);
                 sh.states.push((p, m, t));
             }
@@ -792,16 +854,47 @@ pub fn fuzz_fmi3<M: Model>(seed: u64, cases: usize) {
                 _ => (std::ptr::null(), token.as_ptr(), 0, 0),
             };
             let req = [1u32];
-            let p = fmi3::instantiate_co_simulation::<M>(name, tok, std::ptr::null(), 0, 0, event_mode, 0, req.as_ptr(), n_req, env, Some(log3), None);
+            let p = fmi3::instantiate_co_simulation::<M>(
+                name,
+                tok,
+                std::ptr::null(),
+                0,
+                0,
+                event_mode,
+                0,
+                req.as_ptr(),
+                n_req,
+                env,
+                Some(log3),
+                None,
+            );
             assert!(p.is_null(), "{}: bad instantiation accepted (case {case})", M::NAME);
             assert!(!logs.0.is_empty(), "{}: bad instantiation not logged (case {case})", M::NAME);
-            let p = fmi3::instantiate_model_exchange::<M>(c"me".as_ptr(), token.as_ptr(), std::ptr::null(), 0, 0, env, Some(log3));
+            let p = fmi3::instantiate_model_exchange::<M>(
+                c"me".as_ptr(),
+                token.as_ptr(),
+                std::ptr::null(),
+                0,
+                0,
+                env,
+                Some(log3),
+            );
             assert!(p.is_null(), "{}: Model Exchange instantiated", M::NAME);
             logs.0.clear();
 
             let inst = fmi3::instantiate_co_simulation::<M>(
-                c"fuzz".as_ptr(), token.as_ptr(), std::ptr::null(), 0, rng.below(2) as u8, 0, rng.below(2) as u8,
-                std::ptr::null(), 0, env, Some(log3), None,
+                c"fuzz".as_ptr(),
+                token.as_ptr(),
+                std::ptr::null(),
+                0,
+                rng.below(2) as u8,
+                0,
+                rng.below(2) as u8,
+                std::ptr::null(),
+                0,
+                env,
+                Some(log3),
+                None,
             );
             assert!(!inst.is_null(), "{}: instantiation failed: {:?}", M::NAME, logs.0);
             let mut sh = Shadow { mode: Mode::Instantiated, states: Vec::new(), freed: Vec::new(), time: 0.0 };
@@ -811,16 +904,37 @@ pub fn fuzz_fmi3<M: Model>(seed: u64, cases: usize) {
             let n_calls = 10 + rng.below(60);
             for k in 0..n_calls {
                 let o = if legal_prefix && k == 0 {
-                    Outcome { function: "fmi3EnterInitializationMode", mask: spec3::ENTER_INITIALIZATION_MODE,
-                        status: fmi3::enter_initialization_mode::<M>(inst, 0, 0.0, 0.0, 0, 0.0), must: Must::Succeed,
-                        then: Then::Mode(Mode::InitializationMode) }
+                    Outcome {
+                        function: "fmi3EnterInitializationMode",
+                        mask: spec3::ENTER_INITIALIZATION_MODE,
+                        status: fmi3::enter_initialization_mode::<M>(inst, 0, 0.0, 0.0, 0, 0.0),
+                        must: Must::Succeed,
+                        then: Then::Mode(Mode::InitializationMode),
+                    }
                 } else if legal_prefix && k == 1 {
-                    Outcome { function: "fmi3ExitInitializationMode", mask: spec3::EXIT_INITIALIZATION_MODE,
-                        status: fmi3::exit_initialization_mode::<M>(inst), must: Must::Any, then: Then::Mode(Mode::StepMode) }
+                    Outcome {
+                        function: "fmi3ExitInitializationMode",
+                        mask: spec3::EXIT_INITIALIZATION_MODE,
+                        status: fmi3::exit_initialization_mode::<M>(inst),
+                        must: Must::Any,
+                        then: Then::Mode(Mode::StepMode),
+                    }
                 } else if rng.chance(3) {
                     // NULL and garbage handles: Error, no effect on the real instance.
                     let bad = if rng.chance(50) { std::ptr::null_mut() } else { garbage_ptr(&mut rng) };
-                    assert_eq!(fmi3::do_step::<M>(bad, 0.0, 0.02, 0, std::ptr::null_mut(), std::ptr::null_mut(), std::ptr::null_mut(), std::ptr::null_mut()), Status::Error);
+                    assert_eq!(
+                        fmi3::do_step::<M>(
+                            bad,
+                            0.0,
+                            0.02,
+                            0,
+                            std::ptr::null_mut(),
+                            std::ptr::null_mut(),
+                            std::ptr::null_mut(),
+                            std::ptr::null_mut()
+                        ),
+                        Status::Error
+                    );
                     assert_eq!(fmi3::reset::<M>(bad), Status::Error);
                     fmi3::free_instance::<M>(bad);
                     continue;
@@ -893,10 +1007,28 @@ unsafe fn random_call2<M: Model>(rng: &mut FuzzRng, c: *mut c_void, sh: &Shadow)
         1 => {
             let start = if rng.chance(85) { 0.0 } else { rng.f64() };
             let s = fmi2::setup_experiment::<M>(c, 0, 0.0, start, 0, 0.0);
-            o("fmi2SetupExperiment", m::SETUP_EXPERIMENT, s, if start.is_finite() { Must::Succeed } else { Must::Fail }, Then::Nothing)
+            o(
+                "fmi2SetupExperiment",
+                m::SETUP_EXPERIMENT,
+                s,
+                if start.is_finite() { Must::Succeed } else { Must::Fail },
+                Then::Nothing,
+            )
         }
-        2 => o("fmi2EnterInitializationMode", m::ENTER_INITIALIZATION_MODE, fmi2::enter_initialization_mode::<M>(c), Must::Succeed, Then::Mode(Mode::InitializationMode)),
-        3 | 4 => o("fmi2ExitInitializationMode", m::EXIT_INITIALIZATION_MODE, fmi2::exit_initialization_mode::<M>(c), Must::Any, Then::Mode(Mode::StepMode)),
+        2 => o(
+            "fmi2EnterInitializationMode",
+            m::ENTER_INITIALIZATION_MODE,
+            fmi2::enter_initialization_mode::<M>(c),
+            Must::Succeed,
+            Then::Mode(Mode::InitializationMode),
+        ),
+        3 | 4 => o(
+            "fmi2ExitInitializationMode",
+            m::EXIT_INITIALIZATION_MODE,
+            fmi2::exit_initialization_mode::<M>(c),
+            Must::Any,
+            Then::Mode(Mode::StepMode),
+        ),
         5..=8 => {
             let tc = if rng.chance(90) { sh.time } else { rng.pick(&[f64::NAN, sh.time - 1.0]) };
             let h = if rng.chance(85) { 0.02 } else { rng.pick(&[0.0, -1.0, f64::NAN, 1e300, 1e-12]) };
@@ -921,7 +1053,13 @@ unsafe fn random_call2<M: Model>(rng: &mut FuzzRng, c: *mut c_void, sh: &Shadow)
         16 => {
             let mut p = std::ptr::null_mut();
             let s = fmi2::get_fmu_state::<M>(c, &mut p);
-            o("fmi2GetFMUstate", m::GET_FMU_STATE, s, Must::Succeed, if s == Status::Ok { Then::NewState(p) } else { Then::Nothing })
+            o(
+                "fmi2GetFMUstate",
+                m::GET_FMU_STATE,
+                s,
+                Must::Succeed,
+                if s == Status::Ok { Then::NewState(p) } else { Then::Nothing },
+            )
         }
         17 => {
             let (p, good) = pick_state(rng, sh);
@@ -984,8 +1122,13 @@ pub fn fuzz_fmi2<M: Model>(seed: u64, cases: usize) {
                 _ => (c"fuzz".as_ptr(), 7, guid.as_ptr()),
             };
             let p = fmi2::instantiate::<M>(name, ty, g, std::ptr::null(), &callbacks, 0, 0);
-            assert!(p.is_null() && !logs.0.is_empty(), "{}: bad fmi2Instantiate accepted or not logged (case {case})", M::NAME);
-            assert!(fmi2::instantiate::<M>(c"x".as_ptr(), 1, guid.as_ptr(), std::ptr::null(), std::ptr::null(), 0, 0).is_null());
+            assert!(
+                p.is_null() && !logs.0.is_empty(),
+                "{}: bad fmi2Instantiate accepted or not logged (case {case})",
+                M::NAME
+            );
+            assert!(fmi2::instantiate::<M>(c"x".as_ptr(), 1, guid.as_ptr(), std::ptr::null(), std::ptr::null(), 0, 0)
+                .is_null());
             logs.0.clear();
             let c = fmi2::instantiate::<M>(c"fuzz".as_ptr(), 1, guid.as_ptr(), std::ptr::null(), &callbacks, 0, 0);
             assert!(!c.is_null(), "{}: fmi2Instantiate failed: {:?}", M::NAME, logs.0);
@@ -994,11 +1137,21 @@ pub fn fuzz_fmi2<M: Model>(seed: u64, cases: usize) {
             let legal_prefix = rng.chance(70);
             for k in 0..10 + rng.below(60) {
                 let o = if legal_prefix && k == 0 {
-                    Outcome { function: "fmi2EnterInitializationMode", mask: spec2::ENTER_INITIALIZATION_MODE,
-                        status: fmi2::enter_initialization_mode::<M>(c), must: Must::Succeed, then: Then::Mode(Mode::InitializationMode) }
+                    Outcome {
+                        function: "fmi2EnterInitializationMode",
+                        mask: spec2::ENTER_INITIALIZATION_MODE,
+                        status: fmi2::enter_initialization_mode::<M>(c),
+                        must: Must::Succeed,
+                        then: Then::Mode(Mode::InitializationMode),
+                    }
                 } else if legal_prefix && k == 1 {
-                    Outcome { function: "fmi2ExitInitializationMode", mask: spec2::EXIT_INITIALIZATION_MODE,
-                        status: fmi2::exit_initialization_mode::<M>(c), must: Must::Any, then: Then::Mode(Mode::StepMode) }
+                    Outcome {
+                        function: "fmi2ExitInitializationMode",
+                        mask: spec2::EXIT_INITIALIZATION_MODE,
+                        status: fmi2::exit_initialization_mode::<M>(c),
+                        must: Must::Any,
+                        then: Then::Mode(Mode::StepMode),
+                    }
                 } else if rng.chance(3) {
                     let bad = if rng.chance(50) { std::ptr::null_mut() } else { garbage_ptr(&mut rng) };
                     assert_eq!(fmi2::do_step::<M>(bad, 0.0, 0.02, 0), Status::Error);
@@ -1060,7 +1213,13 @@ macro_rules! fmu_conformance_tests {
         #[test]
         fn serialized_states_restore_exactly() {
             let h = <$model as $crate::Model>::STEP_SIZE;
-            $crate::testing::assert_state_round_trip::<$model>(&[], h, 13, 12, &$crate::testing::wiggle_inputs::<$model>);
+            $crate::testing::assert_state_round_trip::<$model>(
+                &[],
+                h,
+                13,
+                12,
+                &$crate::testing::wiggle_inputs::<$model>,
+            );
         }
     };
 }
@@ -1094,7 +1253,20 @@ impl<M: Model> Driven<M> {
         let token = CString::new(M::TOKEN).unwrap_or_default();
         let mut logs = Box::new(Logs::default());
         let env = (&mut *logs as *mut Logs).cast::<c_void>();
-        let p = fmi3::instantiate_co_simulation::<M>(c"rt".as_ptr(), token.as_ptr(), std::ptr::null(), 0, 0, 0, 0, std::ptr::null(), 0, env, Some(log3), None);
+        let p = fmi3::instantiate_co_simulation::<M>(
+            c"rt".as_ptr(),
+            token.as_ptr(),
+            std::ptr::null(),
+            0,
+            0,
+            0,
+            0,
+            std::ptr::null(),
+            0,
+            env,
+            Some(log3),
+            None,
+        );
         assert!(!p.is_null(), "{}: instantiation failed: {:?}", M::NAME, logs.0);
         let d = Driven { p, logs, _m: std::marker::PhantomData };
         for (i, v) in params {
@@ -1202,7 +1374,10 @@ pub fn assert_state_round_trip<M: Model>(
         let bytes = a.serialize(s);
         let expected = a.run(before, after, h, drive);
         let moved = expected.windows(2).any(|w| {
-            M::VARIABLES.iter().enumerate().any(|(i, v)| v.causality == Causality::Output && !w[0].1.value(i).identical(w[1].1.value(i)))
+            M::VARIABLES
+                .iter()
+                .enumerate()
+                .any(|(i, v)| v.causality == Causality::Output && !w[0].1.value(i).identical(w[1].1.value(i)))
         });
         assert!(moved, "{}: no output changes after the saved point: the comparison would say nothing", M::NAME);
 
@@ -1215,7 +1390,11 @@ pub fn assert_state_round_trip<M: Model>(
         let b = Driven::<M>::new(&[]);
         b.restore(&bytes);
         assert_same_run::<M>("restored in a fresh instance", &expected, &b.run(before, after, h, drive));
-        assert!(b.serialize_current() == a.serialize_current(), "{}: the two restored runs end in different states", M::NAME);
+        assert!(
+            b.serialize_current() == a.serialize_current(),
+            "{}: the two restored runs end in different states",
+            M::NAME
+        );
 
         // Instantiated state: back to the start, initializes and runs as the first time.
         b.restore(&instantiated);
@@ -1232,12 +1411,20 @@ pub fn assert_state_round_trip<M: Model>(
             let st = fmi3::deserialize_fmu_state::<M>(c.p, bad.as_ptr(), bad.len(), &mut p);
             assert_eq!(st, Status::Error, "{}: bad serialized state accepted", M::NAME);
             assert!(p.is_null());
-            assert!(c.logs.0.iter().any(|(_, m)| m.contains("fmi3DeserializeFMUState")), "{}: refusal not logged", M::NAME);
+            assert!(
+                c.logs.0.iter().any(|(_, m)| m.contains("fmi3DeserializeFMUState")),
+                "{}: refusal not logged",
+                M::NAME
+            );
             fmi3::reset::<M>(c.p);
         }
         let mut short = vec![0u8; bytes.len() - 1];
-        assert_eq!(fmi3::serialize_fmu_state::<M>(a.p, s, short.as_mut_ptr(), short.len()), Status::Error, "{}: short buffer accepted", M::NAME);
+        assert_eq!(
+            fmi3::serialize_fmu_state::<M>(a.p, s, short.as_mut_ptr(), short.len()),
+            Status::Error,
+            "{}: short buffer accepted",
+            M::NAME
+        );
         bytes.len()
     }
 }
-

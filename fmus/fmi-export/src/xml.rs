@@ -180,7 +180,8 @@ pub fn check_table(vars: &[Var]) -> Vec<String> {
         }
         if let Some(deps) = v.initial_dependencies {
             if !is_initial_unknown(v) {
-                bad("only initial unknowns (calculated outputs and calculated parameters) have initial dependencies".into());
+                bad("only initial unknowns (calculated outputs and calculated parameters) have initial dependencies"
+                    .into());
             }
             for &d in deps {
                 match vars.get(d) {
@@ -469,7 +470,8 @@ pub fn fmi2<M: Model>() -> String {
     o.push_str("  </ModelVariables>\n  <ModelStructure>\n");
     // Position of a visible variable by value reference (time = vr 0 is position 1); knowns
     // FMI 2 cannot see are frozen at their start values there and drop out.
-    let position = |vr: usize| if vr == 0 { Some(1) } else { visible.iter().position(|&(r, _)| r == vr).map(|k| k + 2) };
+    let position =
+        |vr: usize| if vr == 0 { Some(1) } else { visible.iter().position(|&(r, _)| r == vr).map(|k| k + 2) };
     let outputs: Vec<usize> =
         visible.iter().filter(|(_, v)| v.causality == Causality::Output).filter_map(|&(vr, _)| position(vr)).collect();
     if !outputs.is_empty() {
@@ -498,10 +500,7 @@ pub fn fmi2<M: Model>() -> String {
 
 /// Lazily built NUL-terminated XML for the exported `agrisim_model_description_*` symbols;
 /// NULL if building panicked (it cannot cross the C boundary).
-pub fn c_text(
-    cell: &std::sync::OnceLock<Option<std::ffi::CString>>,
-    build: fn() -> String,
-) -> *const std::ffi::c_char {
+pub fn c_text(cell: &std::sync::OnceLock<Option<std::ffi::CString>>, build: fn() -> String) -> *const std::ffi::c_char {
     cell.get_or_init(|| std::panic::catch_unwind(build).ok().and_then(|s| std::ffi::CString::new(s).ok()))
         .as_ref()
         .map_or(std::ptr::null(), |c| c.as_ptr())

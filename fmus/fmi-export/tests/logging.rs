@@ -56,7 +56,11 @@ type Calls = Vec<(Status, String, String)>;
 
 unsafe extern "C" fn record(env: *mut c_void, status: Status, category: *const c_char, message: *const c_char) {
     let calls = &mut *(env as *mut Calls);
-    calls.push((status, CStr::from_ptr(category).to_string_lossy().into(), CStr::from_ptr(message).to_string_lossy().into()));
+    calls.push((
+        status,
+        CStr::from_ptr(category).to_string_lossy().into(),
+        CStr::from_ptr(message).to_string_lossy().into(),
+    ));
 }
 
 /// Runs `steps` steps (warning in the last one) and one failing call with the given logging
@@ -68,7 +72,18 @@ fn run(logging_on: bool, categories: Option<&[&CStr]>, steps: usize) -> (Calls, 
     let token = CString::new(Chatty::TOKEN).unwrap();
     unsafe {
         let p = fmi3::instantiate_co_simulation::<Chatty>(
-            c"chatty".as_ptr(), token.as_ptr(), std::ptr::null(), 0, logging_on as u8, 0, 0, std::ptr::null(), 0, env, Some(record), None,
+            c"chatty".as_ptr(),
+            token.as_ptr(),
+            std::ptr::null(),
+            0,
+            logging_on as u8,
+            0,
+            0,
+            std::ptr::null(),
+            0,
+            env,
+            Some(record),
+            None,
         );
         assert!(!p.is_null());
         if let Some(cats) = categories {
@@ -82,7 +97,10 @@ fn run(logging_on: bool, categories: Option<&[&CStr]>, steps: usize) -> (Calls, 
             if k + 1 == steps {
                 assert_eq!(fmi3::set_boolean::<Chatty>(p, &1, 1, &1, 1), Status::Ok);
             }
-            assert_eq!(fmi3::do_step::<Chatty>(p, k as f64 * 0.5, 0.5, 0, &mut a, &mut b, &mut c, &mut last), Status::Ok);
+            assert_eq!(
+                fmi3::do_step::<Chatty>(p, k as f64 * 0.5, 0.5, 0, &mut a, &mut b, &mut c, &mut last),
+                Status::Ok
+            );
         }
         assert_eq!(fmi3::get_float64::<Chatty>(p, &99, 1, &mut 0.0, 1), Status::Error);
         fmi3::free_instance::<Chatty>(p);

@@ -279,7 +279,10 @@ mod tests {
         assert_eq!(&bytes[..8], b"AGF\x01\x02\x00\x00\x00");
         assert_eq!(bytes.len(), max_size(2, 2) - 2);
         let f = decode(&bytes).unwrap();
-        assert_eq!(f, vec![Frame { seq: 1, stamp_ns: 5, payload: b"ab" }, Frame { seq: 2, stamp_ns: -7, payload: b"" }]);
+        assert_eq!(
+            f,
+            vec![Frame { seq: 1, stamp_ns: 5, payload: b"ab" }, Frame { seq: 2, stamp_ns: -7, payload: b"" }]
+        );
         assert!(is_frame_list(&bytes) && !is_frame_list(&[0, 1, 0, 0, 1, 0, 0, 0, 0]));
         assert!(is_framed_mime("application/x-ros2-cdr-frames; version=1; type=a/msg/B"));
         assert!(!is_framed_mime("application/x-ros2-cdr; type=a/msg/B"));

@@ -18,7 +18,8 @@ const MAX_RANGE: f64 = 40.0;
 fn main() {
     let n: usize = common::arg("--rays").map_or(2_000_000, |s| s.parse().expect("--rays N"));
     let cfg = match common::arg("--config") {
-        Some(p) => GreenhouseConfig::from_toml_str(&std::fs::read_to_string(&p).expect("read --config")).unwrap_or_else(|e| panic!("{e}")),
+        Some(p) => GreenhouseConfig::from_toml_str(&std::fs::read_to_string(&p).expect("read --config"))
+            .unwrap_or_else(|e| panic!("{e}")),
         None => GreenhouseConfig::default(),
     };
     let t = Instant::now();

@@ -49,11 +49,30 @@ fn main() {
     println!("rows               {rows} ({} active, hall {} x {} m)", cfg.active_rows, cfg.length, cfg.width);
     println!("objects            {}", gh.objects.len());
     println!("generate           {gen_s:.3} s");
-    println!("objects in memory  {:.1} MiB ({} B per object incl. name)", obj_bytes as f64 / 1048576.0, obj_bytes / gh.objects.len());
+    println!(
+        "objects in memory  {:.1} MiB ({} B per object incl. name)",
+        obj_bytes as f64 / 1048576.0,
+        obj_bytes / gh.objects.len()
+    );
     println!("RSS after generate {:.1} MiB (+{:.1})", rss_gen, rss_gen - base_rss);
-    println!("RayCaster build    {build_s:.3} s ({} nodes), RSS {:.1} MiB (+{:.1})", rc.node_count(), rss_rc, rss_rc - rss_gen);
-    println!("occupancy map      {map_s:.3} s ({} x {} cells at 5 cm, {} occupied)", map.width, map.height, map.occupied_count());
-    println!("rays/s             {:.3e} (1 thread, {} rays, {:.1} % hit)", rays.len() as f64 / cast_s, rays.len(), 100.0 * hits as f64 / rays.len() as f64);
+    println!(
+        "RayCaster build    {build_s:.3} s ({} nodes), RSS {:.1} MiB (+{:.1})",
+        rc.node_count(),
+        rss_rc,
+        rss_rc - rss_gen
+    );
+    println!(
+        "occupancy map      {map_s:.3} s ({} x {} cells at 5 cm, {} occupied)",
+        map.width,
+        map.height,
+        map.occupied_count()
+    );
+    println!(
+        "rays/s             {:.3e} (1 thread, {} rays, {:.1} % hit)",
+        rays.len() as f64 / cast_s,
+        rays.len(),
+        100.0 * hits as f64 / rays.len() as f64
+    );
     if let Some(p) = common::arg("--glb") {
         let t = Instant::now();
         gltf::write_glb(&gh.objects, std::path::Path::new(&p)).unwrap();

@@ -232,7 +232,10 @@ impl GreenhouseConfig {
             return err("ripeness", "six non-negative weights, not all zero".into());
         }
         if self.fruit_height[1] > self.plant_height {
-            return err("fruit_height", format!("top {} is above plant_height {}", self.fruit_height[1], self.plant_height));
+            return err(
+                "fruit_height",
+                format!("top {} is above plant_height {}", self.fruit_height[1], self.plant_height),
+            );
         }
         let need_w = self.rows as f64 * self.row_pitch();
         if need_w > self.width {

@@ -200,7 +200,8 @@ impl Environment {
             None => None,
         };
         let utc_offset = range("utc_offset", r.utc_offset.unwrap_or(2.0), -12.0, 14.0)?;
-        let rain_rate = range("rain_rate", r.rain_rate.unwrap_or(if weather == Weather::Rain { 8.0 } else { 0.0 }), 0.0, 500.0)?;
+        let rain_rate =
+            range("rain_rate", r.rain_rate.unwrap_or(if weather == Weather::Rain { 8.0 } else { 0.0 }), 0.0, 500.0)?;
         let temperature = range("temperature", r.temperature.unwrap_or(20.0), -60.0, 60.0)?;
         let humidity = range("humidity", r.humidity.unwrap_or(70.0), 0.0, 100.0)?;
         let pressure = range("pressure", r.pressure.unwrap_or(p_std), 300.0, 1100.0)?;

@@ -93,12 +93,32 @@ fn estimate(cfg: &GreenhouseConfig) -> usize {
 fn hall(b: &mut Builder, cfg: &GreenhouseConfig) {
     let (l, w, h, t) = (cfg.length, cfg.width, cfg.height, SLAB);
     let bx = |hx: f64, hy: f64, hz: f64| Shape::Box { half: [hx, hy, hz] };
-    b.push("floor".into(), Kind::Floor, bx(0.5 * l + t, 0.5 * w + t, 0.5 * t), Placement::at(0.5 * l, 0.5 * w, -0.5 * t));
-    b.push("wall_xmin".into(), Kind::Wall, bx(0.5 * t, 0.5 * w + t, 0.5 * h), Placement::at(-0.5 * t, 0.5 * w, 0.5 * h));
-    b.push("wall_xmax".into(), Kind::Wall, bx(0.5 * t, 0.5 * w + t, 0.5 * h), Placement::at(l + 0.5 * t, 0.5 * w, 0.5 * h));
+    b.push(
+        "floor".into(),
+        Kind::Floor,
+        bx(0.5 * l + t, 0.5 * w + t, 0.5 * t),
+        Placement::at(0.5 * l, 0.5 * w, -0.5 * t),
+    );
+    b.push(
+        "wall_xmin".into(),
+        Kind::Wall,
+        bx(0.5 * t, 0.5 * w + t, 0.5 * h),
+        Placement::at(-0.5 * t, 0.5 * w, 0.5 * h),
+    );
+    b.push(
+        "wall_xmax".into(),
+        Kind::Wall,
+        bx(0.5 * t, 0.5 * w + t, 0.5 * h),
+        Placement::at(l + 0.5 * t, 0.5 * w, 0.5 * h),
+    );
     b.push("wall_ymin".into(), Kind::Wall, bx(0.5 * l, 0.5 * t, 0.5 * h), Placement::at(0.5 * l, -0.5 * t, 0.5 * h));
     b.push("wall_ymax".into(), Kind::Wall, bx(0.5 * l, 0.5 * t, 0.5 * h), Placement::at(0.5 * l, w + 0.5 * t, 0.5 * h));
-    b.push("roof".into(), Kind::Roof, bx(0.5 * l + t, 0.5 * w + t, 0.5 * t), Placement::at(0.5 * l, 0.5 * w, h + 0.5 * t));
+    b.push(
+        "roof".into(),
+        Kind::Roof,
+        bx(0.5 * l + t, 0.5 * w + t, 0.5 * t),
+        Placement::at(0.5 * l, 0.5 * w, h + 0.5 * t),
+    );
 }
 
 /// Posts in the row line, the overhead gutter, and two heating pipes under the row.
@@ -196,14 +216,19 @@ fn plant(b: &mut Builder, cfg: &GreenhouseConfig, seed: u64, r: usize, p: usize,
             let lim = (half_env - radius).max(0.0);
             fy = fy.clamp(y - lim, y + lim);
             let x_row = x - (p as f64 + 0.5) * cfg.plant_spacing;
-            let (xl, xh) = ((x - 0.5 * cfg.plant_spacing).max(x_row + radius), (x + 0.5 * cfg.plant_spacing).min(x_row + cfg.row_length - radius));
+            let (xl, xh) = (
+                (x - 0.5 * cfg.plant_spacing).max(x_row + radius),
+                (x + 0.5 * cfg.plant_spacing).min(x_row + cfg.row_length - radius),
+            );
             fx = if xl <= xh { fx.clamp(xl, xh) } else { x };
             let stage = rng.weighted(&cfg.ripeness) as u8 + 1;
             // Fruit of a truss hang at different levels instead of interpenetrating: a fruit
             // that would overlap one already on this plant hangs just below it.
             // (Rarely the bottom of the band is reached: then just above the one it touches,
             // still under the truss; failing that, where it was.)
-            let fz = hang_clear(&placed, [fx, fy, fz], radius, -1.0, f_lo, zt - radius).or_else(|| hang_clear(&placed, [fx, fy, fz], radius, 1.0, f_lo, zt - radius)).unwrap_or(fz);
+            let fz = hang_clear(&placed, [fx, fy, fz], radius, -1.0, f_lo, zt - radius)
+                .or_else(|| hang_clear(&placed, [fx, fy, fz], radius, 1.0, f_lo, zt - radius))
+                .unwrap_or(fz);
             placed.push(([fx, fy, fz], radius));
             b.push(
                 format!("row{r}/plant{p}/fruit{t}_{f}"),

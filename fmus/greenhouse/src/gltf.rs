@@ -90,8 +90,14 @@ pub fn glb_bytes(objects: &[Object]) -> Vec<u8> {
             }
         }
         let vp = views.len();
-        views.push(format!(r#"{{"buffer":0,"byteOffset":{pos_off},"byteLength":{},"target":34962}}"#, idx_off - pos_off));
-        views.push(format!(r#"{{"buffer":0,"byteOffset":{idx_off},"byteLength":{},"target":34963}}"#, bin.len() - idx_off));
+        views.push(format!(
+            r#"{{"buffer":0,"byteOffset":{pos_off},"byteLength":{},"target":34962}}"#,
+            idx_off - pos_off
+        ));
+        views.push(format!(
+            r#"{{"buffer":0,"byteOffset":{idx_off},"byteLength":{},"target":34963}}"#,
+            bin.len() - idx_off
+        ));
         let ap = accessors.len();
         accessors.push(format!(
             r#"{{"bufferView":{vp},"componentType":5126,"count":{},"type":"VEC3","min":[{},{},{}],"max":[{},{},{}]}}"#,
@@ -103,7 +109,11 @@ pub fn glb_bytes(objects: &[Object]) -> Vec<u8> {
             hi[1],
             hi[2]
         ));
-        accessors.push(format!(r#"{{"bufferView":{},"componentType":5125,"count":{},"type":"SCALAR"}}"#, vp + 1, 3 * t.len()));
+        accessors.push(format!(
+            r#"{{"bufferView":{},"componentType":5125,"count":{},"type":"SCALAR"}}"#,
+            vp + 1,
+            3 * t.len()
+        ));
         let c = colour(*kind);
         let blend = if c[3] < 1.0 { r#","alphaMode":"BLEND""# } else { "" };
         let name = kind_name(*kind);
@@ -165,7 +175,10 @@ pub fn write_glb(objects: &[Object], path: &Path) -> std::io::Result<()> {
 /// Splits .glb bytes into (JSON text, BIN chunk), checking the header and chunk framing.
 pub fn parse_glb(bytes: &[u8]) -> Result<(String, Vec<u8>), String> {
     let u32_at = |o: usize| -> Result<u32, String> {
-        bytes.get(o..o + 4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])).ok_or_else(|| format!("truncated at byte {o}"))
+        bytes
+            .get(o..o + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+            .ok_or_else(|| format!("truncated at byte {o}"))
     };
     if u32_at(0)? != GLB_MAGIC {
         return Err("bad magic".into());

@@ -49,7 +49,14 @@ impl Layout {
         let x_end = x_start + cfg.row_length;
         let active = cfg.first_active_row..cfg.first_active_row + cfg.active_rows;
         let rows: Vec<Row> = (0..cfg.rows)
-            .map(|i| Row { index: i, y: y0 + i as f64 * pitch, x_start, x_end, width: cfg.row_width, active: active.contains(&i) })
+            .map(|i| Row {
+                index: i,
+                y: y0 + i as f64 * pitch,
+                x_start,
+                x_end,
+                width: cfg.row_width,
+                active: active.contains(&i),
+            })
             .collect();
         let act: Vec<&Row> = rows.iter().filter(|r| r.active).collect();
         let aisles: Vec<Aisle> = act

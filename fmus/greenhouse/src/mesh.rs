@@ -24,7 +24,9 @@ pub fn local(shape: &Shape) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
     match *shape {
         Shape::Box { half: [x, y, z] } => {
             let v: Vec<[f64; 3]> = (0..8)
-                .map(|k| [if k & 1 != 0 { x } else { -x }, if k & 2 != 0 { y } else { -y }, if k & 4 != 0 { z } else { -z }])
+                .map(|k| {
+                    [if k & 1 != 0 { x } else { -x }, if k & 2 != 0 { y } else { -y }, if k & 4 != 0 { z } else { -z }]
+                })
                 .collect();
             // Faces as quads (a, b, c, d) counter-clockwise from outside.
             let quads = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [0, 4, 6, 2], [1, 3, 7, 5]];

@@ -31,7 +31,13 @@ impl OccupancyMap {
         assert!(resolution > 0.0, "resolution must be positive");
         let width = (((bounds[2] - bounds[0]) / resolution) - EPS).ceil().max(1.0) as usize;
         let height = (((bounds[3] - bounds[1]) / resolution) - EPS).ceil().max(1.0) as usize;
-        let mut map = OccupancyMap { resolution, origin: [bounds[0], bounds[1]], width, height, data: vec![FREE; width * height] };
+        let mut map = OccupancyMap {
+            resolution,
+            origin: [bounds[0], bounds[1]],
+            width,
+            height,
+            data: vec![FREE; width * height],
+        };
         for o in objects {
             map.add(o, z_band);
         }
@@ -47,7 +53,13 @@ impl OccupancyMap {
         let c = o.placement.translation;
         match o.shape {
             Shape::Sphere { radius } => {
-                let dz = if c[2] < z0 { z0 - c[2] } else if c[2] > z1 { c[2] - z1 } else { 0.0 };
+                let dz = if c[2] < z0 {
+                    z0 - c[2]
+                } else if c[2] > z1 {
+                    c[2] - z1
+                } else {
+                    0.0
+                };
                 let r2 = radius * radius - dz * dz;
                 if r2 > 0.0 {
                     self.fill_disc(c[0], c[1], r2.sqrt());

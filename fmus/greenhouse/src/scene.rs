@@ -18,7 +18,9 @@ pub enum Kind {
     Leaf,
     Truss,
     /// A tomato; `ripeness` is the USDA stage 1 (green) .. 6 (red).
-    Fruit { ripeness: u8 },
+    Fruit {
+        ripeness: u8,
+    },
     Obstacle,
     /// A robot link (added at run time by the FMUs that move it).
     Robot,
@@ -28,10 +30,17 @@ pub enum Kind {
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Shape {
     /// Axis-aligned box with half extents (x, y, z) before the object's rotation.
-    Box { half: [f64; 3] },
+    Box {
+        half: [f64; 3],
+    },
     /// Cylinder along the local z axis.
-    Cylinder { radius: f64, half_height: f64 },
-    Sphere { radius: f64 },
+    Cylinder {
+        radius: f64,
+        half_height: f64,
+    },
+    Sphere {
+        radius: f64,
+    },
 }
 
 /// Rigid placement: translation and a unit quaternion (x, y, z, w).

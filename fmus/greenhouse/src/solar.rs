@@ -83,7 +83,9 @@ pub fn delta_t_estimate(year: i32, month: u32) -> f64 {
         45.45 + 1.067 * t - t * t / 260.0 - t.powi(3) / 718.0
     } else if y < 2005.0 {
         let t = y - 2000.0;
-        63.86 + 0.3345 * t - 0.060374 * t * t + 0.0017275 * t.powi(3) + 0.000651814 * t.powi(4)
+        63.86 + 0.3345 * t - 0.060374 * t * t
+            + 0.0017275 * t.powi(3)
+            + 0.000651814 * t.powi(4)
             + 0.00002373599 * t.powi(5)
     } else if y < 2050.0 {
         let t = y - 2000.0;
@@ -110,10 +112,8 @@ fn earth(jme: f64) -> (f64, f64, f64) {
         jme,
     ) / 1e8;
     let b = poly(&[series(&B0, jme), series(&B1, jme)], jme) / 1e8;
-    let r = poly(
-        &[series(&R0, jme), series(&R1, jme), series(&R2, jme), series(&R3, jme), series(&R4, jme)],
-        jme,
-    ) / 1e8;
+    let r =
+        poly(&[series(&R0, jme), series(&R1, jme), series(&R2, jme), series(&R3, jme), series(&R4, jme)], jme) / 1e8;
     (rem360(l.to_degrees()), b.to_degrees(), r)
 }
 
@@ -151,20 +151,14 @@ pub fn solar_position(i: &SolarInput) -> SolarPosition {
     let beta = -b;
     let (dpsi, deps) = nutation(jce);
     let u = jme / 10.0;
-    let eps0 = poly(
-        &[84381.448, -4680.93, -1.55, 1999.25, -51.38, -249.67, -39.05, 7.12, 27.87, 5.79, 2.45],
-        u,
-    );
+    let eps0 = poly(&[84381.448, -4680.93, -1.55, 1999.25, -51.38, -249.67, -39.05, 7.12, 27.87, 5.79, 2.45], u);
     let eps = (eps0 / 3600.0 + deps).to_radians();
     let lambda = (theta + dpsi - 20.4898 / (3600.0 * r)).to_radians();
-    let nu0 = rem360(
-        280.46061837 + 360.98564736629 * (jd - 2451545.0) + 0.000387933 * jc * jc - jc.powi(3) / 38710000.0,
-    );
+    let nu0 =
+        rem360(280.46061837 + 360.98564736629 * (jd - 2451545.0) + 0.000387933 * jc * jc - jc.powi(3) / 38710000.0);
     let nu = nu0 + dpsi * eps.cos();
     let beta_r = beta.to_radians();
-    let alpha = rem360(
-        (lambda.sin() * eps.cos() - beta_r.tan() * eps.sin()).atan2(lambda.cos()).to_degrees(),
-    );
+    let alpha = rem360((lambda.sin() * eps.cos() - beta_r.tan() * eps.sin()).atan2(lambda.cos()).to_degrees());
     let delta = (beta_r.sin() * eps.cos() + beta_r.cos() * eps.sin() * lambda.sin()).asin();
     let h = rem360(nu + i.longitude - alpha).to_radians();
 

@@ -25,9 +25,19 @@ fn different_seed_changes_random_parts_only() {
     let b = generate(&c, 6);
     assert_eq!(a.objects.len(), b.objects.len());
     assert_eq!(a.layout, b.layout);
-    let fruit_moved = a.objects.iter().zip(&b.objects).filter(|(x, y)| matches!(x.kind, Kind::Fruit { .. }) && x.placement != y.placement).count();
+    let fruit_moved = a
+        .objects
+        .iter()
+        .zip(&b.objects)
+        .filter(|(x, y)| matches!(x.kind, Kind::Fruit { .. }) && x.placement != y.placement)
+        .count();
     assert!(fruit_moved > 1000, "only {fruit_moved} fruit moved");
-    let ripeness_changed = a.objects.iter().zip(&b.objects).filter(|(x, y)| matches!(x.kind, Kind::Fruit { .. }) && x.kind != y.kind).count();
+    let ripeness_changed = a
+        .objects
+        .iter()
+        .zip(&b.objects)
+        .filter(|(x, y)| matches!(x.kind, Kind::Fruit { .. }) && x.kind != y.kind)
+        .count();
     assert!(ripeness_changed > 500);
     let obst = |g: &agrisim_greenhouse::Greenhouse| -> Vec<[f64; 3]> {
         g.objects.iter().filter(|o| o.kind == Kind::Obstacle).map(|o| o.placement.translation).collect()
@@ -93,7 +103,12 @@ fn check_layout(c: &GreenhouseConfig, seed: u64) {
     let overlaps_open = |o: &Object, r: [f64; 4]| {
         let (mn, mx) = o.aabb();
         let e = 1e-9;
-        mx[2] > NAV_BAND.0 && mn[2] < NAV_BAND.1 && mn[0] < r[2] - e && mx[0] > r[0] + e && mn[1] < r[3] - e && mx[1] > r[1] + e
+        mx[2] > NAV_BAND.0
+            && mn[2] < NAV_BAND.1
+            && mn[0] < r[2] - e
+            && mx[0] > r[0] + e
+            && mn[1] < r[3] - e
+            && mx[1] > r[1] + e
     };
     for a in &l.aisles {
         let r = [a.x_start, a.y - 0.5 * a.width, a.x_end, a.y + 0.5 * a.width];
@@ -109,7 +124,9 @@ fn check_layout(c: &GreenhouseConfig, seed: u64) {
     let [x, y, yaw] = l.start_pose;
     assert_eq!(yaw, 0.0);
     let foot = [x - 0.6, y - 0.45, x + 0.6, y + 0.45];
-    assert!(foot[0] >= l.headland[0] && foot[2] <= l.headland[2] && foot[1] >= l.headland[1] && foot[3] <= l.headland[3]);
+    assert!(
+        foot[0] >= l.headland[0] && foot[2] <= l.headland[2] && foot[1] >= l.headland[1] && foot[3] <= l.headland[3]
+    );
     for o in &g.objects {
         assert!(!overlaps_open(o, foot), "{} on the start footprint", o.name);
     }
@@ -117,7 +134,8 @@ fn check_layout(c: &GreenhouseConfig, seed: u64) {
     let map = OccupancyMap::from_objects(&g.objects, 0.05, NAV_BAND, l.bounds);
     let mut k = 0.0;
     while k <= 1.0 {
-        let (px, py) = (foot[0] + 0.01 + k * (foot[2] - foot[0] - 0.02), foot[1] + 0.01 + k * (foot[3] - foot[1] - 0.02));
+        let (px, py) =
+            (foot[0] + 0.01 + k * (foot[2] - foot[0] - 0.02), foot[1] + 0.01 + k * (foot[3] - foot[1] - 0.02));
         assert!(!map.is_occupied_at(px, y) && !map.is_occupied_at(x, py));
         k += 0.05;
     }

@@ -5,7 +5,8 @@ use agrisim_greenhouse::gltf::{glb_bytes, parse_glb, triangles, write_glb};
 use agrisim_greenhouse::{generate, GreenhouseConfig, Kind};
 
 fn scene() -> Vec<agrisim_greenhouse::Object> {
-    let c = GreenhouseConfig::from_toml_str("rows = 3\nactive_rows = 3\nrow_length = 4.0\nrandom_obstacles = 1").unwrap();
+    let c =
+        GreenhouseConfig::from_toml_str("rows = 3\nactive_rows = 3\nrow_length = 4.0\nrandom_obstacles = 1").unwrap();
     generate(&c, 1).objects
 }
 

@@ -45,7 +45,10 @@ fn axis_aligned_box_fills_exactly_its_cells() {
 #[test]
 fn z_band_filters() {
     let b = obj(Shape::Box { half: [0.25, 0.25, 0.25] }, Placement::at(1.0, 1.0, 3.0));
-    assert_eq!(OccupancyMap::from_objects(std::slice::from_ref(&b), 0.05, (0.0, 2.0), [0.0, 0.0, 2.0, 2.0]).occupied_count(), 0);
+    assert_eq!(
+        OccupancyMap::from_objects(std::slice::from_ref(&b), 0.05, (0.0, 2.0), [0.0, 0.0, 2.0, 2.0]).occupied_count(),
+        0
+    );
     assert_eq!(OccupancyMap::from_objects(&[b], 0.05, (0.0, 2.8), [0.0, 0.0, 2.0, 2.0]).occupied_count(), 100);
     // The floor slab's top face at z = 0 merely touches a band starting at 0.
     let floor = obj(Shape::Box { half: [5.0, 5.0, 0.1] }, Placement::at(1.0, 1.0, -0.1));
@@ -76,7 +79,10 @@ fn upright_cylinder_is_a_disc() {
 fn horizontal_cylinder_is_a_band() {
     // A pipe along x at z = 0.1, r = 0.05: in band (0.0, 0.5) it covers y in [0.95, 1.05].
     let q = quat_axis_angle([0.0, 1.0, 0.0], std::f64::consts::FRAC_PI_2);
-    let p = obj(Shape::Cylinder { radius: 0.05, half_height: 0.5 }, Placement { translation: [1.0, 1.0, 0.1], rotation: q });
+    let p = obj(
+        Shape::Cylinder { radius: 0.05, half_height: 0.5 },
+        Placement { translation: [1.0, 1.0, 0.1], rotation: q },
+    );
     let m = OccupancyMap::from_objects(&[p], 0.05, (0.0, 0.5), [0.0, 0.0, 2.0, 2.0]);
     assert!(m.is_occupied_at(1.0, 1.0) && m.is_occupied_at(0.52, 1.04) && m.is_occupied_at(1.48, 0.96));
     assert!(!m.is_occupied_at(0.4, 1.0) && !m.is_occupied_at(1.6, 1.0) && !m.is_occupied_at(1.0, 1.12));

@@ -7,7 +7,6 @@ use agrisim_math::Rng;
 mod common;
 use common::{random_solids, unit};
 
-
 fn random_dir(rng: &mut Rng) -> [f64; 3] {
     unit([rng.scene_normal(), rng.scene_normal(), rng.scene_normal()])
 }
@@ -59,7 +58,8 @@ fn axis_aligned_rays_agree_too() {
     let (cfg, objs) = small_scene();
     let rc = RayCaster::new(&objs);
     let mut rng = Rng::scene(3);
-    let dirs = [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
+    let dirs =
+        [[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [0.0, 0.0, -1.0]];
     for k in 0..6000 {
         let o = [rng.range(0.0, cfg.length), rng.range(0.0, cfg.width), rng.range(0.0, 3.0)];
         let d = dirs[k % 6];
@@ -122,7 +122,6 @@ fn empty_scene_casts_nothing() {
     assert!(rc.cast([0.0; 3], [1.0, 0.0, 0.0], 0.0, 10.0, &[]).is_none());
 }
 
-
 /// Exact-on-the-surface signed distance bound (max form): < 0 inside, 0 on the surface.
 fn sdf(o: &Object, p: [f64; 3]) -> f64 {
     let m = o.placement.matrix();
@@ -136,7 +135,9 @@ fn sdf(o: &Object, p: [f64; 3]) -> f64 {
     match o.shape {
         Shape::Sphere { radius } => (l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt() - radius,
         Shape::Box { half } => (l[0].abs() - half[0]).max(l[1].abs() - half[1]).max(l[2].abs() - half[2]),
-        Shape::Cylinder { radius, half_height } => ((l[0] * l[0] + l[1] * l[1]).sqrt() - radius).max(l[2].abs() - half_height),
+        Shape::Cylinder { radius, half_height } => {
+            ((l[0] * l[0] + l[1] * l[1]).sqrt() - radius).max(l[2].abs() - half_height)
+        }
     }
 }
 
@@ -268,7 +269,13 @@ fn pass_through_equals_the_hit_to_hit_walk() {
     assert!(recent.held() > 0, "no occluder remembered");
     // A cache filled on one scene and used with another: its entries name other primitives
     // there (here a pane of glass where an opaque slab was), and the answers stay exact.
-    let slab = |id: u32, kind: Kind| Object { id, name: "slab".into(), kind, shape: Shape::Box { half: [1.0, 1.0, 0.01] }, placement: Placement::yawed([0.0, 0.0, 2.0], 0.0) };
+    let slab = |id: u32, kind: Kind| Object {
+        id,
+        name: "slab".into(),
+        kind,
+        shape: Shape::Box { half: [1.0, 1.0, 0.01] },
+        placement: Placement::yawed([0.0, 0.0, 2.0], 0.0),
+    };
     let (roof, glass) = (RayCaster::new(&[slab(0, Kind::Obstacle)]), RayCaster::new(&[slab(0, Kind::Roof)]));
     let nothing = RayCaster::new(&[]);
     let below: Vec<[f64; 3]> = (0..8).map(|i| [0.1 * i as f64 - 0.4, 0.0, 0.5]).collect();
@@ -317,7 +324,13 @@ fn packets_equal_single_rays() {
             let spread = [0.0005, 0.005, 0.05, 0.3][k % 4];
             let n = 1 + k % MAX_PACKET;
             let dirs: Vec<[f64; 3]> = (0..n)
-                .map(|_| unit([c[0] + spread * rng.range(-1.0, 1.0), c[1] + spread * rng.range(-1.0, 1.0), c[2] + spread * rng.range(-1.0, 1.0)]))
+                .map(|_| {
+                    unit([
+                        c[0] + spread * rng.range(-1.0, 1.0),
+                        c[1] + spread * rng.range(-1.0, 1.0),
+                        c[2] + spread * rng.range(-1.0, 1.0),
+                    ])
+                })
                 .collect();
             let (tmin, tmax) = (rng.range(0.0, 0.2), rng.range(0.5, 60.0));
             let mut out = vec![None; n];
@@ -330,11 +343,17 @@ fn packets_equal_single_rays() {
             }
             // Each ray going on from its own near limit (past a pane it met): the single ray
             // cast from that limit.
-            let mins: Vec<f64> = out.iter().map(|h| h.map_or(rng.range(0.0, 1.0), |h| h.distance + [1e-4, 0.0, -1e-3][k % 3])).collect();
+            let mins: Vec<f64> =
+                out.iter().map(|h| h.map_or(rng.range(0.0, 1.0), |h| h.distance + [1e-4, 0.0, -1e-3][k % 3])).collect();
             let mut beyond = vec![None; n];
             rc.cast_packet_beyond(o, &dirs, &mins, tmax, &movers, &mut beyond);
             for i in 0..n {
-                assert_eq!(beyond[i], rc.cast_among(o, dirs[i], mins[i], tmax, &movers), "packet {k} ray {i} beyond {}", mins[i]);
+                assert_eq!(
+                    beyond[i],
+                    rc.cast_among(o, dirs[i], mins[i], tmax, &movers),
+                    "packet {k} ray {i} beyond {}",
+                    mins[i]
+                );
                 beyond_hits += (beyond[i].is_some() && beyond[i] != out[i]) as usize;
             }
             // Own origins (a moving LiDAR: up to 5 cm apart) and own mover poses.
@@ -342,17 +361,39 @@ fn packets_equal_single_rays() {
             // Poses all over (the rays' directions in the robot's frame then differ in sign:
             // single rays), or a base that moved a little between firings (one packet).
             let poses: Vec<RigidPose> = match k % 2 {
-                0 => (0..n).map(|_| RigidPose::yawed(o[0] + rng.range(-1.0, 1.0), o[1] + rng.range(-1.0, 1.0), 0.0, rng.range(-3.0, 3.0))).collect(),
+                0 => (0..n)
+                    .map(|_| {
+                        RigidPose::yawed(
+                            o[0] + rng.range(-1.0, 1.0),
+                            o[1] + rng.range(-1.0, 1.0),
+                            0.0,
+                            rng.range(-3.0, 3.0),
+                        )
+                    })
+                    .collect(),
                 _ => {
                     let (x, y, yaw) = (o[0] + rng.range(-1.0, 1.0), o[1] + rng.range(-1.0, 1.0), rng.range(-3.0, 3.0));
-                    (0..n).map(|_| RigidPose::yawed(x + rng.range(-0.02, 0.02), y + rng.range(-0.02, 0.02), 0.0, yaw + rng.range(-0.01, 0.01))).collect()
+                    (0..n)
+                        .map(|_| {
+                            RigidPose::yawed(
+                                x + rng.range(-0.02, 0.02),
+                                y + rng.range(-0.02, 0.02),
+                                0.0,
+                                yaw + rng.range(-0.01, 0.01),
+                            )
+                        })
+                        .collect()
                 }
             };
             mixed_signs += (0..3).any(|a| dirs.iter().any(|d| d[a] > 0.0) && dirs.iter().any(|d| d[a] < 0.0)) as usize;
             // No movers at all (the scene alone).
             rc.cast_packet_posed(&origins, &dirs, tmin, tmax, &RayCaster::new(&[]), &poses, &mut out);
             for i in 0..n {
-                assert_eq!(out[i], rc.cast(origins[i], dirs[i], tmin, tmax, &[]), "posed packet {k} ray {i} without movers");
+                assert_eq!(
+                    out[i],
+                    rc.cast(origins[i], dirs[i], tmin, tmax, &[]),
+                    "posed packet {k} ray {i} without movers"
+                );
             }
             rc.cast_packet_posed(&origins, &dirs, tmin, tmax, &local, &poses, &mut out);
             for i in 0..n {

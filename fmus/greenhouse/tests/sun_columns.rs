@@ -12,7 +12,6 @@ use agrisim_math::Rng;
 mod common;
 use common::{random_solids, unit};
 
-
 /// Sun directions: random ones from 3 deg up, straight overhead and in the x-z and y-z
 /// planes (a zero slope on one axis).
 fn suns(rng: &mut Rng) -> Vec<[f64; 3]> {
@@ -26,21 +25,40 @@ fn suns(rng: &mut Rng) -> Vec<[f64; 3]> {
 /// with `hint`, any index) is blocked exactly when the scene's query finds something opaque,
 /// and a clear one gets the scene's answer from the glass-and-film tree. Returns whether the
 /// columns cleared it and whether the lists found it blocked.
-fn check(rc: &RayCaster, grid: &SunColumns, movers: &RayCaster, opaque: impl Fn(u32) -> bool + Copy, p: [f64; 3], hint: u32) -> (bool, bool) {
+fn check(
+    rc: &RayCaster,
+    grid: &SunColumns,
+    movers: &RayCaster,
+    opaque: impl Fn(u32) -> bool + Copy,
+    p: [f64; 3],
+    hint: u32,
+) -> (bool, bool) {
     let s = grid.dir();
     let nothing = RayCaster::new(&[]);
     let cleared = grid.clear(p);
     if cleared {
-        assert!(rc.pass_through(p, s, 0.0, 1000.0, &nothing, opaque).is_some(), "{p:?} cleared toward {s:?}, but an opaque object blocks it");
+        assert!(
+            rc.pass_through(p, s, 0.0, 1000.0, &nothing, opaque).is_some(),
+            "{p:?} cleared toward {s:?}, but an opaque object blocks it"
+        );
     }
     let scene = rc.pass_through(p, s, 1e-6, 1000.0, &nothing, opaque);
     let answer = grid.occluder(rc, p, 1e-6, 1000.0, None);
     for (with, a) in [(None, answer), (Some(hint), grid.occluder(rc, p, 1e-6, 1000.0, Some(hint)))] {
         match a {
-            Shadow::Blocked(_) => assert!(scene.is_none(), "{p:?} toward {s:?}: blocked by the lists (hint {with:?}), not by the scene"),
+            Shadow::Blocked(_) => {
+                assert!(scene.is_none(), "{p:?} toward {s:?}: blocked by the lists (hint {with:?}), not by the scene")
+            }
             Shadow::Clear => {
-                assert!(scene.is_some(), "{p:?} toward {s:?}: clear by the lists (hint {with:?}), blocked in the scene");
-                assert_eq!(grid.translucent().pass_through(p, s, 1e-6, 1000.0, movers, opaque), rc.pass_through(p, s, 1e-6, 1000.0, movers, opaque), "{p:?} toward {s:?}");
+                assert!(
+                    scene.is_some(),
+                    "{p:?} toward {s:?}: clear by the lists (hint {with:?}), blocked in the scene"
+                );
+                assert_eq!(
+                    grid.translucent().pass_through(p, s, 1e-6, 1000.0, movers, opaque),
+                    rc.pass_through(p, s, 1e-6, 1000.0, movers, opaque),
+                    "{p:?} toward {s:?}"
+                );
             }
             Shadow::Unknown => panic!("{p:?}: a grid with lists answered unknown"),
         }
@@ -55,7 +73,13 @@ fn cleared_rays_meet_no_opaque_object_in_the_greenhouse() {
     let objs = generate(&cfg, cfg.seed).objects;
     let rc = RayCaster::new(&objs);
     let opaque = |id: u32| objs.get(id as usize).is_none_or(|o| !matches!(o.kind, Kind::Wall | Kind::Roof));
-    let base = Object { id: objs.len() as u32, name: "base".into(), kind: Kind::Robot, shape: Shape::Box { half: [0.6, 0.45, 0.3] }, placement: Placement::yawed([6.0, 3.0, 0.5], 0.3) };
+    let base = Object {
+        id: objs.len() as u32,
+        name: "base".into(),
+        kind: Kind::Robot,
+        shape: Shape::Box { half: [0.6, 0.45, 0.3] },
+        placement: Placement::yawed([6.0, 3.0, 0.5], 0.3),
+    };
     let movers = RayCaster::new(std::slice::from_ref(&base));
     let mut rng = Rng::scene(5);
     // (cleared, tried) for points in the air and on surfaces; rays the lists found blocked.
@@ -72,7 +96,11 @@ fn cleared_rays_meet_no_opaque_object_in_the_greenhouse() {
                 let (c, b) = check(&rc, &grid, &movers, opaque, p, rng.below(hints as u64) as u32);
                 (air.0, blocked) = (air.0 + c as usize, blocked + b as usize);
                 if let Some(h) = rc.cast_among(p, d, 0.0, 100.0, &movers) {
-                    let n = if h.normal[0] * d[0] + h.normal[1] * d[1] + h.normal[2] * d[2] > 0.0 { h.normal.map(|v| -v) } else { h.normal };
+                    let n = if h.normal[0] * d[0] + h.normal[1] * d[1] + h.normal[2] * d[2] > 0.0 {
+                        h.normal.map(|v| -v)
+                    } else {
+                        h.normal
+                    };
                     let q = [0, 1, 2].map(|a| p[a] + h.distance * d[a] + 1e-6 * n[a]);
                     surface.1 += 1;
                     let (c, b) = check(&rc, &grid, &movers, opaque, q, rng.below(hints as u64) as u32);
@@ -81,10 +109,16 @@ fn cleared_rays_meet_no_opaque_object_in_the_greenhouse() {
             }
         }
     }
-    eprintln!("cleared: {} of {} points in the air, {} of {} on surfaces; {blocked} blocked", air.0, air.1, surface.0, surface.1);
+    eprintln!(
+        "cleared: {} of {} points in the air, {} of {} on surfaces; {blocked} blocked",
+        air.0, air.1, surface.0, surface.1
+    );
     assert!(air.0 > air.1 / 5 && surface.0 > surface.1 / 10, "cleared: air {air:?}, surfaces {surface:?}");
     assert!(blocked > (air.1 + surface.1) / 40, "only {blocked} blocked");
-    assert!(SunColumns::new(&rc, unit([1.0, 0.0, 0.04]), opaque, 0.05, 1 << 22).is_none(), "no grid for a sun 2 deg up");
+    assert!(
+        SunColumns::new(&rc, unit([1.0, 0.0, 0.04]), opaque, 0.05, 1 << 22).is_none(),
+        "no grid for a sun 2 deg up"
+    );
 }
 
 #[test]
@@ -128,7 +162,10 @@ fn without_lists_or_for_another_scene_the_lists_do_not_answer() {
         let p = [rng.range(0.0, 10.0), rng.range(0.0, 10.0), rng.range(0.0, 10.0)];
         let cleared = coarse.clear(p);
         let a = coarse.occluder(&rc, p, 1e-6, 1000.0, None);
-        assert!(if cleared { a == Shadow::Clear } else { a == Shadow::Unknown }, "{p:?}: {a:?} from a grid without lists");
+        assert!(
+            if cleared { a == Shadow::Clear } else { a == Shadow::Unknown },
+            "{p:?}: {a:?} from a grid without lists"
+        );
         assert_eq!(fine.occluder(&other, p, 1e-6, 1000.0, None), Shadow::Unknown, "{p:?}: for another scene");
         assert_eq!(fine.occluder(&rc, p, -1.0, 1000.0, None), Shadow::Unknown, "{p:?}: a ray starting behind p");
         unknown += (a == Shadow::Unknown) as usize;

@@ -59,7 +59,8 @@ pub fn accel_params(io: &Store) -> NoiseParams {
 
 /// The mount pose in `io`.
 pub fn mount(io: &Store) -> Result<Mount, String> {
-    let [x, y, z, roll, pitch, yaw] = [MOUNT_X, MOUNT_Y, MOUNT_Z, MOUNT_ROLL, MOUNT_PITCH, MOUNT_YAW].map(|i| finite(io, i));
+    let [x, y, z, roll, pitch, yaw] =
+        [MOUNT_X, MOUNT_Y, MOUNT_Z, MOUNT_ROLL, MOUNT_PITCH, MOUNT_YAW].map(|i| finite(io, i));
     Ok(Mount { translation: [x?, y?, z?], rotation: Quat::from_rpy(roll?, pitch?, yaw?) })
 }
 

@@ -71,10 +71,32 @@ agrisim_fmi::variables! { pub VARIABLES {
 /// What the sample at the start time depends on: the sampling and noise parameters, the
 /// mount and the base motion (not its position), and the start time.
 const SAMPLE: &[usize] = &[
-    RATE, SEED, MOUNT_X, MOUNT_Y, MOUNT_Z, MOUNT_ROLL, MOUNT_PITCH, MOUNT_YAW, GRAVITY,
-    GYRO_NOISE_DENSITY, GYRO_BIAS_MEAN, GYRO_BIAS_STDDEV, GYRO_DYNAMIC_BIAS_STDDEV, GYRO_DYNAMIC_BIAS_CORRELATION_TIME,
-    GYRO_BIAS_INSTABILITY, ACCEL_NOISE_DENSITY, ACCEL_BIAS_MEAN, ACCEL_BIAS_STDDEV, ACCEL_DYNAMIC_BIAS_STDDEV,
-    ACCEL_DYNAMIC_BIAS_CORRELATION_TIME, ACCEL_BIAS_INSTABILITY, BASE_YAW, VX, VY, WZ, Var::TIME,
+    RATE,
+    SEED,
+    MOUNT_X,
+    MOUNT_Y,
+    MOUNT_Z,
+    MOUNT_ROLL,
+    MOUNT_PITCH,
+    MOUNT_YAW,
+    GRAVITY,
+    GYRO_NOISE_DENSITY,
+    GYRO_BIAS_MEAN,
+    GYRO_BIAS_STDDEV,
+    GYRO_DYNAMIC_BIAS_STDDEV,
+    GYRO_DYNAMIC_BIAS_CORRELATION_TIME,
+    GYRO_BIAS_INSTABILITY,
+    ACCEL_NOISE_DENSITY,
+    ACCEL_BIAS_MEAN,
+    ACCEL_BIAS_STDDEV,
+    ACCEL_DYNAMIC_BIAS_STDDEV,
+    ACCEL_DYNAMIC_BIAS_CORRELATION_TIME,
+    ACCEL_BIAS_INSTABILITY,
+    BASE_YAW,
+    VX,
+    VY,
+    WZ,
+    Var::TIME,
 ];
 /// The message adds its frame and the orientation switch to the sample.
 const MESSAGE: &[usize] = &agrisim_fmi::concat::<28>(&[SAMPLE, &[FRAME_ID, ENABLE_ORIENTATION]]);

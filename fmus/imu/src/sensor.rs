@@ -36,7 +36,15 @@ pub struct ImuSensor {
 
 impl ImuSensor {
     /// A sensor whose noise starts at `start_ns`. Draws the turn-on biases from `seed`.
-    pub fn new(rate: f64, mount: Mount, gravity: f64, gyro: &NoiseParams, accel: &NoiseParams, seed: u64, start_ns: i64) -> Result<ImuSensor, String> {
+    pub fn new(
+        rate: f64,
+        mount: Mount,
+        gravity: f64,
+        gyro: &NoiseParams,
+        accel: &NoiseParams,
+        seed: u64,
+        start_ns: i64,
+    ) -> Result<ImuSensor, String> {
         if !(rate.is_finite() && rate > 0.0) {
             return Err(format!("parameter rate must be positive and finite, got {rate}"));
         }

@@ -65,13 +65,23 @@ fn curve(axes: &[Vec<f64>], tau0: f64, max_tau: f64) -> Curve {
 
 /// Density from the slope -1/2 line fitted (slope fixed) to taus in [lo, hi], read at 1 s.
 fn white_density(c: &Curve, lo: f64, hi: f64) -> f64 {
-    let logs: Vec<f64> =
-        c.taus.iter().zip(&c.adev).filter(|(t, _)| (lo..=hi).contains(*t)).map(|(t, a)| a.ln() + 0.5 * t.ln()).collect();
+    let logs: Vec<f64> = c
+        .taus
+        .iter()
+        .zip(&c.adev)
+        .filter(|(t, _)| (lo..=hi).contains(*t))
+        .map(|(t, a)| a.ln() + 0.5 * t.ln())
+        .collect();
     (logs.iter().sum::<f64>() / logs.len() as f64).exp()
 }
 
 fn floor(c: &Curve, from_tau: f64, to_tau: f64) -> (f64, f64) {
-    c.taus.iter().zip(&c.adev).filter(|(t, _)| (from_tau..=to_tau).contains(*t)).map(|(t, a)| (*a, *t)).fold((f64::INFINITY, 0.0), |m, p| if p.0 < m.0 { p } else { m })
+    c.taus
+        .iter()
+        .zip(&c.adev)
+        .filter(|(t, _)| (from_tau..=to_tau).contains(*t))
+        .map(|(t, a)| (*a, *t))
+        .fold((f64::INFINITY, 0.0), |m, p| if p.0 < m.0 { p } else { m })
 }
 
 #[test]

@@ -16,8 +16,16 @@ const G: f64 = 9.80665;
 /// Every noise source off.
 fn noiseless(io: &mut Store) {
     for i in [
-        GYRO_NOISE_DENSITY, GYRO_BIAS_MEAN, GYRO_BIAS_STDDEV, GYRO_DYNAMIC_BIAS_STDDEV, GYRO_BIAS_INSTABILITY,
-        ACCEL_NOISE_DENSITY, ACCEL_BIAS_MEAN, ACCEL_BIAS_STDDEV, ACCEL_DYNAMIC_BIAS_STDDEV, ACCEL_BIAS_INSTABILITY,
+        GYRO_NOISE_DENSITY,
+        GYRO_BIAS_MEAN,
+        GYRO_BIAS_STDDEV,
+        GYRO_DYNAMIC_BIAS_STDDEV,
+        GYRO_BIAS_INSTABILITY,
+        ACCEL_NOISE_DENSITY,
+        ACCEL_BIAS_MEAN,
+        ACCEL_BIAS_STDDEV,
+        ACCEL_DYNAMIC_BIAS_STDDEV,
+        ACCEL_BIAS_INSTABILITY,
     ] {
         io.set_f64(i, 0.0);
     }
@@ -131,7 +139,13 @@ fn orientation_is_base_yaw_advanced_by_the_rate_then_the_mount() {
     // Yaw at the sample (t = 0.02): 1.0 + 0.5 * 0.02; then pitch 0.3 about the mount's y.
     let (y, p): (f64, f64) = ((1.0 + 0.5 * H) / 2.0, 0.3 / 2.0);
     let want = (-y.sin() * p.sin(), y.cos() * p.sin(), y.sin() * p.cos(), y.cos() * p.cos());
-    assert!((q.x - want.0).abs() < 1e-12 && (q.y - want.1).abs() < 1e-12 && (q.z - want.2).abs() < 1e-12 && (q.w - want.3).abs() < 1e-12, "{q:?} vs {want:?}");
+    assert!(
+        (q.x - want.0).abs() < 1e-12
+            && (q.y - want.1).abs() < 1e-12
+            && (q.z - want.2).abs() < 1e-12
+            && (q.w - want.3).abs() < 1e-12,
+        "{q:?} vs {want:?}"
+    );
 }
 
 #[test]
@@ -144,7 +158,8 @@ fn samples_follow_the_rate_on_simulation_time() {
         m.do_step(&mut io, k as f64 * H, H, &mut Quiet).unwrap();
         assert_eq!(io.i64(IMU_SEQ), 4 * k + 5);
         assert_eq!(msg(&io).header.stamp.to_nanos(), (k + 1) * 20_000_000);
-        let stamps: Vec<i64> = messages(&io, IMU).iter().map(|b| sensor_msgs::Imu::from_cdr(b).unwrap().header.stamp.to_nanos()).collect();
+        let stamps: Vec<i64> =
+            messages(&io, IMU).iter().map(|b| sensor_msgs::Imu::from_cdr(b).unwrap().header.stamp.to_nanos()).collect();
         let first = if k < 4 { 0 } else { (k - 4) * 20_000_000 + 5_000_000 };
         assert_eq!(stamps, (first..=(k + 1) * 20_000_000).step_by(5_000_000).collect::<Vec<_>>(), "step {k}");
     }
@@ -156,7 +171,9 @@ fn samples_follow_the_rate_on_simulation_time() {
         m.do_step(&mut io, k as f64 * H, H, &mut Quiet).unwrap();
         let new = (io.i64(IMU_SEQ) - before) as usize;
         let all = messages(&io, IMU);
-        stamps.extend(all[all.len() - new..].iter().map(|b| sensor_msgs::Imu::from_cdr(b).unwrap().header.stamp.to_nanos()));
+        stamps.extend(
+            all[all.len() - new..].iter().map(|b| sensor_msgs::Imu::from_cdr(b).unwrap().header.stamp.to_nanos()),
+        );
     }
     let want: Vec<i64> = (1..=30).map(|k| k * 33_333_333).collect();
     assert_eq!(stamps, want);
@@ -207,7 +224,18 @@ fn through_the_fmi3_layer() {
     let token = std::ffi::CString::new(Imu::TOKEN).unwrap();
     unsafe {
         let p = fmi3::instantiate_co_simulation::<Imu>(
-            c"imu".as_ptr(), token.as_ptr(), std::ptr::null(), 0, 0, 0, 0, std::ptr::null(), 0, std::ptr::null_mut(), None, None,
+            c"imu".as_ptr(),
+            token.as_ptr(),
+            std::ptr::null(),
+            0,
+            0,
+            0,
+            0,
+            std::ptr::null(),
+            0,
+            std::ptr::null_mut(),
+            None,
+            None,
         );
         assert!(!p.is_null());
         let vr = |i: usize| i as u32 + 1;
@@ -226,7 +254,11 @@ fn through_the_fmi3_layer() {
         let (mut size, mut data) = (0usize, std::ptr::null::<u8>());
         assert_eq!(fmi3::get_binary::<Imu>(p, &vr(IMU), 1, &mut size, &mut data, 1), Status::Ok);
         let frames = agrisim_frames::decode(std::slice::from_raw_parts(data, size)).unwrap();
-        assert_eq!(frames.iter().map(|f| f.seq).collect::<Vec<_>>(), (2..=11).collect::<Vec<_>>(), "the samples of the last 0.1 s");
+        assert_eq!(
+            frames.iter().map(|f| f.seq).collect::<Vec<_>>(),
+            (2..=11).collect::<Vec<_>>(),
+            "the samples of the last 0.1 s"
+        );
         let m = sensor_msgs::Imu::from_cdr(frames.last().unwrap().payload).unwrap();
         assert_eq!(m.header.stamp.to_nanos(), 100_000_000);
         assert_eq!(m.orientation_covariance[0], -1.0);

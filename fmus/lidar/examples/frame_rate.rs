@@ -12,21 +12,30 @@ use agrisim_greenhouse::{generate, GreenhouseConfig};
 use std::time::Instant;
 
 fn main() {
-    let scene = std::env::args().nth(1).filter(|p| p != "-").map(|p| std::fs::read_to_string(p).expect("scene file")).unwrap_or_default();
+    let scene = std::env::args()
+        .nth(1)
+        .filter(|p| p != "-")
+        .map(|p| std::fs::read_to_string(p).expect("scene file"))
+        .unwrap_or_default();
     let robot_links = std::env::args().nth(2).is_none_or(|s| s != "false");
     let threads: i32 = std::env::args().nth(3).map_or(2, |s| s.parse().expect("THREADS"));
     let cfg = GreenhouseConfig::from_toml_str(&scene).expect("scene");
     let t = Instant::now();
     let gh = generate(&cfg, cfg.seed);
     let aisle = &gh.layout.aisles[0];
-    let poses = [("start pose", gh.layout.start_pose), ("aisle 0 middle", [0.5 * (aisle.x_start + aisle.x_end), aisle.y, 0.0])];
+    let poses =
+        [("start pose", gh.layout.start_pose), ("aisle 0 middle", [0.5 * (aisle.x_start + aisle.x_end), aisle.y, 0.0])];
     let mut io = Store::new(Lidar::VARIABLES);
     *io.value_mut(SCENE) = Value::String(scene.clone());
     *io.value_mut(ROBOT_LINKS) = Value::Boolean(robot_links);
     *io.value_mut(CAST_THREADS) = Value::Int32(threads);
     let mut m = Lidar::new();
     m.initialize(&mut io, 0.0, &mut Quiet).expect("initialize");
-    println!("scene: {} objects, generated and prepared in {:.2} s", m.scene().unwrap().object_count(), t.elapsed().as_secs_f64());
+    println!(
+        "scene: {} objects, generated and prepared in {:.2} s",
+        m.scene().unwrap().object_count(),
+        t.elapsed().as_secs_f64()
+    );
     let mut k = 0;
     for (name, [x, y, yaw]) in poses {
         io.set_f64(BASE_X, x);
@@ -53,4 +62,3 @@ fn main() {
         println!("{name}: {rays} rays in {secs:.3} s = {:.0} rays/s ({:.1} % returns), {threads} thread(s), clouds {digest:016x}", rays as f64 / secs, 100.0 * returns as f64 / rays as f64);
     }
 }
-

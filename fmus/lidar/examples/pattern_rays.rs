@@ -21,7 +21,11 @@ fn main() {
     let gh = generate(&cfg, cfg.seed);
     let rc = RayCaster::new(&gh.objects);
     let none = RayCaster::new(&[]);
-    let p = ScanPattern::mid360(ds::POINT_RATE, ds::FOV_ELEVATION_MIN_DEG.to_radians(), ds::FOV_ELEVATION_MAX_DEG.to_radians());
+    let p = ScanPattern::mid360(
+        ds::POINT_RATE,
+        ds::FOV_ELEVATION_MIN_DEG.to_radians(),
+        ds::FOV_ELEVATION_MAX_DEG.to_radians(),
+    );
     let per_frame = (ds::POINT_RATE / ds::FRAME_RATE) as i64;
     // Spots along the aisles, the sensor 0.5 m up (as the random-ray bench), one after another
     // with `frames` frames each.
@@ -43,7 +47,9 @@ fn main() {
     }
     let (lo, hi) = (ds::RANGE_MIN, ds::RANGE_MAX);
     let single = || -> Vec<f64> {
-        rays.iter().map(|r| rc.cast([r[0], r[1], r[2]], [r[3], r[4], r[5]], lo, hi, &[]).map_or(f64::INFINITY, |h| h.distance)).collect()
+        rays.iter()
+            .map(|r| rc.cast([r[0], r[1], r[2]], [r[3], r[4], r[5]], lo, hi, &[]).map_or(f64::INFINITY, |h| h.distance))
+            .collect()
     };
     let packets = || -> Vec<f64> {
         let mut dist = Vec::with_capacity(rays.len());
@@ -69,7 +75,11 @@ fn main() {
     let (dist, secs, secs_single) = common::time_packets_and_single(&single, &packets);
     let n = rays.len();
     let hits = dist.iter().filter(|d| d.is_finite()).count();
-    println!("LiDAR pattern rays {n} ({frames} frames x {} spots), hits {:.1} %", spots.len(), 100.0 * hits as f64 / n as f64);
+    println!(
+        "LiDAR pattern rays {n} ({frames} frames x {} spots), hits {:.1} %",
+        spots.len(),
+        100.0 * hits as f64 / n as f64
+    );
     println!("rays/s             {:.3e} in packets of {LIDAR_PACKET}, {:.3e} as single rays (single thread, best of 3; identical hits)", n as f64 / secs, n as f64 / secs_single);
     if let Some(dir) = common::arg("--out") {
         let dir = std::path::PathBuf::from(dir);

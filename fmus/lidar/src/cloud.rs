@@ -57,7 +57,12 @@ impl CloudBuilder {
             fields: FIELDS
                 .iter()
                 .enumerate()
-                .map(|(i, name)| PointField { name: name.to_string(), offset: 4 * i as u32, datatype: PointField::FLOAT32, count: 1 })
+                .map(|(i, name)| PointField {
+                    name: name.to_string(),
+                    offset: 4 * i as u32,
+                    datatype: PointField::FLOAT32,
+                    count: 1,
+                })
                 .collect(),
             is_bigendian: false,
             point_step: POINT_STEP as u32,

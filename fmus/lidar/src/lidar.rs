@@ -20,8 +20,8 @@ use crate::trajectory::Trajectory;
 use agrisim_fmi::{Log, Model, OutPort, Store, Var};
 use agrisim_fmu_util::{on_threads, to_ns, Schedule};
 use agrisim_greenhouse::environment::Environment;
-use agrisim_greenhouse::RigidPose;
 use agrisim_greenhouse::weather::Conditions;
+use agrisim_greenhouse::RigidPose;
 use agrisim_math::{Pose2, Rng};
 use agrisim_msgs::sensor_msgs::PointCloud2;
 use agrisim_msgs::Message;
@@ -100,12 +100,15 @@ impl Config {
         let point_rate = param(io, POINT_RATE, positive, "positive")?;
         let points_per_frame = (point_rate / frame_rate).round();
         if !(1.0..=MAX_POINTS_PER_FRAME as f64).contains(&points_per_frame) {
-            return Err(format!("point_rate / frame_rate = {points_per_frame} points per frame, outside [1, {MAX_POINTS_PER_FRAME}]"));
+            return Err(format!(
+                "point_rate / frame_rate = {points_per_frame} points per frame, outside [1, {MAX_POINTS_PER_FRAME}]"
+            ));
         }
         let range_min = param(io, RANGE_MIN, |v| v >= 0.0, ">= 0")?;
         let range_max = param(io, RANGE_MAX, |v| v > range_min, "above range_min")?;
         let el_min = param(io, ELEVATION_MIN, |v| v.abs() < 90.0, "within (-90, 90) deg")?;
-        let el_max = param(io, ELEVATION_MAX, |v| v.abs() < 90.0 && v > el_min, "within (-90, 90) deg and above elevation_min")?;
+        let el_max =
+            param(io, ELEVATION_MAX, |v| v.abs() < 90.0 && v > el_min, "within (-90, 90) deg and above elevation_min")?;
         let m = SENSOR_PORTS.mount(io)?;
         let mount = Mount::new(m.translation, m.roll, m.pitch, m.yaw);
         let (extinction, visibility) = match io.string(ENVIRONMENT).trim() {
@@ -169,7 +172,12 @@ struct Batch {
 impl Default for Batch {
     fn default() -> Batch {
         let pose = RigidPose::yawed(0.0, 0.0, 0.0, 0.0);
-        Batch { origins: [[0.0; 3]; LIDAR_PACKET], dirs: [[0.0; 3]; LIDAR_PACKET], poses: [pose; LIDAR_PACKET], hits: [None; LIDAR_PACKET] }
+        Batch {
+            origins: [[0.0; 3]; LIDAR_PACKET],
+            dirs: [[0.0; 3]; LIDAR_PACKET],
+            poses: [pose; LIDAR_PACKET],
+            hits: [None; LIDAR_PACKET],
+        }
     }
 }
 
@@ -252,7 +260,15 @@ impl Lidar {
                 batch.poses[i] = base;
             }
             let k = rays.len();
-            c.scene.caster.cast_packet_posed(&batch.origins[..k], &batch.dirs[..k], c.range.0, c.range.1, robot, &batch.poses[..k], &mut batch.hits[..k]);
+            c.scene.caster.cast_packet_posed(
+                &batch.origins[..k],
+                &batch.dirs[..k],
+                c.range.0,
+                c.range.1,
+                robot,
+                &batch.poses[..k],
+                &mut batch.hits[..k],
+            );
             for ((ray, hit), d) in rays.iter_mut().zip(&batch.hits[..k]).zip(&batch.dirs[..k]) {
                 ray.echo = hit.filter(|h| detected(h.distance, c.range.1, c.extinction)).map(|h| {
                     let rho = reflectivity::of_kind(c.scene.kind(h.object));

@@ -129,7 +129,11 @@ mod tests {
     use super::*;
 
     fn pattern() -> ScanPattern {
-        ScanPattern::mid360(ds::POINT_RATE, ds::FOV_ELEVATION_MIN_DEG.to_radians(), ds::FOV_ELEVATION_MAX_DEG.to_radians())
+        ScanPattern::mid360(
+            ds::POINT_RATE,
+            ds::FOV_ELEVATION_MIN_DEG.to_radians(),
+            ds::FOV_ELEVATION_MAX_DEG.to_radians(),
+        )
     }
 
     /// Fraction of 1 deg x 1 deg (azimuth x elevation) cells of the field hit by points

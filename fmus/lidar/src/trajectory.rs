@@ -23,7 +23,8 @@ impl Trajectory {
             self.samples.pop_back();
         }
         if let Some((_, last)) = self.samples.back() {
-            let d = (pose.yaw - last.yaw + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+            let d =
+                (pose.yaw - last.yaw + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
             pose.yaw = last.yaw + d;
         }
         self.samples.push_back((time, pose));

@@ -7,5 +7,8 @@ agrisim_fmi::fmu_conformance_tests!(agrisim_fmu_lidar::Lidar, seeds = 4, cases =
 #[test]
 fn initial_dependencies_hold_in_fog() {
     let fog = agrisim_fmi::Value::String("weather = \"fog\"\nvisibility = 30.0".into());
-    agrisim_fmi::testing::assert_initial_dependencies::<agrisim_fmu_lidar::Lidar>(&[(agrisim_fmu_lidar::ports::ENVIRONMENT, fog)]);
+    agrisim_fmi::testing::assert_initial_dependencies::<agrisim_fmu_lidar::Lidar>(&[(
+        agrisim_fmu_lidar::ports::ENVIRONMENT,
+        fog,
+    )]);
 }

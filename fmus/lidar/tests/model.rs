@@ -61,7 +61,10 @@ fn default_frame_has_20000_points_and_a_valid_layout() {
     assert!(!c.is_bigendian && c.is_dense);
     let fields: Vec<_> = c.fields.iter().map(|f| (f.name.as_str(), f.offset, f.datatype, f.count)).collect();
     let f32_ = PointField::FLOAT32;
-    assert_eq!(fields, [("x", 0, f32_, 1), ("y", 4, f32_, 1), ("z", 8, f32_, 1), ("intensity", 12, f32_, 1), ("t", 16, f32_, 1)]);
+    assert_eq!(
+        fields,
+        [("x", 0, f32_, 1), ("y", 4, f32_, 1), ("z", 8, f32_, 1), ("intensity", 12, f32_, 1), ("t", 16, f32_, 1)]
+    );
     assert_eq!(c.header.frame_id, "lidar_link");
     // Sensor convention: stamp = first point of the frame (0.1 .. 0.2 s), t in [0, 0.1).
     assert_eq!(c.header.stamp.to_nanos(), 100_000_000);
@@ -222,7 +225,12 @@ fn the_robots_links_are_hit_where_the_joints_put_them() {
     // Joint 1 swings the left arm out to the left (+y), beyond the base.
     let swung = self_points(true, |io| io.set_f64(LEFT_Q1, 1.6));
     let left = |ps: &[Point]| ps.iter().filter(|p| p.xyz[1] > 0.55).count();
-    println!("robot points in 3 frames: ready {}, arm swung out {} ({} beside the base)", ready.len(), swung.len(), left(&swung));
+    println!(
+        "robot points in 3 frames: ready {}, arm swung out {} ({} beside the base)",
+        ready.len(),
+        swung.len(),
+        left(&swung)
+    );
     assert!(left(&ready) == 0 && left(&swung) > 10, "{} {}", left(&ready), left(&swung));
     // Robot points come back with the robot's reflectivity (0.3): intensity 45 at normal incidence or below.
     assert!(swung.iter().all(|p| p.intensity <= 45.0 * 1.06));
@@ -307,7 +315,18 @@ fn through_the_fmi3_layer() {
     let vr = |i: usize| i as u32 + 1;
     unsafe {
         let p = fmi3::instantiate_co_simulation::<Lidar>(
-            c"lidar".as_ptr(), token.as_ptr(), std::ptr::null(), 0, 0, 0, 0, std::ptr::null(), 0, std::ptr::null_mut(), None, None,
+            c"lidar".as_ptr(),
+            token.as_ptr(),
+            std::ptr::null(),
+            0,
+            0,
+            0,
+            0,
+            std::ptr::null(),
+            0,
+            std::ptr::null_mut(),
+            None,
+            None,
         );
         assert!(!p.is_null());
         assert_eq!(fmi3::set_string::<Lidar>(p, &vr(SCENE), 1, &scene.as_ptr(), 1), Status::Ok);

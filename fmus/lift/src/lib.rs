@@ -66,7 +66,10 @@ impl Lift {
         self.last_setpoint = sp;
         if !(sp.is_finite() && sp >= self.range.0 && sp <= self.range.1) {
             self.refused = true;
-            log.warning(format_args!("setpoint {sp} m refused at t={t}: outside [{}, {}] m; keeping target {} m", self.range.0, self.range.1, self.target));
+            log.warning(format_args!(
+                "setpoint {sp} m refused at t={t}: outside [{}, {}] m; keeping target {} m",
+                self.range.0, self.range.1, self.target
+            ));
             return;
         }
         self.refused = false;
@@ -82,7 +85,13 @@ impl Lift {
         io.set_f64(POSITION, p);
         io.set_f64(VELOCITY, v);
         io.set_f64(TARGET, self.target);
-        let st = if self.refused { status::REFUSED } else if t < self.profile.end_time() { status::MOVING } else { status::AT_TARGET };
+        let st = if self.refused {
+            status::REFUSED
+        } else if t < self.profile.end_time() {
+            status::MOVING
+        } else {
+            status::AT_TARGET
+        };
         io.set_i32(STATUS, st);
         io.set_f64(PAYLOAD_MASS, io.f64(CARRIED_MASS));
         io.set_f64(PAYLOAD_HEIGHT, io.f64(BASE_HEIGHT) + p);
@@ -91,7 +100,8 @@ impl Lift {
 
 impl Model for Lift {
     const NAME: &'static str = "Lift";
-    const DESCRIPTION: &'static str = "Prismatic lift with position set-point, velocity/acceleration limits and range check";
+    const DESCRIPTION: &'static str =
+        "Prismatic lift with position set-point, velocity/acceleration limits and range check";
     const VARIABLES: &'static [Var] = VARIABLES;
 
     agrisim_fmi::whole_state!();
@@ -113,7 +123,14 @@ impl Model for Lift {
         if !(p0 >= lo && p0 <= hi) {
             return Err(format!("position0 {p0} outside [{lo}, {hi}]"));
         }
-        *self = Lift { profile: Profile::hold(start_time, p0), target: p0, last_setpoint: f64::NAN, refused: false, range: (lo, hi), limits: (vmax, amax) };
+        *self = Lift {
+            profile: Profile::hold(start_time, p0),
+            target: p0,
+            last_setpoint: f64::NAN,
+            refused: false,
+            range: (lo, hi),
+            limits: (vmax, amax),
+        };
         self.take_setpoint(io, start_time, log);
         self.write_outputs(io, start_time);
         Ok(())

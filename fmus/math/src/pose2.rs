@@ -26,7 +26,11 @@ impl Pose2 {
     /// `self ∘ other`: `other` (given in self's frame) expressed in self's parent frame.
     pub fn compose(&self, other: &Pose2) -> Pose2 {
         let (s, c) = self.yaw.sin_cos();
-        Pose2 { x: self.x + c * other.x - s * other.y, y: self.y + s * other.x + c * other.y, yaw: wrap_angle(self.yaw + other.yaw) }
+        Pose2 {
+            x: self.x + c * other.x - s * other.y,
+            y: self.y + s * other.x + c * other.y,
+            yaw: wrap_angle(self.yaw + other.yaw),
+        }
     }
 
     pub fn inverse(&self) -> Pose2 {

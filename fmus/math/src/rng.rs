@@ -215,7 +215,18 @@ mod tests {
         let mass = |a: f64, b: f64| {
             let n = 200;
             let h = (b - a) / n as f64;
-            (0..=n).map(|i| pdf(a + i as f64 * h) * h / 3.0 * if i == 0 || i == n { 1.0 } else if i % 2 == 1 { 4.0 } else { 2.0 }).sum::<f64>()
+            (0..=n)
+                .map(|i| {
+                    pdf(a + i as f64 * h) * h / 3.0
+                        * if i == 0 || i == n {
+                            1.0
+                        } else if i % 2 == 1 {
+                            4.0
+                        } else {
+                            2.0
+                        }
+                })
+                .sum::<f64>()
         };
         let mut p: Vec<f64> = edges.windows(2).map(|w| mass(w[0], w[1])).collect();
         let tail = 0.5 * (1.0 - p.iter().sum::<f64>());

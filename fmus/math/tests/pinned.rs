@@ -72,5 +72,8 @@ fn scene_flavour_is_pinned() {
 /// rand_distr 0.6.0.
 #[test]
 fn ziggurat_normal_is_pinned() {
-    assert_eq!(bits(Rng::new(42), 5, Rng::normal_ziggurat), [4604760684537638908, 13829914759692564649, 13828692691625705375, 13826347314233292575, 13830947226000179636]);
+    assert_eq!(
+        bits(Rng::new(42), 5, Rng::normal_ziggurat),
+        [4604760684537638908, 13829914759692564649, 13828692691625705375, 13826347314233292575, 13830947226000179636]
+    );
 }

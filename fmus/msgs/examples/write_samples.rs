@@ -39,11 +39,7 @@ fn main() -> ExitCode {
             }
         }
         println!("checked {checked} files, {failed} failed");
-        return if failed == 0 && checked > 0 {
-            ExitCode::SUCCESS
-        } else {
-            ExitCode::FAILURE
-        };
+        return if failed == 0 && checked > 0 { ExitCode::SUCCESS } else { ExitCode::FAILURE };
     }
     if let Err(e) = std::fs::create_dir_all(&dir) {
         eprintln!("cannot create {}: {e}", dir.display());

@@ -25,20 +25,11 @@ impl Time {
         let sec = nanos.div_euclid(NANOS_PER_SEC);
         let nanosec = nanos.rem_euclid(NANOS_PER_SEC) as u32;
         if sec > i32::MAX as i64 {
-            Self {
-                sec: i32::MAX,
-                nanosec: 999_999_999,
-            }
+            Self { sec: i32::MAX, nanosec: 999_999_999 }
         } else if sec < i32::MIN as i64 {
-            Self {
-                sec: i32::MIN,
-                nanosec: 0,
-            }
+            Self { sec: i32::MIN, nanosec: 0 }
         } else {
-            Self {
-                sec: sec as i32,
-                nanosec,
-            }
+            Self { sec: sec as i32, nanosec }
         }
     }
 

@@ -29,19 +29,9 @@ pub enum CdrError {
     /// The encapsulation kind is not plain CDR (BE `00 00` or LE `00 01`), e.g. XCDR2 or PL_CDR.
     UnsupportedEncapsulation { kind: [u8; 2] },
     /// The buffer ended while reading `what`.
-    UnexpectedEof {
-        what: &'static str,
-        offset: usize,
-        needed: usize,
-        available: usize,
-    },
+    UnexpectedEof { what: &'static str, offset: usize, needed: usize, available: usize },
     /// A length or count field announces more data than the rest of the buffer holds.
-    LengthTooLarge {
-        what: &'static str,
-        offset: usize,
-        length: u64,
-        available: usize,
-    },
+    LengthTooLarge { what: &'static str, offset: usize, length: u64, available: usize },
     /// String bytes are not valid UTF-8.
     InvalidUtf8 { offset: usize },
     /// A string's last byte (at `offset`) is not the NUL terminator.
@@ -53,47 +43,31 @@ pub enum CdrError {
 impl fmt::Display for CdrError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            CdrError::MissingHeader { len } => write!(
-                f,
-                "CDR buffer of {len} bytes is too short for the 4-byte encapsulation header"
-            ),
+            CdrError::MissingHeader { len } => {
+                write!(f, "CDR buffer of {len} bytes is too short for the 4-byte encapsulation header")
+            }
             CdrError::UnsupportedEncapsulation { kind } => write!(
                 f,
                 "unsupported CDR encapsulation kind {:02x} {:02x} at byte 0 \
                  (expected 00 01 for CDR_LE or 00 00 for CDR_BE)",
                 kind[0], kind[1]
             ),
-            CdrError::UnexpectedEof {
-                what,
-                offset,
-                needed,
-                available,
-            } => write!(
+            CdrError::UnexpectedEof { what, offset, needed, available } => write!(
                 f,
                 "CDR data truncated reading {what} at byte {offset}: \
                  need {needed} bytes, {available} left"
             ),
-            CdrError::LengthTooLarge {
-                what,
-                offset,
-                length,
-                available,
-            } => write!(
-                f,
-                "CDR {what} at byte {offset} announces {length} but only {available} bytes remain"
-            ),
+            CdrError::LengthTooLarge { what, offset, length, available } => {
+                write!(f, "CDR {what} at byte {offset} announces {length} but only {available} bytes remain")
+            }
             CdrError::InvalidUtf8 { offset } => {
                 write!(f, "CDR string starting at byte {offset} is not valid UTF-8")
             }
-            CdrError::MissingNul { offset, found } => write!(
-                f,
-                "CDR string not NUL-terminated: byte {offset} is 0x{found:02x}, expected 0x00"
-            ),
+            CdrError::MissingNul { offset, found } => {
+                write!(f, "CDR string not NUL-terminated: byte {offset} is 0x{found:02x}, expected 0x00")
+            }
             CdrError::InvalidBool { offset, value } => {
-                write!(
-                    f,
-                    "CDR bool at byte {offset} has value {value}, expected 0 or 1"
-                )
+                write!(f, "CDR bool at byte {offset} has value {value}, expected 0 or 1")
             }
         }
     }
@@ -221,11 +195,7 @@ macro_rules! read_prim {
             let b = self.take(N, $what)?;
             let mut a = [0u8; N];
             a.copy_from_slice(b);
-            Ok(if self.little_endian {
-                <$t>::from_le_bytes(a)
-            } else {
-                <$t>::from_be_bytes(a)
-            })
+            Ok(if self.little_endian { <$t>::from_le_bytes(a) } else { <$t>::from_be_bytes(a) })
         }
     };
 }
@@ -242,11 +212,7 @@ impl<'a> CdrReader<'a> {
             [0x00, 0x00] => false,
             kind => return Err(CdrError::UnsupportedEncapsulation { kind }),
         };
-        Ok(Self {
-            data,
-            pos: HEADER_LEN,
-            little_endian,
-        })
+        Ok(Self { data, pos: HEADER_LEN, little_endian })
     }
 
     /// Current offset in the whole buffer (header included).
@@ -270,12 +236,7 @@ impl<'a> CdrReader<'a> {
     fn take(&mut self, n: usize, what: &'static str) -> Result<&'a [u8], CdrError> {
         let available = self.remaining();
         if n > available {
-            return Err(CdrError::UnexpectedEof {
-                what,
-                offset: self.pos,
-                needed: n,
-                available,
-            });
+            return Err(CdrError::UnexpectedEof { what, offset: self.pos, needed: n, available });
         }
         let s = &self.data[self.pos..self.pos + n];
         self.pos += n;
@@ -333,10 +294,7 @@ impl<'a> CdrReader<'a> {
         let bytes = self.take(len, "string")?;
         let (body, nul) = bytes.split_at(len - 1);
         if nul[0] != 0 {
-            return Err(CdrError::MissingNul {
-                offset: start + len - 1,
-                found: nul[0],
-            });
+            return Err(CdrError::MissingNul { offset: start + len - 1, found: nul[0] });
         }
         match std::str::from_utf8(body) {
             Ok(s) => Ok(s.to_owned()),

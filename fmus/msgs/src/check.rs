@@ -4,8 +4,8 @@
 use crate::cdr::CdrError;
 use crate::message::Message;
 use crate::{
-    agrisim, builtin_interfaces, control_msgs, geometry_msgs, nav_msgs, rosgraph_msgs, sensor_msgs,
-    shape_msgs, std_msgs, tf2_msgs, trajectory_msgs,
+    agrisim, builtin_interfaces, control_msgs, geometry_msgs, nav_msgs, rosgraph_msgs, sensor_msgs, shape_msgs,
+    std_msgs, tf2_msgs, trajectory_msgs,
 };
 
 /// `Some(Ok(()))` when `bytes` decode as `type_name` (`pkg/msg/Type`), `Some(Err)` when they

@@ -131,7 +131,14 @@ fn parse_fields(package: &str, text: &str) -> Vec<Field> {
         let (ty, arity) = match ty.split_once('[') {
             Some((t, rest)) => {
                 let inner = rest.trim_end_matches(']');
-                (t, if inner.is_empty() || inner.starts_with("<=") { Arity::Seq } else { inner.parse().map_or(Arity::Seq, Arity::Fixed) })
+                (
+                    t,
+                    if inner.is_empty() || inner.starts_with("<=") {
+                        Arity::Seq
+                    } else {
+                        inner.parse().map_or(Arity::Seq, Arity::Fixed)
+                    },
+                )
             }
             None => (ty, Arity::One),
         };
@@ -154,7 +161,10 @@ fn parse_fields(package: &str, text: &str) -> Vec<Field> {
 pub enum DynError {
     UnknownType(String),
     /// `path` is the field's place in the message (`pose.position.x`).
-    Field { path: String, reason: String },
+    Field {
+        path: String,
+        reason: String,
+    },
     Cdr(CdrError),
 }
 
@@ -190,11 +200,17 @@ pub fn is_known(type_name: &str) -> bool {
 fn min_size(base: &Base) -> usize {
     match base {
         Base::Prim(p) => p.size(),
-        Base::Msg(m) => fields_of(m).map(|fs| fs.iter().map(|f| match f.arity {
-            Arity::One => min_size(&f.base),
-            Arity::Fixed(n) => n * min_size(&f.base),
-            Arity::Seq => 4,
-        }).sum()).unwrap_or(1),
+        Base::Msg(m) => fields_of(m)
+            .map(|fs| {
+                fs.iter()
+                    .map(|f| match f.arity {
+                        Arity::One => min_size(&f.base),
+                        Arity::Fixed(n) => n * min_size(&f.base),
+                        Arity::Seq => 4,
+                    })
+                    .sum()
+            })
+            .unwrap_or(1),
     }
 }
 

@@ -42,22 +42,12 @@ impl Default for Quaternion {
 }
 
 impl Quaternion {
-    pub const IDENTITY: Self = Self {
-        x: 0.0,
-        y: 0.0,
-        z: 0.0,
-        w: 1.0,
-    };
+    pub const IDENTITY: Self = Self { x: 0.0, y: 0.0, z: 0.0, w: 1.0 };
 
     /// Rotation of `yaw` radians about +z (the common planar-robot case).
     pub fn from_yaw(yaw: f64) -> Self {
         let (s, c) = (0.5 * yaw).sin_cos();
-        Self {
-            x: 0.0,
-            y: 0.0,
-            z: s,
-            w: c,
-        }
+        Self { x: 0.0, y: 0.0, z: s, w: c }
     }
 }
 
@@ -91,10 +81,7 @@ ros_message! {
 
 impl Default for PoseWithCovariance {
     fn default() -> Self {
-        Self {
-            pose: Pose::default(),
-            covariance: [0.0; 36],
-        }
+        Self { pose: Pose::default(), covariance: [0.0; 36] }
     }
 }
 
@@ -127,10 +114,7 @@ ros_message! {
 
 impl Default for TwistWithCovariance {
     fn default() -> Self {
-        Self {
-            twist: Twist::default(),
-            covariance: [0.0; 36],
-        }
+        Self { twist: Twist::default(), covariance: [0.0; 36] }
     }
 }
 

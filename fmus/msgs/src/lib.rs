@@ -26,8 +26,8 @@
 
 pub mod cdr;
 mod check;
-pub mod message;
 pub mod dynamic;
+pub mod message;
 pub mod schema;
 
 pub mod agrisim;
@@ -42,7 +42,7 @@ pub mod std_msgs;
 pub mod tf2_msgs;
 pub mod trajectory_msgs;
 
-pub use check::check_cdr;
 pub use cdr::{CdrError, CdrField, CdrReader, CdrWriter, CDR_LE_HEADER};
+pub use check::check_cdr;
 pub use message::{mime_type, mime_type_for, type_name_from_mime, Message, MIME_PREFIX};
 pub use schema::{all_type_names, msg_text, ros2msg_schema};

@@ -14,8 +14,7 @@
 use std::collections::BTreeSet;
 
 /// Separator line before each dependency in a `ros2msg` schema.
-pub const SEPARATOR: &str =
-    "================================================================================";
+pub const SEPARATOR: &str = "================================================================================";
 
 macro_rules! msg_table {
     ($( $pkg:literal / $ty:literal ),* $(,)?) => {
@@ -98,14 +97,12 @@ fn split_type_name(name: &str) -> Option<(&str, &str)> {
 /// The .msg text of a type (`pkg/msg/Type` or `pkg/Type`), exactly as in models/msgs.
 pub fn msg_text(type_name: &str) -> Option<&'static str> {
     let (pkg, ty) = split_type_name(type_name)?;
-    MSG_TEXTS
-        .iter()
-        .find_map(|(full, text)| (split_type_name(full) == Some((pkg, ty))).then_some(*text))
+    MSG_TEXTS.iter().find_map(|(full, text)| (split_type_name(full) == Some((pkg, ty))).then_some(*text))
 }
 
 const PRIMITIVES: &[&str] = &[
-    "bool", "byte", "char", "float32", "float64", "int8", "uint8", "int16", "uint16", "int32",
-    "uint32", "int64", "uint64", "string", "wstring",
+    "bool", "byte", "char", "float32", "float64", "int8", "uint8", "int16", "uint16", "int32", "uint32", "int64",
+    "uint64", "string", "wstring",
 ];
 
 /// Direct message-type dependencies of a .msg text, as `pkg/Type`, sorted and unique.

@@ -22,9 +22,6 @@ ros_message! {
 
 impl Header {
     pub fn new(stamp: Time, frame_id: impl Into<String>) -> Self {
-        Self {
-            stamp,
-            frame_id: frame_id.into(),
-        }
+        Self { stamp, frame_id: frame_id.into() }
     }
 }

@@ -77,10 +77,18 @@ fn bad_values_are_named() {
     assert!(e.to_string().contains("fields: x, y, z"), "{e}");
     let e = encode("geometry_msgs/msg/Twist", &twist("x", Value::String("fast".into()))).unwrap_err();
     assert_eq!(e.to_string(), "field linear.x: expected a number, got a string");
-    let e = encode("sensor_msgs/msg/PointField", &Value::Struct(vec![("datatype".into(), Value::Int(300))])).unwrap_err();
+    let e =
+        encode("sensor_msgs/msg/PointField", &Value::Struct(vec![("datatype".into(), Value::Int(300))])).unwrap_err();
     assert_eq!(e.to_string(), "field datatype: 300 is out of range [0, 255]");
-    let e = encode("geometry_msgs/msg/PoseWithCovariance", &Value::Struct(vec![("covariance".into(), Value::Array(vec![Value::Float(1.0); 3]))])).unwrap_err();
+    let e = encode(
+        "geometry_msgs/msg/PoseWithCovariance",
+        &Value::Struct(vec![("covariance".into(), Value::Array(vec![Value::Float(1.0); 3]))]),
+    )
+    .unwrap_err();
     assert_eq!(e.to_string(), "field covariance: expected 36 elements, got 3");
-    assert_eq!(encode("geometry_msgs/msg/Twistt", &Value::Struct(vec![])).unwrap_err(), DynError::UnknownType("geometry_msgs/msg/Twistt".into()));
+    assert_eq!(
+        encode("geometry_msgs/msg/Twistt", &Value::Struct(vec![])).unwrap_err(),
+        DynError::UnknownType("geometry_msgs/msg/Twistt".into())
+    );
     assert!(decode("nope", &[0, 1, 0, 0]).is_err());
 }

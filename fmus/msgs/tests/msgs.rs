@@ -65,18 +65,7 @@ fn f64le(v: f64) -> [u8; 8] {
 
 #[test]
 fn golden_twist_is_header_plus_48_bytes() {
-    let t = Twist {
-        linear: Vector3 {
-            x: 1.0,
-            y: 2.0,
-            z: 3.0,
-        },
-        angular: Vector3 {
-            x: -1.0,
-            y: 0.0,
-            z: 0.5,
-        },
-    };
+    let t = Twist { linear: Vector3 { x: 1.0, y: 2.0, z: 3.0 }, angular: Vector3 { x: -1.0, y: 0.0, z: 0.5 } };
     let expected: Vec<u8> = [
         vec![0x00, 0x01, 0x00, 0x00],
         vec![0, 0, 0, 0, 0, 0, 0xf0, 0x3f], // 1.0
@@ -94,23 +83,12 @@ fn golden_twist_is_header_plus_48_bytes() {
 #[test]
 fn golden_header_and_clock() {
     let h = Header::new(Time::new(1, 2), "ab");
-    assert_eq!(
-        h.to_cdr(),
-        vec![0, 1, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0, 3, 0, 0, 0, b'a', b'b', 0]
-    );
+    assert_eq!(h.to_cdr(), vec![0, 1, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0, 3, 0, 0, 0, b'a', b'b', 0]);
     // Empty string is length 1 + NUL, not length 0.
-    assert_eq!(
-        Header::default().to_cdr(),
-        vec![0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0]
-    );
-    let c = Clock {
-        clock: Time::new(5, 6),
-    };
+    assert_eq!(Header::default().to_cdr(), vec![0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0]);
+    let c = Clock { clock: Time::new(5, 6) };
     assert_eq!(c.to_cdr(), vec![0, 1, 0, 0, 5, 0, 0, 0, 6, 0, 0, 0]);
-    assert_eq!(
-        Time::new(-2, 0).to_cdr(),
-        vec![0, 1, 0, 0, 0xfe, 0xff, 0xff, 0xff, 0, 0, 0, 0]
-    );
+    assert_eq!(Time::new(-2, 0).to_cdr(), vec![0, 1, 0, 0, 0xfe, 0xff, 0xff, 0xff, 0, 0, 0, 0]);
 }
 
 #[test]
@@ -119,18 +97,9 @@ fn golden_pose_stamped_pads_after_string() {
     // aligned to 8 relative to the end of the encapsulation header -> 1 pad byte.
     let p = PoseStamped {
         header: Header::new(Time::new(1, 2), "ab"),
-        pose: Pose {
-            position: Point {
-                x: 1.0,
-                y: 2.0,
-                z: 3.0,
-            },
-            orientation: Quaternion::IDENTITY,
-        },
+        pose: Pose { position: Point { x: 1.0, y: 2.0, z: 3.0 }, orientation: Quaternion::IDENTITY },
     };
-    let mut expected = vec![
-        0, 1, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0, 3, 0, 0, 0, b'a', b'b', 0, 0,
-    ];
+    let mut expected = vec![0, 1, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0, 3, 0, 0, 0, b'a', b'b', 0, 0];
     for v in [1.0, 2.0, 3.0, 0.0, 0.0, 0.0, 1.0] {
         expected.extend_from_slice(&f64le(v));
     }
@@ -145,14 +114,7 @@ fn golden_transform_stamped_pads_twice() {
     let t = TransformStamped {
         header: Header::new(Time::new(0, 0), "odom"),
         child_frame_id: "base".into(),
-        transform: Transform {
-            translation: Vector3 {
-                x: 1.0,
-                y: 0.0,
-                z: 0.0,
-            },
-            rotation: Quaternion::IDENTITY,
-        },
+        transform: Transform { translation: Vector3 { x: 1.0, y: 0.0, z: 0.0 }, rotation: Quaternion::IDENTITY },
     };
     let mut expected = vec![0, 1, 0, 0];
     expected.extend_from_slice(&[0; 8]);
@@ -200,72 +162,30 @@ fn errors_name_what_and_where() {
     assert_eq!(e, CdrError::MissingHeader { len: 2 });
 
     let e = Clock::from_cdr(&[0, 0x0a, 0, 0, 5, 0, 0, 0, 6, 0, 0, 0]).unwrap_err();
-    assert!(matches!(
-        e,
-        CdrError::UnsupportedEncapsulation { kind: [0, 0x0a] }
-    ));
+    assert!(matches!(e, CdrError::UnsupportedEncapsulation { kind: [0, 0x0a] }));
     assert!(e.to_string().contains("byte 0"), "{e}");
 
     let e = Clock::from_cdr(&[0, 1, 0, 0, 5, 0, 0, 0, 6]).unwrap_err();
-    assert_eq!(
-        e,
-        CdrError::UnexpectedEof {
-            what: "uint32",
-            offset: 8,
-            needed: 4,
-            available: 1
-        }
-    );
+    assert_eq!(e, CdrError::UnexpectedEof { what: "uint32", offset: 8, needed: 4, available: 1 });
     assert!(e.to_string().contains("byte 8"), "{e}");
 
     // String length larger than the buffer.
-    let e = Header::from_cdr(&[
-        0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0xff, 0xff, 0xff, 0x7f, b'a',
-    ])
-    .unwrap_err();
-    assert!(
-        matches!(
-            e,
-            CdrError::LengthTooLarge {
-                what: "string length",
-                offset: 12,
-                ..
-            }
-        ),
-        "{e:?}"
-    );
+    let e = Header::from_cdr(&[0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0xff, 0xff, 0xff, 0x7f, b'a']).unwrap_err();
+    assert!(matches!(e, CdrError::LengthTooLarge { what: "string length", offset: 12, .. }), "{e:?}");
     assert!(e.to_string().contains("byte 12"), "{e}");
 
     // Missing NUL.
-    let e = Header::from_cdr(&[0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 0, 0, b'a', b'b'])
-        .unwrap_err();
-    assert_eq!(
-        e,
-        CdrError::MissingNul {
-            offset: 17,
-            found: b'b'
-        }
-    );
+    let e = Header::from_cdr(&[0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 2, 0, 0, 0, b'a', b'b']).unwrap_err();
+    assert_eq!(e, CdrError::MissingNul { offset: 17, found: b'b' });
 
     // Invalid UTF-8.
-    let e = Header::from_cdr(&[
-        0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 3, 0, 0, 0, 0xc3, 0x28, 0,
-    ])
-    .unwrap_err();
+    let e = Header::from_cdr(&[0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 3, 0, 0, 0, 0xc3, 0x28, 0]).unwrap_err();
     assert_eq!(e, CdrError::InvalidUtf8 { offset: 16 });
 
     // Huge sequence count: rejected before allocating.
     let e = TFMessage::from_cdr(&[0, 1, 0, 0, 0xff, 0xff, 0xff, 0xff, 0, 0, 0, 0]).unwrap_err();
     assert!(
-        matches!(
-            e,
-            CdrError::LengthTooLarge {
-                what: "sequence count",
-                offset: 4,
-                length: 0xffff_ffff,
-                ..
-            }
-        ),
+        matches!(e, CdrError::LengthTooLarge { what: "sequence count", offset: 4, length: 0xffff_ffff, .. }),
         "{e:?}"
     );
 
@@ -300,43 +220,23 @@ fn reader_primitives_and_bool() {
     assert_eq!(r.remaining(), 0);
     let bad = [0, 1, 0, 0, 2];
     let e = CdrReader::new(&bad).unwrap().read_bool().unwrap_err();
-    assert_eq!(
-        e,
-        CdrError::InvalidBool {
-            offset: 4,
-            value: 2
-        }
-    );
+    assert_eq!(e, CdrError::InvalidBool { offset: 4, value: 2 });
 }
 
 // ---------------------------------------------------------------- time, mime
 
 #[test]
 fn time_constructors_are_exact() {
-    assert_eq!(
-        Time::from_nanos(1_700_000_000_123_456_789),
-        Time::new(1_700_000_000, 123_456_789)
-    );
+    assert_eq!(Time::from_nanos(1_700_000_000_123_456_789), Time::new(1_700_000_000, 123_456_789));
     assert_eq!(Time::from_nanos(-1_700_000_000), Time::new(-2, 300_000_000));
     assert_eq!(Time::from_nanos(i64::MAX), Time::new(i32::MAX, 999_999_999));
     assert_eq!(Time::from_nanos(i64::MIN), Time::new(i32::MIN, 0));
     // 0.02 s steps: 62 ticks of 50 Hz = 1.24 s exactly (f64 would give 1.2400000000000002).
     assert_eq!(Time::from_ticks(62, 50), Time::new(1, 240_000_000));
-    assert_eq!(
-        Time::from_ticks(3_000_000_001, 1_000_000_000),
-        Time::new(3, 1)
-    );
+    assert_eq!(Time::from_ticks(3_000_000_001, 1_000_000_000), Time::new(3, 1));
     assert_eq!(Time::from_ticks(1, 3), Time::new(0, 333_333_333));
     assert_eq!(Time::from_ticks(-1, 10), Time::new(-1, 900_000_000));
-    for n in [
-        0i64,
-        1,
-        999_999_999,
-        1_000_000_000,
-        -1,
-        -999_999_999,
-        123_456_789_012,
-    ] {
+    for n in [0i64, 1, 999_999_999, 1_000_000_000, -1, -999_999_999, 123_456_789_012] {
         assert_eq!(Time::from_nanos(n).to_nanos(), n);
     }
     assert_eq!(Time::new(1, 500_000_000).as_secs_f64(), 1.5);
@@ -344,23 +244,11 @@ fn time_constructors_are_exact() {
 
 #[test]
 fn mime_types() {
-    assert_eq!(
-        mime_type::<Twist>(),
-        "application/x-ros2-cdr-frames; version=1; type=geometry_msgs/msg/Twist"
-    );
+    assert_eq!(mime_type::<Twist>(), "application/x-ros2-cdr-frames; version=1; type=geometry_msgs/msg/Twist");
     assert_eq!(Twist::MIME_TYPE, mime_type::<Twist>());
-    assert_eq!(
-        type_name_from_mime(Twist::MIME_TYPE),
-        Some("geometry_msgs/msg/Twist")
-    );
-    assert_eq!(
-        type_name_from_mime("application/x-ros2-cdr ;type = a/msg/B"),
-        Some("a/msg/B")
-    );
-    assert_eq!(
-        type_name_from_mime("application/x-ros2-cdr-frames; type=a/msg/B; version=1"),
-        Some("a/msg/B")
-    );
+    assert_eq!(type_name_from_mime(Twist::MIME_TYPE), Some("geometry_msgs/msg/Twist"));
+    assert_eq!(type_name_from_mime("application/x-ros2-cdr ;type = a/msg/B"), Some("a/msg/B"));
+    assert_eq!(type_name_from_mime("application/x-ros2-cdr-frames; type=a/msg/B; version=1"), Some("a/msg/B"));
     assert_eq!(type_name_from_mime("application/x-ros2-cdr-frames; version=1"), None);
     assert_eq!(type_name_from_mime("application/octet-stream"), None);
     assert_eq!(type_name_from_mime("application/x-ros2-cdr; type="), None);
@@ -382,10 +270,7 @@ fn schema_texts_exist_and_resolve() {
         let msg_lines: Vec<&str> = schema.lines().filter(|l| l.starts_with("MSG: ")).collect();
         let uniq: BTreeSet<&&str> = msg_lines.iter().collect();
         assert_eq!(uniq.len(), msg_lines.len(), "{name}");
-        assert_eq!(
-            schema.lines().filter(|l| *l == schema::SEPARATOR).count(),
-            msg_lines.len()
-        );
+        assert_eq!(schema.lines().filter(|l| *l == schema::SEPARATOR).count(), msg_lines.len());
         assert_eq!(schema::SEPARATOR.len(), 80);
     }
     assert_eq!(ros2msg_schema("nope_msgs/msg/Nothing"), None);
@@ -412,10 +297,7 @@ fn schema_order_matches_rosbag2() {
     );
     let t = ros2msg_schema("geometry_msgs/msg/Twist").unwrap();
     assert!(t.contains("\n================================================================================\nMSG: geometry_msgs/Vector3\n"));
-    assert_eq!(
-        ros2msg_schema("builtin_interfaces/msg/Time").unwrap(),
-        msg_text("builtin_interfaces/Time").unwrap()
-    );
+    assert_eq!(ros2msg_schema("builtin_interfaces/msg/Time").unwrap(), msg_text("builtin_interfaces/Time").unwrap());
 }
 
 #[test]
@@ -439,11 +321,7 @@ fn below(rng: &mut Rng, n: usize) -> usize {
 fn truncations_always_fail_cleanly() {
     for s in all_samples() {
         for len in 0..s.bytes.len() {
-            assert!(
-                (s.decode)(&s.bytes[..len]).is_err(),
-                "{} prefix {len} decoded",
-                s.name
-            );
+            assert!((s.decode)(&s.bytes[..len]).is_err(), "{} prefix {len} decoded", s.name);
         }
     }
 }
@@ -507,10 +385,7 @@ fn garbage_never_panics() {
     }
     assert!(cases > 100_000, "{cases}");
     assert!(checked > cases / 2, "check_cdr compared on {checked} of {cases}");
-    assert!(
-        ok > 0,
-        "fuzz never produced a decodable message: generator too weak"
-    );
+    assert!(ok > 0, "fuzz never produced a decodable message: generator too weak");
     eprintln!("fuzz: {cases} decodes, {ok} succeeded, no panic");
 }
 

@@ -68,13 +68,10 @@ impl Joint {
     pub fn transform(&self, q: f64) -> Pose {
         match self.kind {
             JointKind::Fixed => self.origin,
-            JointKind::Revolute | JointKind::Continuous => {
-                self.origin.mul(&Pose::from_axis_angle(self.axis, q))
-            }
+            JointKind::Revolute | JointKind::Continuous => self.origin.mul(&Pose::from_axis_angle(self.axis, q)),
             JointKind::Prismatic => {
                 let a = self.axis;
-                self.origin
-                    .mul(&Pose::from_translation([a[0] * q, a[1] * q, a[2] * q]))
+                self.origin.mul(&Pose::from_translation([a[0] * q, a[1] * q, a[2] * q]))
             }
         }
     }
@@ -133,8 +130,7 @@ impl Robot {
     /// Loads and validates a URDF file. Errors name the file and the offending element.
     pub fn from_urdf_file(path: impl AsRef<Path>) -> Result<Robot, String> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
         Robot::from_urdf_str(&text).map_err(|e| format!("{}: {e}", path.display()))
     }
 
@@ -167,16 +163,9 @@ impl Robot {
                         ))
                     }
                 };
-                colliders.push(Collider {
-                    shape,
-                    origin: pose_of(&c.origin),
-                });
+                colliders.push(Collider { shape, origin: pose_of(&c.origin) });
             }
-            links.push(Link {
-                name: l.name.clone(),
-                mass: l.inertial.mass.value,
-                colliders,
-            });
+            links.push(Link { name: l.name.clone(), mass: l.inertial.mass.value, colliders });
         }
 
         let mut joints = Vec::with_capacity(urdf.joints.len());
@@ -188,10 +177,7 @@ impl Robot {
             }
             for (role, l) in [("parent", &j.parent.link), ("child", &j.child.link)] {
                 if !link_index.contains_key(l) {
-                    return Err(format!(
-                        "joint \"{}\": {role} link \"{l}\" does not exist",
-                        j.name
-                    ));
+                    return Err(format!("joint \"{}\": {role} link \"{l}\" does not exist", j.name));
                 }
             }
             let kind = match &j.joint_type {
@@ -199,26 +185,14 @@ impl Robot {
                 urdf_rs::JointType::Continuous => JointKind::Continuous,
                 urdf_rs::JointType::Prismatic => JointKind::Prismatic,
                 urdf_rs::JointType::Fixed => JointKind::Fixed,
-                other => {
-                    return Err(format!(
-                        "joint \"{}\": type {other:?} not supported",
-                        j.name
-                    ))
-                }
+                other => return Err(format!("joint \"{}\": type {other:?} not supported", j.name)),
             };
             let a = j.axis.xyz.0;
             let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
             if kind.is_movable() && !(n > 1e-12 && n.is_finite()) {
-                return Err(format!(
-                    "joint \"{}\": axis {a:?} is not a direction",
-                    j.name
-                ));
+                return Err(format!("joint \"{}\": axis {a:?} is not a direction", j.name));
             }
-            let axis = if kind.is_movable() {
-                a.map(|x| x / n)
-            } else {
-                a
-            };
+            let axis = if kind.is_movable() { a.map(|x| x / n) } else { a };
             let limits = match kind {
                 JointKind::Fixed => None,
                 JointKind::Continuous => Some(Limits {
@@ -230,27 +204,13 @@ impl Robot {
                 _ => {
                     let l = &j.limit;
                     if l.lower.is_nan() || l.upper.is_nan() || l.lower > l.upper {
-                        return Err(format!(
-                            "joint \"{}\": limit lower {} above upper {}",
-                            j.name, l.lower, l.upper
-                        ));
+                        return Err(format!("joint \"{}\": limit lower {} above upper {}", j.name, l.lower, l.upper));
                     }
-                    Some(Limits {
-                        lower: l.lower,
-                        upper: l.upper,
-                        velocity: l.velocity,
-                        effort: l.effort,
-                    })
+                    Some(Limits { lower: l.lower, upper: l.upper, velocity: l.velocity, effort: l.effort })
                 }
             };
-            if joint_by_child
-                .insert(j.child.link.clone(), joints.len())
-                .is_some()
-            {
-                return Err(format!(
-                    "joint \"{}\": link \"{}\" already has a parent joint",
-                    j.name, j.child.link
-                ));
+            if joint_by_child.insert(j.child.link.clone(), joints.len()).is_some() {
+                return Err(format!("joint \"{}\": link \"{}\" already has a parent joint", j.name, j.child.link));
             }
             joints.push(Joint {
                 name: j.name.clone(),
@@ -263,20 +223,12 @@ impl Robot {
             });
         }
 
-        let roots: Vec<&str> = links
-            .iter()
-            .map(|l| l.name.as_str())
-            .filter(|n| !joint_by_child.contains_key(*n))
-            .collect();
+        let roots: Vec<&str> =
+            links.iter().map(|l| l.name.as_str()).filter(|n| !joint_by_child.contains_key(*n)).collect();
         let root = match roots.as_slice() {
             [r] => r.to_string(),
             [] => return Err("robot: no root link (the joints form a cycle)".into()),
-            many => {
-                return Err(format!(
-                    "robot: {} root links {many:?}; a URDF must be one tree",
-                    many.len()
-                ))
-            }
+            many => return Err(format!("robot: {} root links {many:?}; a URDF must be one tree", many.len())),
         };
 
         // Breadth-first order from the root; any joint not reached is on a cycle.
@@ -294,25 +246,11 @@ impl Robot {
         }
         if order.len() != joints.len() {
             let bad = (0..joints.len()).find(|i| !order.contains(i)).unwrap();
-            return Err(format!(
-                "joint \"{}\": not reachable from root \"{root}\" (cycle)",
-                joints[bad].name
-            ));
+            return Err(format!("joint \"{}\": not reachable from root \"{root}\" (cycle)", joints[bad].name));
         }
         let joints: Vec<Joint> = order.into_iter().map(|i| joints[i].clone()).collect();
-        let joint_by_child = joints
-            .iter()
-            .enumerate()
-            .map(|(i, j)| (j.child.clone(), i))
-            .collect();
-        Ok(Robot {
-            name: urdf.name.clone(),
-            root,
-            links,
-            joints,
-            link_index,
-            joint_by_child,
-        })
+        let joint_by_child = joints.iter().enumerate().map(|(i, j)| (j.child.clone(), i)).collect();
+        Ok(Robot { name: urdf.name.clone(), root, links, joints, link_index, joint_by_child })
     }
 
     pub fn links(&self) -> &[Link] {
@@ -360,19 +298,10 @@ impl Robot {
     pub fn fk_slice(&self, q: &[f64]) -> Result<BTreeMap<String, Pose>, String> {
         let n = self.movable_joints().count();
         if q.len() != n {
-            return Err(format!(
-                "fk_slice: {} values for {n} movable joints",
-                q.len()
-            ));
+            return Err(format!("fk_slice: {} values for {n} movable joints", q.len()));
         }
         let mut it = q.iter();
-        Ok(self.fk_with(|j| {
-            if j.kind.is_movable() {
-                *it.next().unwrap()
-            } else {
-                0.0
-            }
-        }))
+        Ok(self.fk_with(|j| if j.kind.is_movable() { *it.next().unwrap() } else { 0.0 }))
     }
 
     fn fk_with(&self, mut q: impl FnMut(&Joint) -> f64) -> BTreeMap<String, Pose> {
@@ -411,18 +340,11 @@ impl Robot {
     pub fn chain_fk(chain: &[Joint], q: &[f64]) -> Result<Pose, String> {
         let n = chain.iter().filter(|j| j.kind.is_movable()).count();
         if q.len() != n {
-            return Err(format!(
-                "chain_fk: {} values for {n} movable joints",
-                q.len()
-            ));
+            return Err(format!("chain_fk: {} values for {n} movable joints", q.len()));
         }
         let mut it = q.iter();
         Ok(chain.iter().fold(Pose::IDENTITY, |acc, j| {
-            let qj = if j.kind.is_movable() {
-                *it.next().unwrap()
-            } else {
-                0.0
-            };
+            let qj = if j.kind.is_movable() { *it.next().unwrap() } else { 0.0 };
             acc.mul(&j.transform(qj))
         }))
     }

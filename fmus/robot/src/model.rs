@@ -172,7 +172,12 @@ impl RobotModel {
         let mut fk_joints = Vec::with_capacity(robot.joints().len());
         for j in robot.joints() {
             let source = source_of(&j.name, j.kind);
-            fk_joints.push(FkJoint { parent: index[j.parent.as_str()], child: index[j.child.as_str()], joint: j.clone(), source });
+            fk_joints.push(FkJoint {
+                parent: index[j.parent.as_str()],
+                child: index[j.child.as_str()],
+                joint: j.clone(),
+                source,
+            });
         }
         let box_interior = box_interior(&robot)?;
         for side in Side::BOTH {
@@ -220,7 +225,9 @@ fn source_of(name: &str, kind: JointKind) -> Source {
     }
     for side in Side::BOTH {
         let Some(rest) = name.strip_prefix(side.prefix()) else { continue };
-        if let Some(i) = rest.strip_prefix("_joint").and_then(|n| n.parse::<usize>().ok()).filter(|i| (1..=7).contains(i)) {
+        if let Some(i) =
+            rest.strip_prefix("_joint").and_then(|n| n.parse::<usize>().ok()).filter(|i| (1..=7).contains(i))
+        {
             return Source::Arm(side, i - 1);
         }
         if rest.starts_with("_finger_joint") {
@@ -239,7 +246,8 @@ fn finger_pads(robot: &Robot, side: Side) -> Result<FingerPads, String> {
     if joint.parent != hand || joint.kind != JointKind::Prismatic {
         return Err(format!("robot URDF: {p}_finger_joint1 must be a prismatic joint on {hand}"));
     }
-    let axis_ok = (joint.axis[1] - 1.0).abs() < 1e-9 && joint.origin.max_abs_diff(&RPose::from_translation(joint.origin.trans)) < 1e-9;
+    let axis_ok = (joint.axis[1] - 1.0).abs() < 1e-9
+        && joint.origin.max_abs_diff(&RPose::from_translation(joint.origin.trans)) < 1e-9;
     let [c] = robot.colliders(&joint.child).unwrap_or(&[]) else {
         return Err(format!("robot URDF: {} needs exactly one collision box (the pad)", joint.child));
     };

@@ -10,10 +10,7 @@ pub struct Pose {
 }
 
 impl Pose {
-    pub const IDENTITY: Pose = Pose {
-        rot: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
-        trans: [0.0; 3],
-    };
+    pub const IDENTITY: Pose = Pose { rot: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], trans: [0.0; 3] };
 
     /// URDF `<origin xyz rpy>`: R = Rz(yaw) Ry(pitch) Rx(roll) (fixed axes x, y, z).
     pub fn from_xyz_rpy(xyz: [f64; 3], rpy: [f64; 3]) -> Pose {
@@ -46,10 +43,7 @@ impl Pose {
     }
 
     pub fn from_translation(t: [f64; 3]) -> Pose {
-        Pose {
-            trans: t,
-            ..Pose::IDENTITY
-        }
+        Pose { trans: t, ..Pose::IDENTITY }
     }
 
     /// `self * other`: `other` expressed in `self`'s parent frame.
@@ -60,10 +54,7 @@ impl Pose {
                 *v = (0..3).map(|k| self.rot[i][k] * other.rot[k][j]).sum();
             }
         }
-        Pose {
-            rot,
-            trans: self.transform_point(other.trans),
-        }
+        Pose { rot, trans: self.transform_point(other.trans) }
     }
 
     pub fn rotate(&self, v: [f64; 3]) -> [f64; 3] {
@@ -73,29 +64,14 @@ impl Pose {
 
     pub fn transform_point(&self, p: [f64; 3]) -> [f64; 3] {
         let r = self.rotate(p);
-        [
-            r[0] + self.trans[0],
-            r[1] + self.trans[1],
-            r[2] + self.trans[2],
-        ]
+        [r[0] + self.trans[0], r[1] + self.trans[1], r[2] + self.trans[2]]
     }
 
     pub fn inverse(&self) -> Pose {
         let r = &self.rot;
-        let rt = [
-            [r[0][0], r[1][0], r[2][0]],
-            [r[0][1], r[1][1], r[2][1]],
-            [r[0][2], r[1][2], r[2][2]],
-        ];
-        let t = Pose {
-            rot: rt,
-            trans: [0.0; 3],
-        }
-        .rotate(self.trans);
-        Pose {
-            rot: rt,
-            trans: [-t[0], -t[1], -t[2]],
-        }
+        let rt = [[r[0][0], r[1][0], r[2][0]], [r[0][1], r[1][1], r[2][1]], [r[0][2], r[1][2], r[2][2]]];
+        let t = Pose { rot: rt, trans: [0.0; 3] }.rotate(self.trans);
+        Pose { rot: rt, trans: [-t[0], -t[1], -t[2]] }
     }
 
     /// Column `i` of the rotation: the child's axis `i` in the parent frame.

@@ -19,10 +19,7 @@ fn bad_file_errors_carry_the_path_and_element() {
         r#"{HEAD}<link name="a"/><joint name="j" type="fixed"><parent link="a"/><child link="ghost"/></joint></robot>"#
     )).unwrap();
     let e = Robot::from_urdf_file(&p).unwrap_err();
-    assert!(
-        e.contains("bad.urdf") && e.contains("joint \"j\"") && e.contains("ghost"),
-        "{e}"
-    );
+    assert!(e.contains("bad.urdf") && e.contains("joint \"j\"") && e.contains("ghost"), "{e}");
     std::fs::write(&p, "<robot name=").unwrap();
     let e = Robot::from_urdf_file(&p).unwrap_err();
     assert!(e.contains("bad.urdf"), "{e}");
@@ -41,23 +38,17 @@ fn mesh_collisions_are_refused() {
 #[test]
 fn tree_shape_is_checked() {
     let two_roots = format!(r#"{HEAD}<link name="a"/><link name="b"/></robot>"#);
-    assert!(Robot::from_urdf_str(&two_roots)
-        .unwrap_err()
-        .contains("root"));
+    assert!(Robot::from_urdf_str(&two_roots).unwrap_err().contains("root"));
     let two_parents = format!(
         r#"{HEAD}<link name="a"/><link name="b"/><link name="c"/>
         <joint name="j1" type="fixed"><parent link="a"/><child link="c"/></joint>
         <joint name="j2" type="fixed"><parent link="b"/><child link="c"/></joint></robot>"#
     );
-    assert!(Robot::from_urdf_str(&two_parents)
-        .unwrap_err()
-        .contains("j2"));
+    assert!(Robot::from_urdf_str(&two_parents).unwrap_err().contains("j2"));
     let floating = format!(
         r#"{HEAD}<link name="a"/><link name="b"/><joint name="f" type="floating"><parent link="a"/><child link="b"/></joint></robot>"#
     );
-    assert!(Robot::from_urdf_str(&floating)
-        .unwrap_err()
-        .contains("joint \"f\""));
+    assert!(Robot::from_urdf_str(&floating).unwrap_err().contains("joint \"f\""));
 }
 
 #[test]

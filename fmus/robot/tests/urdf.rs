@@ -16,18 +16,12 @@ fn robot() -> Robot {
 }
 
 const SIDES: [&str; 2] = ["left", "right"];
-const WHEELS: [(&str, f64, f64); 4] = [
-    ("front_left", 1.0, 1.0),
-    ("front_right", 1.0, -1.0),
-    ("rear_left", -1.0, 1.0),
-    ("rear_right", -1.0, -1.0),
-];
+const WHEELS: [(&str, f64, f64); 4] =
+    [("front_left", 1.0, 1.0), ("front_right", 1.0, -1.0), ("rear_left", -1.0, 1.0), ("rear_right", -1.0, -1.0)];
 
 // Franka Emika, FCI documentation "Robot and interface specifications": joint position,
 // velocity and torque limits of the Panda.
-const Q_MIN: [f64; 7] = [
-    -2.8973, -1.7628, -2.8973, -3.0718, -2.8973, -0.0175, -2.8973,
-];
+const Q_MIN: [f64; 7] = [-2.8973, -1.7628, -2.8973, -3.0718, -2.8973, -0.0175, -2.8973];
 const Q_MAX: [f64; 7] = [2.8973, 1.7628, 2.8973, -0.0698, 2.8973, 3.7525, 2.8973];
 const DQ_MAX: [f64; 7] = [2.1750, 2.1750, 2.1750, 2.1750, 2.6100, 2.6100, 2.6100];
 const TAU_MAX: [f64; 7] = [87.0, 87.0, 87.0, 87.0, 12.0, 12.0, 12.0];
@@ -61,12 +55,7 @@ fn m4_mul(a: &M4, b: &M4) -> M4 {
 fn dh(a: f64, d: f64, alpha: f64, theta: f64) -> M4 {
     let (st, ct) = theta.sin_cos();
     let (sa, ca) = alpha.sin_cos();
-    [
-        [ct, -st, 0.0, a],
-        [st * ca, ct * ca, -sa, -d * sa],
-        [st * sa, ct * sa, ca, d * ca],
-        [0.0, 0.0, 0.0, 1.0],
-    ]
+    [[ct, -st, 0.0, a], [st * ca, ct * ca, -sa, -d * sa], [st * sa, ct * sa, ca, d * ca], [0.0, 0.0, 0.0, 1.0]]
 }
 
 /// Flange (link8) in link0 by the DH product.
@@ -90,36 +79,18 @@ fn to_m4(p: &Pose) -> M4 {
 }
 
 fn max_diff(a: &M4, b: &M4) -> f64 {
-    (0..4)
-        .flat_map(|i| (0..4).map(move |j| (i, j)))
-        .map(|(i, j)| (a[i][j] - b[i][j]).abs())
-        .fold(0.0, f64::max)
+    (0..4).flat_map(|i| (0..4).map(move |j| (i, j))).map(|(i, j)| (a[i][j] - b[i][j]).abs()).fold(0.0, f64::max)
 }
 
 /// Deterministic configurations inside the Franka limits (plus the zero pose and the
 /// manual's "ready" pose), so failures are reproducible.
 fn test_configs() -> Vec<[f64; 7]> {
-    let mut out = vec![
-        [0.0; 7],
-        [
-            0.0,
-            -PI / 4.0,
-            0.0,
-            -3.0 * PI / 4.0,
-            0.0,
-            PI / 2.0,
-            PI / 4.0,
-        ],
-        Q_MIN,
-        Q_MAX,
-    ];
+    let mut out = vec![[0.0; 7], [0.0, -PI / 4.0, 0.0, -3.0 * PI / 4.0, 0.0, PI / 2.0, PI / 4.0], Q_MIN, Q_MAX];
     let mut s: u64 = 0x2545_F491_4F6C_DD1D;
     for _ in 0..20 {
         let mut q = [0.0; 7];
         for i in 0..7 {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             let u = (s >> 11) as f64 / (1u64 << 53) as f64;
             q[i] = Q_MIN[i] + u * (Q_MAX[i] - Q_MIN[i]);
         }
@@ -139,31 +110,14 @@ fn parses_with_urdf_rs() {
 fn joint_counts_and_kinds() {
     let r = robot();
     assert_eq!(r.root, "base_link");
-    let count = |f: &dyn Fn(&str) -> bool, k: JointKind| {
-        r.joints()
-            .iter()
-            .filter(|j| f(&j.name) && j.kind == k)
-            .count()
-    };
-    assert_eq!(
-        count(&|n| n.ends_with("_steer_joint"), JointKind::Revolute),
-        4
-    );
-    assert_eq!(
-        count(&|n| n.ends_with("_drive_joint"), JointKind::Continuous),
-        4
-    );
+    let count =
+        |f: &dyn Fn(&str) -> bool, k: JointKind| r.joints().iter().filter(|j| f(&j.name) && j.kind == k).count();
+    assert_eq!(count(&|n| n.ends_with("_steer_joint"), JointKind::Revolute), 4);
+    assert_eq!(count(&|n| n.ends_with("_drive_joint"), JointKind::Continuous), 4);
     assert_eq!(count(&|n| n == "lift_joint", JointKind::Prismatic), 1);
-    let arm = |n: &str| {
-        SIDES
-            .iter()
-            .any(|s| (1..=7).any(|i| n == format!("{s}_joint{i}")))
-    };
+    let arm = |n: &str| SIDES.iter().any(|s| (1..=7).any(|i| n == format!("{s}_joint{i}")));
     assert_eq!(count(&arm, JointKind::Revolute), 14);
-    assert_eq!(
-        count(&|n| n.contains("_finger_joint"), JointKind::Prismatic),
-        4
-    );
+    assert_eq!(count(&|n| n.contains("_finger_joint"), JointKind::Prismatic), 4);
     // Nothing else moves.
     assert_eq!(r.movable_joints().count(), 8 + 1 + 14 + 4);
 }
@@ -193,49 +147,29 @@ fn base_wheels_lift_and_sensor_mounts_match_the_fmus() {
     assert_eq!((l.lower, l.upper, l.velocity), (0.0, 0.8, 0.2));
     assert_eq!(lift.axis, [0.0, 0.0, 1.0]);
     let z0 = fk["lift_link"].trans[2];
-    let up = r
-        .fk(&BTreeMap::from([("lift_joint".to_string(), 0.8)]))
-        .unwrap();
+    let up = r.fk(&BTreeMap::from([("lift_joint".to_string(), 0.8)])).unwrap();
     assert!((up["lift_link"].trans[2] - z0 - 0.8).abs() < 1e-12);
-    assert!(
-        (up["left_hand"].trans[2] - fk["left_hand"].trans[2] - 0.8).abs() < 1e-12,
-        "arms ride the lift"
-    );
+    assert!((up["left_hand"].trans[2] - fk["left_hand"].trans[2] - 0.8).abs() < 1e-12, "arms ride the lift");
     // lift lib.rs base_height: carried mass centre 0.45 m above the floor at 0.
     assert!((z0 - 0.45).abs() < 1e-12);
 
     for f in ["lidar_link", "imu_link"] {
         assert!(dist(fk[f].trans, [0.0, 0.0, 1.0]) < 1e-12, "{f}");
-        assert!(
-            fk[f].max_abs_diff(&Pose::from_translation([0.0, 0.0, 1.0])) < 1e-12,
-            "{f} unrotated"
-        );
+        assert!(fk[f].max_abs_diff(&Pose::from_translation([0.0, 0.0, 1.0])) < 1e-12, "{f} unrotated");
     }
 }
 
 #[test]
 fn camera_optical_frame_convention() {
     let r = robot();
-    for q in [
-        BTreeMap::new(),
-        BTreeMap::from([("lift_joint".to_string(), 0.3)]),
-    ] {
+    for q in [BTreeMap::new(), BTreeMap::from([("lift_joint".to_string(), 0.3)])] {
         let fk = r.fk(&q).unwrap();
         let cam = fk["camera_link"];
         let opt = fk["camera_color_optical_frame"];
         let neg = |v: [f64; 3]| v.map(|x| -x);
-        assert!(
-            dist(opt.axis(2), cam.axis(0)) < 1e-12,
-            "z_optical = x_camera (forward)"
-        );
-        assert!(
-            dist(opt.axis(0), neg(cam.axis(1))) < 1e-12,
-            "x_optical = -y_camera (right)"
-        );
-        assert!(
-            dist(opt.axis(1), neg(cam.axis(2))) < 1e-12,
-            "y_optical = -z_camera (down)"
-        );
+        assert!(dist(opt.axis(2), cam.axis(0)) < 1e-12, "z_optical = x_camera (forward)");
+        assert!(dist(opt.axis(0), neg(cam.axis(1))) < 1e-12, "x_optical = -y_camera (right)");
+        assert!(dist(opt.axis(1), neg(cam.axis(2))) < 1e-12, "y_optical = -z_camera (down)");
         assert!(dist(opt.trans, cam.trans) < 1e-12);
     }
 }
@@ -270,15 +204,9 @@ fn harvest_box_is_an_open_box_with_a_frame_inside_at_the_bottom() {
 #[test]
 fn frames_present_and_moving_links_have_mass() {
     let r = robot();
-    for f in [
-        "base_link",
-        "camera_link",
-        "camera_color_optical_frame",
-        "lidar_link",
-        "imu_link",
-        "harvest_box",
-        "lift_link",
-    ] {
+    for f in
+        ["base_link", "camera_link", "camera_color_optical_frame", "lidar_link", "imu_link", "harvest_box", "lift_link"]
+    {
         assert!(r.link(f).is_some(), "{f} missing");
     }
     for s in SIDES {
@@ -295,18 +223,10 @@ fn frames_present_and_moving_links_have_mass() {
     }
     for l in &u.links {
         if !l.collision.is_empty() {
-            assert!(
-                l.inertial.mass.value > 0.0,
-                "{} has geometry but no mass",
-                l.name
-            );
+            assert!(l.inertial.mass.value > 0.0, "{} has geometry but no mass", l.name);
             let i = &l.inertial.inertia;
             let (a, b, c) = (i.ixx, i.iyy, i.izz);
-            assert!(
-                a > 0.0 && b > 0.0 && c > 0.0 && a + b >= c && b + c >= a && a + c >= b,
-                "{}: inertia",
-                l.name
-            );
+            assert!(a > 0.0 && b > 0.0 && c > 0.0 && a + b >= c && b + c >= a && a + c >= b, "{}: inertia", l.name);
             assert!(!l.visual.is_empty(), "{}: visual geometry", l.name);
         }
     }
@@ -328,11 +248,7 @@ fn panda_limits_equal_franka_figures() {
             assert_eq!(j.axis, [0.0, 0.0, 1.0]);
         }
         for k in 1..=2 {
-            let l = r
-                .joint(&format!("{s}_finger_joint{k}"))
-                .unwrap()
-                .limits
-                .unwrap();
+            let l = r.joint(&format!("{s}_finger_joint{k}")).unwrap().limits.unwrap();
             assert_eq!((l.lower, l.upper), (0.0, 0.04));
         }
     }
@@ -342,14 +258,8 @@ fn panda_limits_equal_franka_figures() {
 fn panda_fk_matches_the_dh_product() {
     let r = robot();
     for s in SIDES {
-        let chain = r
-            .chain(&format!("{s}_link0"), &format!("{s}_link8"))
-            .unwrap();
-        let names: Vec<&str> = chain
-            .iter()
-            .filter(|j| j.kind.is_movable())
-            .map(|j| j.name.as_str())
-            .collect();
+        let chain = r.chain(&format!("{s}_link0"), &format!("{s}_link8")).unwrap();
+        let names: Vec<&str> = chain.iter().filter(|j| j.kind.is_movable()).map(|j| j.name.as_str()).collect();
         let expect: Vec<String> = (1..=7).map(|i| format!("{s}_joint{i}")).collect();
         assert_eq!(names, expect);
         for q in test_configs() {
@@ -364,10 +274,7 @@ fn panda_fk_matches_the_dh_product() {
             let qm: BTreeMap<String, f64> = expect.iter().cloned().zip(q).collect();
             let fk = r.fk(&qm).unwrap();
             let via_dh = m4_mul(&to_m4(&fk[&format!("{s}_link0")]), &want);
-            assert!(
-                max_diff(&to_m4(&fk[&format!("{s}_link8")]), &via_dh) < 1e-9,
-                "{s} {q:?}: fk"
-            );
+            assert!(max_diff(&to_m4(&fk[&format!("{s}_link8")]), &via_dh) < 1e-9, "{s} {q:?}: fk");
         }
     }
     // Zero pose, spelled out: flange at (0.088, 0, 0.333 + 0.316 + 0.384 - 0.107), pointing down.
@@ -391,10 +298,7 @@ fn arm_chains_from_the_lift() {
         let rel = fk["lift_link"].inverse().mul(&fk[&format!("{s}_hand")]);
         assert!(rel.max_abs_diff(&Robot::chain_fk(&chain, &q).unwrap()) < 1e-12);
     }
-    assert!(r
-        .chain("left_hand", "lift_link")
-        .unwrap_err()
-        .contains("not an ancestor"));
+    assert!(r.chain("left_hand", "lift_link").unwrap_err().contains("not an ancestor"));
     assert!(r.chain("lift_link", "nope").unwrap_err().contains("nope"));
     // The arms sit left (+y) and right (-y) of the carriage.
     let fk = r.fk(&BTreeMap::new()).unwrap();
@@ -404,14 +308,8 @@ fn arm_chains_from_the_lift() {
 #[test]
 fn fk_inputs_are_checked() {
     let r = robot();
-    assert!(r
-        .fk(&BTreeMap::from([("left_joint9".to_string(), 0.0)]))
-        .unwrap_err()
-        .contains("left_joint9"));
-    assert!(r
-        .fk(&BTreeMap::from([("lidar_joint".to_string(), 0.0)]))
-        .unwrap_err()
-        .contains("fixed"));
+    assert!(r.fk(&BTreeMap::from([("left_joint9".to_string(), 0.0)])).unwrap_err().contains("left_joint9"));
+    assert!(r.fk(&BTreeMap::from([("lidar_joint".to_string(), 0.0)])).unwrap_err().contains("fixed"));
     assert!(r.fk_slice(&[0.0; 3]).is_err());
     let n = r.movable_joints().count();
     let a = r.fk_slice(&vec![0.0; n]).unwrap();
@@ -426,19 +324,9 @@ fn check_urdf_accepts_the_file() {
     let out = std::process::Command::new("check_urdf").arg(urdf_path()).output().unwrap_or_else(|e| {
         panic!("cannot run check_urdf ({e}): install Debian's liburdfdom-tools (scripts/setup does)")
     });
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(
-        out.status.success(),
-        "check_urdf rejected the URDF:\n{text}"
-    );
-    assert!(
-        text.contains("Successfully Parsed XML") && text.contains("root Link: base_link"),
-        "{text}"
-    );
+    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success(), "check_urdf rejected the URDF:\n{text}");
+    assert!(text.contains("Successfully Parsed XML") && text.contains("root Link: base_link"), "{text}");
 }
 
 fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -458,8 +346,5 @@ fn urdf_is_up_to_date_with_its_generator() {
     assert!(st.success());
     let fresh = std::fs::read_to_string(&tmp).unwrap();
     std::fs::remove_file(&tmp).ok();
-    assert!(
-        fresh == std::fs::read_to_string(urdf_path()).unwrap(),
-        "re-run models/robot/generate_urdf.py"
-    );
+    assert!(fresh == std::fs::read_to_string(urdf_path()).unwrap(), "re-run models/robot/generate_urdf.py");
 }

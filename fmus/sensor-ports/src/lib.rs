@@ -12,8 +12,8 @@
 pub mod robot;
 
 use agrisim_fmi::{checked_f64, Start, Store, Var};
-use agrisim_robot::model::Coords;
 use agrisim_greenhouse::cast_scene::{load_cached, CastScene};
+use agrisim_robot::model::Coords;
 use std::sync::Arc;
 
 #[doc(hidden)]
@@ -105,10 +105,15 @@ pub const fn mount_param(name: &'static str, start: f64, unit: &'static str) -> 
 
 /// The robot's own base box, a moving obstacle for the rays (as the world FMU has it).
 pub const BASE_BOX: [Var; 4] = [
-    Var::param("base_length", Start::Float64(1.2)).unit("m").range(0.01, 20.0).desc("Robot base box extent along base_link x"),
+    Var::param("base_length", Start::Float64(1.2))
+        .unit("m")
+        .range(0.01, 20.0)
+        .desc("Robot base box extent along base_link x"),
     Var::param("base_width", Start::Float64(0.9)).unit("m").range(0.01, 20.0),
     Var::param("base_height", Start::Float64(0.6)).unit("m").range(0.01, 20.0),
-    Var::param("base_clearance", Start::Float64(0.05)).unit("m").range(0.0, 5.0)
+    Var::param("base_clearance", Start::Float64(0.05))
+        .unit("m")
+        .range(0.0, 5.0)
         .desc("Height of the box bottom above the floor (base_link is on the floor)"),
 ];
 
@@ -226,14 +231,48 @@ mod tests {
         assert_eq!(
             names,
             [
-                "scene", "scene_seed", "own", "mount_x", "mount_y", "mount_z", "mount_roll", "mount_pitch", "mount_yaw", "base_length",
-                "base_width", "base_height", "base_clearance", "base_x", "base_y", "base_yaw", "out", "robot_links", "lift_position",
-                "left_q1", "left_q2", "left_q3", "left_q4", "left_q5", "left_q6", "left_q7", "left_finger_width", "right_q1", "right_q2",
-                "right_q3", "right_q4", "right_q5", "right_q6", "right_q7", "right_finger_width"
+                "scene",
+                "scene_seed",
+                "own",
+                "mount_x",
+                "mount_y",
+                "mount_z",
+                "mount_roll",
+                "mount_pitch",
+                "mount_yaw",
+                "base_length",
+                "base_width",
+                "base_height",
+                "base_clearance",
+                "base_x",
+                "base_y",
+                "base_yaw",
+                "out",
+                "robot_links",
+                "lift_position",
+                "left_q1",
+                "left_q2",
+                "left_q3",
+                "left_q4",
+                "left_q5",
+                "left_q6",
+                "left_q7",
+                "left_finger_width",
+                "right_q1",
+                "right_q2",
+                "right_q3",
+                "right_q4",
+                "right_q5",
+                "right_q6",
+                "right_q7",
+                "right_finger_width"
             ]
         );
         assert_eq!((OWN, OUT, SENSOR_PORTS.base_pose), (2, 16, [13, 14, 15]));
-        assert_eq!((SENSOR_PORTS.robot_links, SENSOR_PORTS.lift, SENSOR_PORTS.arms[1][6], SENSOR_PORTS.widths), (17, 18, 33, [26, 34]));
+        assert_eq!(
+            (SENSOR_PORTS.robot_links, SENSOR_PORTS.lift, SENSOR_PORTS.arms[1][6], SENSOR_PORTS.widths),
+            (17, 18, 33, [26, 34])
+        );
         assert_eq!(SENSOR_PORTS.link, "test_link");
         assert_eq!(VARIABLES[MOUNT_X].description, "test_link position on base_link");
     }

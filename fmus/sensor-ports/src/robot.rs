@@ -84,7 +84,9 @@ impl RobotBody {
     pub fn new(first_id: u32, dims: [f64; 4], own_link: &str) -> Result<RobotBody, String> {
         let model = model()?;
         let links = (model.robot.links().iter().enumerate())
-            .filter(|(_, l)| !l.colliders.is_empty() && (l.name == "base_link" || !chassis_link(&l.name)) && l.name != own_link)
+            .filter(|(_, l)| {
+                !l.colliders.is_empty() && (l.name == "base_link" || !chassis_link(&l.name)) && l.name != own_link
+            })
             .map(|(i, _)| i)
             .collect();
         Ok(RobotBody { model, first_id, dims, links })
@@ -110,7 +112,9 @@ impl RobotBody {
                 };
                 match c.shape {
                     RShape::Box { size } => push(Shape::Box { half: size.map(|v| 0.5 * v) }, &pose),
-                    RShape::Cylinder { radius, length } => push(Shape::Cylinder { radius, half_height: 0.5 * length }, &pose),
+                    RShape::Cylinder { radius, length } => {
+                        push(Shape::Cylinder { radius, half_height: 0.5 * length }, &pose)
+                    }
                     RShape::Sphere { radius } => push(Shape::Sphere { radius }, &pose),
                     // A capsule is its cylinder and the two end spheres (an exact union).
                     RShape::Capsule { radius, length } => {

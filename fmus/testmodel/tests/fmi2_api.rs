@@ -7,14 +7,25 @@ use agrisim_fmu_testmodel::*;
 
 type Logs = Vec<String>;
 
-unsafe extern "C" fn capture(env: *mut c_void, _name: *const c_char, _s: Status, _cat: *const c_char, msg: *const c_char) {
+unsafe extern "C" fn capture(
+    env: *mut c_void,
+    _name: *const c_char,
+    _s: Status,
+    _cat: *const c_char,
+    msg: *const c_char,
+) {
     (*(env as *mut Logs)).push(CStr::from_ptr(msg).to_string_lossy().into_owned());
 }
 
 fn callbacks(logs: &mut Logs) -> fmi2::CallbackFunctions {
     fmi2::CallbackFunctions {
         // SAFETY: called without variadic arguments.
-        logger: Some(unsafe { std::mem::transmute::<unsafe extern "C" fn(*mut c_void, *const c_char, Status, *const c_char, *const c_char), agrisim_fmi::logger::Fmi2Logger>(capture) }),
+        logger: Some(unsafe {
+            std::mem::transmute::<
+                unsafe extern "C" fn(*mut c_void, *const c_char, Status, *const c_char, *const c_char),
+                agrisim_fmi::logger::Fmi2Logger,
+            >(capture)
+        }),
         allocate_memory: None,
         free_memory: None,
         step_finished: None,
@@ -32,7 +43,15 @@ fn legal_run_with_setup_experiment() {
     let cb = callbacks(&mut logs);
     let guid = CString::new(TestModel::GUID).unwrap();
     unsafe {
-        let c = fmi2::instantiate::<TestModel>(c"a".as_ptr(), fmi2::FMI2_CO_SIMULATION, guid.as_ptr(), std::ptr::null(), &cb, 0, 0);
+        let c = fmi2::instantiate::<TestModel>(
+            c"a".as_ptr(),
+            fmi2::FMI2_CO_SIMULATION,
+            guid.as_ptr(),
+            std::ptr::null(),
+            &cb,
+            0,
+            0,
+        );
         assert!(!c.is_null());
         assert_eq!(fmi2::setup_experiment::<TestModel>(c, 0, 0.0, 1.0, 1, 3.0), Status::Ok);
         assert_eq!(fmi2::enter_initialization_mode::<TestModel>(c), Status::Ok);
@@ -81,7 +100,9 @@ fn instantiate_checks_guid_and_type() {
     let guid = CString::new(TestModel::GUID).unwrap();
     unsafe {
         assert!(fmi2::instantiate::<TestModel>(c"a".as_ptr(), 0, guid.as_ptr(), std::ptr::null(), &cb, 0, 0).is_null());
-        assert!(fmi2::instantiate::<TestModel>(c"a".as_ptr(), 1, c"{x}".as_ptr(), std::ptr::null(), &cb, 0, 0).is_null());
+        assert!(
+            fmi2::instantiate::<TestModel>(c"a".as_ptr(), 1, c"{x}".as_ptr(), std::ptr::null(), &cb, 0, 0).is_null()
+        );
     }
     assert!(logs[0].contains("Co-Simulation") && logs[1].contains("fmuGUID"), "{logs:?}");
 }
@@ -91,7 +112,9 @@ fn percent_signs_are_escaped_for_printf_style_loggers() {
     let mut logs = Logs::new();
     let cb = callbacks(&mut logs);
     unsafe {
-        assert!(fmi2::instantiate::<TestModel>(c"a".as_ptr(), 1, c"100%s".as_ptr(), std::ptr::null(), &cb, 0, 0).is_null());
+        assert!(
+            fmi2::instantiate::<TestModel>(c"a".as_ptr(), 1, c"100%s".as_ptr(), std::ptr::null(), &cb, 0, 0).is_null()
+        );
     }
     assert!(logs[0].contains("100%%s"), "{logs:?}");
 }

@@ -57,18 +57,47 @@ fn errors_name_the_function_the_variable_and_the_reason() {
         (Box::new(|i| i.set_f64(0, 1.0)), &["fmi3SetFloat64", "'time'"]),
         (Box::new(|i| i.set_f64(999, 1.0)), &["fmi3SetFloat64", "unknown value reference 999"]),
         (Box::new(|i| i.set_i32(vr(X), 1)), &["fmi3SetInt32", "'x'", "Float64"]),
-        (Box::new(|i| unsafe {
-            let mut v = [0i64; 2];
-            fmi3::get_int64::<TestModel>(i.p, &vr(MSG_SEQ), 1, v.as_mut_ptr(), 2)
-        }), &["fmi3GetInt64", "nValues (2)"]),
-        (Box::new(|i| unsafe { fmi3::get_float64::<TestModel>(i.p, std::ptr::null(), 1, [0.0].as_mut_ptr(), 1) }), &["fmi3GetFloat64", "valueReferences is NULL"]),
-        (Box::new(|i| unsafe { fmi3::get_float32::<TestModel>(i.p, &vr(X), 1, [0.0f32].as_mut_ptr(), 1) }), &["fmi3GetFloat32", "'x'"]),
+        (
+            Box::new(|i| unsafe {
+                let mut v = [0i64; 2];
+                fmi3::get_int64::<TestModel>(i.p, &vr(MSG_SEQ), 1, v.as_mut_ptr(), 2)
+            }),
+            &["fmi3GetInt64", "nValues (2)"],
+        ),
+        (
+            Box::new(|i| unsafe { fmi3::get_float64::<TestModel>(i.p, std::ptr::null(), 1, [0.0].as_mut_ptr(), 1) }),
+            &["fmi3GetFloat64", "valueReferences is NULL"],
+        ),
+        (
+            Box::new(|i| unsafe { fmi3::get_float32::<TestModel>(i.p, &vr(X), 1, [0.0f32].as_mut_ptr(), 1) }),
+            &["fmi3GetFloat32", "'x'"],
+        ),
         (Box::new(|i| i.step(0.5, 0.02)), &["fmi3DoStep", "currentCommunicationPoint"]),
         (Box::new(|i| i.step(0.0, -0.02)), &["fmi3DoStep", "communicationStepSize"]),
         (Box::new(|i| i.step(0.0, f64::NAN)), &["fmi3DoStep", "communicationStepSize"]),
-        (Box::new(|i| unsafe { fmi3::do_step::<TestModel>(i.p, 0.0, 0.02, 0, std::ptr::null_mut(), std::ptr::null_mut(), std::ptr::null_mut(), std::ptr::null_mut()) }), &["fmi3DoStep", "NULL"]),
-        (Box::new(|i| unsafe { fmi3::unsupported::<TestModel>(i.p, "fmi3EnterEventMode") }), &["fmi3EnterEventMode", "event mode"]),
-        (Box::new(|i| unsafe { fmi3::set_fmu_state::<TestModel>(i.p, 0x1234 as *mut _) }), &["fmi3SetFMUState", "not a live FMU state"]),
+        (
+            Box::new(|i| unsafe {
+                fmi3::do_step::<TestModel>(
+                    i.p,
+                    0.0,
+                    0.02,
+                    0,
+                    std::ptr::null_mut(),
+                    std::ptr::null_mut(),
+                    std::ptr::null_mut(),
+                    std::ptr::null_mut(),
+                )
+            }),
+            &["fmi3DoStep", "NULL"],
+        ),
+        (
+            Box::new(|i| unsafe { fmi3::unsupported::<TestModel>(i.p, "fmi3EnterEventMode") }),
+            &["fmi3EnterEventMode", "event mode"],
+        ),
+        (
+            Box::new(|i| unsafe { fmi3::set_fmu_state::<TestModel>(i.p, 0x1234 as *mut _) }),
+            &["fmi3SetFMUState", "not a live FMU state"],
+        ),
     ];
     for (call, needles) in cases {
         let i = I3::stepping();
@@ -105,7 +134,10 @@ fn model_errors_and_panics_become_error_and_fmu_state_recovers() {
         assert_eq!(i.set_i32(vr(FAULT), fault), Status::Ok);
         assert_eq!(i.step(0.02, 0.02), Status::Error);
         let msg = i.last_error();
-        assert!(msg.contains("fmi3DoStep") && msg.contains(if fault == 1 { "injected failure" } else { "panicked" }), "{msg}");
+        assert!(
+            msg.contains("fmi3DoStep") && msg.contains(if fault == 1 { "injected failure" } else { "panicked" }),
+            "{msg}"
+        );
         assert_eq!(i.f64(vr(X)).0, Status::Error, "no getters in Error");
     }
     // Restoring the state leaves Error and rewinds everything, including time and fault.
@@ -126,7 +158,10 @@ fn binary_echo_returns_fmu_owned_bytes_and_counts_messages() {
     assert_eq!(i.step(0.0, 0.02), Status::Ok);
     let (mut sizes, mut ptrs) = ([0usize; 2], [std::ptr::null::<u8>(); 2]);
     let vrs = [vr(MSG_OUT), vr(MSG_IN)];
-    assert_eq!(unsafe { fmi3::get_binary::<TestModel>(i.p, vrs.as_ptr(), 2, sizes.as_mut_ptr(), ptrs.as_mut_ptr(), 2) }, Status::Ok);
+    assert_eq!(
+        unsafe { fmi3::get_binary::<TestModel>(i.p, vrs.as_ptr(), 2, sizes.as_mut_ptr(), ptrs.as_mut_ptr(), 2) },
+        Status::Ok
+    );
     for k in 0..2 {
         assert_eq!(unsafe { std::slice::from_raw_parts(ptrs[k], sizes[k]) }, &msg);
     }
@@ -136,7 +171,10 @@ fn binary_echo_returns_fmu_owned_bytes_and_counts_messages() {
     // An empty binary is returned as size 0 with a non-NULL pointer.
     let empty: *const u8 = std::ptr::null();
     assert_eq!(unsafe { fmi3::set_binary::<TestModel>(i.p, &vr(MSG_IN), 1, &0, &empty, 1) }, Status::Ok);
-    assert_eq!(unsafe { fmi3::get_binary::<TestModel>(i.p, &vr(MSG_IN), 1, sizes.as_mut_ptr(), ptrs.as_mut_ptr(), 1) }, Status::Ok);
+    assert_eq!(
+        unsafe { fmi3::get_binary::<TestModel>(i.p, &vr(MSG_IN), 1, sizes.as_mut_ptr(), ptrs.as_mut_ptr(), 1) },
+        Status::Ok
+    );
     assert!(sizes[0] == 0 && !ptrs[0].is_null());
 }
 
@@ -159,7 +197,18 @@ fn instantiation_checks_token_event_mode_and_accepts_null_resource_path() {
     let good = CString::new(TestModel::TOKEN).unwrap();
     let inst = |token: &CStr, event_mode: u8| unsafe {
         fmi3::instantiate_co_simulation::<TestModel>(
-            c"x".as_ptr(), token.as_ptr(), std::ptr::null(), 0, 0, event_mode, 0, std::ptr::null(), 0, env, Some(capture), None,
+            c"x".as_ptr(),
+            token.as_ptr(),
+            std::ptr::null(),
+            0,
+            0,
+            event_mode,
+            0,
+            std::ptr::null(),
+            0,
+            env,
+            Some(capture),
+            None,
         )
     };
     assert!(inst(c"{other}", 0).is_null());
@@ -168,7 +217,18 @@ fn instantiation_checks_token_event_mode_and_accepts_null_resource_path() {
     assert!(!p.is_null());
     unsafe { fmi3::free_instance::<TestModel>(p) };
     assert!(logs[0].1.contains("instantiationToken") && logs[1].1.contains("eventModeUsed"), "{logs:?}");
-    assert!(unsafe { fmi3::instantiate_model_exchange::<TestModel>(c"x".as_ptr(), good.as_ptr(), std::ptr::null(), 0, 0, env, Some(capture)) }.is_null());
+    assert!(unsafe {
+        fmi3::instantiate_model_exchange::<TestModel>(
+            c"x".as_ptr(),
+            good.as_ptr(),
+            std::ptr::null(),
+            0,
+            0,
+            env,
+            Some(capture),
+        )
+    }
+    .is_null());
     assert!(logs.last().unwrap().1.contains("Co-Simulation only"));
 }
 
@@ -181,10 +241,14 @@ fn invalid_handles_are_errors_not_crashes() {
         // An FMI 2 handle is not an FMI 3 instance.
         let guid = CString::new(TestModel::GUID).unwrap();
         let cb = agrisim_fmi::fmi2::CallbackFunctions {
-            logger: None, allocate_memory: None, free_memory: None, step_finished: None,
+            logger: None,
+            allocate_memory: None,
+            free_memory: None,
+            step_finished: None,
             component_environment: std::ptr::null_mut(),
         };
-        let c = agrisim_fmi::fmi2::instantiate::<TestModel>(c"x".as_ptr(), 1, guid.as_ptr(), std::ptr::null(), &cb, 0, 0);
+        let c =
+            agrisim_fmi::fmi2::instantiate::<TestModel>(c"x".as_ptr(), 1, guid.as_ptr(), std::ptr::null(), &cb, 0, 0);
         assert!(!c.is_null());
         assert_eq!(fmi3::terminate::<TestModel>(c), Status::Error);
         agrisim_fmi::fmi2::free_instance::<TestModel>(c);
@@ -207,7 +271,8 @@ fn exported_symbols_serve_the_same_xml() {
 #[test]
 fn binary_input_above_its_max_size_is_refused_before_it_is_read() {
     let i = I3::stepping();
-    let set = |bytes: &[u8]| unsafe { fmi3::set_binary::<TestModel>(i.p, &vr(MSG_IN), 1, &bytes.len(), &bytes.as_ptr(), 1) };
+    let set =
+        |bytes: &[u8]| unsafe { fmi3::set_binary::<TestModel>(i.p, &vr(MSG_IN), 1, &bytes.len(), &bytes.as_ptr(), 1) };
     let mut bytes = vec![0u8; MAX_MESSAGE];
     bytes[..9].copy_from_slice(EMPTY_STRING_CDR);
     assert_eq!(set(&bytes), Status::Ok, "maxSize bytes are fine");

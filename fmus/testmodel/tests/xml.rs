@@ -44,10 +44,20 @@ fn fmi2_description_hides_fmi3_only_variables_and_indexes_by_position() {
     assert_ne!(TestModel::GUID, TestModel::TOKEN, "the FMI 2 interface is another interface");
     assert!(!x.contains("msg_in") && !x.contains("msg_seq") && !x.contains("msg_out") && !x.contains("maxSize"));
     // time, k, x0, u, hold, label, fault, x, steps, above_half -> x is position 8, x0 position 3
-    assert!(x.contains(r#"<Outputs>
-      <Unknown index="8" dependencies=""/>"#), "{x}");
-    assert!(x.contains(r#"<InitialUnknowns>
-      <Unknown index="8" dependencies="3"/>"#), "{x}");
+    assert!(
+        x.contains(
+            r#"<Outputs>
+      <Unknown index="8" dependencies=""/>"#
+        ),
+        "{x}"
+    );
+    assert!(
+        x.contains(
+            r#"<InitialUnknowns>
+      <Unknown index="8" dependencies="3"/>"#
+        ),
+        "{x}"
+    );
     assert_eq!(x.matches("<ScalarVariable").count(), 10);
     assert!(x.contains(r#"<String start="agrisim &quot;test&quot; &lt;model&gt; &amp; more"/>"#));
 }
@@ -100,9 +110,15 @@ fn tokens_are_hashes_of_the_interface() {
     let t = TestModel::TOKEN;
     assert_eq!(t.len(), 38);
     assert!(t.starts_with('{') && t.ends_with('}') && t.matches('-').count() == 4, "{t}");
-    assert_eq!(t.as_bytes(), agrisim_fmi::token::guid(agrisim_fmi::token::hash("3.0", "TestModel", TestModel::VARIABLES)));
+    assert_eq!(
+        t.as_bytes(),
+        agrisim_fmi::token::guid(agrisim_fmi::token::hash("3.0", "TestModel", TestModel::VARIABLES))
+    );
     // Another start value is another interface.
     let mut vars = TestModel::VARIABLES.to_vec();
     vars[0] = Var::tunable("k", Start::Float64(2.0));
-    assert_ne!(agrisim_fmi::token::hash("3.0", "TestModel", &vars), agrisim_fmi::token::hash("3.0", "TestModel", TestModel::VARIABLES));
+    assert_ne!(
+        agrisim_fmi::token::hash("3.0", "TestModel", &vars),
+        agrisim_fmi::token::hash("3.0", "TestModel", TestModel::VARIABLES)
+    );
 }

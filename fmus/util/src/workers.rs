@@ -8,7 +8,11 @@ use std::sync::Mutex;
 
 /// Runs `work(index, item)` on every item of `items` on `threads` threads (the caller's
 /// among them); returns the sum of what it returns.
-pub fn on_threads<T: Send>(threads: usize, items: impl Iterator<Item = T> + Send, work: impl Fn(usize, T) -> usize + Sync) -> usize {
+pub fn on_threads<T: Send>(
+    threads: usize,
+    items: impl Iterator<Item = T> + Send,
+    work: impl Fn(usize, T) -> usize + Sync,
+) -> usize {
     let queue = Mutex::new(items.enumerate());
     let drain = || {
         let mut sum = 0;

@@ -100,7 +100,13 @@ fn measure(label: &str, scene: &str) {
 }
 
 /// Mean wall time per step [us] over `n` steps of `drive(k)` (inputs set per step).
-fn time_steps(m: &mut GreenhouseWorld, io: &mut Store, t0: f64, n: usize, mut drive: impl FnMut(&mut Store, usize)) -> f64 {
+fn time_steps(
+    m: &mut GreenhouseWorld,
+    io: &mut Store,
+    t0: f64,
+    n: usize,
+    mut drive: impl FnMut(&mut Store, usize),
+) -> f64 {
     let t = Instant::now();
     for k in 0..n {
         drive(io, k);
@@ -146,7 +152,13 @@ fn measure_arms() {
         [agrisim_robot::Pose::IDENTITY; 2],
     );
     let t = Instant::now();
-    let msg = agrisim_fmu_world::planning_scene::planning_scene(scene, &harvest_free, [io.f64(BASE_X), io.f64(BASE_Y)], 2.5, 0);
+    let msg = agrisim_fmu_world::planning_scene::planning_scene(
+        scene,
+        &harvest_free,
+        [io.f64(BASE_X), io.f64(BASE_Y)],
+        2.5,
+        0,
+    );
     let bytes = msg.to_cdr().len();
     let scene_ms = t.elapsed().as_secs_f64() * 1e3;
     println!(
@@ -170,7 +182,10 @@ fn measure_fall() -> f64 {
     let fruit = gh
         .objects
         .iter()
-        .find(|o| matches!(o.kind, agrisim_greenhouse::scene::Kind::Fruit { .. }) && o.placement.translation[2] > tcp0[2] + 0.1)
+        .find(|o| {
+            matches!(o.kind, agrisim_greenhouse::scene::Kind::Fruit { .. })
+                && o.placement.translation[2] > tcp0[2] + 0.1
+        })
         .unwrap();
     let p = fruit.placement.translation;
     let lift = p[2] - tcp0[2];

@@ -122,7 +122,13 @@ pub fn robot_contacts(world: &SceneWorld, harvest: &Harvest) -> Vec<RobotContact
     for &(f, fruit, ref fruit_aabb) in &carried {
         for &(object, other, ref aabb) in &candidates {
             if category_of(world.objects[object].kind) == Category::Structure && fruit_aabb.intersects(aabb) {
-                out.extend(contact(Toucher::Carried(f), fruit, Other::Object(object), other, Category::CarriedStructure));
+                out.extend(contact(
+                    Toucher::Carried(f),
+                    fruit,
+                    Other::Object(object),
+                    other,
+                    Category::CarriedStructure,
+                ));
             }
         }
     }
@@ -217,7 +223,14 @@ mod tests {
     use super::*;
 
     fn c(part: usize, object: usize, category: Category) -> RobotContact {
-        RobotContact { toucher: Toucher::Part(part), other: Other::Object(object), category, point: Vector::ZERO, normal: Vector::X, depth: 0.0 }
+        RobotContact {
+            toucher: Toucher::Part(part),
+            other: Other::Object(object),
+            category,
+            point: Vector::ZERO,
+            normal: Vector::X,
+            depth: 0.0,
+        }
     }
 
     #[test]
@@ -239,11 +252,21 @@ mod tests {
     #[test]
     fn categories_are_counted_apart() {
         let mut t = ContactTracker::default();
-        let arm = RobotContact { toucher: Toucher::Part(5), other: Other::Part(20), category: Category::ArmArm, point: Vector::ZERO, normal: Vector::X, depth: 0.0 };
+        let arm = RobotContact {
+            toucher: Toucher::Part(5),
+            other: Other::Part(20),
+            category: Category::ArmArm,
+            point: Vector::ZERO,
+            normal: Vector::X,
+            depth: 0.0,
+        };
         t.update(&[c(0, 1, Category::Plant), arm]);
         t.update(&[c(0, 1, Category::Plant), c(2, 9, Category::Structure)]);
         t.update(&[arm, RobotContact { other: Other::Part(21), ..arm }]);
-        assert_eq!([t.onsets_in(Category::Plant), t.onsets_in(Category::Structure), t.onsets_in(Category::ArmArm)], [1, 1, 3]);
+        assert_eq!(
+            [t.onsets_in(Category::Plant), t.onsets_in(Category::Structure), t.onsets_in(Category::ArmArm)],
+            [1, 1, 3]
+        );
     }
 
     #[test]

@@ -66,7 +66,10 @@ mod tests {
     fn cylinder_axis_is_the_objects_z() {
         let (shape, offset) = shape_of(&Shape::Cylinder { radius: 0.1, half_height: 1.0 }).unwrap();
         let aabb = shape.compute_aabb(&offset);
-        assert!((aabb.maxs.z - 1.0).abs() < 1e-6 && (aabb.maxs.x - 0.1).abs() < 1e-6 && (aabb.maxs.y - 0.1).abs() < 1e-6, "{aabb:?}");
+        assert!(
+            (aabb.maxs.z - 1.0).abs() < 1e-6 && (aabb.maxs.x - 0.1).abs() < 1e-6 && (aabb.maxs.y - 0.1).abs() < 1e-6,
+            "{aabb:?}"
+        );
     }
 
     #[test]

@@ -50,11 +50,18 @@ pub const FLOOR_EPS: f64 = 0.005;
 pub enum FruitState {
     OnPlant,
     /// Held by one or both grippers, following `leader`'s hand.
-    Held { leader: Side },
+    Held {
+        leader: Side,
+    },
     /// Released and under gravity; `rest` = time spent resting so far, `airborne` since release.
-    Falling { rest: f64, airborne: f64 },
+    Falling {
+        rest: f64,
+        airborne: f64,
+    },
     /// At rest inside the harvest box, at pose `in_box` in harvest_box_link.
-    Placed { in_box: RPose },
+    Placed {
+        in_box: RPose,
+    },
     /// At rest anywhere but the box (frozen there).
     Dropped,
 }
@@ -144,7 +151,14 @@ impl Harvest {
 
     /// Applies the attach/release rules for both grippers (left first) with the hands at
     /// `hands` (map frame) and the finger gaps `widths`, for a step of `h` seconds.
-    pub fn grip(&mut self, world: &mut SceneWorld, pads: &[FingerPads; 2], hands: &[RPose; 2], widths: [f64; 2], h: f64) {
+    pub fn grip(
+        &mut self,
+        world: &mut SceneWorld,
+        pads: &[FingerPads; 2],
+        hands: &[RPose; 2],
+        widths: [f64; 2],
+        h: f64,
+    ) {
         for side in Side::BOTH {
             let s = side as usize;
             let (w, prev) = (widths[s], self.grippers[s].width);
@@ -252,7 +266,13 @@ impl Harvest {
 
     /// Kinematic targets of held and placed fruit for hands at `hands` and the box frame at
     /// `box_pose` (map frame); only those that move.
-    pub fn fruit_moves(&self, world: &SceneWorld, hands: &[RPose; 2], box_pose: &RPose, out: &mut Vec<(RigidBodyHandle, Pose)>) {
+    pub fn fruit_moves(
+        &self,
+        world: &SceneWorld,
+        hands: &[RPose; 2],
+        box_pose: &RPose,
+        out: &mut Vec<(RigidBodyHandle, Pose)>,
+    ) {
         for (&f, state) in &self.fruit {
             let target = match state {
                 FruitState::Held { leader } => hands[*leader as usize].mul(&self.grippers[*leader as usize].grip),
@@ -279,7 +299,14 @@ impl Harvest {
 
     /// Settles falling fruit after the physics step of `h` seconds: floor -> dropped; at rest
     /// -> placed (inside the box) or dropped. `box_vel` is the box's velocity [m/s].
-    pub fn settle(&mut self, world: &mut SceneWorld, interior: &BoxInterior, box_pose: &RPose, box_vel: [f64; 3], h: f64) {
+    pub fn settle(
+        &mut self,
+        world: &mut SceneWorld,
+        interior: &BoxInterior,
+        box_pose: &RPose,
+        box_vel: [f64; 3],
+        h: f64,
+    ) {
         let falling: Vec<(usize, f64, f64)> = self
             .fruit
             .iter()
@@ -342,7 +369,8 @@ mod tests {
 
     #[test]
     fn a_fruit_held_by_both_grippers_is_carried_once() {
-        let mut h = Harvest::new(HarvestParams { grasp_tolerance: 0.0, release_margin: 0.0 }, [0.08; 2], [RPose::IDENTITY; 2]);
+        let mut h =
+            Harvest::new(HarvestParams { grasp_tolerance: 0.0, release_margin: 0.0 }, [0.08; 2], [RPose::IDENTITY; 2]);
         assert_eq!(h.carried().count(), 0);
         h.grippers[1].held = Some(4);
         assert_eq!(h.carried().collect::<Vec<_>>(), [4]);

@@ -20,7 +20,13 @@ use rapier3d::parry::bounding_volume::Aabb;
 use rapier3d::prelude::*;
 
 /// Objects whose bounding box comes within `radius` [m] (horizontally) of `centre` (x, y).
-pub fn planning_scene(world: &SceneWorld, harvest: &Harvest, centre: [f64; 2], radius: f64, stamp_ns: i64) -> PlanningScene {
+pub fn planning_scene(
+    world: &SceneWorld,
+    harvest: &Harvest,
+    centre: [f64; 2],
+    radius: f64,
+    stamp_ns: i64,
+) -> PlanningScene {
     let (cx, cy, r) = (centre[0] as Real, centre[1] as Real, radius as Real);
     let query = Aabb::new(Vector::new(cx - r, cy - r, -1e6), Vector::new(cx + r, cy + r, 1e6));
     let qp = world.query_pipeline();

@@ -126,11 +126,30 @@ agrisim_fmi::variables! { pub VARIABLES {
 
 /// The robot's configuration inputs: base pose, lift, arm joints, finger gaps.
 const ROBOT: &[usize] = &[
-    BASE_X, BASE_Y, BASE_YAW, LIFT_POSITION, LEFT_Q1, LEFT_Q2, LEFT_Q3, LEFT_Q4, LEFT_Q5, LEFT_Q6, LEFT_Q7, RIGHT_Q1, RIGHT_Q2,
-    RIGHT_Q3, RIGHT_Q4, RIGHT_Q5, RIGHT_Q6, RIGHT_Q7, LEFT_FINGER_WIDTH, RIGHT_FINGER_WIDTH,
+    BASE_X,
+    BASE_Y,
+    BASE_YAW,
+    LIFT_POSITION,
+    LEFT_Q1,
+    LEFT_Q2,
+    LEFT_Q3,
+    LEFT_Q4,
+    LEFT_Q5,
+    LEFT_Q6,
+    LEFT_Q7,
+    RIGHT_Q1,
+    RIGHT_Q2,
+    RIGHT_Q3,
+    RIGHT_Q4,
+    RIGHT_Q5,
+    RIGHT_Q6,
+    RIGHT_Q7,
+    LEFT_FINGER_WIDTH,
+    RIGHT_FINGER_WIDTH,
 ];
 /// What the contacts at the start depend on: the scene, the base box and the robot's configuration.
-const CONTACTS: [usize; 26] = agrisim_fmi::concat(&[&[SCENE, SEED, BASE_LENGTH, BASE_WIDTH, BASE_HEIGHT, BASE_CLEARANCE], ROBOT]);
+const CONTACTS: [usize; 26] =
+    agrisim_fmi::concat(&[&[SCENE, SEED, BASE_LENGTH, BASE_WIDTH, BASE_HEIGHT, BASE_CLEARANCE], ROBOT]);
 /// The first collision_state: the contacts, stamped on the collision_rate grid.
 const COLLISION_REPORT: [usize; 28] = agrisim_fmi::concat(&[&CONTACTS, &[COLLISION_RATE, Var::TIME]]);
 /// Which fruit is the target (and where it is).

@@ -135,7 +135,8 @@ impl SceneWorld {
         }
         let shape = base.shape();
         let body = bodies.insert(RigidBodyBuilder::kinematic_position_based().pose(robot_pose));
-        let collider = colliders.insert_with_parent(ColliderBuilder::new(shape.clone()).user_data(ROBOT_TAG), body, &mut bodies);
+        let collider =
+            colliders.insert_with_parent(ColliderBuilder::new(shape.clone()).user_data(ROBOT_TAG), body, &mut bodies);
         let mut world = SceneWorld {
             bodies,
             colliders,
@@ -163,7 +164,14 @@ impl SceneWorld {
     /// gravity, the kinematic bodies moving linearly across them; otherwise they teleport.
     /// `awake` lists further kinematic bodies falling things may land on (carried and placed
     /// fruit): rapier's solver only sees kinematic bodies that are awake.
-    pub fn advance(&mut self, moves: &[(RigidBodyHandle, Pose)], awake: &[RigidBodyHandle], h: f64, dynamic: bool, max_dt: f64) {
+    pub fn advance(
+        &mut self,
+        moves: &[(RigidBodyHandle, Pose)],
+        awake: &[RigidBodyHandle],
+        h: f64,
+        dynamic: bool,
+        max_dt: f64,
+    ) {
         if !dynamic {
             for &(body, pose) in moves {
                 self.bodies[body].set_position(pose, true);

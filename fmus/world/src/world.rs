@@ -71,7 +71,15 @@ struct Running {
 }
 
 /// A serialized [`Running`] (see `save_state`).
-type SavedRun = (SceneWorld, (Coords, [f64; 3], Vec<RPose>, RPose), Harvest, ContactTracker, (Schedule, Schedule, Schedule), Ports, Option<i32>);
+type SavedRun = (
+    SceneWorld,
+    (Coords, [f64; 3], Vec<RPose>, RPose),
+    Harvest,
+    ContactTracker,
+    (Schedule, Schedule, Schedule),
+    Ports,
+    Option<i32>,
+);
 
 /// The world's message ports.
 #[derive(Clone, serde::Serialize, serde::Deserialize)]
@@ -146,7 +154,10 @@ fn coords_input(io: &Store, model: &RobotModel) -> Result<Coords, String> {
     c.widths = [io.f64(LEFT_FINGER_WIDTH), io.f64(RIGHT_FINGER_WIDTH)];
     let all = std::iter::once(c.lift).chain(c.arms.iter().flatten().copied()).chain(c.widths);
     if let Some(bad) = all.zip(0..).find(|(v, _)| !v.is_finite()) {
-        return Err(format!("robot joint input #{} (lift, left_q1..7, right_q1..7, widths) is not finite: {}", bad.1, bad.0));
+        return Err(format!(
+            "robot joint input #{} (lift, left_q1..7, right_q1..7, widths) is not finite: {}",
+            bad.1, bad.0
+        ));
     }
     for side in Side::BOTH {
         let s = side as usize;
@@ -177,7 +188,9 @@ impl Running {
         self.report_ground_truth(io, t);
         if let Some(stamp) = self.scene_schedule.due(t) {
             let [x, y, _] = self.robot.planar;
-            self.ports.scene.publish(stamp, planning_scene(&self.world, &self.harvest, [x, y], self.scene_radius, stamp).to_cdr());
+            self.ports
+                .scene
+                .publish(stamp, planning_scene(&self.world, &self.harvest, [x, y], self.scene_radius, stamp).to_cdr());
         }
         self.ports.sync(io, to_ns(t), self.window_ns);
     }
@@ -371,18 +384,23 @@ impl Model for GreenhouseWorld {
         let r = self.run.as_ref().ok_or("the world is not initialized")?;
         let robot = (&r.robot.coords, &r.robot.planar, &r.robot.link_in_base, &r.robot.box_pose);
         let schedules = (&r.collision_schedule, &r.fruit_schedule, &r.scene_schedule);
-        agrisim_fmi::serial::write(&(&r.world, robot, &r.harvest, &r.tracker, schedules, &r.ports, r.published_target), out)
+        agrisim_fmi::serial::write(
+            &(&r.world, robot, &r.harvest, &r.tracker, schedules, &r.ports, r.published_target),
+            out,
+        )
     }
 
     fn load_state(&mut self, bytes: &[u8]) -> Result<(), String> {
         let r = self.run.as_mut().ok_or("the world is not initialized")?;
         let saved: SavedRun = agrisim_fmi::serial::read(bytes)?;
-        let (world, (coords, planar, link_in_base, box_pose), harvest, tracker, schedules, ports, published_target) = saved;
+        let (world, (coords, planar, link_in_base, box_pose), harvest, tracker, schedules, ports, published_target) =
+            saved;
         if world.fruit.len() != r.world.fruit.len() || link_in_base.len() != r.robot.link_in_base.len() {
             return Err("the saved world is of another scene or robot".into());
         }
         r.world.adopt(world);
-        (r.robot.coords, r.robot.planar, r.robot.link_in_base, r.robot.box_pose) = (coords, planar, link_in_base, box_pose);
+        (r.robot.coords, r.robot.planar, r.robot.link_in_base, r.robot.box_pose) =
+            (coords, planar, link_in_base, box_pose);
         (r.harvest, r.tracker, r.ports, r.published_target) = (harvest, tracker, ports, published_target);
         (r.collision_schedule, r.fruit_schedule, r.scene_schedule) = schedules;
         Ok(())

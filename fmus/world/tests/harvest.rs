@@ -100,7 +100,11 @@ fn ik(model: &RobotModel, c: &Coords, side: Side, target: [f64; 3], approach: [f
         }
         let lambda2 = 1e-4;
         let jjt: Vec<Vec<f64>> = (0..6)
-            .map(|i| (0..6).map(|k| (0..7).map(|j| jac[i][j] * jac[k][j]).sum::<f64>() + if i == k { lambda2 } else { 0.0 }).collect())
+            .map(|i| {
+                (0..6)
+                    .map(|k| (0..7).map(|j| jac[i][j] * jac[k][j]).sum::<f64>() + if i == k { lambda2 } else { 0.0 })
+                    .collect()
+            })
             .collect();
         let y = solve(jjt, e.clone());
         for j in 0..7 {
@@ -373,7 +377,10 @@ fn released_elsewhere_falls_to_the_floor_in_the_analytic_time() {
     let fall = z0 - r - 0.005; // landing = lowest point within 5 mm of the floor
     let analytic = (2.0 * fall / G).sqrt();
     let measured = steps as f64 * H;
-    assert!((measured - analytic).abs() <= 2.0 * H + 1e-9, "fell {fall:.3} m in {measured:.3} s, analytic {analytic:.3} s");
+    assert!(
+        (measured - analytic).abs() <= 2.0 * H + 1e-9,
+        "fell {fall:.3} m in {measured:.3} s, analytic {analytic:.3} s"
+    );
     let p = sim.fruit_centre(f);
     assert!(p[2] - r < 0.01 && p[2] - r > -0.01, "on the floor: {p:?}");
     // It stays there (frozen) while time passes.
@@ -526,7 +533,11 @@ fn a_hand_pushed_into_the_wall_is_a_structure_contact() {
 /// approaching horizontally from the aisle (+y): the robot clear of the rows.
 fn aisle_grasp_setup() -> (usize, [f64; 3], Coords) {
     let model = RobotModel::load().unwrap();
-    let (f, (p, _)) = fruit_list().into_iter().enumerate().find(|(_, (p, _))| p[0] > 8.0 && p[1] > 7.0 && p[1] < 7.2).expect("a fruit on the aisle side");
+    let (f, (p, _)) = fruit_list()
+        .into_iter()
+        .enumerate()
+        .find(|(_, (p, _))| p[0] > 8.0 && p[1] > 7.0 && p[1] < 7.2)
+        .expect("a fruit on the aisle side");
     let planar = [p[0] - 0.3, 6.2, 0.0];
     // The left shoulder 0.1 m below the fruit.
     let shoulder = link_in_base(&model, &Coords::default(), "left_link1").trans[2];
@@ -543,7 +554,8 @@ fn a_carried_fruit_pushed_into_the_wall_is_a_carried_structure_contact() {
     let mut c = c0;
     close(&mut sim, &mut c, Side::Left).expect("held");
     assert_eq!(sim.io.i32(LEFT_HELD_ID), sim.fruit_id(f));
-    let touched = |sim: &Sim| [CONTACT_ROBOT_STRUCTURE, CONTACT_ARM_ARM, CONTACT_CARRIED_STRUCTURE].map(|v| sim.io.i32(v));
+    let touched =
+        |sim: &Sim| [CONTACT_ROBOT_STRUCTURE, CONTACT_ARM_ARM, CONTACT_CARRIED_STRUCTURE].map(|v| sim.io.i32(v));
     assert_eq!(touched(&sim), [0, 0, 0], "picked from among its truss: no carried contact");
     // Out of the row, the hand pointing ahead (base +x): carried through free air, nothing
     // counts (the counters are cumulative: their end values tell).
@@ -583,7 +595,10 @@ fn a_carried_fruit_pushed_into_the_wall_is_a_carried_structure_contact() {
     let s = sim.collision_state();
     assert!(s.in_collision && sim.io.bool(COLLISION));
     let [hit] = s.contacts.as_slice() else { panic!("one contact: {s:?}") };
-    assert_eq!((hit.robot_link.as_str(), hit.object_name.as_str(), hit.object_kind.as_str()), ("carried_fruit", "wall_xmin", "wall"));
+    assert_eq!(
+        (hit.robot_link.as_str(), hit.object_name.as_str(), hit.object_kind.as_str()),
+        ("carried_fruit", "wall_xmin", "wall")
+    );
     assert!(hit.position.x.abs() < 0.002 && hit.normal.x > 0.99 && (hit.depth - 0.01).abs() < 0.002, "{hit:?}");
     // Back into free air: no onset; pushed in again: a second one.
     glide(&mut sim, wall, &far, &near, 20, |_, _| {});
@@ -663,7 +678,11 @@ fn planning_scene_lists_the_objects_near_the_robot() {
             assert_eq!(c.kind, agrisim_fmu_world::collision_report::kind_label(o.kind));
             let p = c.pose.position;
             let t = o.placement.translation;
-            assert!((p.x - t[0]).abs() < 1e-4 && (p.y - t[1]).abs() < 1e-4 && (p.z - t[2]).abs() < 1e-4, "{}: {p:?} vs {t:?}", o.name);
+            assert!(
+                (p.x - t[0]).abs() < 1e-4 && (p.y - t[1]).abs() < 1e-4 && (p.z - t[2]).abs() < 1e-4,
+                "{}: {p:?} vs {t:?}",
+                o.name
+            );
             match o.shape {
                 agrisim_greenhouse::Shape::Sphere { radius } => {
                     assert_eq!(c.primitive.r#type, SolidPrimitive::SPHERE);
@@ -671,7 +690,10 @@ fn planning_scene_lists_the_objects_near_the_robot() {
                 }
                 agrisim_greenhouse::Shape::Cylinder { radius, half_height } => {
                     assert_eq!(c.primitive.r#type, SolidPrimitive::CYLINDER);
-                    assert!((c.primitive.dimensions[0] - 2.0 * half_height).abs() < 1e-5 && (c.primitive.dimensions[1] - radius).abs() < 1e-6);
+                    assert!(
+                        (c.primitive.dimensions[0] - 2.0 * half_height).abs() < 1e-5
+                            && (c.primitive.dimensions[1] - radius).abs() < 1e-6
+                    );
                     // Same orientation as the scene object (cylinder axis = local z).
                     let q = c.pose.orientation;
                     let [qx, qy, qz, qw] = o.placement.rotation;
@@ -731,5 +753,8 @@ fn a_second_fruit_lands_on_the_first_in_the_box() {
     let gap = dist(sim.fruit_centre(a), sim.fruit_centre(b)) - 0.5 * (sim.diameter(a) + sim.diameter(b));
     assert!(gap > -0.003, "the second fruit rests on the first, not inside it (gap {gap} m)");
     assert!(gap < 0.05, "released at the same spot: they touch (gap {gap} m)");
-    assert_eq!((sim.io.i32(PICKED_COUNT), sim.io.i32(DROPPED_COUNT), sim.io.i32(LAST_PLACED_ID)), (2, 0, sim.fruit_id(b)));
+    assert_eq!(
+        (sim.io.i32(PICKED_COUNT), sim.io.i32(DROPPED_COUNT), sim.io.i32(LAST_PLACED_ID)),
+        (2, 0, sim.fruit_id(b))
+    );
 }

@@ -39,7 +39,13 @@ fn collision_state(io: &Store) -> CollisionState {
 
 /// Steps the base from `from` toward `to` in `n` equal moves (one per step) until it collides;
 /// returns the step index of the first collision.
-fn drive_until_contact(m: &mut GreenhouseWorld, io: &mut Store, from: [f64; 3], to: [f64; 3], n: usize) -> Option<usize> {
+fn drive_until_contact(
+    m: &mut GreenhouseWorld,
+    io: &mut Store,
+    from: [f64; 3],
+    to: [f64; 3],
+    n: usize,
+) -> Option<usize> {
     for k in 1..=n {
         let f = k as f64 / n as f64;
         set_pose(io, std::array::from_fn(|i| from[i] + f * (to[i] - from[i])));
@@ -90,11 +96,17 @@ fn driving_into_the_first_post_of_a_row_reports_it() {
     let k = drive_until_contact(&mut m, &mut io, from, to, 520).expect("the post is hit");
     let front = io.f64(BASE_X) + half_len;
     let s = collision_state(&io);
-    assert!((front - face).abs() < 0.002, "first contact with the front at {front}, post face at {face} (step {k}): {s:?}");
+    assert!(
+        (front - face).abs() < 0.002,
+        "first contact with the front at {front}, post face at {face} (step {k}): {s:?}"
+    );
     assert!(s.in_collision);
     assert_eq!(s.count, 1, "{s:?}");
     let c = &s.contacts[0];
-    assert_eq!((c.object_name.as_str(), c.object_kind.as_str(), c.robot_link.as_str()), ("row2/post0", "post", "base_link"));
+    assert_eq!(
+        (c.object_name.as_str(), c.object_kind.as_str(), c.robot_link.as_str()),
+        ("row2/post0", "post", "base_link")
+    );
     assert_eq!(c.object_id, post.id);
     // Normal from the object to the robot: -x; contact on the post's front face.
     assert!(c.normal.x < -0.999, "normal {:?}", c.normal);
@@ -214,12 +226,18 @@ fn ground_truth_fruit_and_target() {
         m.do_step(&mut io, k as f64 * H, H, &mut Quiet).unwrap();
     }
     assert_eq!((io.i64(FRUIT_POSES_SEQ), io.i64(TARGET_SEQ)), (2, 2));
-    assert_eq!(PoseArray::from_cdr(agrisim_fmi::port::latest(&io, FRUIT_POSES)).unwrap().header.stamp.to_nanos(), 1_000_000_000);
+    assert_eq!(
+        PoseArray::from_cdr(agrisim_fmi::port::latest(&io, FRUIT_POSES)).unwrap().header.stamp.to_nanos(),
+        1_000_000_000
+    );
     // Selecting another fruit publishes it at once; -1 clears the scalars.
     io.set_i32(TARGET_FRUIT, 3);
     m.do_step(&mut io, 1.0, H, &mut Quiet).unwrap();
     assert_eq!(io.i64(TARGET_SEQ), 3);
-    assert_eq!(PoseStamped::from_cdr(agrisim_fmi::port::latest(&io, TARGET)).unwrap().pose.position, poses.poses[3].position);
+    assert_eq!(
+        PoseStamped::from_cdr(agrisim_fmi::port::latest(&io, TARGET)).unwrap().pose.position,
+        poses.poses[3].position
+    );
     io.set_i32(TARGET_FRUIT, -1);
     m.do_step(&mut io, 1.02, H, &mut Quiet).unwrap();
     assert!(!io.bool(TARGET_VALID));

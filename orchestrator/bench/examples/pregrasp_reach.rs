@@ -42,9 +42,14 @@ fn scene_near(g: &agrisim_greenhouse::Greenhouse, c: [f64; 2], radius: f64) -> P
         .filter_map(|o| {
             let p = o.placement.translation;
             let (primitive, size) = match o.shape {
-                Shape::Box { half } => (SolidPrimitive::new_box(2.0 * half[0], 2.0 * half[1], 2.0 * half[2]), half.iter().map(|h| h * h).sum::<f64>().sqrt()),
+                Shape::Box { half } => (
+                    SolidPrimitive::new_box(2.0 * half[0], 2.0 * half[1], 2.0 * half[2]),
+                    half.iter().map(|h| h * h).sum::<f64>().sqrt(),
+                ),
                 Shape::Sphere { radius } => (SolidPrimitive::sphere(radius), radius),
-                Shape::Cylinder { radius, half_height } => (SolidPrimitive::cylinder(2.0 * half_height, radius), radius.max(half_height)),
+                Shape::Cylinder { radius, half_height } => {
+                    (SolidPrimitive::cylinder(2.0 * half_height, radius), radius.max(half_height))
+                }
             };
             if ((p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2)).sqrt() > radius + size {
                 return None;
@@ -54,7 +59,10 @@ fn scene_near(g: &agrisim_greenhouse::Greenhouse, c: [f64; 2], radius: f64) -> P
                 id: o.id.to_string(),
                 kind: kind_label(o.kind).into(),
                 primitive,
-                pose: Pose { position: Point { x: p[0], y: p[1], z: p[2] }, orientation: Quaternion { x: q[0], y: q[1], z: q[2], w: q[3] } },
+                pose: Pose {
+                    position: Point { x: p[0], y: p[1], z: p[2] },
+                    orientation: Quaternion { x: q[0], y: q[1], z: q[2], w: q[3] },
+                },
             })
         })
         .collect();
@@ -123,7 +131,13 @@ fn main() {
                 Err(err) => {
                     *reasons.entry(family(&err)).or_default() += 1;
                     // What blocks: the kinds of the scene objects the failure names.
-                    let mut kinds: Vec<&str> = err.split("object \"").skip(1).filter_map(|r| r.split('"').next()?.parse::<u32>().ok()).filter_map(|id| g.objects.iter().find(|o| o.id == id)).map(|o| kind_label(o.kind)).collect();
+                    let mut kinds: Vec<&str> = err
+                        .split("object \"")
+                        .skip(1)
+                        .filter_map(|r| r.split('"').next()?.parse::<u32>().ok())
+                        .filter_map(|id| g.objects.iter().find(|o| o.id == id))
+                        .map(|o| kind_label(o.kind))
+                        .collect();
                     kinds.sort_unstable();
                     kinds.dedup();
                     *blockers.entry(format!("{class}: {}", kinds.join("+"))).or_default() += 1;

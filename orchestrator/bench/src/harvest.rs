@@ -8,14 +8,16 @@
 //! (robot against structure, arm against arm, base against anything), within the time
 //! limit. Planning success means every motion the trial asked for was planned.
 
-use crate::trials::{run_one, run_trials, write_summary, Exec, TrialPlan};
 use super::harvest_targets::{draw, eligible, HarvestTarget, Visibility};
-use crate::initial_pose::initial_estimate;
-use crate::scenes::{by_scene, SceneResult, Scenes};
 use super::map::{grid_message, prior_map};
 use super::nav::{decimate, trial_seed};
-use super::report::{self, bar_chart, count_table, interval, opt, per_kind, rate_table, render_with, view_bounds, TrialTrace};
+use super::report::{
+    self, bar_chart, count_table, interval, opt, per_kind, rate_table, render_with, view_bounds, TrialTrace,
+};
 use super::stats::{percentile, wilson, Z95};
+use crate::initial_pose::initial_estimate;
+use crate::scenes::{by_scene, SceneResult, Scenes};
+use crate::trials::{run_one, run_trials, write_summary, Exec, TrialPlan};
 use agrisim_bus::{Node, Reader};
 use agrisim_error::{err, Result};
 use agrisim_greenhouse::occupancy::OccupancyMap;
@@ -154,7 +156,11 @@ impl Touches {
         let mut next = std::collections::BTreeSet::new();
         for c in &cs.contacts {
             // Arm-arm and carried-fruit contacts are failures, judged from the world's counters.
-            if picked(c.object_id) || c.object_kind == "robot_arm" || c.robot_link == "carried_fruit" || !next.insert(c.object_id) {
+            if picked(c.object_id)
+                || c.object_kind == "robot_arm"
+                || c.robot_link == "carried_fruit"
+                || !next.insert(c.object_id)
+            {
                 continue;
             }
             if !self.now.contains(&c.object_id) {
@@ -167,7 +173,10 @@ impl Touches {
 
 /// The failure a base contact in `cs` is, if any: the base must touch nothing.
 pub(crate) fn base_contact(cs: &CollisionState) -> Option<String> {
-    cs.contacts.iter().find(|c| c.robot_link == "base_link").map(|c| format!("the base touched {} ({})", c.object_name, c.object_kind))
+    cs.contacts
+        .iter()
+        .find(|c| c.robot_link == "base_link")
+        .map(|c| format!("the base touched {} ({})", c.object_name, c.object_kind))
 }
 
 /// Contact counters of the world FMU that end a trial as a collision (judged after every
@@ -191,7 +200,10 @@ impl HarvestSetup {
         let classes = &s.harvest.visibility;
         for c in classes {
             if ![Visibility::Free, Visibility::PartlyOccluded, Visibility::BehindStem].iter().any(|v| v.name() == c) {
-                return Err(err!("scenario {}: [harvest] visibility: unknown class \"{c}\" (free, partly_occluded, behind_stem)", s.path.display()));
+                return Err(err!(
+                    "scenario {}: [harvest] visibility: unknown class \"{c}\" (free, partly_occluded, behind_stem)",
+                    s.path.display()
+                ));
             }
         }
         let mut candidates = eligible(&g.objects, &g.layout);
@@ -255,7 +267,14 @@ impl Reports {
 }
 
 /// Runs one trial into `mcap` with the built-in harvest node.
-pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index: u64, seed: u64, mcap: &Path) -> Result<HarvestTrial> {
+pub fn run_trial(
+    s: &Scenario,
+    o: &RunOptions,
+    setup: &HarvestSetup,
+    index: u64,
+    seed: u64,
+    mcap: &Path,
+) -> Result<HarvestTrial> {
     run_trial_with(s, o, setup, index, seed, mcap, &builtin_node, TRIAL_TIMEOUT)
 }
 
@@ -263,16 +282,30 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index: u64,
 /// simulated time. The judge reads the node's messages (/harvest/status, /harvest/plans),
 /// the bus and the world FMU's ground truth; nothing else of the node.
 #[allow(clippy::too_many_arguments)]
-pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index: u64, seed: u64, mcap: &Path, node: HarvestNodeFactory, timeout: f64) -> Result<HarvestTrial> {
+pub fn run_trial_with(
+    s: &Scenario,
+    o: &RunOptions,
+    setup: &HarvestSetup,
+    index: u64,
+    seed: u64,
+    mcap: &Path,
+    node: HarvestNodeFactory,
+    timeout: f64,
+) -> Result<HarvestTrial> {
     let wall = Instant::now();
     let mut rng = Rng::new(seed);
     let target = draw(&setup.candidates, &setup.layout, &mut rng).expect("candidates checked non-empty");
     let harvest = node(target.fruit_index, seed);
     let node_name = harvest.name().to_string();
     // An external node takes the harvest node's place: it is told the task the same way.
-    let task = o.nodes.external.contains(&node_name).then(|| crate::task_publisher::TaskPublisher::new(target.fruit_index));
+    let task =
+        o.nodes.external.contains(&node_name).then(|| crate::task_publisher::TaskPublisher::new(target.fruit_index));
     let mut m = harvest_session(s, o, setup, target.start, seed, mcap, harvest, task)?;
-    let (world, arm_l, arm_r) = (m.component("world", "harvest benchmark")?, m.component("arm_left", "harvest benchmark")?, m.component("arm_right", "harvest benchmark")?);
+    let (world, arm_l, arm_r) = (
+        m.component("world", "harvest benchmark")?,
+        m.component("arm_left", "harvest benchmark")?,
+        m.component("arm_right", "harvest benchmark")?,
+    );
     let chassis = m.component("chassis", "harvest benchmark")?;
     let max_ticks = (timeout / s.timing.step).round() as u64;
     let mut path = vec![[m.number(chassis, "x")?, m.number(chassis, "y")?]];
@@ -306,7 +339,10 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
                 if success {
                     time_to_harvest = Some(k as f64 * s.timing.step);
                 }
-                judged = Some(((!success).then(|| st.failure_category.clone()), if success { String::new() } else { st.detail.clone() }));
+                judged = Some((
+                    (!success).then(|| st.failure_category.clone()),
+                    if success { String::new() } else { st.detail.clone() },
+                ));
                 return Ok(());
             }
         }
@@ -383,7 +419,16 @@ pub fn run_trial_with(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, index:
 /// true one), the robot state publisher, `harvest` (the node under test), the fault
 /// injector, and `task` (what tells an external node its task), recording into `mcap`.
 #[allow(clippy::too_many_arguments)]
-pub fn harvest_session(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, start: [f64; 3], seed: u64, mcap: &Path, harvest: Box<dyn Node>, task: Option<crate::task_publisher::TaskPublisher>) -> Result<agrisim_session::Session> {
+pub fn harvest_session(
+    s: &Scenario,
+    o: &RunOptions,
+    setup: &HarvestSetup,
+    start: [f64; 3],
+    seed: u64,
+    mcap: &Path,
+    harvest: Box<dyn Node>,
+    task: Option<crate::task_publisher::TaskPublisher>,
+) -> Result<agrisim_session::Session> {
     let mut s = s.clone();
     let chassis = s.parameters.entry("chassis".into()).or_default();
     for (k, v) in ["x0", "y0", "yaw0"].iter().zip(start) {
@@ -407,7 +452,15 @@ pub fn harvest_session(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, start
 }
 
 /// Runs `trials` trials and writes trials.jsonl, summary.json, report.html and trials/*.mcap.
-pub fn bench_harvest(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, resume: bool, exec: Exec, progress: impl FnMut(u64, u64)) -> Result<HarvestSummary> {
+pub fn bench_harvest(
+    s: &Scenario,
+    o: &RunOptions,
+    plan: TrialPlan,
+    out: &Path,
+    resume: bool,
+    exec: Exec,
+    progress: impl FnMut(u64, u64),
+) -> Result<HarvestSummary> {
     let o = o.record_default(s, agrisim_session::Profile::Standard);
     let seed = plan.seed;
     let scenes = Scenes::all(s, plan.scenes, HarvestSetup::new)?;
@@ -439,7 +492,9 @@ pub fn harvest_worker(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path,
     let o = o.record_default(s, agrisim_session::Profile::Standard);
     let scenes = Scenes::for_trial(s, plan.scenes, i, HarvestSetup::new)?;
     let (k, s, setup) = scenes.of(i);
-    run_one(out, i, |i, mcap| run_trial(s, &o, setup, i, trial_seed(plan.seed, i), mcap).map(|t| HarvestTrial { scene: k, ..t }))
+    run_one(out, i, |i, mcap| {
+        run_trial(s, &o, setup, i, trial_seed(plan.seed, i), mcap).map(|t| HarvestTrial { scene: k, ..t })
+    })
 }
 
 /// The record of a trial whose process died: an error, with its target (drawn as the trial
@@ -489,7 +544,8 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, results: &[HarvestTrial]) -> Har
     let n = results.len() as u64;
     let outcomes: Vec<(u64, bool)> = results.iter().map(|t| (t.scene, t.outcome == "success")).collect();
     let (per_scene, cluster_bootstrap95) = by_scene(s, plan.scenes, seed, &outcomes);
-    let distinct_targets = results.iter().map(|t| (t.scene, t.fruit_id)).collect::<std::collections::BTreeSet<_>>().len() as u64;
+    let distinct_targets =
+        results.iter().map(|t| (t.scene, t.fruit_id)).collect::<std::collections::BTreeSet<_>>().len() as u64;
     let ok = results.iter().filter(|t| t.outcome == "success").count() as u64;
     let planned = results.iter().filter(|t| t.planning_ok).count() as u64;
     // Planning is judged only where it was decided: a trial that failed before asking for
@@ -553,7 +609,11 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, results: &[HarvestTrial]) -> Har
             }
             m
         },
-        tracking_rms_mean: if n == 0 { 0.0 } else { results.iter().map(|t| 0.5 * (t.tracking_rms[0] + t.tracking_rms[1])).sum::<f64>() / n as f64 },
+        tracking_rms_mean: if n == 0 {
+            0.0
+        } else {
+            results.iter().map(|t| 0.5 * (t.tracking_rms[0] + t.tracking_rms[1])).sum::<f64>() / n as f64
+        },
         time_to_harvest_mean: if tth.is_empty() { None } else { Some(tth.iter().sum::<f64>() / tth.len() as f64) },
         rtf: if wall > 0.0 { sim / wall } else { 0.0 },
         sim_time: sim,
@@ -576,24 +636,46 @@ fn report_html(g: &agrisim_greenhouse::Greenhouse, sum: &HarvestSummary, results
     let rows = vec![
         ("scenario".to_string(), sum.scenario.clone()),
         ("seed".to_string(), sum.seed.to_string()),
-        ("trials x scenes".to_string(), format!("{} in {} scene(s), {} distinct targets", sum.trials, sum.scenes, sum.distinct_targets)),
+        (
+            "trials x scenes".to_string(),
+            format!("{} in {} scene(s), {} distinct targets", sum.trials, sum.scenes, sum.distinct_targets),
+        ),
         ("harvested".to_string(), format!("{} / {} = {:.3}", sum.successes, sum.trials, sum.success_rate)),
         ("harvest Wilson 95 %".to_string(), interval(sum.wilson95)),
         ("harvest cluster bootstrap 95 % (over scenes)".to_string(), interval(sum.cluster_bootstrap95)),
-        ("planning (of decided trials)".to_string(), format!("{} / {} = {:.3}", sum.planning_successes, sum.planning_decided, sum.planning_success_rate)),
+        (
+            "planning (of decided trials)".to_string(),
+            format!("{} / {} = {:.3}", sum.planning_successes, sum.planning_decided, sum.planning_success_rate),
+        ),
         ("planning Wilson 95 %".to_string(), interval(sum.planning_wilson95)),
-        ("harvested given planning".to_string(), format!("{:.3}, Wilson 95 % {}", sum.conditional_success_rate, interval(sum.conditional_wilson95))),
+        (
+            "harvested given planning".to_string(),
+            format!("{:.3}, Wilson 95 % {}", sum.conditional_success_rate, interval(sum.conditional_wilson95)),
+        ),
         ("mean time to harvest [s]".to_string(), opt(sum.time_to_harvest_mean)),
-        ("plans; planning time charged per trial [s]".to_string(), format!("{}; {:.3}", sum.plans, sum.thinking_time_mean)),
+        (
+            "plans; planning time charged per trial [s]".to_string(),
+            format!("{}; {:.3}", sum.plans, sum.thinking_time_mean),
+        ),
         ("plant touches per trial".to_string(), per_kind(&sum.touches_per_trial)),
         ("joint tracking RMS mean [rad]".to_string(), format!("{:.2e}", sum.tracking_rms_mean)),
-        ("wall-clock figures".to_string(), "in summary.json (rtf, planning_time_p50/p95/max, thinking_over_wall)".to_string()),
+        (
+            "wall-clock figures".to_string(),
+            "in summary.json (rtf, planning_time_p50/p95/max, thinking_over_wall)".to_string(),
+        ),
     ];
     let classes = sum.per_visibility.iter().map(|(k, c)| (k.clone(), c.trials, c.successes, c.wilson95));
     let times: Vec<f64> = results.iter().filter_map(|t| t.time_to_harvest).collect();
     let mut sections = vec![];
     if sum.scenes > 1 {
-        let scenes = sum.per_scene.iter().map(|r| (format!("{} (greenhouse seed {})", r.scene, r.scene_seed), r.trials, r.successes, wilson(r.successes, r.trials, Z95)));
+        let scenes = sum.per_scene.iter().map(|r| {
+            (
+                format!("{} (greenhouse seed {})", r.scene, r.scene_seed),
+                r.trials,
+                r.successes,
+                wilson(r.successes, r.trials, Z95),
+            )
+        });
         let note = "<p>The map above is scene 0's; the trials of the other scenes are drawn on it.</p>";
         sections.push(("Harvested per scene".to_string(), rate_table(["scene", "trials", "harvested"], scenes) + note));
     }
@@ -609,13 +691,22 @@ fn report_html(g: &agrisim_greenhouse::Greenhouse, sum: &HarvestSummary, results
             success: t.outcome == "success",
             reason: match &t.failure {
                 None => format!("harvested in {} s", opt(t.time_to_harvest)),
-                Some(f) => format!("{f} (stage {}, {}): {}", t.failed_stage.as_deref().unwrap_or("-"), t.visibility, t.detail),
+                Some(f) => {
+                    format!("{f} (stage {}, {}): {}", t.failed_stage.as_deref().unwrap_or("-"), t.visibility, t.detail)
+                }
             },
             target: t.fruit,
             path: t.path.clone(),
         })
         .collect();
-    render_with(&format!("agrisim harvest benchmark: {}", sum.scenario), &rows, &g.objects, view_bounds(&g.layout, &traces), &traces, &sections)
+    render_with(
+        &format!("agrisim harvest benchmark: {}", sum.scenario),
+        &rows,
+        &g.objects,
+        view_bounds(&g.layout, &traces),
+        &traces,
+        &sections,
+    )
 }
 
 #[cfg(test)]
@@ -627,7 +718,12 @@ mod tests {
         CollisionState {
             contacts: contacts
                 .iter()
-                .map(|&(id, kind, link)| Contact { object_id: id, object_kind: kind.into(), robot_link: link.into(), ..Contact::default() })
+                .map(|&(id, kind, link)| Contact {
+                    object_id: id,
+                    object_kind: kind.into(),
+                    robot_link: link.into(),
+                    ..Contact::default()
+                })
                 .collect(),
             ..CollisionState::default()
         }
@@ -639,11 +735,24 @@ mod tests {
     #[test]
     fn touches_count_onsets_by_kind() {
         let mut t = Touches::default();
-        t.update(&state(&[(5, "leaf", "left_link5"), (5, "leaf", "left_link6"), (9, "fruit", "left_hand")]), |id| id == 9);
-        t.update(&state(&[(5, "leaf", "left_link5"), (7, "stem", "left_link4"), (0, "robot_arm", "left_link7"), (13, "post", "carried_fruit")]), |id| id == 9);
+        t.update(&state(&[(5, "leaf", "left_link5"), (5, "leaf", "left_link6"), (9, "fruit", "left_hand")]), |id| {
+            id == 9
+        });
+        t.update(
+            &state(&[
+                (5, "leaf", "left_link5"),
+                (7, "stem", "left_link4"),
+                (0, "robot_arm", "left_link7"),
+                (13, "post", "carried_fruit"),
+            ]),
+            |id| id == 9,
+        );
         t.update(&state(&[]), |id| id == 9);
         t.update(&state(&[(5, "leaf", "left_link5"), (11, "fruit", "right_hand")]), |id| id == 9);
-        assert_eq!(t.by_kind, BTreeMap::from([("leaf".to_string(), 2), ("stem".to_string(), 1), ("fruit".to_string(), 1)]));
+        assert_eq!(
+            t.by_kind,
+            BTreeMap::from([("leaf".to_string(), 2), ("stem".to_string(), 1), ("fruit".to_string(), 1)])
+        );
     }
 
     /// report.html holds only what the seed determines: trials that differ in their
@@ -651,17 +760,29 @@ mod tests {
     /// class and per failure category, the time to harvest in the histogram.
     #[test]
     fn report_is_the_same_whatever_the_wall_clock() {
-        let s = Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/scenarios/harvest.toml")).unwrap();
+        let s =
+            Scenario::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../models/scenarios/harvest.toml")).unwrap();
         let g = agrisim_session::scene::generate_scene(&s).unwrap();
         let targets = eligible(&g.objects, &g.layout);
         let trials = |wall: f64| -> Vec<HarvestTrial> {
             let picked = targets.iter().step_by(97).take(3).enumerate();
             picked
                 .map(|(i, t)| {
-                    let mut r = HarvestTrial { sim_time: 30.0, wall_time: wall * (i + 1) as f64, plans: 2, planning_times: vec![wall * 1e-3; 2], ..HarvestTrial::of_target(i as u64, 1, t) };
+                    let mut r = HarvestTrial {
+                        sim_time: 30.0,
+                        wall_time: wall * (i + 1) as f64,
+                        plans: 2,
+                        planning_times: vec![wall * 1e-3; 2],
+                        ..HarvestTrial::of_target(i as u64, 1, t)
+                    };
                     r.path = vec![[t.start[0], t.start[1]], [t.start[0] + 0.5, t.start[1]]];
-                    let (failure, stage, planning) = [(None, None, "ok"), (Some("grasp"), Some("grasp"), "not_reached"), (Some("planning"), Some("pre_grasp"), "failed")][i];
-                    (r.failure, r.failed_stage, r.planning, r.planning_ok) = (failure.map(String::from), stage.map(String::from), planning.into(), planning == "ok");
+                    let (failure, stage, planning) = [
+                        (None, None, "ok"),
+                        (Some("grasp"), Some("grasp"), "not_reached"),
+                        (Some("planning"), Some("pre_grasp"), "failed"),
+                    ][i];
+                    (r.failure, r.failed_stage, r.planning, r.planning_ok) =
+                        (failure.map(String::from), stage.map(String::from), planning.into(), planning == "ok");
                     if failure.is_none() {
                         (r.outcome, r.time_to_harvest) = ("success".into(), Some(27.3));
                     }
@@ -677,7 +798,9 @@ mod tests {
         assert_eq!(html, report_html(&g, &sb, &b));
         assert!(!html.contains("real-time"));
         assert_eq!(html.matches("<polyline").count(), 3);
-        assert!(html.contains("<tr><td>grasp</td><td>1</td></tr>") && html.contains("<tr><td>planning</td><td>1</td></tr>"));
+        assert!(
+            html.contains("<tr><td>grasp</td><td>1</td></tr>") && html.contains("<tr><td>planning</td><td>1</td></tr>")
+        );
         assert!(html.contains("<th>planning (of decided trials)</th><td>1 / 2 = 0.500</td>"));
         for (k, c) in &sa.per_visibility {
             assert!(html.contains(&format!("<tr><td>{k}</td><td>{}</td><td>{}</td>", c.trials, c.successes)), "{k}");

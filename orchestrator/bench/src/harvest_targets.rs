@@ -66,7 +66,15 @@ impl Visibility {
 
 /// The visibility of the fruit at `c` (radius `r`, object `id`) from the aisle in direction
 /// `toward` (+1: +y), looking as far as `reach` from its centre.
-fn visibility(caster: &RayCaster, objects: &[Object], id: u32, c: [f64; 3], r: f64, toward: f64, reach: f64) -> Visibility {
+fn visibility(
+    caster: &RayCaster,
+    objects: &[Object],
+    id: u32,
+    c: [f64; 3],
+    r: f64,
+    toward: f64,
+    reach: f64,
+) -> Visibility {
     let dir = [0.0, toward, 0.0];
     let k = 0.7 * r;
     let mut blocked = false;
@@ -91,7 +99,8 @@ fn visibility(caster: &RayCaster, objects: &[Object], id: u32, c: [f64; 3], r: f
 
 /// The fruit a harvest trial may target, in fruit-list order.
 pub fn eligible(objects: &[Object], layout: &Layout) -> Vec<HarvestTarget> {
-    let fruits: Vec<(usize, &Object)> = objects.iter().filter(|o| matches!(o.kind, Kind::Fruit { .. })).enumerate().collect();
+    let fruits: Vec<(usize, &Object)> =
+        objects.iter().filter(|o| matches!(o.kind, Kind::Fruit { .. })).enumerate().collect();
     let caster = RayCaster::new(objects);
     let mut out = vec![];
     for &(index, o) in &fruits {
@@ -101,7 +110,11 @@ pub fn eligible(objects: &[Object], layout: &Layout) -> Vec<HarvestTarget> {
         if ripeness < RIPE_STAGE || c[2] < HEIGHT_RANGE.0 || c[2] > HEIGHT_RANGE.1 {
             continue;
         }
-        let Some(row) = layout.rows.iter().filter(|r| r.active).min_by(|a, b| (a.y - c[1]).abs().total_cmp(&(b.y - c[1]).abs())) else { continue };
+        let Some(row) =
+            layout.rows.iter().filter(|r| r.active).min_by(|a, b| (a.y - c[1]).abs().total_cmp(&(b.y - c[1]).abs()))
+        else {
+            continue;
+        };
         if c[0] < row.x_start + ROW_END_MARGIN || c[0] > row.x_end - ROW_END_MARGIN {
             continue;
         }
@@ -111,10 +124,23 @@ pub fn eligible(objects: &[Object], layout: &Layout) -> Vec<HarvestTarget> {
         }
         // The aisle on the fruit's side must exist (the outer rows face a wall on one side).
         let toward = offset.signum();
-        let Some(aisle) = layout.aisles.iter().find(|a| (a.y - row.y) * toward > 0.0 && (a.y - row.y).abs() <= a.width && a.x_start <= c[0] && c[0] <= a.x_end) else { continue };
+        let Some(aisle) = layout.aisles.iter().find(|a| {
+            (a.y - row.y) * toward > 0.0 && (a.y - row.y).abs() <= a.width && a.x_start <= c[0] && c[0] <= a.x_end
+        }) else {
+            continue;
+        };
         let reach = (aisle.y - c[1]).abs();
         let visibility = visibility(&caster, objects, o.id, c, radius, toward, reach);
-        out.push(HarvestTarget { fruit_index: index, object_id: o.id, name: o.name.clone(), center: c, radius, side: -toward, visibility, start: [0.0, aisle.y, 0.0] });
+        out.push(HarvestTarget {
+            fruit_index: index,
+            object_id: o.id,
+            name: o.name.clone(),
+            center: c,
+            radius,
+            side: -toward,
+            visibility,
+            start: [0.0, aisle.y, 0.0],
+        });
     }
     out
 }
@@ -153,7 +179,13 @@ mod tests {
         let c = eligible(&g.objects, &g.layout);
         assert!(c.len() >= 30, "only {} eligible fruit", c.len());
         for t in &c {
-            let row = g.layout.rows.iter().filter(|r| r.active).min_by(|a, b| (a.y - t.center[1]).abs().total_cmp(&(b.y - t.center[1]).abs())).unwrap();
+            let row = g
+                .layout
+                .rows
+                .iter()
+                .filter(|r| r.active)
+                .min_by(|a, b| (a.y - t.center[1]).abs().total_cmp(&(b.y - t.center[1]).abs()))
+                .unwrap();
             // The robot's aisle is on the fruit's side of the row, and the fruit is ripe.
             assert!((t.start[1] - row.y) * (t.center[1] - row.y) > 0.0);
             assert_eq!(t.side, -(t.center[1] - row.y).signum());
@@ -167,7 +199,8 @@ mod tests {
         // Free and partly hidden fruit are both common. Fruit hang from trusses beside the
         // stem, so a stem rarely stands right in front of one (0 in this scene).
         let count = |v: Visibility| c.iter().filter(|t| t.visibility == v).count();
-        let (free, partly, stem) = (count(Visibility::Free), count(Visibility::PartlyOccluded), count(Visibility::BehindStem));
+        let (free, partly, stem) =
+            (count(Visibility::Free), count(Visibility::PartlyOccluded), count(Visibility::BehindStem));
         eprintln!("eligible {}: free {free}, partly occluded {partly}, behind a stem {stem}", c.len());
         assert!(free > 100 && partly > 100 && free + partly + stem == c.len());
         // Starts within the range around the stand-off, both headings.
@@ -186,9 +219,27 @@ mod tests {
     #[test]
     fn visibility_classes_follow_what_is_in_the_way() {
         use agrisim_greenhouse::Placement;
-        let fruit = Object { id: 0, name: "f".into(), kind: Kind::Fruit { ripeness: 6 }, shape: Shape::Sphere { radius: 0.03 }, placement: Placement::at(1.0, 0.0, 1.0) };
-        let stem = Object { id: 1, name: "s".into(), kind: Kind::Stem, shape: Shape::Cylinder { radius: 0.01, half_height: 1.0 }, placement: Placement::at(1.0, 0.1, 1.0) };
-        let leaf = Object { id: 1, name: "l".into(), kind: Kind::Leaf, shape: Shape::Box { half: [0.02, 0.005, 0.02] }, placement: Placement::at(1.02, 0.2, 1.0) };
+        let fruit = Object {
+            id: 0,
+            name: "f".into(),
+            kind: Kind::Fruit { ripeness: 6 },
+            shape: Shape::Sphere { radius: 0.03 },
+            placement: Placement::at(1.0, 0.0, 1.0),
+        };
+        let stem = Object {
+            id: 1,
+            name: "s".into(),
+            kind: Kind::Stem,
+            shape: Shape::Cylinder { radius: 0.01, half_height: 1.0 },
+            placement: Placement::at(1.0, 0.1, 1.0),
+        };
+        let leaf = Object {
+            id: 1,
+            name: "l".into(),
+            kind: Kind::Leaf,
+            shape: Shape::Box { half: [0.02, 0.005, 0.02] },
+            placement: Placement::at(1.02, 0.2, 1.0),
+        };
         let v = |objs: &[Object]| visibility(&RayCaster::new(objs), objs, 0, [1.0, 0.0, 1.0], 0.03, 1.0, 1.0);
         assert_eq!(v(&[fruit.clone(), stem]), Visibility::BehindStem);
         assert_eq!(v(&[fruit.clone()]), Visibility::Free);

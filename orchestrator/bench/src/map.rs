@@ -33,8 +33,12 @@ pub fn map_bounds(layout: &agrisim_greenhouse::Layout) -> [f64; 4] {
 /// the very plants it sees), and obstacles (the robot must find them with its LiDAR).
 pub fn building_plan(g: &agrisim_greenhouse::Greenhouse) -> OccupancyMap {
     use agrisim_greenhouse::Kind;
-    let structure: Vec<_> =
-        g.objects.iter().filter(|o| matches!(o.kind, Kind::Wall | Kind::Roof | Kind::Post | Kind::Gutter | Kind::HeatingPipe)).cloned().collect();
+    let structure: Vec<_> = g
+        .objects
+        .iter()
+        .filter(|o| matches!(o.kind, Kind::Wall | Kind::Roof | Kind::Post | Kind::Gutter | Kind::HeatingPipe))
+        .cloned()
+        .collect();
     let mut map = OccupancyMap::from_objects(&structure, MAP_RESOLUTION, MAP_BAND, map_bounds(&g.layout));
     for r in &g.layout.rows {
         map.fill_rect(r.x_start, r.y - 0.5 * r.width, r.x_end, r.y + 0.5 * r.width);
@@ -50,7 +54,10 @@ pub fn mapping_run(seen: &agrisim_greenhouse::Greenhouse) -> OccupancyMap {
 }
 
 /// The scenario's prior map (`[nav] prior_map`) for a trial in scene `g`.
-pub fn prior_map(s: &agrisim_session::Scenario, g: &agrisim_greenhouse::Greenhouse) -> agrisim_error::Result<OccupancyMap> {
+pub fn prior_map(
+    s: &agrisim_session::Scenario,
+    g: &agrisim_greenhouse::Greenhouse,
+) -> agrisim_error::Result<OccupancyMap> {
     Ok(match s.nav.prior_map {
         agrisim_session::PriorMap::Plan => building_plan(g),
         agrisim_session::PriorMap::MappingRun => mapping_run(&agrisim_session::scene::mapping_run_scene(s)?),
@@ -66,7 +73,10 @@ pub fn grid_message(map: &OccupancyMap, t_ns: i64) -> OccupancyGrid {
             resolution: map.resolution as f32,
             width: map.width as u32,
             height: map.height as u32,
-            origin: Pose { position: Point { x: map.origin[0], y: map.origin[1], z: 0.0 }, orientation: Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 } },
+            origin: Pose {
+                position: Point { x: map.origin[0], y: map.origin[1], z: 0.0 },
+                orientation: Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 },
+            },
         },
         data: map.data.clone(),
     }
@@ -78,7 +88,8 @@ mod tests {
     use agrisim_greenhouse::{config::GreenhouseConfig, generate, Kind};
 
     fn small() -> GreenhouseConfig {
-        GreenhouseConfig::from_toml_str("rows = 4\nactive_rows = 3\nrow_length = 12.0\nlength = 20.0\nwidth = 14.0").unwrap()
+        GreenhouseConfig::from_toml_str("rows = 4\nactive_rows = 3\nrow_length = 12.0\nlength = 20.0\nwidth = 14.0")
+            .unwrap()
     }
 
     /// The plan knows the rows, not the plants: two crops (plant seeds) give the same map.
@@ -86,7 +97,9 @@ mod tests {
     fn the_plan_does_not_depend_on_the_plants() {
         let cfg = small();
         let (a, b) = (generate(&cfg, 1), generate(&cfg, 2));
-        let leaves = |g: &agrisim_greenhouse::Greenhouse| g.objects.iter().filter(|o| o.kind == Kind::Leaf).map(|o| o.placement.translation).collect::<Vec<_>>();
+        let leaves = |g: &agrisim_greenhouse::Greenhouse| {
+            g.objects.iter().filter(|o| o.kind == Kind::Leaf).map(|o| o.placement.translation).collect::<Vec<_>>()
+        };
         assert_ne!(leaves(&a), leaves(&b), "the two seeds must grow different plants");
         assert_eq!(building_plan(&a).data, building_plan(&b).data);
     }
@@ -110,7 +123,14 @@ mod tests {
             let [_, sy, _] = g.layout.start_pose;
             assert!(!map.is_occupied_at(x0 + h, sy), "{name}: the wall is thicker than its face");
             let floor = if name == "plan" {
-                let structure: Vec<_> = g.objects.iter().filter(|o| matches!(o.kind, Kind::Wall | Kind::Roof | Kind::Post | Kind::Gutter | Kind::HeatingPipe)).cloned().collect();
+                let structure: Vec<_> = g
+                    .objects
+                    .iter()
+                    .filter(|o| {
+                        matches!(o.kind, Kind::Wall | Kind::Roof | Kind::Post | Kind::Gutter | Kind::HeatingPipe)
+                    })
+                    .cloned()
+                    .collect();
                 let mut m = OccupancyMap::from_objects(&structure, MAP_RESOLUTION, MAP_BAND, g.layout.bounds);
                 for r in &g.layout.rows {
                     m.fill_rect(r.x_start, r.y - 0.5 * r.width, r.x_end, r.y + 0.5 * r.width);
@@ -123,7 +143,11 @@ mod tests {
             };
             assert_eq!((map.width, map.height), (floor.width + 2, floor.height + 2), "{name}");
             for j in 0..floor.height {
-                assert_eq!(&map.data[(j + 1) * map.width + 1..(j + 1) * map.width + 1 + floor.width], &floor.data[j * floor.width..(j + 1) * floor.width], "{name}: row {j}");
+                assert_eq!(
+                    &map.data[(j + 1) * map.width + 1..(j + 1) * map.width + 1 + floor.width],
+                    &floor.data[j * floor.width..(j + 1) * floor.width],
+                    "{name}: row {j}"
+                );
             }
         }
     }
@@ -175,7 +199,12 @@ mod tests {
     fn the_plan_pins_the_pose_in_the_headland() {
         let g = generate(&GreenhouseConfig::default(), 3);
         let [sx, sy, _] = g.layout.start_pose;
-        let structure: Vec<_> = g.objects.iter().filter(|o| matches!(o.kind, Kind::Wall | Kind::Roof | Kind::Post | Kind::Gutter | Kind::HeatingPipe)).cloned().collect();
+        let structure: Vec<_> = g
+            .objects
+            .iter()
+            .filter(|o| matches!(o.kind, Kind::Wall | Kind::Roof | Kind::Post | Kind::Gutter | Kind::HeatingPipe))
+            .cloned()
+            .collect();
         let mut floor_only = OccupancyMap::from_objects(&structure, MAP_RESOLUTION, MAP_BAND, g.layout.bounds);
         for r in &g.layout.rows {
             floor_only.fill_rect(r.x_start, r.y - 0.5 * r.width, r.x_end, r.y + 0.5 * r.width);
@@ -184,7 +213,8 @@ mod tests {
         for yaw in [0.0, 1.5, 3.0] {
             let pose = [sx, sy + 0.4, yaw];
             let pts = slice(&g, pose);
-            let ((now, n_now), (before, n_before)) = (settled_error(&plan, &pts, pose), settled_error(&floor_only, &pts, pose));
+            let ((now, n_now), (before, n_before)) =
+                (settled_error(&plan, &pts, pose), settled_error(&floor_only, &pts, pose));
             println!("yaw {yaw}: settled {now:.3} m with the walls' faces ({n_now} matches), {before:.3} m without ({n_before})");
             assert!(now < 0.05 && n_now == 10, "yaw {yaw}: {now:.3} m, {n_now} matches");
             assert_eq!(n_before, 10, "yaw {yaw}");
@@ -199,10 +229,18 @@ mod tests {
         let g = generate(&small(), 3);
         let map = building_plan(&g);
         let mut plants = 0;
-        for o in g.objects.iter().filter(|o| matches!(o.kind, Kind::Stem | Kind::Leaf | Kind::Truss | Kind::Fruit { .. })) {
+        for o in
+            g.objects.iter().filter(|o| matches!(o.kind, Kind::Stem | Kind::Leaf | Kind::Truss | Kind::Fruit { .. }))
+        {
             let c = o.placement.translation;
             if c[2] > MAP_BAND.0 && c[2] < MAP_BAND.1 {
-                assert!(map.is_occupied_at(c[0], c[1]), "{} at ({:.2}, {:.2}) outside the mapped envelopes", o.name, c[0], c[1]);
+                assert!(
+                    map.is_occupied_at(c[0], c[1]),
+                    "{} at ({:.2}, {:.2}) outside the mapped envelopes",
+                    o.name,
+                    c[0],
+                    c[1]
+                );
                 plants += 1;
             }
         }

@@ -6,22 +6,22 @@
 //! or in failure with a reason: collision, timeout, no_path, stuck, goal_missed, error.
 //! Ground truth is read here only to judge; the navigation stack never sees it.
 
-use crate::trials::{run_one, run_trials, write_summary, Exec, TrialPlan};
 use super::report::{self, bar_chart, count_table, interval, opt, rate_table, render_with, view_bounds, TrialTrace};
 use super::stats::{wilson, Z95};
 use super::targets::draw_target;
-use agrisim_error::Result;
 use crate::initial_pose::initial_estimate;
-use crate::scenes::{by_scene, SceneResult, Scenes};
 use crate::map::{grid_message, prior_map, MAP_BAND, MAP_RESOLUTION};
+use crate::scenes::{by_scene, SceneResult, Scenes};
+use crate::trials::{run_one, run_trials, write_summary, Exec, TrialPlan};
 use agrisim_bus::Node;
-use agrisim_math::Rng;
-use agrisim_nodes::{FaultInjector, GoalPublisher, MapServer, OdomTf};
-use agrisim_session::{prepare, RunOptions, Scenario};
+use agrisim_error::Result;
 use agrisim_greenhouse::occupancy::OccupancyMap;
+use agrisim_math::Rng;
 use agrisim_msgs::agrisim::NavigationStatus;
 use agrisim_msgs::geometry_msgs::PoseStamped;
 use agrisim_msgs::Message;
+use agrisim_nodes::{FaultInjector, GoalPublisher, MapServer, OdomTf};
+use agrisim_session::{prepare, RunOptions, Scenario};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -109,7 +109,9 @@ pub fn nav_worker(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, i: 
 /// draws it) and the reason.
 fn failed_trial(s: &Scenario, setup: &NavSetup, index: u64, seed: u64, reason: String) -> NavRecord {
     let nav = &s.nav;
-    let target = draw_target(&setup.layout, &setup.truth, &mut Rng::new(seed), nav.targets_in_headland, nav.aisle_margin, 0.7).unwrap_or([0.0; 3]);
+    let target =
+        draw_target(&setup.layout, &setup.truth, &mut Rng::new(seed), nav.targets_in_headland, nav.aisle_margin, 0.7)
+            .unwrap_or([0.0; 3]);
     let trial = NavTrial {
         trial: index,
         scene: 0,
@@ -130,12 +132,21 @@ fn failed_trial(s: &Scenario, setup: &NavSetup, index: u64, seed: u64, reason: S
 }
 
 /// Runs one trial into `mcap`.
-pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &NavSetup, index: u64, seed: u64, mcap: &Path) -> Result<(NavTrial, Vec<[f64; 2]>)> {
+pub fn run_trial(
+    s: &Scenario,
+    o: &RunOptions,
+    setup: &NavSetup,
+    index: u64,
+    seed: u64,
+    mcap: &Path,
+) -> Result<(NavTrial, Vec<[f64; 2]>)> {
     let wall = Instant::now();
     let mut rng = Rng::new(seed);
     let nav = &s.nav;
     let target = draw_target(&setup.layout, &setup.truth, &mut rng, nav.targets_in_headland, nav.aisle_margin, 0.7)
-        .ok_or_else(|| agrisim_error::err!("scenario {}: no free navigation target could be drawn", s.path.display()))?;
+        .ok_or_else(|| {
+            agrisim_error::err!("scenario {}: no free navigation target could be drawn", s.path.display())
+        })?;
     // The localizer starts from an operator's estimate of the start pose, never the true one.
     let (estimate, initial_pose_error) = initial_estimate(setup.layout.start_pose, nav.initial_pose_std, seed);
     let navigator = agrisim_nav::Navigator::new(agrisim_nav::NavConfig::for_estimate(estimate, nav.initial_pose_std));
@@ -174,12 +185,17 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &NavSetup, index: u64, see
                 match st.state.as_str() {
                     "succeeded" => {
                         let d = (x - target[0]).hypot(y - target[1]);
-                        outcome = Some(if d <= nav.goal_tolerance { (true, None) } else { (false, Some("goal_missed".into())) });
+                        outcome = Some(if d <= nav.goal_tolerance {
+                            (true, None)
+                        } else {
+                            (false, Some("goal_missed".into()))
+                        });
                         time_to_goal = Some(k as f64 * step);
                         return Ok(());
                     }
                     "failed" => {
-                        outcome = Some((false, Some(if st.detail.is_empty() { "failed".into() } else { st.detail.clone() })));
+                        outcome =
+                            Some((false, Some(if st.detail.is_empty() { "failed".into() } else { st.detail.clone() })));
                         return Ok(());
                     }
                     _ => {}
@@ -235,12 +251,28 @@ struct NavRecord {
     path: Vec<[f64; 2]>,
 }
 
-fn nav_record(s: &Scenario, o: &RunOptions, setup: &NavSetup, seed: u64, scene: u64, i: u64, mcap: &Path) -> Result<NavRecord> {
+fn nav_record(
+    s: &Scenario,
+    o: &RunOptions,
+    setup: &NavSetup,
+    seed: u64,
+    scene: u64,
+    i: u64,
+    mcap: &Path,
+) -> Result<NavRecord> {
     let (trial, path) = run_trial(s, o, setup, i, trial_seed(seed, i), mcap)?;
     Ok(NavRecord { trial: NavTrial { scene, ..trial }, path: decimate(&path, 10) })
 }
 
-pub fn bench_nav(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, resume: bool, exec: Exec, progress: impl FnMut(u64, u64)) -> Result<NavSummary> {
+pub fn bench_nav(
+    s: &Scenario,
+    o: &RunOptions,
+    plan: TrialPlan,
+    out: &Path,
+    resume: bool,
+    exec: Exec,
+    progress: impl FnMut(u64, u64),
+) -> Result<NavSummary> {
     let o = o.record_default(s, agrisim_session::Profile::Standard);
     let seed = plan.seed;
     let scenes = Scenes::all(s, plan.scenes, NavSetup::new)?;
@@ -256,7 +288,10 @@ pub fn bench_nav(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, resu
         },
         |i, reason| {
             let (k, s, setup) = scenes.of(i);
-            NavRecord { trial: NavTrial { scene: k, ..failed_trial(s, setup, i, trial_seed(seed, i), reason).trial }, path: vec![] }
+            NavRecord {
+                trial: NavTrial { scene: k, ..failed_trial(s, setup, i, trial_seed(seed, i), reason).trial },
+                path: vec![],
+            }
         },
         |r| serde_json::to_string(&r.trial).expect("plain struct"),
     )?;
@@ -264,7 +299,13 @@ pub fn bench_nav(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, resu
     let traces: Vec<TrialTrace> = done
         .results
         .iter()
-        .map(|r| TrialTrace { index: r.trial.trial, success: r.trial.outcome == "success", reason: r.trial.reason.clone().unwrap_or_else(|| "success".into()), target: r.trial.target, path: r.path.clone() })
+        .map(|r| TrialTrace {
+            index: r.trial.trial,
+            success: r.trial.outcome == "success",
+            reason: r.trial.reason.clone().unwrap_or_else(|| "success".into()),
+            target: r.trial.target,
+            path: r.path.clone(),
+        })
         .collect();
     let results: Vec<NavTrial> = done.results.into_iter().map(|r| r.trial).collect();
     let summary = summarize(s, plan, &results);
@@ -276,7 +317,13 @@ pub fn bench_nav(s: &Scenario, o: &RunOptions, plan: TrialPlan, out: &Path, resu
 
 /// The report page: figures the seed determines only (the wall-clock ones are in
 /// summary.json), so the same seed gives the same page.
-fn report_html(objects: &[agrisim_greenhouse::Object], layout: &agrisim_greenhouse::Layout, sum: &NavSummary, results: &[NavTrial], traces: &[TrialTrace]) -> String {
+fn report_html(
+    objects: &[agrisim_greenhouse::Object],
+    layout: &agrisim_greenhouse::Layout,
+    sum: &NavSummary,
+    results: &[NavTrial],
+    traces: &[TrialTrace],
+) -> String {
     let rows = vec![
         ("scenario".to_string(), sum.scenario.clone()),
         ("seed".to_string(), sum.seed.to_string()),
@@ -291,7 +338,14 @@ fn report_html(objects: &[agrisim_greenhouse::Object], layout: &agrisim_greenhou
     ];
     let mut sections = vec![];
     if sum.scenes > 1 {
-        let scenes = sum.per_scene.iter().map(|r| (format!("{} (greenhouse seed {})", r.scene, r.scene_seed), r.trials, r.successes, wilson(r.successes, r.trials, Z95)));
+        let scenes = sum.per_scene.iter().map(|r| {
+            (
+                format!("{} (greenhouse seed {})", r.scene, r.scene_seed),
+                r.trials,
+                r.successes,
+                wilson(r.successes, r.trials, Z95),
+            )
+        });
         let note = "<p>The map above is scene 0's; the trials of the other scenes are drawn on it.</p>";
         sections.push(("Reached per scene".to_string(), rate_table(["scene", "trials", "reached"], scenes) + note));
     }
@@ -300,7 +354,14 @@ fn report_html(objects: &[agrisim_greenhouse::Object], layout: &agrisim_greenhou
         ("Failure taxonomy (trials not reached)".to_string(), count_table(["reason", "trials"], &sum.failures)),
         ("Time to goal (successful trials, simulated)".to_string(), bar_chart(&times, 5.0, "time to goal [s]")),
     ]);
-    render_with(&format!("agrisim nav benchmark: {}", sum.scenario), &rows, objects, view_bounds(layout, traces), traces, &sections)
+    render_with(
+        &format!("agrisim nav benchmark: {}", sum.scenario),
+        &rows,
+        objects,
+        view_bounds(layout, traces),
+        traces,
+        &sections,
+    )
 }
 
 /// Every `every`-th point of `path`, and its last.
@@ -344,6 +405,10 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, results: &[NavTrial]) -> NavSumm
         time_to_goal_mean: if ttg.is_empty() { None } else { Some(ttg.iter().sum::<f64>() / ttg.len() as f64) },
         path_length_mean: if n == 0 { 0.0 } else { results.iter().map(|t| t.path_length).sum::<f64>() / n as f64 },
         // Over the trials that drove (a trial whose process died has no clearance).
-        min_clearance_min: results.iter().filter(|t| t.sim_time > 0.0).map(|t| t.min_clearance).fold(f64::INFINITY, f64::min),
+        min_clearance_min: results
+            .iter()
+            .filter(|t| t.sim_time > 0.0)
+            .map(|t| t.min_clearance)
+            .fold(f64::INFINITY, f64::min),
     }
 }

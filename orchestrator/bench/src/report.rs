@@ -35,7 +35,13 @@ fn escape(s: &str) -> String {
 }
 
 /// Writes the report. `summary` rows are (label, value) pairs shown in a table.
-pub fn render(title: &str, summary: &[(String, String)], objects: &[Object], bounds: [f64; 4], trials: &[TrialTrace]) -> String {
+pub fn render(
+    title: &str,
+    summary: &[(String, String)],
+    objects: &[Object],
+    bounds: [f64; 4],
+    trials: &[TrialTrace],
+) -> String {
     render_with(title, summary, objects, bounds, trials, &[])
 }
 
@@ -56,12 +62,24 @@ pub fn bar_chart(values: &[f64], bin: f64, label: &str) -> String {
     for (i, &c) in counts.iter().enumerate() {
         let bh = c as f64 / top * h;
         let x = 40.0 + i as f64 * 24.0;
-        let _ = write!(svg, r##"<rect x="{x:.1}" y="{:.1}" width="{bw}" height="{bh:.1}" fill="#4a7ab5"><title>{:.0}-{:.0}: {c}</title></rect>"##, h - bh, i as f64 * bin, (i + 1) as f64 * bin);
+        let _ = write!(
+            svg,
+            r##"<rect x="{x:.1}" y="{:.1}" width="{bw}" height="{bh:.1}" fill="#4a7ab5"><title>{:.0}-{:.0}: {c}</title></rect>"##,
+            h - bh,
+            i as f64 * bin,
+            (i + 1) as f64 * bin
+        );
         if i % 2 == 0 {
             let _ = write!(svg, r#"<text x="{x:.1}" y="{:.0}" font-size="10">{:.0}</text>"#, h + 14.0, i as f64 * bin);
         }
     }
-    let _ = write!(svg, r#"<text x="0" y="12" font-size="10">{}</text><text x="40" y="{:.0}" font-size="11">{}</text></svg>"#, top as u64, h + 34.0, escape(label));
+    let _ = write!(
+        svg,
+        r#"<text x="0" y="12" font-size="10">{}</text><text x="40" y="{:.0}" font-size="11">{}</text></svg>"#,
+        top as u64,
+        h + 34.0,
+        escape(label)
+    );
     svg
 }
 
@@ -70,7 +88,14 @@ pub fn bar_chart(values: &[f64], bin: f64, label: &str) -> String {
 pub fn rate_table(head: [&str; 3], rows: impl IntoIterator<Item = (String, u64, u64, [f64; 2])>) -> String {
     let body: String = rows
         .into_iter()
-        .map(|(k, n, ok, w)| format!("<tr><td>{}</td><td>{n}</td><td>{ok}</td><td>{:.3}</td><td>{}</td></tr>", escape(&k), ok as f64 / n.max(1) as f64, interval(w)))
+        .map(|(k, n, ok, w)| {
+            format!(
+                "<tr><td>{}</td><td>{n}</td><td>{ok}</td><td>{:.3}</td><td>{}</td></tr>",
+                escape(&k),
+                ok as f64 / n.max(1) as f64,
+                interval(w)
+            )
+        })
         .collect();
     let [k, n, ok] = head.map(escape);
     format!("<table><tr><th>{k}</th><th>{n}</th><th>{ok}</th><th>fraction</th><th>Wilson 95 %</th></tr>{body}</table>")
@@ -128,7 +153,14 @@ pub fn write(out: &Path, html: &str) -> Result<()> {
 }
 
 /// [`render`] with extra sections (heading, HTML) after the map.
-pub fn render_with(title: &str, summary: &[(String, String)], objects: &[Object], bounds: [f64; 4], trials: &[TrialTrace], sections: &[(String, String)]) -> String {
+pub fn render_with(
+    title: &str,
+    summary: &[(String, String)],
+    objects: &[Object],
+    bounds: [f64; 4],
+    trials: &[TrialTrace],
+    sections: &[(String, String)],
+) -> String {
     let [x0, y0, x1, y1] = bounds;
     let scale = 900.0 / (x1 - x0).max(y1 - y0).max(1e-6);
     let (w, h) = ((x1 - x0) * scale, (y1 - y0) * scale);
@@ -136,7 +168,10 @@ pub fn render_with(title: &str, summary: &[(String, String)], objects: &[Object]
     let px = |x: f64| (x - x0) * scale;
     let py = |y: f64| (y1 - y) * scale;
     let mut svg = String::new();
-    let _ = write!(svg, r##"<svg xmlns="http://www.w3.org/2000/svg" width="{w:.0}" height="{h:.0}" viewBox="0 0 {w:.1} {h:.1}" style="background:#f7f5ef">"##);
+    let _ = write!(
+        svg,
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="{w:.0}" height="{h:.0}" viewBox="0 0 {w:.1} {h:.1}" style="background:#f7f5ef">"##
+    );
     for o in objects {
         let c = colour(o.kind);
         if c == "none" || matches!(o.kind, Kind::Gutter | Kind::Roof | Kind::Fruit { .. } | Kind::Leaf) {
@@ -147,23 +182,55 @@ pub fn render_with(title: &str, summary: &[(String, String)], objects: &[Object]
             Shape::Box { half } => {
                 let [qx, qy, qz, qw] = o.placement.rotation;
                 let yaw = (2.0 * (qw * qz + qx * qy)).atan2(1.0 - 2.0 * (qy * qy + qz * qz));
-                let _ = write!(svg, r#"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="{c}" transform="rotate({:.2} {:.1} {:.1})"/>"#,
-                    px(x - half[0]), py(y + half[1]), 2.0 * half[0] * scale, 2.0 * half[1] * scale, -yaw.to_degrees(), px(x), py(y));
+                let _ = write!(
+                    svg,
+                    r#"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="{c}" transform="rotate({:.2} {:.1} {:.1})"/>"#,
+                    px(x - half[0]),
+                    py(y + half[1]),
+                    2.0 * half[0] * scale,
+                    2.0 * half[1] * scale,
+                    -yaw.to_degrees(),
+                    px(x),
+                    py(y)
+                );
             }
             Shape::Cylinder { radius, .. } | Shape::Sphere { radius } => {
-                let _ = write!(svg, r#"<circle cx="{:.1}" cy="{:.1}" r="{:.1}" fill="{c}"/>"#, px(x), py(y), (radius * scale).max(0.6));
+                let _ = write!(
+                    svg,
+                    r#"<circle cx="{:.1}" cy="{:.1}" r="{:.1}" fill="{c}"/>"#,
+                    px(x),
+                    py(y),
+                    (radius * scale).max(0.6)
+                );
             }
         }
     }
     for t in trials {
         let c = if t.success { "#1a7f37" } else { "#cf222e" };
         let pts: Vec<String> = t.path.iter().map(|p| format!("{:.1},{:.1}", px(p[0]), py(p[1]))).collect();
-        let _ = write!(svg, r#"<polyline points="{}" fill="none" stroke="{c}" stroke-width="1.2" stroke-opacity="0.6"><title>trial {} {}</title></polyline>"#, pts.join(" "), t.index, escape(&t.reason));
-        let _ = write!(svg, r#"<circle cx="{:.1}" cy="{:.1}" r="3" fill="none" stroke="{c}" stroke-width="1.5"><title>target of trial {}</title></circle>"#, px(t.target[0]), py(t.target[1]), t.index);
+        let _ = write!(
+            svg,
+            r#"<polyline points="{}" fill="none" stroke="{c}" stroke-width="1.2" stroke-opacity="0.6"><title>trial {} {}</title></polyline>"#,
+            pts.join(" "),
+            t.index,
+            escape(&t.reason)
+        );
+        let _ = write!(
+            svg,
+            r#"<circle cx="{:.1}" cy="{:.1}" r="3" fill="none" stroke="{c}" stroke-width="1.5"><title>target of trial {}</title></circle>"#,
+            px(t.target[0]),
+            py(t.target[1]),
+            t.index
+        );
     }
     svg.push_str("</svg>");
-    let rows: String = summary.iter().map(|(k, v)| format!("<tr><th>{}</th><td>{}</td></tr>", escape(k), escape(v))).collect();
-    let failures: String = trials.iter().filter(|t| !t.success).map(|t| format!("<li>trial {:04}: {}</li>", t.index, escape(&t.reason))).collect();
+    let rows: String =
+        summary.iter().map(|(k, v)| format!("<tr><th>{}</th><td>{}</td></tr>", escape(k), escape(v))).collect();
+    let failures: String = trials
+        .iter()
+        .filter(|t| !t.success)
+        .map(|t| format!("<li>trial {:04}: {}</li>", t.index, escape(&t.reason)))
+        .collect();
     format!(
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{t}</title><style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse}}th,td{{border:1px solid #ccc;padding:4px 10px;text-align:left}}</style></head>\n<body><h1>{t}</h1><table>{rows}</table><h2>Top-down map and trial paths</h2><p>Green: success, red: failure; circles: targets. Map frame x to the right, y up.</p>{svg}{extra}<h2>Failures</h2><ul>{failures}</ul></body></html>\n",
         t = escape(title),

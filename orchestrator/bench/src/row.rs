@@ -151,16 +151,26 @@ pub fn draw_segment(setup: &HarvestSetup, length: f64, rng: &mut Rng) -> Option<
     let hi = along.iter().map(|t| t.center[0]).fold(f64::NEG_INFINITY, f64::max);
     let x0 = lo + (hi - lo - length).max(0.0) * rng.uniform();
     let x1 = x0 + length;
-    let mut targets: Vec<HarvestTarget> = along.into_iter().filter(|t| (x0..x1).contains(&t.center[0])).cloned().collect();
+    let mut targets: Vec<HarvestTarget> =
+        along.into_iter().filter(|t| (x0..x1).contains(&t.center[0])).cloned().collect();
     targets.sort_by(|a, b| a.center[0].total_cmp(&b.center[0]).then(a.fruit_index.cmp(&b.fruit_index)));
     let first = targets.first().map_or(x0, |t| agrisim_harvest::geometry::standoff(t.center, t.side)[0]);
     Some(Segment { aisle_y, x_range: [x0, x1], start: [first - LEAD_IN, aisle_y, 0.0], targets })
 }
 
 /// Runs one segment into `mcap` with the built-in row node.
-pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, length: f64, index: u64, seed: u64, mcap: &Path) -> Result<RowTrial> {
+pub fn run_trial(
+    s: &Scenario,
+    o: &RunOptions,
+    setup: &HarvestSetup,
+    length: f64,
+    index: u64,
+    seed: u64,
+    mcap: &Path,
+) -> Result<RowTrial> {
     let wall = Instant::now();
-    let seg = draw_segment(setup, length, &mut Rng::new(seed)).ok_or_else(|| err!("scenario {}: no aisle with reachable ripe fruit", s.path.display()))?;
+    let seg = draw_segment(setup, length, &mut Rng::new(seed))
+        .ok_or_else(|| err!("scenario {}: no aisle with reachable ripe fruit", s.path.display()))?;
     let node = RowNode::new(seg.targets.iter().map(|t| t.fruit_index).collect(), seed);
     let mut m = harvest_session(s, o, setup, seg.start, seed, mcap, Box::new(node), None)?;
     let (world, chassis) = (m.component("world", "row benchmark")?, m.component("chassis", "row benchmark")?);
@@ -256,7 +266,11 @@ pub fn run_trial(s: &Scenario, o: &RunOptions, setup: &HarvestSetup, length: f64
                 visibility: t.visibility.name().into(),
                 harvested: placed_at.is_some(),
                 failed_stage: failure.as_ref().and(st.map(|s| s.stage.clone())),
-                detail: if failure.is_some() { st.map(|s| s.detail.clone()).unwrap_or_default() } else { String::new() },
+                detail: if failure.is_some() {
+                    st.map(|s| s.detail.clone()).unwrap_or_default()
+                } else {
+                    String::new()
+                },
                 failure,
                 placed_at,
             }
@@ -322,7 +336,16 @@ fn failed_trial(setup: &HarvestSetup, length: f64, index: u64, seed: u64, reason
 /// Runs `plan.trials` segments and writes trials.jsonl, summary.json, report.html and
 /// trials/*.mcap.
 #[allow(clippy::too_many_arguments)]
-pub fn bench_row(s: &Scenario, o: &RunOptions, plan: TrialPlan, length: f64, out: &Path, resume: bool, exec: Exec, progress: impl FnMut(u64, u64)) -> Result<RowSummary> {
+pub fn bench_row(
+    s: &Scenario,
+    o: &RunOptions,
+    plan: TrialPlan,
+    length: f64,
+    out: &Path,
+    resume: bool,
+    exec: Exec,
+    progress: impl FnMut(u64, u64),
+) -> Result<RowSummary> {
     check_length(length)?;
     let o = o.record_default(s, agrisim_session::Profile::Standard);
     let seed = plan.seed;
@@ -356,7 +379,9 @@ pub fn row_worker(s: &Scenario, o: &RunOptions, plan: TrialPlan, length: f64, ou
     let o = o.record_default(s, agrisim_session::Profile::Standard);
     let scenes = Scenes::for_trial(s, plan.scenes, i, HarvestSetup::new)?;
     let (k, s, setup) = scenes.of(i);
-    run_one(out, i, |i, mcap| run_trial(s, &o, setup, length, i, trial_seed(plan.seed, i), mcap).map(|t| RowTrial { scene: k, ..t }))
+    run_one(out, i, |i, mcap| {
+        run_trial(s, &o, setup, length, i, trial_seed(plan.seed, i), mcap).map(|t| RowTrial { scene: k, ..t })
+    })
 }
 
 fn check_length(length: f64) -> Result<()> {
@@ -395,7 +420,8 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, length: f64, results: &[RowTrial
     cycles.sort_by(f64::total_cmp);
     let sim: f64 = results.iter().map(|t| t.sim_time).sum();
     let wall: f64 = results.iter().map(|t| t.wall_time).sum();
-    let clusters: Vec<(u64, u64)> = results.iter().filter(|t| t.targets > 0).map(|t| (t.harvested, t.targets)).collect();
+    let clusters: Vec<(u64, u64)> =
+        results.iter().filter(|t| t.targets > 0).map(|t| (t.harvested, t.targets)).collect();
     RowSummary {
         scenario: s.name.clone(),
         seed: plan.seed,
@@ -430,9 +456,15 @@ fn write_report(s: &Scenario, sum: &RowSummary, results: &[RowTrial], out: &Path
         ("scenario".to_string(), sum.scenario.clone()),
         ("segments x length".to_string(), format!("{} x {} m", sum.segments, sum.segment_length)),
         ("ripe fruit reachable / harvested".to_string(), format!("{} / {}", sum.targets, sum.harvested)),
-        ("harvested fraction".to_string(), format!("{:.3} (cluster bootstrap 95 % {})", sum.harvested_fraction, interval(sum.cluster_bootstrap95))),
+        (
+            "harvested fraction".to_string(),
+            format!("{:.3} (cluster bootstrap 95 % {})", sum.harvested_fraction, interval(sum.cluster_bootstrap95)),
+        ),
         ("fruit per hour".to_string(), format!("{:.1}", sum.fruit_per_hour)),
-        ("cycle time mean / p50 / p95 [s]".to_string(), format!("{} / {} / {}", opt(sum.cycle_time_mean), opt(sum.cycle_time_p50), opt(sum.cycle_time_p95))),
+        (
+            "cycle time mean / p50 / p95 [s]".to_string(),
+            format!("{} / {} / {}", opt(sum.cycle_time_mean), opt(sum.cycle_time_p50), opt(sum.cycle_time_p95)),
+        ),
         ("plant touches per fruit".to_string(), per_kind(&sum.touches_per_fruit)),
         ("dropped fruit".to_string(), sum.dropped.to_string()),
         ("segments ended".to_string(), format!("{:?}", sum.segments_ended)),
@@ -449,11 +481,30 @@ fn write_report(s: &Scenario, sum: &RowSummary, results: &[RowTrial], out: &Path
         .iter()
         .filter(|t| t.scene == 0)
         .flat_map(|t| {
-            let path = TrialTrace { index: t.trial, success: t.harvested == t.targets, reason: format!("segment {}: {}/{} harvested, ended {}", t.trial, t.harvested, t.targets, t.ended), target: t.start, path: t.path.clone() };
-            std::iter::once(path).chain(t.fruit.iter().map(move |f| TrialTrace { index: t.trial, success: f.harvested, reason: f.failure.clone().unwrap_or_default(), target: f.fruit, path: vec![] }))
+            let path = TrialTrace {
+                index: t.trial,
+                success: t.harvested == t.targets,
+                reason: format!("segment {}: {}/{} harvested, ended {}", t.trial, t.harvested, t.targets, t.ended),
+                target: t.start,
+                path: t.path.clone(),
+            };
+            std::iter::once(path).chain(t.fruit.iter().map(move |f| TrialTrace {
+                index: t.trial,
+                success: f.harvested,
+                reason: f.failure.clone().unwrap_or_default(),
+                target: f.fruit,
+                path: vec![],
+            }))
         })
         .collect();
     let [x0, y0, x1, y1] = g.layout.bounds;
-    let html = render_with(&format!("agrisim row harvest benchmark: {}", s.name), &rows, &g.objects, [x0, y0, x1, y1], &traces, &sections);
+    let html = render_with(
+        &format!("agrisim row harvest benchmark: {}", s.name),
+        &rows,
+        &g.objects,
+        [x0, y0, x1, y1],
+        &traces,
+        &sections,
+    );
     report::write(out, &html)
 }

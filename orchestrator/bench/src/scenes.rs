@@ -42,17 +42,31 @@ pub struct Scenes<T> {
 
 impl<T> Scenes<T> {
     /// All `scenes` scenes, scene 0 first.
-    pub fn all(s: &Scenario, scenes: u64, setup: impl Fn(&Scenario) -> agrisim_error::Result<T>) -> agrisim_error::Result<Scenes<T>> {
+    pub fn all(
+        s: &Scenario,
+        scenes: u64,
+        setup: impl Fn(&Scenario) -> agrisim_error::Result<T>,
+    ) -> agrisim_error::Result<Scenes<T>> {
         Scenes::of_indices(s, scenes, 0..scenes.max(1), setup)
     }
 
     /// Only trial `trial`'s scene (a worker process runs one trial).
-    pub fn for_trial(s: &Scenario, scenes: u64, trial: u64, setup: impl Fn(&Scenario) -> agrisim_error::Result<T>) -> agrisim_error::Result<Scenes<T>> {
+    pub fn for_trial(
+        s: &Scenario,
+        scenes: u64,
+        trial: u64,
+        setup: impl Fn(&Scenario) -> agrisim_error::Result<T>,
+    ) -> agrisim_error::Result<Scenes<T>> {
         let k = scene_of(trial, scenes);
         Scenes::of_indices(s, scenes, k..k + 1, setup)
     }
 
-    fn of_indices(s: &Scenario, scenes: u64, ks: std::ops::Range<u64>, setup: impl Fn(&Scenario) -> agrisim_error::Result<T>) -> agrisim_error::Result<Scenes<T>> {
+    fn of_indices(
+        s: &Scenario,
+        scenes: u64,
+        ks: std::ops::Range<u64>,
+        setup: impl Fn(&Scenario) -> agrisim_error::Result<T>,
+    ) -> agrisim_error::Result<Scenes<T>> {
         let list = ks
             .map(|k| {
                 let s = in_scene(s, k);

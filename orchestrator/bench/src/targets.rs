@@ -1,19 +1,29 @@
 //! Seeded navigation targets: a point on an aisle's centre line or in the headland, away from
 //! the aisle ends and from anything the static map marks occupied.
 
-use agrisim_math::Rng;
 use agrisim_greenhouse::occupancy::OccupancyMap;
 use agrisim_greenhouse::Layout;
+use agrisim_math::Rng;
 
 /// Draws a target (x, y, yaw) for a trial. Aisles are chosen in proportion to their length,
 /// the headland with probability 1/4 when allowed; the yaw is uniform (the base is omni).
-pub fn draw_target(layout: &Layout, map: &OccupancyMap, rng: &mut Rng, headland: bool, margin: f64, clearance: f64) -> Option<[f64; 3]> {
+pub fn draw_target(
+    layout: &Layout,
+    map: &OccupancyMap,
+    rng: &mut Rng,
+    headland: bool,
+    margin: f64,
+    clearance: f64,
+) -> Option<[f64; 3]> {
     let lengths: Vec<f64> = layout.aisles.iter().map(|a| (a.x_end - a.x_start - 2.0 * margin).max(0.0)).collect();
     let total: f64 = lengths.iter().sum();
     for _ in 0..1000 {
         let (x, y) = if headland && (total == 0.0 || rng.uniform() < 0.25) {
             let [x0, y0, x1, y1] = layout.headland;
-            (x0 + margin + rng.uniform() * (x1 - x0 - 2.0 * margin).max(0.0), y0 + margin + rng.uniform() * (y1 - y0 - 2.0 * margin).max(0.0))
+            (
+                x0 + margin + rng.uniform() * (x1 - x0 - 2.0 * margin).max(0.0),
+                y0 + margin + rng.uniform() * (y1 - y0 - 2.0 * margin).max(0.0),
+            )
         } else {
             if total == 0.0 {
                 return None;

@@ -114,7 +114,9 @@ pub fn run_one<R: Serialize>(out: &Path, i: u64, trial: impl FnOnce(u64, &Path) 
 
 fn load<R: DeserializeOwned>(json: &Path) -> Result<R> {
     let text = std::fs::read_to_string(json).context(|| format!("cannot read {}", json.display()))?;
-    serde_json::from_str::<R>(&text).map_err(|e| err!("{}: not a trial result of this benchmark ({e}); remove it to run the trial again", json.display()))
+    serde_json::from_str::<R>(&text).map_err(|e| {
+        err!("{}: not a trial result of this benchmark ({e}); remove it to run the trial again", json.display())
+    })
 }
 
 /// Why a worker process ended without a result.
@@ -251,11 +253,7 @@ fn run_in_process<R: Serialize + DeserializeOwned>(
     let mut done = Completed { results: vec![], interrupted: None, resumed: 0 };
     for i in 0..n {
         let (mcap, json) = (trial_file(&dir, i, "mcap"), trial_file(&dir, i, "json"));
-        let earlier = if resume && mcap.is_file() && json.is_file() {
-            Some(load::<R>(&json)?)
-        } else {
-            None
-        };
+        let earlier = if resume && mcap.is_file() && json.is_file() { Some(load::<R>(&json)?) } else { None };
         let result = match earlier {
             Some(r) => {
                 done.resumed += 1;
@@ -296,4 +294,3 @@ pub fn write_summary<S: Serialize>(out: &Path, summary: &S, interrupted: Option<
     }
     write_atomic(&out.join("summary.json"), (serde_json::to_string_pretty(&v).expect("plain value") + "\n").as_bytes())
 }
-

@@ -59,12 +59,25 @@ struct Bench {
 impl Bench {
     fn new() -> Bench {
         let fmu_dir = root().join("target/fmu");
-        assert!(fmu_dir.join("Greenhouse.fmu").exists(), "{} has no packed FMUs: run `target/release/agrisim fmu pack` (scripts/setup does)", fmu_dir.display());
+        assert!(
+            fmu_dir.join("Greenhouse.fmu").exists(),
+            "{} has no packed FMUs: run `target/release/agrisim fmu pack` (scripts/setup does)",
+            fmu_dir.display()
+        );
         let dir = tempfile::tempdir().unwrap();
         let mut scenario = Scenario::load(&root().join("models/scenarios/harvest.toml")).unwrap();
         // The judge's checks need a harvest that succeeds: a fruit in plain view.
         scenario.harvest.visibility = vec!["free".into()];
-        let options = RunOptions { fmu_dir, cache_dir: dir.path().join("cache"), seed: None, duration: None, fmu_overrides: BTreeMap::new(), fmu_log: None, record: None, nodes: Default::default() };
+        let options = RunOptions {
+            fmu_dir,
+            cache_dir: dir.path().join("cache"),
+            seed: None,
+            duration: None,
+            fmu_overrides: BTreeMap::new(),
+            fmu_log: None,
+            record: None,
+            nodes: Default::default(),
+        };
         let setup = HarvestSetup::new(&scenario).unwrap();
         Bench { scenario, options, setup, dir }
     }
@@ -81,12 +94,30 @@ fn header(t_ns: i64) -> Header {
 }
 
 fn status(t_ns: i64, stage: &str, outcome: &str, category: &str, detail: &str) -> (i64, Said) {
-    let m = HarvestStatus { header: header(t_ns), stage: stage.into(), target_id: 0, target_name: String::new(), outcome: outcome.into(), failure_category: category.into(), detail: detail.into(), plans: 0 };
+    let m = HarvestStatus {
+        header: header(t_ns),
+        stage: stage.into(),
+        target_id: 0,
+        target_name: String::new(),
+        outcome: outcome.into(),
+        failure_category: category.into(),
+        detail: detail.into(),
+        plans: 0,
+    };
     (t_ns, Said::Status(m))
 }
 
 fn plan(t_ns: i64, ok: bool, optional: bool) -> (i64, Said) {
-    let m = PlanResult { header: header(t_ns), stage: "pre_grasp".into(), arm: "left".into(), kind: "free".into(), ok, optional, detail: if ok { String::new() } else { "no path".into() }, planning_time: 0.004 };
+    let m = PlanResult {
+        header: header(t_ns),
+        stage: "pre_grasp".into(),
+        arm: "left".into(),
+        kind: "free".into(),
+        ok,
+        optional,
+        detail: if ok { String::new() } else { "no path".into() },
+        planning_time: 0.004,
+    };
     (t_ns, Said::Plan(m))
 }
 
@@ -129,11 +160,40 @@ fn a_scripted_node_is_judged_from_its_messages_and_the_ground_truth() {
     // A failure report is taken as the category and stage the node names. A failed plan
     // with a fallback does not fail planning, but a trial that ends (here at the grasp)
     // before asking for every plan leaves planning undecided; a failed required plan fails it.
-    let grasp = b.trial("grasp", &|_, _| Box::new(Scripted { script: vec![plan(500_000_000, false, true), status(1_000_000_000, "grasp", "failure", "grasp", "closed on nothing")] }), 10.0);
-    assert_eq!((grasp.failure.as_deref(), grasp.failed_stage.as_deref(), grasp.detail.as_str()), (Some("grasp"), Some("grasp"), "closed on nothing"));
+    let grasp = b.trial(
+        "grasp",
+        &|_, _| {
+            Box::new(Scripted {
+                script: vec![
+                    plan(500_000_000, false, true),
+                    status(1_000_000_000, "grasp", "failure", "grasp", "closed on nothing"),
+                ],
+            })
+        },
+        10.0,
+    );
+    assert_eq!(
+        (grasp.failure.as_deref(), grasp.failed_stage.as_deref(), grasp.detail.as_str()),
+        (Some("grasp"), Some("grasp"), "closed on nothing")
+    );
     assert!(!grasp.planning_ok && grasp.planning == "not_reached" && grasp.plans == 1);
-    let planning = b.trial("planning", &|_, _| Box::new(Scripted { script: vec![plan(500_000_000, true, false), plan(600_000_000, false, false), status(600_000_000, "approach", "failure", "planning", "no IK")] }), 10.0);
-    assert_eq!((planning.failure.as_deref(), planning.plans, planning.planning_ok, planning.planning.as_str()), (Some("planning"), 2, false, "failed"));
+    let planning = b.trial(
+        "planning",
+        &|_, _| {
+            Box::new(Scripted {
+                script: vec![
+                    plan(500_000_000, true, false),
+                    plan(600_000_000, false, false),
+                    status(600_000_000, "approach", "failure", "planning", "no IK"),
+                ],
+            })
+        },
+        10.0,
+    );
+    assert_eq!(
+        (planning.failure.as_deref(), planning.plans, planning.planning_ok, planning.planning.as_str()),
+        (Some("planning"), 2, false, "failed")
+    );
 
     // A node that says nothing times out.
     let silent = b.trial("silent", &|_, _| Box::new(Scripted { script: vec![] }), 1.0);

@@ -135,7 +135,8 @@ impl Tap {
     /// Every message since the last call on every topic `keep` accepts, topic by topic in
     /// name order, oldest first: (topic, type, sample).
     pub fn take(&mut self, bus: &mut Bus, keep: impl Fn(&str) -> bool) -> Vec<(String, String, Sample)> {
-        let topics: Vec<(String, String)> = bus.topics().filter(|(t, _)| keep(t)).map(|(t, ty)| (t.to_string(), ty.to_string())).collect();
+        let topics: Vec<(String, String)> =
+            bus.topics().filter(|(t, _)| keep(t)).map(|(t, ty)| (t.to_string(), ty.to_string())).collect();
         let mut out = vec![];
         for (topic, ty) in topics {
             let samples = self.readers.entry(topic.clone()).or_insert_with(|| Reader::new(&topic)).take_samples(bus);
@@ -183,7 +184,13 @@ impl Bus {
         match M::from_cdr(&s.cdr) {
             Ok(m) => Some(m),
             Err(e) => {
-                self.rejected.push(format!("topic {topic}: message {} ({} bytes, published at t={} s) is not a valid {}: {e}; skipped", s.seq, s.cdr.len(), s.time_ns as f64 / 1e9, M::TYPE_NAME));
+                self.rejected.push(format!(
+                    "topic {topic}: message {} ({} bytes, published at t={} s) is not a valid {}: {e}; skipped",
+                    s.seq,
+                    s.cdr.len(),
+                    s.time_ns as f64 / 1e9,
+                    M::TYPE_NAME
+                ));
                 None
             }
         }
@@ -240,7 +247,8 @@ mod tests {
         bus.publish_raw("/b", "x/msg/B", 1, vec![1]);
         bus.publish_raw("/a", "x/msg/A", 1, vec![2]);
         bus.publish_raw("/a", "x/msg/A", 2, vec![3]);
-        let got: Vec<(String, Vec<u8>)> = tap.take(&mut bus, |t| t != "/c").into_iter().map(|(t, _, s)| (t, s.cdr.to_vec())).collect();
+        let got: Vec<(String, Vec<u8>)> =
+            tap.take(&mut bus, |t| t != "/c").into_iter().map(|(t, _, s)| (t, s.cdr.to_vec())).collect();
         // A topic is joined at its newest message, then followed in full.
         assert_eq!(got, [("/a".to_string(), vec![3]), ("/b".to_string(), vec![1])]);
         bus.publish_raw("/a", "x/msg/A", 3, vec![4]);

@@ -13,7 +13,11 @@ pub fn message_type(mime: &str, file: &str, label: &str) -> Result<String> {
 /// A message leaving FMU `comp` on output `var` must decode as the type its port declares.
 pub fn check_message(comp: &str, var: &str, ty: &str, bytes: &[u8], t_ns: i64) -> Result<()> {
     match agrisim_msgs::check_cdr(ty, bytes) {
-        Some(Err(e)) => Err(crate::err!("FMU '{comp}': output '{var}' at t={} is not a valid {ty} message ({} bytes): {e}", t_ns as f64 / 1e9, bytes.len())),
+        Some(Err(e)) => Err(crate::err!(
+            "FMU '{comp}': output '{var}' at t={} is not a valid {ty} message ({} bytes): {e}",
+            t_ns as f64 / 1e9,
+            bytes.len()
+        )),
         _ => Ok(()),
     }
 }

@@ -91,7 +91,8 @@ pub const HEAVY_PERIOD: f64 = 5.0;
 /// Period of IMU samples in the `standard` profile [s] (50 Hz: noise compresses badly).
 pub const IMU_PERIOD: f64 = 0.02;
 const HEAVY_TYPES: [&str; 2] = ["sensor_msgs/msg/PointCloud2", "sensor_msgs/msg/Image"];
-const JUDGE_TOPICS: [&str; 5] = ["/harvest/status", "/harvest/plans", "/navigate/status", "/collision", "/agrisim/status"];
+const JUDGE_TOPICS: [&str; 5] =
+    ["/harvest/status", "/harvest/plans", "/navigate/status", "/collision", "/agrisim/status"];
 const GROUND_TRUTH_SIGNALS: [&str; 2] = ["/fmu/world/signals", "/fmu/chassis/signals"];
 
 impl RecordPolicy {
@@ -181,7 +182,12 @@ mod tests {
         assert_eq!(judge.rule("/collision", "agrisim_msgs/msg/CollisionState"), Rule::Keep);
         assert_eq!(judge.rule("/imu", "sensor_msgs/msg/Imu"), Rule::Drop);
         assert_eq!(RecordPolicy::profile(Profile::None).rule("/collision", "x"), Rule::Drop);
-        let custom = RecordPolicy { profile: Profile::None, include: vec!["/camera/*".into()], exclude: vec!["/camera/labels".into()], decimate: BTreeMap::from([("/imu".into(), 0.05)]) };
+        let custom = RecordPolicy {
+            profile: Profile::None,
+            include: vec!["/camera/*".into()],
+            exclude: vec!["/camera/labels".into()],
+            decimate: BTreeMap::from([("/imu".into(), 0.05)]),
+        };
         assert_eq!(custom.rule("/camera/color/image_raw", "sensor_msgs/msg/Image"), Rule::Keep);
         assert_eq!(custom.rule("/camera/labels", "sensor_msgs/msg/Image"), Rule::Drop);
         assert_eq!(custom.rule("/imu", "sensor_msgs/msg/Imu"), Rule::Every(0.05));

@@ -126,7 +126,10 @@ mod tests {
 
     /// Runs `body` as the consumer of `q` on a thread of its own, guarded as the recorder's
     /// writer thread is.
-    fn consumer<R: Send + 'static>(q: &Arc<Queue<Vec<u8>>>, body: impl FnOnce(&Queue<Vec<u8>>) -> R + Send + 'static) -> std::thread::JoinHandle<R> {
+    fn consumer<R: Send + 'static>(
+        q: &Arc<Queue<Vec<u8>>>,
+        body: impl FnOnce(&Queue<Vec<u8>>) -> R + Send + 'static,
+    ) -> std::thread::JoinHandle<R> {
         let q = q.clone();
         std::thread::spawn(move || {
             let _unblock = FailOnPanic::new(q.clone(), "consumer panicked");
@@ -143,7 +146,12 @@ mod tests {
             let mut got = vec![];
             while let Some(item) = q.pop() {
                 let s = q.lock();
-                assert!(s.bytes <= 1000 || s.items.len() == 1, "queue over its limit: {} bytes in {} items", s.bytes, s.items.len());
+                assert!(
+                    s.bytes <= 1000 || s.items.len() == 1,
+                    "queue over its limit: {} bytes in {} items",
+                    s.bytes,
+                    s.items.len()
+                );
                 drop(s);
                 got.push(item);
                 std::thread::yield_now();

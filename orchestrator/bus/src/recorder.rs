@@ -136,14 +136,28 @@ impl Recorder {
             .compression_level(1)
             .compression_threads(workers)
             .chunk_size(Some(bytes));
-        let writer = options.create(BufWriter::new(file)).context(|| format!("cannot start MCAP file {}", path.display()))?;
-        let writer = WriterThread::start(Sink { writer, path: path.display().to_string(), schemas: BTreeMap::new(), topics: vec![] }).context(|| format!("cannot start the writer thread of {}", path.display()))?;
-        Ok(Recorder { writer: Some(writer), path: path.to_path_buf(), policy, topics: vec![], by_name: BTreeMap::new() })
+        let writer =
+            options.create(BufWriter::new(file)).context(|| format!("cannot start MCAP file {}", path.display()))?;
+        let writer = WriterThread::start(Sink {
+            writer,
+            path: path.display().to_string(),
+            schemas: BTreeMap::new(),
+            topics: vec![],
+        })
+        .context(|| format!("cannot start the writer thread of {}", path.display()))?;
+        Ok(Recorder {
+            writer: Some(writer),
+            path: path.to_path_buf(),
+            policy,
+            topics: vec![],
+            by_name: BTreeMap::new(),
+        })
     }
 
     /// Queues `cmd` for the writer thread; an error the writer met since is reported here.
     fn send(&mut self, cmd: Cmd) -> Result<()> {
-        let w = self.writer.as_ref().ok_or_else(|| crate::err!("{}: recording already finished", self.path.display()))?;
+        let w =
+            self.writer.as_ref().ok_or_else(|| crate::err!("{}: recording already finished", self.path.display()))?;
         w.queue.push(cmd).map_err(|e| crate::err!("{e}"))
     }
 
@@ -202,7 +216,8 @@ impl Recorder {
         let (failure, finished) = w.finish();
         if finished.is_ok() {
             let part = part_path(&self.path);
-            std::fs::rename(&part, &self.path).context(|| format!("renaming {} to {}", part.display(), self.path.display()))?;
+            std::fs::rename(&part, &self.path)
+                .context(|| format!("renaming {} to {}", part.display(), self.path.display()))?;
         }
         match failure {
             Some(e) => Err(crate::err!("{e}")),
@@ -226,8 +241,15 @@ impl Drop for Recorder {
 /// What the stepping thread asks of the writer thread, in order.
 enum Cmd {
     /// A topic was named (its MCAP channel is added at its first message).
-    Topic { name: String, type_name: String },
-    Message { topic: u16, time_ns: i64, cdr: Payload },
+    Topic {
+        name: String,
+        type_name: String,
+    },
+    Message {
+        topic: u16,
+        time_ns: i64,
+        cdr: Payload,
+    },
     Metadata(mcap::records::Metadata),
 }
 
@@ -314,10 +336,20 @@ impl Sink {
                 let id = self.mcap_channel(i)?;
                 let t = &mut self.topics[i];
                 t.sequence += 1;
-                let header = mcap::records::MessageHeader { channel_id: id, sequence: t.sequence, log_time: time_ns as u64, publish_time: time_ns as u64 };
-                self.writer.write_to_known_channel(&header, cdr.as_slice()).map_err(|e| format!("writing {}: {}", self.path, chain(&e)))
+                let header = mcap::records::MessageHeader {
+                    channel_id: id,
+                    sequence: t.sequence,
+                    log_time: time_ns as u64,
+                    publish_time: time_ns as u64,
+                };
+                self.writer
+                    .write_to_known_channel(&header, cdr.as_slice())
+                    .map_err(|e| format!("writing {}: {}", self.path, chain(&e)))
             }
-            Cmd::Metadata(m) => self.writer.write_metadata(&m).map_err(|e| format!("{}: MCAP metadata {}: {}", self.path, m.name, chain(&e))),
+            Cmd::Metadata(m) => self
+                .writer
+                .write_metadata(&m)
+                .map_err(|e| format!("{}: MCAP metadata {}: {}", self.path, m.name, chain(&e))),
         }
     }
 
@@ -331,13 +363,19 @@ impl Sink {
             Some(id) => *id,
             None => {
                 let text = agrisim_msgs::ros2msg_schema(type_name).expect("checked when the channel was made");
-                let id = self.writer.add_schema(type_name, "ros2msg", text.as_bytes()).map_err(|e| format!("{}: MCAP schema {type_name}: {}", self.path, chain(&e)))?;
+                let id = self
+                    .writer
+                    .add_schema(type_name, "ros2msg", text.as_bytes())
+                    .map_err(|e| format!("{}: MCAP schema {type_name}: {}", self.path, chain(&e)))?;
                 self.schemas.insert(type_name.clone(), id);
                 id
             }
         };
         let metadata = BTreeMap::from([("offered_qos_profiles".to_string(), QOS_VOLATILE.to_string())]);
-        let id = self.writer.add_channel(schema_id, topic, "cdr", &metadata).map_err(|e| format!("{}: MCAP channel {topic}: {}", self.path, chain(&e)))?;
+        let id = self
+            .writer
+            .add_channel(schema_id, topic, "cdr", &metadata)
+            .map_err(|e| format!("{}: MCAP channel {topic}: {}", self.path, chain(&e)))?;
         self.topics[i].mcap_id = Some(id);
         Ok(id)
     }
@@ -354,7 +392,14 @@ mod tests {
         (0..count)
             .map(|k| {
                 let data = (0..n).map(|i| ((i / 997 + k) as u8).wrapping_add((rng.next_u64() & 7) as u8)).collect();
-                Image { height: 1, width: n as u32, encoding: "mono8".into(), step: n as u32, data, ..Default::default() }
+                Image {
+                    height: 1,
+                    width: n as u32,
+                    encoding: "mono8".into(),
+                    step: n as u32,
+                    data,
+                    ..Default::default()
+                }
             })
             .collect()
     }

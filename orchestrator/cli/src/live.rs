@@ -75,7 +75,12 @@ type Topic = (&'static str, &'static str);
 fn outputs_of(node: &str) -> Option<(&'static [Topic], &'static [&'static str])> {
     Some(match node {
         "navigator" => (
-            &[("/cmd_vel", "geometry_msgs/msg/Twist"), ("/navigate/status", "agrisim_msgs/msg/NavigationStatus"), ("/localization/pose", "geometry_msgs/msg/PoseStamped"), ("/plan", "nav_msgs/msg/Path")],
+            &[
+                ("/cmd_vel", "geometry_msgs/msg/Twist"),
+                ("/navigate/status", "agrisim_msgs/msg/NavigationStatus"),
+                ("/localization/pose", "geometry_msgs/msg/PoseStamped"),
+                ("/plan", "nav_msgs/msg/Path"),
+            ],
             &["/cmd_vel", "/navigate/status"],
         ),
         "command_script" => (&[("/cmd_vel", "geometry_msgs/msg/Twist")], &["/cmd_vel"]),
@@ -113,7 +118,9 @@ impl LiveArgs {
                 return Err(err!("--external needs --ros2 (the external node talks to the run over ROS 2)"));
             }
             return Ok(match foxglove {
-                Some(addr) => NodePlan { external, extra: Some(Arc::new(move |_: &SystemIo| Ok(vec![foxglove_view(addr)?]))) },
+                Some(addr) => {
+                    NodePlan { external, extra: Some(Arc::new(move |_: &SystemIo| Ok(vec![foxglove_view(addr)?]))) }
+                }
                 None => NodePlan::default(),
             });
         }
@@ -139,7 +146,9 @@ impl LiveArgs {
         let mode = match self.ros2_mode.as_str() {
             "realtime" if self.ros2_rate > 0.0 && self.ros2_rate.is_finite() => Mode::Realtime { rate: self.ros2_rate },
             "realtime" => return Err(err!("--ros2-rate {}: must be a positive number", self.ros2_rate)),
-            _ if self.ros2_timeout > 0.0 && self.ros2_timeout.is_finite() => Mode::Lockstep { timeout: Duration::from_secs_f64(self.ros2_timeout) },
+            _ if self.ros2_timeout > 0.0 && self.ros2_timeout.is_finite() => {
+                Mode::Lockstep { timeout: Duration::from_secs_f64(self.ros2_timeout) }
+            }
             _ => return Err(err!("--ros2-timeout {}: must be a positive number", self.ros2_timeout)),
         };
         let remap = Remap::parse(&self.remap).map_err(|e| err!("--ros2-remap: {e}"))?;
@@ -157,7 +166,18 @@ impl LiveArgs {
                     inbound.push(t.clone());
                 }
             }
-            let config = BridgeConfig { domain, mode, inbound, inbound_scalars: inputs.scalars.clone(), outbound: inputs.outputs.clone(), lockstep: lockstep.clone(), remap: remap.clone(), loopback_only, startup_timeout, distro };
+            let config = BridgeConfig {
+                domain,
+                mode,
+                inbound,
+                inbound_scalars: inputs.scalars.clone(),
+                outbound: inputs.outputs.clone(),
+                lockstep: lockstep.clone(),
+                remap: remap.clone(),
+                loopback_only,
+                startup_timeout,
+                distro,
+            };
             let (bridge, s) = Ros2Bridge::new(config)?;
             stats.lock().expect("stats lock").push(s);
             let mut nodes: Vec<Box<dyn agrisim_bus::Node>> = vec![Box::new(bridge)];
@@ -218,13 +238,15 @@ pub fn report(stats: &Arc<Mutex<Vec<Arc<Mutex<Stats>>>>>, file: Option<&std::pat
     let rt = &t.round_trips;
     let (p50, p99, max) = (quantile_ms(rt, 0.5), quantile_ms(rt, 0.99), quantile_ms(rt, 1.0));
     if let Some(f) = file {
-        let topics: serde_json::Map<String, serde_json::Value> = t.topics.iter().map(|(k, (n, b))| (k.clone(), serde_json::json!({"messages": n, "bytes": b}))).collect();
+        let topics: serde_json::Map<String, serde_json::Value> =
+            t.topics.iter().map(|(k, (n, b))| (k.clone(), serde_json::json!({"messages": n, "bytes": b}))).collect();
         let v = serde_json::json!({
             "instants": t.instants, "published": t.published, "published_bytes": t.published_bytes,
             "received": t.received, "rejected": t.rejected, "lockstep_timeouts": t.lockstep_timeouts,
             "waited_s": t.waited, "round_trip_ms": {"n": rt.len(), "p50": p50, "p99": p99, "max": max}, "topics": topics,
         });
-        std::fs::write(f, serde_json::to_string_pretty(&v).expect("plain value")).map_err(|e| err!("cannot write {}: {e}", f.display()))?;
+        std::fs::write(f, serde_json::to_string_pretty(&v).expect("plain value"))
+            .map_err(|e| err!("cannot write {}: {e}", f.display()))?;
     }
     let mut line = format!(
         "ros2 bridge: {} instants, {} messages ({:.1} MB) published, {} received, {} rejected, {} lockstep timeouts, {:.2} s waiting",

@@ -1,9 +1,9 @@
 //! `agrisim`: the command-line front of the orchestrator: runs, benchmarks, FMU packing,
 //! snapshots and scene export, with progress on a terminal and quiet in pipes.
 
+mod live;
 mod pack;
 mod png;
-mod live;
 mod snapshot;
 
 use agrisim_error::Result;
@@ -15,7 +15,11 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "agrisim", version, about = "Greenhouse-robotics co-simulation: FMUs, SSP systems, ROS 2 messages, MCAP logs")]
+#[command(
+    name = "agrisim",
+    version,
+    about = "Greenhouse-robotics co-simulation: FMUs, SSP systems, ROS 2 messages, MCAP logs"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -228,12 +232,17 @@ impl FmuLog {
 }
 
 fn parse_override(s: &str) -> std::result::Result<(String, String), String> {
-    s.split_once('=').map(|(a, b)| (a.to_string(), b.to_string())).ok_or_else(|| format!("expected COMPONENT=FILE.fmu, got '{s}'"))
+    s.split_once('=')
+        .map(|(a, b)| (a.to_string(), b.to_string()))
+        .ok_or_else(|| format!("expected COMPONENT=FILE.fmu, got '{s}'"))
 }
 
 /// target/<profile>/ of this executable, and target/.
 fn build_dirs() -> (PathBuf, PathBuf) {
-    let exe_dir = std::env::current_exe().ok().and_then(|p| p.parent().map(|d| d.to_path_buf())).unwrap_or_else(|| PathBuf::from("target/release"));
+    let exe_dir = std::env::current_exe()
+        .ok()
+        .and_then(|p| p.parent().map(|d| d.to_path_buf()))
+        .unwrap_or_else(|| PathBuf::from("target/release"));
     let target = exe_dir.parent().map(|p| p.to_path_buf()).unwrap_or_else(|| PathBuf::from("target"));
     (exe_dir, target)
 }
@@ -242,7 +251,11 @@ fn build_dirs() -> (PathBuf, PathBuf) {
 /// so pipes and CI logs get nothing.
 fn progress_printer() -> impl FnMut(u64, u64) {
     let bar = ProgressBar::with_draw_target(None, ProgressDrawTarget::stderr());
-    bar.set_style(ProgressStyle::with_template("[{bar:40}] {percent:>3}% {pos}/{len} ({elapsed}, eta {eta})").expect("valid template").progress_chars("# "));
+    bar.set_style(
+        ProgressStyle::with_template("[{bar:40}] {percent:>3}% {pos}/{len} ({elapsed}, eta {eta})")
+            .expect("valid template")
+            .progress_chars("# "),
+    );
     move |k, n| {
         if bar.length() != Some(n) {
             bar.set_length(n);
@@ -254,7 +267,14 @@ fn progress_printer() -> impl FnMut(u64, u64) {
     }
 }
 
-fn run_options(dirs: Dirs, target: &std::path::Path, seed: Option<u64>, duration: Option<f64>, fmu_overrides: BTreeMap<String, String>, fmu_log: Option<Vec<String>>) -> RunOptions {
+fn run_options(
+    dirs: Dirs,
+    target: &std::path::Path,
+    seed: Option<u64>,
+    duration: Option<f64>,
+    fmu_overrides: BTreeMap<String, String>,
+    fmu_log: Option<Vec<String>>,
+) -> RunOptions {
     RunOptions {
         fmu_dir: dirs.fmu_dir.unwrap_or_else(|| target.join("fmu")),
         cache_dir: dirs.cache_dir.unwrap_or_else(|| target.join("fmu-cache")),
@@ -278,7 +298,9 @@ fn main() -> ExitCode {
             eprintln!("agrisim: second interrupt: exiting now");
             std::process::exit(EXIT_INTERRUPTED as i32);
         }
-        eprintln!("agrisim: interrupt: stopping at the next step and finishing the files (interrupt again to exit at once)");
+        eprintln!(
+            "agrisim: interrupt: stopping at the next step and finishing the files (interrupt again to exit at once)"
+        );
     });
     let result = real_main();
     if interrupt::requested() {
@@ -302,7 +324,11 @@ fn main() -> ExitCode {
 fn worker_command(i: u64) -> std::process::Command {
     let exe = std::env::current_exe().unwrap_or_else(|_| PathBuf::from("agrisim"));
     let mut c = std::process::Command::new(exe);
-    c.args(std::env::args_os().skip(1)).arg("--worker-trial").arg(i.to_string()).stdin(std::process::Stdio::null()).stdout(std::process::Stdio::null());
+    c.args(std::env::args_os().skip(1))
+        .arg("--worker-trial")
+        .arg(i.to_string())
+        .stdin(std::process::Stdio::null())
+        .stdout(std::process::Stdio::null());
     c
 }
 
@@ -316,7 +342,12 @@ fn exec<'a>(a: &TrialArgs, command: &'a dyn Fn(u64) -> std::process::Command) ->
 }
 
 /// The scenario (or the benchmark's default) and run options of a many-trial benchmark.
-fn trial_setup(a: &TrialArgs, default_scenario: &str, target: &Path, bridges: &Bridges) -> Result<(Scenario, RunOptions)> {
+fn trial_setup(
+    a: &TrialArgs,
+    default_scenario: &str,
+    target: &Path,
+    bridges: &Bridges,
+) -> Result<(Scenario, RunOptions)> {
     let s = Scenario::load(a.scenario.as_deref().unwrap_or(Path::new(default_scenario)))?;
     let mut o = run_options(a.dirs.clone(), target, None, None, BTreeMap::new(), a.log.categories());
     o.record = a.record.profile;
@@ -335,7 +366,9 @@ fn real_main() -> Result<()> {
     let bridges = Bridges::default();
     let stats_file = match &cli.command {
         Command::Run { live, .. } => live.ros2_stats.clone(),
-        Command::Bench { command: BenchCommand::Nav(a) | BenchCommand::Harvest(a) | BenchCommand::Row { trials: a, .. } } => a.live.ros2_stats.clone(),
+        Command::Bench {
+            command: BenchCommand::Nav(a) | BenchCommand::Harvest(a) | BenchCommand::Row { trials: a, .. },
+        } => a.live.ros2_stats.clone(),
         _ => None,
     };
     let result = dispatch(cli, &bridges);
@@ -367,7 +400,15 @@ fn dispatch(cli: Cli, bridges: &Bridges) -> Result<()> {
                 return agrisim_bench::nav::nav_worker(&s, &opts, a.plan(), &a.out, i);
             }
             let command = worker_command;
-            let summary = agrisim_bench::nav::bench_nav(&s, &opts, a.plan(), &a.out, a.resume, exec(&a, &command), progress_printer())?;
+            let summary = agrisim_bench::nav::bench_nav(
+                &s,
+                &opts,
+                a.plan(),
+                &a.out,
+                a.resume,
+                exec(&a, &command),
+                progress_printer(),
+            )?;
             println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
         }
         Command::Bench { command: BenchCommand::Harvest(a) } => {
@@ -376,7 +417,15 @@ fn dispatch(cli: Cli, bridges: &Bridges) -> Result<()> {
                 return agrisim_bench::harvest::harvest_worker(&s, &opts, a.plan(), &a.out, i);
             }
             let command = worker_command;
-            let summary = agrisim_bench::harvest::bench_harvest(&s, &opts, a.plan(), &a.out, a.resume, exec(&a, &command), progress_printer())?;
+            let summary = agrisim_bench::harvest::bench_harvest(
+                &s,
+                &opts,
+                a.plan(),
+                &a.out,
+                a.resume,
+                exec(&a, &command),
+                progress_printer(),
+            )?;
             println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
         }
         Command::Bench { command: BenchCommand::Row { trials: a, length } } => {
@@ -385,7 +434,16 @@ fn dispatch(cli: Cli, bridges: &Bridges) -> Result<()> {
                 return agrisim_bench::row::row_worker(&s, &opts, a.plan(), length, &a.out, i);
             }
             let command = worker_command;
-            let summary = agrisim_bench::row::bench_row(&s, &opts, a.plan(), length, &a.out, a.resume, exec(&a, &command), progress_printer())?;
+            let summary = agrisim_bench::row::bench_row(
+                &s,
+                &opts,
+                a.plan(),
+                length,
+                &a.out,
+                a.resume,
+                exec(&a, &command),
+                progress_printer(),
+            )?;
             println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
         }
         Command::Bench { command: BenchCommand::Overhead { scenario, steps, dirs, log, record, out } } => {
@@ -405,7 +463,8 @@ fn dispatch(cli: Cli, bridges: &Bridges) -> Result<()> {
         Command::Scene { command: SceneCommand::Export { scenario, out } } => {
             let s = Scenario::load(&scenario)?;
             let g = agrisim_session::scene::generate_scene(&s)?;
-            agrisim_greenhouse::gltf::write_glb(&g.objects, &out).map_err(|e| agrisim_error::err!("cannot write {}: {e}", out.display()))?;
+            agrisim_greenhouse::gltf::write_glb(&g.objects, &out)
+                .map_err(|e| agrisim_error::err!("cannot write {}: {e}", out.display()))?;
             println!("{} objects -> {}", g.objects.len(), out.display());
         }
         Command::Fmu { command: FmuCommand::Pack { lib_dir, out, systems, ssp_out } } => {

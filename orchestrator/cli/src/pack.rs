@@ -5,8 +5,8 @@
 //! dlopens the library, asks it, and zips XML + binary. Archives are deterministic (sorted
 //! entries, fixed timestamps), so the same build gives byte-identical .fmu files.
 
-use agrisim_error::{Context, Result};
 use agrisim_cosim::model_description::ModelDescription;
+use agrisim_error::{Context, Result};
 use std::ffi::{c_char, CStr};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -49,7 +49,13 @@ pub fn find_fmu_libraries(dir: &Path) -> Result<Vec<PathBuf>> {
 }
 
 fn zip_fmu(out: &Path, xml: &str, binary_dir: &str, identifier: &str, library: &[u8]) -> Result<()> {
-    write_zip(out, &[(format!("binaries/{binary_dir}/{identifier}.so"), library), ("modelDescription.xml".to_string(), xml.as_bytes())])
+    write_zip(
+        out,
+        &[
+            (format!("binaries/{binary_dir}/{identifier}.so"), library),
+            ("modelDescription.xml".to_string(), xml.as_bytes()),
+        ],
+    )
 }
 
 /// A deterministic zip (entries in the given order, fixed timestamps), so the same inputs give
@@ -75,8 +81,12 @@ fn write_zip(out: &Path, entries: &[(String, &[u8])]) -> Result<()> {
 pub fn pack_library(library: &Path, out_dir: &Path) -> Result<Packed> {
     // SAFETY: loading our own FMU library; its initializers are Rust statics only.
     let lib = unsafe { libloading::Library::new(library) }.context(|| format!("cannot load {}", library.display()))?;
-    let xml3 = description(&lib, b"agrisim_model_description_fmi3\0")
-        .ok_or_else(|| agrisim_error::err!("{} does not export agrisim_model_description_fmi3 (not built with export_fmu!)", library.display()))?;
+    let xml3 = description(&lib, b"agrisim_model_description_fmi3\0").ok_or_else(|| {
+        agrisim_error::err!(
+            "{} does not export agrisim_model_description_fmi3 (not built with export_fmu!)",
+            library.display()
+        )
+    })?;
     let md = ModelDescription::parse(&xml3, &library.display().to_string())?;
     let id = md.model_identifier.clone();
     let bytes = std::fs::read(library).context(|| format!("cannot read {}", library.display()))?;
@@ -100,7 +110,10 @@ pub fn pack_library(library: &Path, out_dir: &Path) -> Result<Packed> {
 pub fn pack_all(lib_dir: &Path, out_dir: &Path) -> Result<Vec<Packed>> {
     let libs = find_fmu_libraries(lib_dir)?;
     if libs.is_empty() {
-        return Err(agrisim_error::err!("no FMU libraries (libagrisim_fmu_*.so) in {}: run `cargo build --release` first", lib_dir.display()));
+        return Err(agrisim_error::err!(
+            "no FMU libraries (libagrisim_fmu_*.so) in {}: run `cargo build --release` first",
+            lib_dir.display()
+        ));
     }
     libs.iter().map(|l| pack_library(l, out_dir)).collect()
 }
@@ -125,12 +138,23 @@ pub fn pack_ssps(systems_dir: &Path, fmu_dir: &Path, out_dir: &Path) -> Result<V
         for c in &structure.components {
             let path = resolve_source(&ssd, &c.source, fmu_dir);
             let file = path.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default();
-            let bytes = std::fs::read(&path).context(|| format!("{}: component '{}': cannot read {} (run `agrisim fmu pack` after `cargo build --release`)", ssd.display(), c.name, path.display()))?;
+            let bytes = std::fs::read(&path).context(|| {
+                format!(
+                    "{}: component '{}': cannot read {} (run `agrisim fmu pack` after `cargo build --release`)",
+                    ssd.display(),
+                    c.name,
+                    path.display()
+                )
+            })?;
             resources.insert(format!("resources/{file}"), bytes);
             let (old, new) = (format!("source=\"{}\"", c.source), format!("source=\"resources/{file}\""));
             // Components sharing one FMU (the two arms) were rewritten with the first.
             if !text.contains(&old) && !text.contains(&new) {
-                return Err(agrisim_error::err!("{}: component '{}': cannot find {old} to rewrite", ssd.display(), c.name));
+                return Err(agrisim_error::err!(
+                    "{}: component '{}': cannot find {old} to rewrite",
+                    ssd.display(),
+                    c.name
+                ));
             }
             text = text.replace(&old, &new);
         }

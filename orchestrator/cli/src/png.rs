@@ -17,7 +17,8 @@ pub fn encode_rgb(width: u32, height: u32, rgb: &[u8]) -> Vec<u8> {
 /// A perceptual colour map (blue -> green -> yellow -> red) for t in [0, 1].
 pub fn colormap(t: f64) -> [u8; 3] {
     let t = t.clamp(0.0, 1.0);
-    let stops = [[48.0, 18.0, 59.0], [40.0, 150.0, 220.0], [60.0, 200.0, 90.0], [250.0, 220.0, 40.0], [200.0, 30.0, 20.0]];
+    let stops =
+        [[48.0, 18.0, 59.0], [40.0, 150.0, 220.0], [60.0, 200.0, 90.0], [250.0, 220.0, 40.0], [200.0, 30.0, 20.0]];
     let x = t * (stops.len() - 1) as f64;
     let i = (x.floor() as usize).min(stops.len() - 2);
     let f = x - i as f64;

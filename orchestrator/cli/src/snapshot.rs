@@ -5,15 +5,15 @@
 //! apply as in a run. The robot poses as at work: lift raised, both arms reaching forward
 //! and down (the sensors see its links); the scenario's parameters can set those inputs too.
 
-use agrisim_cosim::archive::FmuArchive;
-use agrisim_error::{Context, Result};
-use agrisim_cosim::fmi3::Instance;
 use crate::png::{colormap, encode_rgb};
-use agrisim_session::RunOptions;
-use agrisim_session::Scenario;
+use agrisim_cosim::archive::FmuArchive;
+use agrisim_cosim::fmi3::Instance;
 use agrisim_cosim::value::{self, Value};
+use agrisim_error::{Context, Result};
 use agrisim_msgs::sensor_msgs::{Image, PointCloud2};
 use agrisim_msgs::Message;
+use agrisim_session::RunOptions;
+use agrisim_session::Scenario;
 use std::path::{Path, PathBuf};
 
 const STEP: f64 = 0.02;
@@ -29,7 +29,8 @@ const ARMS: [f64; 7] = [0.0, 0.6, 0.0, -1.6, 0.0, 2.2, 0.785];
 fn open(s: &Scenario, o: &RunOptions, file: &str, name: &str, pose: [f64; 3]) -> Result<(FmuArchive, Instance)> {
     let a = FmuArchive::open(&o.fmu_dir.join(file), &o.cache_dir)?;
     let mut inst = Instance::instantiate(&a, name, false)?;
-    let var = |n: &str| a.md.variable(n).cloned().ok_or_else(|| agrisim_error::err!("FMU {file} has no variable '{n}'"));
+    let var =
+        |n: &str| a.md.variable(n).cloned().ok_or_else(|| agrisim_error::err!("FMU {file} has no variable '{n}'"));
     value::set(&mut inst, &var("scene")?, &Value::Str(s.scene_toml()))?;
     let environment = s.environment_toml();
     if !environment.is_empty() {
@@ -64,18 +65,28 @@ fn open(s: &Scenario, o: &RunOptions, file: &str, name: &str, pose: [f64; 3]) ->
 
 /// The newest message in message port `name` (a frame list).
 fn get_bin(a: &FmuArchive, inst: &mut Instance, name: &str) -> Result<Vec<u8>> {
-    let v = a.md.variable(name).cloned().ok_or_else(|| agrisim_error::err!("FMU '{}' has no variable '{name}'", inst.name()))?;
+    let v =
+        a.md.variable(name)
+            .cloned()
+            .ok_or_else(|| agrisim_error::err!("FMU '{}' has no variable '{name}'", inst.name()))?;
     match value::get(inst, &v)? {
         Value::Bin(b) => {
-            let frames = agrisim_frames::decode(&b).map_err(|e| agrisim_error::err!("FMU '{}': {name}: {e}", inst.name()))?;
-            frames.last().map(|f| f.payload.to_vec()).ok_or_else(|| agrisim_error::err!("FMU '{}': no message in {name}", inst.name()))
+            let frames =
+                agrisim_frames::decode(&b).map_err(|e| agrisim_error::err!("FMU '{}': {name}: {e}", inst.name()))?;
+            frames
+                .last()
+                .map(|f| f.payload.to_vec())
+                .ok_or_else(|| agrisim_error::err!("FMU '{}': no message in {name}", inst.name()))
         }
         other => Err(agrisim_error::err!("FMU '{}': {name} is {other:?}, expected Binary", inst.name())),
     }
 }
 
 fn get_seq(a: &FmuArchive, inst: &mut Instance, name: &str) -> Result<i64> {
-    let v = a.md.variable(name).cloned().ok_or_else(|| agrisim_error::err!("FMU '{}' has no variable '{name}'", inst.name()))?;
+    let v =
+        a.md.variable(name)
+            .cloned()
+            .ok_or_else(|| agrisim_error::err!("FMU '{}' has no variable '{name}'", inst.name()))?;
     match value::get(inst, &v)? {
         Value::I64(n) => Ok(n),
         other => Err(agrisim_error::err!("FMU '{}': {name} is {other:?}, expected Int64", inst.name())),
@@ -92,7 +103,11 @@ fn write(path: PathBuf, w: u32, h: u32, rgb: &[u8], written: &mut Vec<PathBuf>) 
 pub fn snapshot(s: &Scenario, o: &RunOptions, out: &Path) -> Result<Vec<PathBuf>> {
     std::fs::create_dir_all(out).context(|| format!("cannot create {}", out.display()))?;
     let g = agrisim_session::scene::generate_scene(s)?;
-    let aisle = g.layout.aisles.get(g.layout.aisles.len() / 2).ok_or_else(|| agrisim_error::err!("scenario {}: the greenhouse has no aisle", s.path.display()))?;
+    let aisle = g
+        .layout
+        .aisles
+        .get(g.layout.aisles.len() / 2)
+        .ok_or_else(|| agrisim_error::err!("scenario {}: the greenhouse has no aisle", s.path.display()))?;
     let pose = [aisle.x_start + 1.5, aisle.y, 0.0];
     let mut written = vec![];
 
@@ -102,9 +117,11 @@ pub fn snapshot(s: &Scenario, o: &RunOptions, out: &Path) -> Result<Vec<PathBuf>
         cam.do_step(t, STEP)?;
         t += STEP;
     }
-    let img = Image::from_cdr(&get_bin(&ca, &mut cam, "image")?).map_err(|e| agrisim_error::err!("Camera image: {e}"))?;
+    let img =
+        Image::from_cdr(&get_bin(&ca, &mut cam, "image")?).map_err(|e| agrisim_error::err!("Camera image: {e}"))?;
     write(out.join("rgb.png"), img.width, img.height, &img.data, &mut written)?;
-    let depth = Image::from_cdr(&get_bin(&ca, &mut cam, "depth")?).map_err(|e| agrisim_error::err!("Camera depth: {e}"))?;
+    let depth =
+        Image::from_cdr(&get_bin(&ca, &mut cam, "depth")?).map_err(|e| agrisim_error::err!("Camera depth: {e}"))?;
     let mut rgb = Vec::with_capacity(depth.data.len() / 4 * 3);
     for px in depth.data.chunks_exact(4) {
         let z = f32::from_le_bytes(px.try_into().expect("4 bytes")) as f64;
@@ -128,7 +145,8 @@ pub fn snapshot(s: &Scenario, o: &RunOptions, out: &Path) -> Result<Vec<PathBuf>
             continue;
         }
         seen = n;
-        let pc = PointCloud2::from_cdr(&get_bin(&la, &mut lidar, "points")?).map_err(|e| agrisim_error::err!("Lidar points: {e}"))?;
+        let pc = PointCloud2::from_cdr(&get_bin(&la, &mut lidar, "points")?)
+            .map_err(|e| agrisim_error::err!("Lidar points: {e}"))?;
         for p in pc.data.chunks_exact(pc.point_step as usize) {
             let f = |i: usize| f32::from_le_bytes(p[4 * i..4 * i + 4].try_into().expect("4 bytes")) as f64;
             let (x, y, z) = (f(0), f(1), f(2) + mount_z);
@@ -136,7 +154,8 @@ pub fn snapshot(s: &Scenario, o: &RunOptions, out: &Path) -> Result<Vec<PathBuf>
                 continue; // no return, or roof and gutters (they would hide the rows)
             }
             for (size, top) in views.iter_mut() {
-                let (i, j) = (((x + *size / 2.0) / *size * px as f64) as i64, ((*size / 2.0 - y) / *size * px as f64) as i64);
+                let (i, j) =
+                    (((x + *size / 2.0) / *size * px as f64) as i64, ((*size / 2.0 - y) / *size * px as f64) as i64);
                 if (0..px as i64).contains(&i) && (0..px as i64).contains(&j) {
                     let k = (j as usize * px + i as usize) * 3;
                     top[k..k + 3].copy_from_slice(&colormap(z / 2.5));

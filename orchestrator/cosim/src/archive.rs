@@ -46,10 +46,7 @@ pub struct ImportError {
 
 impl ImportError {
     fn new(fmu: &Path, message: impl Into<String>) -> ImportError {
-        ImportError {
-            fmu: fmu.to_path_buf(),
-            message: message.into(),
-        }
+        ImportError { fmu: fmu.to_path_buf(), message: message.into() }
     }
 }
 
@@ -80,26 +77,24 @@ impl FmuArchive {
     /// bytes) and checks it has a valid FMI 3.0 co-simulation description and a binary for
     /// this platform.
     pub fn open(fmu_path: &Path, cache_root: &Path) -> Result<FmuArchive, ImportError> {
-        let bytes = std::fs::read(fmu_path)
-            .map_err(|e| ImportError::new(fmu_path, format!("cannot read: {e}")))?;
+        let bytes = std::fs::read(fmu_path).map_err(|e| ImportError::new(fmu_path, format!("cannot read: {e}")))?;
         let mut zip = zip::ZipArchive::new(Cursor::new(&bytes[..]))
             .map_err(|e| ImportError::new(fmu_path, format!("not a valid zip archive: {e}")))?;
 
         // Parse the description straight from the archive first: a broken FMU fails before
         // anything is written to the cache, and the cache name can use the model identifier.
         let md_text = {
-            let mut entry = zip.by_name("modelDescription.xml").map_err(|_| {
-                ImportError::new(fmu_path, "no modelDescription.xml at the archive root")
-            })?;
+            let mut entry = zip
+                .by_name("modelDescription.xml")
+                .map_err(|_| ImportError::new(fmu_path, "no modelDescription.xml at the archive root"))?;
             let mut s = String::new();
-            entry.read_to_string(&mut s).map_err(|e| {
-                ImportError::new(fmu_path, format!("cannot read modelDescription.xml: {e}"))
-            })?;
+            entry
+                .read_to_string(&mut s)
+                .map_err(|e| ImportError::new(fmu_path, format!("cannot read modelDescription.xml: {e}")))?;
             s
         };
         let origin = format!("{}!modelDescription.xml", fmu_path.display());
-        let md = ModelDescription::parse(&md_text, &origin)
-            .map_err(|e| ImportError::new(fmu_path, e.to_string()))?;
+        let md = ModelDescription::parse(&md_text, &origin).map_err(|e| ImportError::new(fmu_path, e.to_string()))?;
 
         let stem = sanitize(&md.model_identifier);
         let dir = cache_root.join(format!("{stem}-{:016x}", fnv1a64(&bytes)));
@@ -115,22 +110,12 @@ impl FmuArchive {
                 fmu_path,
                 format!(
                     "no binary for this platform: {rel_lib} is missing (platforms in archive: {})",
-                    if platforms.is_empty() {
-                        "none".to_string()
-                    } else {
-                        platforms.join(", ")
-                    }
+                    if platforms.is_empty() { "none".to_string() } else { platforms.join(", ") }
                 ),
             ));
         }
         let resources_dir = dir.join("resources");
-        Ok(FmuArchive {
-            path: fmu_path.to_path_buf(),
-            dir,
-            md,
-            library_path,
-            resources_dir,
-        })
+        Ok(FmuArchive { path: fmu_path.to_path_buf(), dir, md, library_path, resources_dir })
     }
 }
 
@@ -139,7 +124,8 @@ impl FmuArchive {
 /// the same bytes; returns the directory.
 pub fn unpack(path: &Path, cache_root: &Path) -> Result<PathBuf, ImportError> {
     let bytes = std::fs::read(path).map_err(|e| ImportError::new(path, format!("cannot read: {e}")))?;
-    let mut zip = zip::ZipArchive::new(Cursor::new(&bytes[..])).map_err(|e| ImportError::new(path, format!("not a valid zip archive: {e}")))?;
+    let mut zip = zip::ZipArchive::new(Cursor::new(&bytes[..]))
+        .map_err(|e| ImportError::new(path, format!("not a valid zip archive: {e}")))?;
     let stem = sanitize(&path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
     let dir = cache_root.join(format!("{stem}-{:016x}", fnv1a64(&bytes)));
     if !dir.join(MARKER).is_file() {
@@ -158,8 +144,7 @@ fn extract(
     let io_err = |what: &str, p: &Path, e: std::io::Error| {
         ImportError::new(fmu_path, format!("cannot {what} '{}': {e}", p.display()))
     };
-    std::fs::create_dir_all(cache_root)
-        .map_err(|e| io_err("create cache directory", cache_root, e))?;
+    std::fs::create_dir_all(cache_root).map_err(|e| io_err("create cache directory", cache_root, e))?;
     let dir_name = dir.file_name().and_then(|n| n.to_str()).unwrap_or("fmu");
     // Unique per process and call, so concurrent extractions (threads or processes) never share it.
     static SEQ: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
@@ -172,20 +157,17 @@ fn extract(
 
     let result = (|| {
         for i in 0..zip.len() {
-            let mut entry = zip.by_index(i).map_err(|e| {
-                ImportError::new(fmu_path, format!("corrupt archive entry #{i}: {e}"))
-            })?;
+            let mut entry =
+                zip.by_index(i).map_err(|e| ImportError::new(fmu_path, format!("corrupt archive entry #{i}: {e}")))?;
             let name = entry
                 .name()
-                .map_err(|e| {
-                    ImportError::new(
-                        fmu_path,
-                        format!("archive entry #{i} has an unreadable name: {e}"),
-                    )
-                })?
+                .map_err(|e| ImportError::new(fmu_path, format!("archive entry #{i} has an unreadable name: {e}")))?
                 .into_owned();
             if has_root(&name) {
-                return Err(ImportError::new(fmu_path, format!("archive entry '{name}' has an absolute path; refusing to unpack")));
+                return Err(ImportError::new(
+                    fmu_path,
+                    format!("archive entry '{name}' has an absolute path; refusing to unpack"),
+                ));
             }
             let rel = entry.enclosed_name().ok_or_else(|| {
                 ImportError::new(fmu_path, format!("archive entry '{name}' would be written outside the FMU directory (zip-slip); refusing to unpack"))
@@ -199,9 +181,9 @@ fn extract(
                 std::fs::create_dir_all(parent).map_err(|e| io_err("create", parent, e))?;
             }
             let mut data = Vec::new();
-            entry.read_to_end(&mut data).map_err(|e| {
-                ImportError::new(fmu_path, format!("corrupt archive entry '{name}': {e}"))
-            })?;
+            entry
+                .read_to_end(&mut data)
+                .map_err(|e| ImportError::new(fmu_path, format!("corrupt archive entry '{name}': {e}")))?;
             std::fs::write(&out, &data).map_err(|e| io_err("write", &out, e))?;
         }
         let res = tmp.join("resources");
@@ -237,24 +219,12 @@ fn has_root(name: &str) -> bool {
 
 /// Keeps a name safe as one directory component.
 fn sanitize(s: &str) -> String {
-    s.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect()
+    s.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' || c == '-' { c } else { '_' }).collect()
 }
 
 fn list_dir(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
-        .map(|rd| {
-            rd.filter_map(|e| e.ok())
-                .map(|e| e.file_name().to_string_lossy().into_owned())
-                .collect()
-        })
+        .map(|rd| rd.filter_map(|e| e.ok()).map(|e| e.file_name().to_string_lossy().into_owned()).collect())
         .unwrap_or_default();
     v.sort();
     v

@@ -119,7 +119,17 @@ impl Master {
         for &r in &order.delayed {
             delayed[r] = true;
         }
-        Ok(Master { system, order, inputs_of, delayed, step_ns, message_ticks, tick: 0, inbound: vec![], framed: vec![] })
+        Ok(Master {
+            system,
+            order,
+            inputs_of,
+            delayed,
+            step_ns,
+            message_ticks,
+            tick: 0,
+            inbound: vec![],
+            framed: vec![],
+        })
     }
 
     /// The stepping order and the delayed connections.
@@ -184,8 +194,12 @@ impl Master {
             }
         }
         if !converged {
-            let labels: Vec<&str> = self.order.init_loops.iter().map(|&r| self.system.routes[r].label.as_str()).collect();
-            return Err(crate::err!("initialization did not converge in {INIT_PASSES} passes through the loop(s) {}", labels.join(", ")));
+            let labels: Vec<&str> =
+                self.order.init_loops.iter().map(|&r| self.system.routes[r].label.as_str()).collect();
+            return Err(crate::err!(
+                "initialization did not converge in {INIT_PASSES} passes through the loop(s) {}",
+                labels.join(", ")
+            ));
         }
         for c in &mut self.system.components {
             c.instance.exit_initialization_mode()?;
@@ -197,7 +211,11 @@ impl Master {
     /// Mode if it differs from what was last written there; returns whether it did.
     fn propagate_initial(&mut self, r: usize, last: &mut [Option<Value>]) -> Result<bool> {
         let route = &self.system.routes[r];
-        let (Port::Fmu { comp: src, var: sv, seq: None }, Port::Fmu { comp: dst, var: dv, seq: None }) = (&route.from, &route.to) else { return Ok(false) };
+        let (Port::Fmu { comp: src, var: sv, seq: None }, Port::Fmu { comp: dst, var: dv, seq: None }) =
+            (&route.from, &route.to)
+        else {
+            return Ok(false);
+        };
         let (src, dst) = (*src, *dst);
         let v = value::get(&mut self.system.components[src].instance, sv)?;
         if last[r].as_ref().is_some_and(|l| l.identical(&v)) {
@@ -221,7 +239,13 @@ impl Master {
     /// Returns the whole system to `snapshot` (taken from this master).
     pub fn restore(&mut self, snapshot: &Snapshot) -> Result<()> {
         if snapshot.fmus.len() != self.system.components.len() || snapshot.routes.len() != self.system.routes.len() {
-            return Err(crate::err!("snapshot of another system ({} FMUs, {} routes; this one has {} and {})", snapshot.fmus.len(), snapshot.routes.len(), self.system.components.len(), self.system.routes.len()));
+            return Err(crate::err!(
+                "snapshot of another system ({} FMUs, {} routes; this one has {} and {})",
+                snapshot.fmus.len(),
+                snapshot.routes.len(),
+                self.system.components.len(),
+                self.system.routes.len()
+            ));
         }
         for (c, s) in self.system.components.iter_mut().zip(&snapshot.fmus) {
             c.instance.set_state(s).map_err(|e| crate::err!("restoring FMU '{}': {e}", c.name))?;
@@ -280,7 +304,9 @@ impl Master {
             }
             match &route.from {
                 Port::Fmu { seq: Some(_), .. } => {
-                    self.take_messages(r, t_ns, &mut |system, frame| hooks.message(system, r, frame.stamp_ns, frame.payload))?;
+                    self.take_messages(r, t_ns, &mut |system, frame| {
+                        hooks.message(system, r, frame.stamp_ns, frame.payload)
+                    })?;
                 }
                 Port::Fmu { comp, var, seq: None } => {
                     let Port::Bus { topic } = &route.to else { unreachable!("checked above") };
@@ -327,13 +353,18 @@ impl Master {
         }
         let System { routes, components, .. } = &mut self.system;
         let route = &mut routes[r];
-        let Port::Fmu { comp, var, seq: Some(seq) } = &route.to else { return Err(crate::err!("{}: not a message input", route.label)) };
+        let Port::Fmu { comp, var, seq: Some(seq) } = &route.to else {
+            return Err(crate::err!("{}: not a message input", route.label));
+        };
         let inst = &mut components[*comp].instance;
         let first = route.written as u64 + 1;
         let n = messages.len() as u64;
         if route.framed_to {
             self.framed.clear();
-            agrisim_frames::encode_into(&mut self.framed, messages.enumerate().map(|(i, (stamp_ns, payload))| Frame { seq: first + i as u64, stamp_ns, payload }));
+            agrisim_frames::encode_into(
+                &mut self.framed,
+                messages.enumerate().map(|(i, (stamp_ns, payload))| Frame { seq: first + i as u64, stamp_ns, payload }),
+            );
             inst.set_binary(var.value_reference, &self.framed)?;
         } else {
             let (_, newest) = messages.last().expect("not empty");
@@ -373,7 +404,13 @@ impl Master {
                 ),
                 agrisim_frames::Error::Malformed(_) => String::new(),
             };
-            crate::err!("FMU '{}': message port '{}' at t={} s: {e}{hint} (route {})", system.components[comp].name, var.name, t_ns as f64 / 1e9, route.label)
+            crate::err!(
+                "FMU '{}': message port '{}' at t={} s: {e}{hint} (route {})",
+                system.components[comp].name,
+                var.name,
+                t_ns as f64 / 1e9,
+                route.label
+            )
         };
         let mut cursor = route.cursor;
         if route.framed_from {

@@ -92,12 +92,7 @@ impl VarType {
     pub fn is_supported(self) -> bool {
         matches!(
             self,
-            VarType::Float64
-                | VarType::Int32
-                | VarType::Int64
-                | VarType::Boolean
-                | VarType::String
-                | VarType::Binary
+            VarType::Float64 | VarType::Int32 | VarType::Int64 | VarType::Boolean | VarType::String | VarType::Binary
         )
     }
 }
@@ -237,53 +232,34 @@ impl ModelDescription {
     /// Reads and parses a modelDescription.xml file.
     pub fn from_file(path: &Path) -> Result<ModelDescription, ModelDescriptionError> {
         let origin = path.display().to_string();
-        let xml = std::fs::read_to_string(path).map_err(|e| ModelDescriptionError {
-            origin: origin.clone(),
-            message: format!("cannot read: {e}"),
-        })?;
+        let xml = std::fs::read_to_string(path)
+            .map_err(|e| ModelDescriptionError { origin: origin.clone(), message: format!("cannot read: {e}") })?;
         Self::parse(&xml, &origin)
     }
 
     /// Parses XML text; `origin` names the source in errors.
     pub fn parse(xml: &str, origin: &str) -> Result<ModelDescription, ModelDescriptionError> {
-        let err = |message: String| ModelDescriptionError {
-            origin: origin.to_string(),
-            message,
-        };
-        let doc = roxmltree::Document::parse(xml)
-            .map_err(|e| err(format!("not well-formed XML: {e}")))?;
+        let err = |message: String| ModelDescriptionError { origin: origin.to_string(), message };
+        let doc = roxmltree::Document::parse(xml).map_err(|e| err(format!("not well-formed XML: {e}")))?;
         let root = doc.root_element();
         if root.tag_name().name() != "fmiModelDescription" {
-            return Err(err(format!(
-                "root element is <{}>, expected <fmiModelDescription>",
-                root.tag_name().name()
-            )));
+            return Err(err(format!("root element is <{}>, expected <fmiModelDescription>", root.tag_name().name())));
         }
-        let attr = |node: roxmltree::Node,
-                    name: &str,
-                    what: &str|
-         -> Result<String, ModelDescriptionError> {
-            node.attribute(name)
-                .map(str::to_string)
-                .ok_or_else(|| err(format!("{what} has no attribute '{name}'")))
+        let attr = |node: roxmltree::Node, name: &str, what: &str| -> Result<String, ModelDescriptionError> {
+            node.attribute(name).map(str::to_string).ok_or_else(|| err(format!("{what} has no attribute '{name}'")))
         };
         let fmi_version = attr(root, "fmiVersion", "<fmiModelDescription>")?;
         if !(fmi_version == "3.0" || fmi_version.starts_with("3.0.")) {
-            return Err(err(format!(
-                "fmiVersion is \"{fmi_version}\", only FMI 3.0 is supported here"
-            )));
+            return Err(err(format!("fmiVersion is \"{fmi_version}\", only FMI 3.0 is supported here")));
         }
         let model_name = attr(root, "modelName", "<fmiModelDescription>")?;
         let instantiation_token = attr(root, "instantiationToken", "<fmiModelDescription>")?;
 
-        let cs = child(root, "CoSimulation").ok_or_else(|| {
-            err("no <CoSimulation> element: this FMU does not support co-simulation".into())
-        })?;
+        let cs = child(root, "CoSimulation")
+            .ok_or_else(|| err("no <CoSimulation> element: this FMU does not support co-simulation".into()))?;
         let model_identifier = attr(cs, "modelIdentifier", "<CoSimulation>")?;
         if model_identifier.is_empty() || model_identifier.contains(['/', '\\']) {
-            return Err(err(format!(
-                "<CoSimulation> modelIdentifier \"{model_identifier}\" is not a valid file stem"
-            )));
+            return Err(err(format!("<CoSimulation> modelIdentifier \"{model_identifier}\" is not a valid file stem")));
         }
         // A capability flag: absent is false.
         let flag = |name: &str| -> Result<bool, _> {
@@ -304,15 +280,12 @@ impl ModelDescription {
                 .collect::<Result<Vec<_>, _>>()?,
         };
 
-        let default_step_size =
-            match child(root, "DefaultExperiment").and_then(|d| d.attribute("stepSize")) {
-                None => None,
-                Some(v) => Some(parse_f64(v).ok_or_else(|| {
-                    err(format!(
-                        "<DefaultExperiment> stepSize=\"{v}\" is not a number"
-                    ))
-                })?),
-            };
+        let default_step_size = match child(root, "DefaultExperiment").and_then(|d| d.attribute("stepSize")) {
+            None => None,
+            Some(v) => {
+                Some(parse_f64(v).ok_or_else(|| err(format!("<DefaultExperiment> stepSize=\"{v}\" is not a number")))?)
+            }
+        };
 
         let mut variables = Vec::new();
         if let Some(mv) = child(root, "ModelVariables") {
@@ -320,55 +293,45 @@ impl ModelDescription {
             let mut names = BTreeSet::new();
             for node in mv.children().filter(|n| n.is_element()) {
                 let tag = node.tag_name().name();
-                let ty = VarType::from_element(tag).ok_or_else(|| {
-                    err(format!(
-                        "unknown variable element <{tag}> in <ModelVariables>"
-                    ))
-                })?;
+                let ty = VarType::from_element(tag)
+                    .ok_or_else(|| err(format!("unknown variable element <{tag}> in <ModelVariables>")))?;
                 let name = attr(node, "name", &format!("a <{tag}> variable"))?;
                 let what = format!("variable '{name}'");
                 let vr_text = attr(node, "valueReference", &what)?;
                 let value_reference: u32 = vr_text.trim().parse().map_err(|_| {
-                    err(format!(
-                        "{what}: valueReference=\"{vr_text}\" is not an unsigned 32-bit integer"
-                    ))
+                    err(format!("{what}: valueReference=\"{vr_text}\" is not an unsigned 32-bit integer"))
                 })?;
                 let causality = match node.attribute("causality") {
                     None => Causality::Local,
-                    Some(c) => Causality::parse(c)
-                        .ok_or_else(|| err(format!("{what}: unknown causality \"{c}\"")))?,
+                    Some(c) => Causality::parse(c).ok_or_else(|| err(format!("{what}: unknown causality \"{c}\"")))?,
                 };
                 let variability = match node.attribute("variability") {
                     // FMI 3.0 default: continuous for Float32/64, discrete otherwise.
-                    None if matches!(ty, VarType::Float32 | VarType::Float64) => {
-                        Variability::Continuous
-                    }
+                    None if matches!(ty, VarType::Float32 | VarType::Float64) => Variability::Continuous,
                     None => Variability::Discrete,
-                    Some(v) => Variability::parse(v)
-                        .ok_or_else(|| err(format!("{what}: unknown variability \"{v}\"")))?,
+                    Some(v) => {
+                        Variability::parse(v).ok_or_else(|| err(format!("{what}: unknown variability \"{v}\"")))?
+                    }
                 };
-                if variability == Variability::Continuous
-                    && !matches!(ty, VarType::Float32 | VarType::Float64)
-                {
-                    return Err(err(format!("{what}: variability \"continuous\" is only allowed for Float32/Float64, not {ty}")));
+                if variability == Variability::Continuous && !matches!(ty, VarType::Float32 | VarType::Float64) {
+                    return Err(err(format!(
+                        "{what}: variability \"continuous\" is only allowed for Float32/Float64, not {ty}"
+                    )));
                 }
                 if let Some(other) = vrs.insert(value_reference, name.clone()) {
-                    return Err(err(format!("duplicate valueReference {value_reference}: used by '{other}' and '{name}'")));
+                    return Err(err(format!(
+                        "duplicate valueReference {value_reference}: used by '{other}' and '{name}'"
+                    )));
                 }
                 if !names.insert(name.clone()) {
                     return Err(err(format!("duplicate variable name '{name}'")));
                 }
-                let start = node.attribute("start").map(str::to_string).or_else(|| {
-                    child(node, "Start")
-                        .and_then(|s| s.attribute("value"))
-                        .map(str::to_string)
-                });
+                let start = node
+                    .attribute("start")
+                    .map(str::to_string)
+                    .or_else(|| child(node, "Start").and_then(|s| s.attribute("value")).map(str::to_string));
                 let mime_type = if ty == VarType::Binary {
-                    Some(
-                        node.attribute("mimeType")
-                            .unwrap_or("application/octet-stream")
-                            .to_string(),
-                    )
+                    Some(node.attribute("mimeType").unwrap_or("application/octet-stream").to_string())
                 } else {
                     None
                 };
@@ -394,12 +357,17 @@ impl ModelDescription {
                     _ => continue,
                 };
                 let what = format!("ModelStructure/{}", node.tag_name().name());
-                let vr: u32 = attr(node, "valueReference", &what)?.trim().parse().map_err(|e| err(format!("{what}: bad valueReference: {e}")))?;
+                let vr: u32 = attr(node, "valueReference", &what)?
+                    .trim()
+                    .parse()
+                    .map_err(|e| err(format!("{what}: bad valueReference: {e}")))?;
                 let deps = match node.attribute("dependencies") {
                     None => None,
                     Some(text) => Some(
                         text.split_whitespace()
-                            .map(|d| d.parse::<u32>().map_err(|e| err(format!("{what} {vr}: bad dependency {d:?}: {e}"))))
+                            .map(|d| {
+                                d.parse::<u32>().map_err(|e| err(format!("{what} {vr}: bad dependency {d:?}: {e}")))
+                            })
                             .collect::<Result<Vec<u32>, _>>()?,
                     ),
                 };
@@ -447,8 +415,7 @@ impl ModelDescription {
 }
 
 fn child<'a, 'i>(node: roxmltree::Node<'a, 'i>, name: &str) -> Option<roxmltree::Node<'a, 'i>> {
-    node.children()
-        .find(|n| n.is_element() && n.tag_name().name() == name)
+    node.children().find(|n| n.is_element() && n.tag_name().name() == name)
 }
 
 /// xs:boolean.
@@ -483,10 +450,7 @@ mod tests {
               <Binary name="b" valueReference="3"><Start value="0aff"/></Binary>
             </ModelVariables></fmiModelDescription>"#;
         let md = ModelDescription::parse(xml, "t.xml").unwrap();
-        assert_eq!(
-            md.variable("x").unwrap().variability,
-            Variability::Continuous
-        );
+        assert_eq!(md.variable("x").unwrap().variability, Variability::Continuous);
         assert_eq!(md.variable("n").unwrap().variability, Variability::Discrete);
         assert_eq!(md.variable("n").unwrap().causality, Causality::Local);
         let b = md.variable("b").unwrap();

@@ -55,7 +55,9 @@ pub fn plan(system: &System) -> Order {
     for (i, &c) in step.iter().enumerate() {
         position[c] = i;
     }
-    let delayed: Vec<usize> = (0..system.routes.len()).filter(|&r| fmu_link(system, r).is_some_and(|(a, b)| position[a] >= position[b])).collect();
+    let delayed: Vec<usize> = (0..system.routes.len())
+        .filter(|&r| fmu_link(system, r).is_some_and(|(a, b)| position[a] >= position[b]))
+        .collect();
     let init_loops = delayed.iter().copied().filter(|&r| matters_at_init(system, r)).collect();
     Order { step, delayed, init_loops }
 }
@@ -116,17 +118,23 @@ fn greedy_order(weight: &[Vec<u32>]) -> Vec<usize> {
 /// The plan in words, for `agrisim run --explain`.
 pub fn explain(system: &System, order: &Order) -> String {
     let name = |c: usize| system.components[c].name.as_str();
-    let labels = |routes: &[usize]| routes.iter().map(|&r| format!("  {}\n", system.routes[r].label)).collect::<String>();
+    let labels =
+        |routes: &[usize]| routes.iter().map(|&r| format!("  {}\n", system.routes[r].label)).collect::<String>();
     let mut out = String::new();
     let names: Vec<&str> = order.step.iter().map(|&c| name(c)).collect();
-    out.push_str(&format!("Step order (Gauss-Seidel; each component reads the values its sources have after this step): {}\n", names.join(" -> ")));
+    out.push_str(&format!(
+        "Step order (Gauss-Seidel; each component reads the values its sources have after this step): {}\n",
+        names.join(" -> ")
+    ));
     if order.delayed.is_empty() {
         out.push_str("Delayed connections: none (no loop)\n");
     } else {
         out.push_str("Delayed connections (read before their source steps, one step late; they close a loop):\n");
         out.push_str(&labels(&order.delayed));
     }
-    out.push_str("Initialization: one pass in the step order (every input of a component set before its outputs are read)");
+    out.push_str(
+        "Initialization: one pass in the step order (every input of a component set before its outputs are read)",
+    );
     if order.init_loops.is_empty() {
         out.push_str("; no loop needs iteration\n");
     } else {

@@ -32,12 +32,14 @@ impl Master {
     pub fn serialize_snapshot(&mut self, snapshot: &Snapshot) -> Result<Vec<u8>> {
         let mut fmus = Vec::with_capacity(snapshot.fmus.len());
         for (c, s) in self.system.components.iter_mut().zip(&snapshot.fmus) {
-            let (bytes, state) = c.instance.serialize_state(s).map_err(|e| err!("serializing the state of FMU '{}': {e}", c.name))?;
+            let (bytes, state) =
+                c.instance.serialize_state(s).map_err(|e| err!("serializing the state of FMU '{}': {e}", c.name))?;
             fmus.push(SavedFmu { component: c.name.clone(), state, bytes });
         }
         let routes = snapshot.routes.iter().map(|(c, w)| (c.last, *w)).collect();
         let mut out = MAGIC.to_vec();
-        let body = postcard::to_stdvec(&Saved { tick: snapshot.tick, fmus, routes }).map_err(|e| err!("encoding the system snapshot: {e}"))?;
+        let body = postcard::to_stdvec(&Saved { tick: snapshot.tick, fmus, routes })
+            .map_err(|e| err!("encoding the system snapshot: {e}"))?;
         out.extend_from_slice(&body);
         Ok(out)
     }
@@ -45,7 +47,9 @@ impl Master {
     /// A snapshot of this master from bytes of [`Master::serialize_snapshot`], taken from a
     /// master of the same system (same components in the same order, same routes).
     pub fn deserialize_snapshot(&mut self, bytes: &[u8]) -> Result<Snapshot> {
-        let body = bytes.strip_prefix(MAGIC.as_slice()).ok_or_else(|| err!("not a saved agrisim system snapshot (no \"AGSYS\\x01\" prefix; {} bytes)", bytes.len()))?;
+        let body = bytes.strip_prefix(MAGIC.as_slice()).ok_or_else(|| {
+            err!("not a saved agrisim system snapshot (no \"AGSYS\\x01\" prefix; {} bytes)", bytes.len())
+        })?;
         let saved: Saved = postcard::from_bytes(body).map_err(|e| err!("corrupt system snapshot: {e}"))?;
         let names: Vec<&str> = self.system.components.iter().map(|c| c.name.as_str()).collect();
         let saved_names: Vec<&str> = saved.fmus.iter().map(|f| f.component.as_str()).collect();

@@ -13,9 +13,7 @@ use std::path::{Path, PathBuf};
 
 use roxmltree::Node;
 
-use crate::model_description::{
-    parse_bool, parse_f64, Causality, ModelDescription, ModelVariable, VarType,
-};
+use crate::model_description::{parse_bool, parse_f64, Causality, ModelDescription, ModelVariable, VarType};
 
 pub const NS_SSD: &str = "http://ssp-standard.org/SSP1/SystemStructureDescription";
 pub const NS_SSC: &str = "http://ssp-standard.org/SSP1/SystemStructureCommon";
@@ -37,10 +35,7 @@ pub struct SspError {
 
 impl SspError {
     fn one(file: &Path, problem: impl Into<String>) -> SspError {
-        SspError {
-            file: file.to_path_buf(),
-            problems: vec![problem.into()],
-        }
+        SspError { file: file.to_path_buf(), problems: vec![problem.into()] }
     }
 }
 
@@ -201,16 +196,14 @@ pub struct SystemStructure {
 
 impl SystemStructure {
     pub fn from_file(path: &Path) -> Result<SystemStructure, SspError> {
-        let xml = std::fs::read_to_string(path)
-            .map_err(|e| SspError::one(path, format!("cannot read: {e}")))?;
+        let xml = std::fs::read_to_string(path).map_err(|e| SspError::one(path, format!("cannot read: {e}")))?;
         Self::parse(&xml, path)
     }
 
     /// Parses SSD text; `path` is recorded and used in errors.
     pub fn parse(xml: &str, path: &Path) -> Result<SystemStructure, SspError> {
         let err = |m: String| SspError::one(path, m);
-        let doc = roxmltree::Document::parse(xml)
-            .map_err(|e| err(format!("not well-formed XML: {e}")))?;
+        let doc = roxmltree::Document::parse(xml).map_err(|e| err(format!("not well-formed XML: {e}")))?;
         let root = doc.root_element();
         if !is(root, NS_SSD, "SystemStructureDescription") {
             return Err(err(format!(
@@ -219,8 +212,7 @@ impl SystemStructure {
                 root.tag_name().namespace().unwrap_or("none")
             )));
         }
-        let system =
-            child(root, NS_SSD, "System").ok_or_else(|| err("no ssd:System element".into()))?;
+        let system = child(root, NS_SSD, "System").ok_or_else(|| err("no ssd:System element".into()))?;
         let name = req(system, "name", "ssd:System").map_err(err)?;
 
         let system_connectors = match child(system, NS_SSD, "Connectors") {
@@ -250,7 +242,9 @@ impl SystemStructure {
             }
         }
         if child(system, NS_SSD, "ParameterBindings").is_some() {
-            return Err(err("system-level ssd:ParameterBindings are not supported; bind parameters on each component".into()));
+            return Err(err(
+                "system-level ssd:ParameterBindings are not supported; bind parameters on each component".into()
+            ));
         }
 
         let mut connections = Vec::new();
@@ -295,26 +289,18 @@ fn child<'a, 'i>(node: Node<'a, 'i>, ns: &str, name: &str) -> Option<Node<'a, 'i
     node.children().find(|n| is(*n, ns, name))
 }
 
-fn elements<'a, 'i: 'a>(
-    node: Node<'a, 'i>,
-    ns: &'a str,
-    name: &'a str,
-) -> impl Iterator<Item = Node<'a, 'i>> + 'a {
+fn elements<'a, 'i: 'a>(node: Node<'a, 'i>, ns: &'a str, name: &'a str) -> impl Iterator<Item = Node<'a, 'i>> + 'a {
     node.children().filter(move |n| is(*n, ns, name))
 }
 
 fn req(node: Node, attr: &str, what: &str) -> Result<String, String> {
-    node.attribute(attr)
-        .map(str::to_string)
-        .ok_or_else(|| format!("{what} has no attribute '{attr}'"))
+    node.attribute(attr).map(str::to_string).ok_or_else(|| format!("{what} has no attribute '{attr}'"))
 }
 
 fn opt_f64(node: Node, attr: &str, what: &str) -> Result<Option<f64>, String> {
     match node.attribute(attr) {
         None => Ok(None),
-        Some(v) => parse_f64(v)
-            .map(Some)
-            .ok_or_else(|| format!("{what}: {attr}=\"{v}\" is not a number")),
+        Some(v) => parse_f64(v).map(Some).ok_or_else(|| format!("{what}: {attr}=\"{v}\" is not a number")),
     }
 }
 
@@ -324,12 +310,8 @@ fn parse_connectors(node: Node, owner: &str) -> Result<Vec<Connector>, String> {
         let name = req(c, "name", &format!("a connector of {owner}"))?;
         let what = format!("connector '{name}' of {owner}");
         let kind_s = req(c, "kind", &what)?;
-        let kind = ConnectorKind::parse(&kind_s)
-            .ok_or_else(|| format!("{what}: unknown kind \"{kind_s}\""))?;
-        let ty = match c
-            .children()
-            .find(|n| n.is_element() && n.tag_name().namespace() == Some(NS_SSC))
-        {
+        let kind = ConnectorKind::parse(&kind_s).ok_or_else(|| format!("{what}: unknown kind \"{kind_s}\""))?;
+        let ty = match c.children().find(|n| n.is_element() && n.tag_name().namespace() == Some(NS_SSC)) {
             None => None,
             Some(t) => Some(match t.tag_name().name() {
                 "Real" => ConnectorType::Real,
@@ -338,10 +320,7 @@ fn parse_connectors(node: Node, owner: &str) -> Result<Vec<Connector>, String> {
                 "String" => ConnectorType::String,
                 "Enumeration" => ConnectorType::Enumeration,
                 "Binary" => ConnectorType::Binary {
-                    mime_type: t
-                        .attribute("mime-type")
-                        .or_else(|| t.attribute("mimeType"))
-                        .map(str::to_string),
+                    mime_type: t.attribute("mime-type").or_else(|| t.attribute("mimeType")).map(str::to_string),
                 },
                 other => return Err(format!("{what}: unknown type element ssc:{other}")),
             }),
@@ -349,7 +328,11 @@ fn parse_connectors(node: Node, owner: &str) -> Result<Vec<Connector>, String> {
         let mut topic = None;
         if let Some(anns) = child(c, NS_SSD, "Annotations") {
             for ann in elements(anns, NS_SSC, "Annotation").filter(|a| a.attribute("type") == Some(TOPIC_ANNOTATION)) {
-                let t = ann.descendants().filter(|n| n.is_element()).find_map(|n| n.attribute("name")).filter(|t| !t.is_empty());
+                let t = ann
+                    .descendants()
+                    .filter(|n| n.is_element())
+                    .find_map(|n| n.attribute("name"))
+                    .filter(|t| !t.is_empty());
                 topic = Some(t.ok_or_else(|| format!("{what}: the {TOPIC_ANNOTATION} annotation names no topic (expected an element with a name attribute)"))?.to_string());
             }
         }
@@ -367,9 +350,7 @@ fn parse_component(el: Node) -> Result<Component, String> {
     let source = req(el, "source", &what)?;
     if let Some(t) = el.attribute("type") {
         if t != FMU_COMPONENT_TYPE {
-            return Err(format!(
-                "{what}: type \"{t}\" is not supported (only {FMU_COMPONENT_TYPE})"
-            ));
+            return Err(format!("{what}: type \"{t}\" is not supported (only {FMU_COMPONENT_TYPE})"));
         }
     }
     let connectors = match child(el, NS_SSD, "Connectors") {
@@ -380,12 +361,12 @@ fn parse_component(el: Node) -> Result<Component, String> {
     if let Some(pbs) = child(el, NS_SSD, "ParameterBindings") {
         for pb in elements(pbs, NS_SSD, "ParameterBinding") {
             if let Some(src) = pb.attribute("source") {
-                return Err(format!("{what}: external parameter source \"{src}\" is not supported; put the values inline"));
+                return Err(format!(
+                    "{what}: external parameter source \"{src}\" is not supported; put the values inline"
+                ));
             }
             if pb.attribute("prefix").is_some_and(|p| !p.is_empty()) {
-                return Err(format!(
-                    "{what}: ssd:ParameterBinding prefix is not supported"
-                ));
+                return Err(format!("{what}: ssd:ParameterBinding prefix is not supported"));
             }
             let Some(values) = child(pb, NS_SSD, "ParameterValues") else {
                 continue;
@@ -396,20 +377,12 @@ fn parse_component(el: Node) -> Result<Component, String> {
                 };
                 for p in elements(params, NS_SSV, "Parameter") {
                     let pname = req(p, "name", &format!("an ssv:Parameter of {what}"))?;
-                    parameters.push((
-                        pname.clone(),
-                        parse_param_value(p, &format!("{what}, parameter '{pname}'"))?,
-                    ));
+                    parameters.push((pname.clone(), parse_param_value(p, &format!("{what}, parameter '{pname}'"))?));
                 }
             }
         }
     }
-    Ok(Component {
-        name,
-        source,
-        connectors,
-        parameters,
-    })
+    Ok(Component { name, source, connectors, parameters })
 }
 
 fn parse_param_value(p: Node, what: &str) -> Result<ParamValue, String> {
@@ -436,19 +409,13 @@ fn decode_hex(s: &str) -> Option<Vec<u8>> {
     if s.len() & 1 == 1 {
         return None;
     }
-    (0..s.len())
-        .step_by(2)
-        .map(|i| u8::from_str_radix(s.get(i..i + 2)?, 16).ok())
-        .collect()
+    (0..s.len()).step_by(2).map(|i| u8::from_str_radix(s.get(i..i + 2)?, 16).ok()).collect()
 }
 
 fn parse_connection(c: Node) -> Result<Connection, String> {
     let endpoint = |el: &str, conn: &str| -> Result<Endpoint, String> {
         Ok(Endpoint {
-            element: c
-                .attribute(el)
-                .filter(|s| !s.is_empty())
-                .map(str::to_string),
+            element: c.attribute(el).filter(|s| !s.is_empty()).map(str::to_string),
             connector: req(c, conn, "an ssd:Connection")?,
         })
     };
@@ -457,20 +424,14 @@ fn parse_connection(c: Node) -> Result<Connection, String> {
     let what = format!("connection {start} -> {end}");
     let mut period = None;
     if let Some(anns) = child(c, NS_SSD, "Annotations") {
-        for ann in elements(anns, NS_SSC, "Annotation")
-            .filter(|a| a.attribute("type") == Some(EXCHANGE_ANNOTATION))
-        {
+        for ann in elements(anns, NS_SSC, "Annotation").filter(|a| a.attribute("type") == Some(EXCHANGE_ANNOTATION)) {
             let p = ann
                 .descendants()
                 .find_map(|n| n.attribute("period"))
-                .ok_or_else(|| {
-                    format!("{what}: the {EXCHANGE_ANNOTATION} annotation has no period attribute")
-                })?;
+                .ok_or_else(|| format!("{what}: the {EXCHANGE_ANNOTATION} annotation has no period attribute"))?;
             let v = parse_f64(p)
                 .filter(|v| v.is_finite() && *v > 0.0)
-                .ok_or_else(|| {
-                    format!("{what}: exchange period \"{p}\" must be a positive number of seconds")
-                })?;
+                .ok_or_else(|| format!("{what}: exchange period \"{p}\" must be a positive number of seconds"))?;
             period = Some(v);
         }
     }
@@ -480,10 +441,7 @@ fn parse_connection(c: Node) -> Result<Connection, String> {
 /// Where a component's `source` lives: relative to the .ssd's directory if that file exists
 /// (SSP semantics), else by file name in `fmu_dir` (where `agrisim fmu pack` writes FMUs).
 pub fn resolve_source(ssd_path: &Path, source: &str, fmu_dir: &Path) -> PathBuf {
-    let s = source
-        .strip_prefix("file://")
-        .or_else(|| source.strip_prefix("file:"))
-        .unwrap_or(source);
+    let s = source.strip_prefix("file://").or_else(|| source.strip_prefix("file:")).unwrap_or(source);
     let base = ssd_path.parent().unwrap_or_else(|| Path::new("."));
     let direct = base.join(s);
     if direct.is_file() {
@@ -525,15 +483,8 @@ impl PortType {
             VarType::Int32 | VarType::Int64 => PortType::Integer,
             VarType::Boolean => PortType::Boolean,
             VarType::String => PortType::String,
-            VarType::Binary => {
-                PortType::Binary(v.mime_type.as_deref().map(|m| m.trim().to_string()))
-            }
-            other => {
-                return Err(format!(
-                    "variable '{}' has type {other}, which agrisim does not support",
-                    v.name
-                ))
-            }
+            VarType::Binary => PortType::Binary(v.mime_type.as_deref().map(|m| m.trim().to_string())),
+            other => return Err(format!("variable '{}' has type {other}, which agrisim does not support", v.name)),
         })
     }
 
@@ -543,12 +494,8 @@ impl PortType {
             ConnectorType::Integer => PortType::Integer,
             ConnectorType::Boolean => PortType::Boolean,
             ConnectorType::String => PortType::String,
-            ConnectorType::Binary { mime_type } => {
-                PortType::Binary(mime_type.as_deref().map(|m| m.trim().to_string()))
-            }
-            ConnectorType::Enumeration => {
-                return Err("type ssc:Enumeration is not supported".into())
-            }
+            ConnectorType::Binary { mime_type } => PortType::Binary(mime_type.as_deref().map(|m| m.trim().to_string())),
+            ConnectorType::Enumeration => return Err("type ssc:Enumeration is not supported".into()),
         })
     }
 
@@ -564,27 +511,18 @@ impl PortType {
 
 /// Checks the system against the FMUs' model descriptions, keyed by component name.
 /// Reports every problem found, each naming the connection or component and the variable.
-pub fn validate(
-    sys: &SystemStructure,
-    mds: &BTreeMap<String, ModelDescription>,
-) -> Result<(), SspError> {
+pub fn validate(sys: &SystemStructure, mds: &BTreeMap<String, ModelDescription>) -> Result<(), SspError> {
     let mut problems = Vec::new();
 
     for comp in &sys.components {
         let Some(md) = mds.get(&comp.name) else {
-            problems.push(format!(
-                "component '{}': no model description was loaded for it",
-                comp.name
-            ));
+            problems.push(format!("component '{}': no model description was loaded for it", comp.name));
             continue;
         };
         let fmu = format!("component '{}' (FMU {})", comp.name, md.model_name);
         for c in &comp.connectors {
             let Some(v) = md.variable(&c.name) else {
-                problems.push(format!(
-                    "{fmu}: connector '{}' names no variable of the FMU",
-                    c.name
-                ));
+                problems.push(format!("{fmu}: connector '{}' names no variable of the FMU", c.name));
                 continue;
             };
             let kind_ok = match c.kind {
@@ -608,18 +546,14 @@ pub fn validate(
                         "{fmu}: connector '{}' is declared {a} but the FMU variable is {} ({b})",
                         c.name, v.ty
                     )),
-                    (Err(e), _) | (_, Err(e)) => {
-                        problems.push(format!("{fmu}: connector '{}': {e}", c.name))
-                    }
+                    (Err(e), _) | (_, Err(e)) => problems.push(format!("{fmu}: connector '{}': {e}", c.name)),
                     _ => {}
                 }
             }
         }
         for (pname, value) in &comp.parameters {
             let Some(v) = md.variable(pname) else {
-                problems.push(format!(
-                    "{fmu}: parameter '{pname}' is not a variable of the FMU"
-                ));
+                problems.push(format!("{fmu}: parameter '{pname}' is not a variable of the FMU"));
                 continue;
             };
             if !v.causality.is_settable_parameter() {
@@ -639,10 +573,8 @@ pub fn validate(
                 _ => false,
             };
             if !ok {
-                problems.push(format!(
-                    "{fmu}: parameter '{pname}' is {} but the value {value:?} does not fit it",
-                    v.ty
-                ));
+                problems
+                    .push(format!("{fmu}: parameter '{pname}' is {} but the value {value:?} does not fit it", v.ty));
             }
         }
     }
@@ -662,20 +594,14 @@ pub fn validate(
             (a, b) => problems.extend(a.err().into_iter().chain(b.err())),
         }
         if let Some(first) = driven.insert(&conn.end, conn) {
-            problems.push(format!(
-                "{conn}: input {} is already driven by {first}",
-                conn.end
-            ));
+            problems.push(format!("{conn}: input {} is already driven by {first}", conn.end));
         }
     }
 
     if problems.is_empty() {
         Ok(())
     } else {
-        Err(SspError {
-            file: sys.path.clone(),
-            problems,
-        })
+        Err(SspError { file: sys.path.clone(), problems })
     }
 }
 
@@ -707,44 +633,25 @@ fn endpoint_type(
                     c.kind.name()
                 ));
             }
-            c.ty.as_ref()
-                .map(PortType::of_connector)
-                .transpose()
-                .map_err(|e| format!("{conn}: {e}"))
+            c.ty.as_ref().map(PortType::of_connector).transpose().map_err(|e| format!("{conn}: {e}"))
         }
         Some(el) => {
-            let comp = sys
-                .component(el)
-                .ok_or_else(|| format!("{conn}: there is no component '{el}'"))?;
+            let comp = sys.component(el).ok_or_else(|| format!("{conn}: there is no component '{el}'"))?;
             if comp.connector(&ep.connector).is_none() {
-                return Err(format!(
-                    "{conn}: component '{el}' declares no connector '{}'",
-                    ep.connector
-                ));
+                return Err(format!("{conn}: component '{el}' declares no connector '{}'", ep.connector));
             }
-            let md = mds
-                .get(el)
-                .ok_or_else(|| format!("{conn}: no model description for component '{el}'"))?;
+            let md = mds.get(el).ok_or_else(|| format!("{conn}: no model description for component '{el}'"))?;
             let v = md.variable(&ep.connector).ok_or_else(|| {
-                format!(
-                    "{conn}: FMU {} of component '{el}' has no variable '{}'",
-                    md.model_name, ep.connector
-                )
+                format!("{conn}: FMU {} of component '{el}' has no variable '{}'", md.model_name, ep.connector)
             })?;
-            let want = if is_start {
-                Causality::Output
-            } else {
-                Causality::Input
-            };
+            let want = if is_start { Causality::Output } else { Causality::Input };
             if v.causality != want {
                 return Err(format!(
                     "{conn}: {side} variable '{}' of component '{el}' has causality {}, expected {}",
                     v.name, v.causality, want
                 ));
             }
-            PortType::of_var(v)
-                .map(Some)
-                .map_err(|e| format!("{conn}: component '{el}': {e}"))
+            PortType::of_var(v).map(Some).map_err(|e| format!("{conn}: component '{el}': {e}"))
         }
     }
 }
@@ -763,10 +670,7 @@ mod tests {
 
     #[test]
     fn endpoint_display() {
-        let e = Endpoint {
-            element: None,
-            connector: "/cmd_vel".into(),
-        };
+        let e = Endpoint { element: None, connector: "/cmd_vel".into() };
         assert_eq!(e.to_string(), "<system>./cmd_vel");
     }
 }

@@ -38,8 +38,20 @@ pub struct LoadOptions {
 
 impl LoadOptions {
     /// FMUs from `fmu_dir`, unpacked to `cache_dir`, no overrides.
-    pub fn new(fmu_dir: impl Into<PathBuf>, cache_dir: impl Into<PathBuf>, step: f64, message_period: f64) -> LoadOptions {
-        LoadOptions { fmu_dir: fmu_dir.into(), cache_dir: cache_dir.into(), fmu_overrides: BTreeMap::new(), step, message_period, fmu_log: None }
+    pub fn new(
+        fmu_dir: impl Into<PathBuf>,
+        cache_dir: impl Into<PathBuf>,
+        step: f64,
+        message_period: f64,
+    ) -> LoadOptions {
+        LoadOptions {
+            fmu_dir: fmu_dir.into(),
+            cache_dir: cache_dir.into(),
+            fmu_overrides: BTreeMap::new(),
+            step,
+            message_period,
+            fmu_log: None,
+        }
     }
 }
 
@@ -171,10 +183,15 @@ fn check_log_categories(categories: &[String], mds: &BTreeMap<String, ModelDescr
     }
     for c in categories {
         if !mds.values().any(|md| md.log_categories.contains(c)) {
-            let mut known: Vec<&str> = mds.values().flat_map(|md| md.log_categories.iter().map(String::as_str)).collect();
+            let mut known: Vec<&str> =
+                mds.values().flat_map(|md| md.log_categories.iter().map(String::as_str)).collect();
             known.sort_unstable();
             known.dedup();
-            return Err(crate::err!("FMU log category '{c}': no FMU of {} declares it (they declare: {})", ssd.display(), known.join(", ")));
+            return Err(crate::err!(
+                "FMU log category '{c}': no FMU of {} declares it (they declare: {})",
+                ssd.display(),
+                known.join(", ")
+            ));
         }
     }
     Ok(())
@@ -189,7 +206,11 @@ fn instantiate(archive: &FmuArchive, name: &str, fmu_log: Option<&[String]>) -> 
         return Ok(Instance::instantiate(archive, name, true)?);
     }
     let declared = &archive.md.log_categories;
-    let mine: Vec<&str> = categories.iter().map(String::as_str).filter(|c| declared.is_empty() || declared.iter().any(|d| d == c)).collect();
+    let mine: Vec<&str> = categories
+        .iter()
+        .map(String::as_str)
+        .filter(|c| declared.is_empty() || declared.iter().any(|d| d == c))
+        .collect();
     let mut instance = Instance::instantiate(archive, name, false)?;
     if !mine.is_empty() {
         instance.set_debug_logging(true, &mine)?;
@@ -214,14 +235,19 @@ impl System {
         };
         let mut structure = SystemStructure::from_file(ssd)?;
         for (comp, fmu) in &opts.fmu_overrides {
-            let c = structure.components.iter_mut().find(|c| &c.name == comp).ok_or_else(|| crate::err!("FMU override for '{comp}': no such component in {}", ssd.display()))?;
+            let c = structure
+                .components
+                .iter_mut()
+                .find(|c| &c.name == comp)
+                .ok_or_else(|| crate::err!("FMU override for '{comp}': no such component in {}", ssd.display()))?;
             c.source = fmu.clone();
         }
         let mut archives = BTreeMap::new();
         let mut mds = BTreeMap::new();
         for c in &structure.components {
             let path = ssp::resolve_source(ssd, &c.source, &opts.fmu_dir);
-            let a = FmuArchive::open(&path, &opts.cache_dir).context(|| format!("component '{}' of {}", c.name, ssd.display()))?;
+            let a = FmuArchive::open(&path, &opts.cache_dir)
+                .context(|| format!("component '{}' of {}", c.name, ssd.display()))?;
             mds.insert(c.name.clone(), a.md.clone());
             archives.insert(c.name.clone(), a);
         }
@@ -253,9 +279,16 @@ impl System {
         let Some(comp_name) = &e.element else { return Ok(Port::Bus { topic: self.external_name(&e.connector) }) };
         let comp = self.component_index(comp_name).ok_or_else(|| crate::err!("no component '{comp_name}'"))?;
         let md = &self.components[comp].archive.md;
-        let var = md.variable(&e.connector).ok_or_else(|| crate::err!("FMU '{comp_name}' ({}) has no variable '{}'", md.model_name, e.connector))?.clone();
+        let var = md
+            .variable(&e.connector)
+            .ok_or_else(|| crate::err!("FMU '{comp_name}' ({}) has no variable '{}'", md.model_name, e.connector))?
+            .clone();
         if !value::supported(var.ty) {
-            return Err(crate::err!("FMU '{comp_name}': variable '{}' has type {}, which agrisim cannot exchange", var.name, var.ty.name()));
+            return Err(crate::err!(
+                "FMU '{comp_name}': variable '{}' has type {}, which agrisim cannot exchange",
+                var.name,
+                var.ty.name()
+            ));
         }
         let seq = if var.ty == VarType::Binary {
             let name = format!("{}_seq", var.name);
@@ -291,7 +324,18 @@ impl System {
             };
             let framed = |p: &Port| matches!(p, Port::Fmu { var, .. } if var.mime_type.as_deref().is_some_and(agrisim_frames::is_framed_mime));
             let (framed_from, framed_to) = (framed(&from), framed(&to));
-            routes.push(Route { label, from, to, period_ticks, mime_type: mime, topic, cursor: Default::default(), framed_from, framed_to, written: 0 });
+            routes.push(Route {
+                label,
+                from,
+                to,
+                period_ticks,
+                mime_type: mime,
+                topic,
+                cursor: Default::default(),
+                framed_from,
+                framed_to,
+                written: 0,
+            });
         }
         Ok(routes)
     }
@@ -302,10 +346,18 @@ impl System {
     /// String parameter of that name (e.g. one scene description for all FMUs that build
     /// the scene), unless overridden. Returns what was set, per component, for a run's
     /// metadata.
-    pub fn apply_parameters(&mut self, overrides: &BTreeMap<String, BTreeMap<String, toml::Value>>, master_seed: u64, shared: &BTreeMap<String, String>) -> Result<BTreeMap<String, BTreeMap<String, String>>> {
+    pub fn apply_parameters(
+        &mut self,
+        overrides: &BTreeMap<String, BTreeMap<String, toml::Value>>,
+        master_seed: u64,
+        shared: &BTreeMap<String, String>,
+    ) -> Result<BTreeMap<String, BTreeMap<String, String>>> {
         for name in overrides.keys() {
             if self.component_index(name).is_none() {
-                return Err(crate::err!("scenario parameters for '{name}': no such component in {}", self.structure.path.display()));
+                return Err(crate::err!(
+                    "scenario parameters for '{name}': no such component in {}",
+                    self.structure.path.display()
+                ));
             }
         }
         let mut applied = BTreeMap::new();
@@ -328,12 +380,20 @@ impl System {
             }
             for (name, v) in &comp.parameters {
                 let var = param(name)?;
-                let val = value::from_ssp(&var, v).ok_or_else(|| crate::err!("{}: parameter {}.{name}: value {v:?} does not fit type {}", self.structure.path.display(), comp.name, var.ty.name()))?;
+                let val = value::from_ssp(&var, v).ok_or_else(|| {
+                    crate::err!(
+                        "{}: parameter {}.{name}: value {v:?} does not fit type {}",
+                        self.structure.path.display(),
+                        comp.name,
+                        var.ty.name()
+                    )
+                })?;
                 set.insert(name.clone(), val);
             }
             for (name, v) in overrides.get(&comp.name).into_iter().flatten() {
                 let var = param(name)?;
-                let val = value::from_toml(&var, v).map_err(|e| crate::err!("scenario parameter {}.{name}: {e}", comp.name))?;
+                let val = value::from_toml(&var, v)
+                    .map_err(|e| crate::err!("scenario parameter {}.{name}: {e}", comp.name))?;
                 set.insert(name.clone(), val);
             }
             let mut texts = BTreeMap::new();
@@ -352,7 +412,12 @@ impl System {
     /// Boolean): how a benchmark reads ground-truth outputs.
     pub fn number(&mut self, comp: usize, name: &str) -> Result<f64> {
         let c = &mut self.components[comp];
-        let v = c.archive.md.variable(name).cloned().ok_or_else(|| crate::err!("FMU '{}' has no variable '{name}'", c.name))?;
+        let v = c
+            .archive
+            .md
+            .variable(name)
+            .cloned()
+            .ok_or_else(|| crate::err!("FMU '{}' has no variable '{name}'", c.name))?;
         match value::get(&mut c.instance, &v)? {
             Value::F64(x) => Ok(x),
             Value::Bool(b) => Ok(b as u8 as f64),

@@ -52,7 +52,10 @@ impl Value {
 
 /// True for the types the master moves and records.
 pub fn supported(ty: VarType) -> bool {
-    matches!(ty, VarType::Float64 | VarType::Int32 | VarType::Int64 | VarType::Boolean | VarType::String | VarType::Binary)
+    matches!(
+        ty,
+        VarType::Float64 | VarType::Int32 | VarType::Int64 | VarType::Boolean | VarType::String | VarType::Binary
+    )
 }
 
 pub fn get(inst: &mut Instance, v: &ModelVariable) -> Result<Value> {
@@ -80,7 +83,14 @@ pub fn get(inst: &mut Instance, v: &ModelVariable) -> Result<Value> {
         }
         VarType::String => Value::Str(inst.get_string(v.value_reference)?),
         VarType::Binary => Value::Bin(inst.get_binary(v.value_reference)?),
-        other => return Err(crate::err!("FMU '{}': variable {} has type {}, which agrisim does not exchange", inst.name(), v.name, other.name())),
+        other => {
+            return Err(crate::err!(
+                "FMU '{}': variable {} has type {}, which agrisim does not exchange",
+                inst.name(),
+                v.name,
+                other.name()
+            ))
+        }
     })
 }
 
@@ -93,7 +103,14 @@ pub fn set(inst: &mut Instance, v: &ModelVariable, value: &Value) -> Result<()> 
         (VarType::Boolean, Value::Bool(x)) => inst.set_bool(&vr, &[*x])?,
         (VarType::String, Value::Str(x)) => inst.set_string(v.value_reference, x)?,
         (VarType::Binary, Value::Bin(x)) => inst.set_binary(v.value_reference, x)?,
-        (ty, value) => return Err(crate::err!("FMU '{}': variable {} is {}, cannot set {value:?}", inst.name(), v.name, ty.name())),
+        (ty, value) => {
+            return Err(crate::err!(
+                "FMU '{}': variable {} is {}, cannot set {value:?}",
+                inst.name(),
+                v.name,
+                ty.name()
+            ))
+        }
     }
     Ok(())
 }
@@ -149,7 +166,9 @@ pub fn scalar_from_f64(v: &ModelVariable, x: f64) -> Result<Value> {
     match v.ty {
         VarType::Float64 => Ok(Value::F64(x)),
         VarType::Int32 | VarType::Int64 => int_from_f64(v, x),
-        VarType::Boolean if x.is_nan() => Err(crate::err!("variable '{}' (Boolean): value NaN is not a truth value", v.name)),
+        VarType::Boolean if x.is_nan() => {
+            Err(crate::err!("variable '{}' (Boolean): value NaN is not a truth value", v.name))
+        }
         VarType::Boolean => Ok(Value::Bool(x != 0.0)),
         other => Err(crate::err!("variable '{}' of type {} cannot take a scalar", v.name, other.name())),
     }
@@ -175,7 +194,16 @@ mod tests {
     use crate::model_description::{Causality, Variability};
 
     fn var(name: &str, ty: VarType) -> ModelVariable {
-        ModelVariable { name: name.into(), value_reference: 1, ty, causality: Causality::Input, variability: Variability::Discrete, start: None, mime_type: None, description: None }
+        ModelVariable {
+            name: name.into(),
+            value_reference: 1,
+            ty,
+            causality: Causality::Input,
+            variability: Variability::Discrete,
+            start: None,
+            mime_type: None,
+            description: None,
+        }
     }
 
     #[test]
@@ -186,7 +214,13 @@ mod tests {
         assert_eq!(int_from_f64(&id, 3.0 + 1e-12).unwrap(), Value::I32(3));
         assert_eq!(int_from_f64(&id, 2147483647.0).unwrap(), Value::I32(i32::MAX));
         assert_eq!(int_from_f64(&id, -2147483648.0).unwrap(), Value::I32(i32::MIN));
-        for (x, why) in [(f64::NAN, "NaN is not a finite number"), (f64::INFINITY, "inf is not a finite number"), (2.5, "2.5 is not an integer"), (2147483648.0, "2147483648 is out of range for Int32 [-2147483648, 2147483647]"), (-1e10, "-10000000000 is out of range for Int32")] {
+        for (x, why) in [
+            (f64::NAN, "NaN is not a finite number"),
+            (f64::INFINITY, "inf is not a finite number"),
+            (2.5, "2.5 is not an integer"),
+            (2147483648.0, "2147483648 is out of range for Int32 [-2147483648, 2147483647]"),
+            (-1e10, "-10000000000 is out of range for Int32"),
+        ] {
             let e = int_from_f64(&id, x).unwrap_err().0;
             assert!(e.starts_with("variable 'target_id' (Int32): value "), "{e}");
             assert!(e.contains(why), "{x}: {e}");
@@ -220,7 +254,10 @@ mod tests {
         assert!(from_toml(&id, &t("v = 3.5")).unwrap_err().0.contains("3.5 is not an integer"));
         assert!(from_toml(&id, &t("v = nan")).unwrap_err().0.contains("not a finite number"));
         assert!(from_toml(&id, &t("v = 4294967296")).unwrap_err().0.contains("4294967296 is out of range for Int32"));
-        assert!(from_toml(&id, &t("v = true")).unwrap_err().0.contains("'target_id': value true does not fit type Int32"));
+        assert!(from_toml(&id, &t("v = true"))
+            .unwrap_err()
+            .0
+            .contains("'target_id': value true does not fit type Int32"));
         assert_eq!(from_toml(&var("x", VarType::Float64), &t("v = 2")).unwrap(), Value::F64(2.0));
     }
 }

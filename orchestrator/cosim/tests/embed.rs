@@ -45,7 +45,11 @@ fn root() -> PathBuf {
 #[test]
 fn embedded_engine_runs_base_ssd_with_its_own_hooks() {
     let fmu_dir = root().join("target/fmu");
-    assert!(fmu_dir.join("Lift.fmu").exists(), "{} has no packed FMUs: run `target/release/agrisim fmu pack`", fmu_dir.display());
+    assert!(
+        fmu_dir.join("Lift.fmu").exists(),
+        "{} has no packed FMUs: run `target/release/agrisim fmu pack`",
+        fmu_dir.display()
+    );
     let cache = tempfile::tempdir().unwrap();
     let opts = LoadOptions::new(&fmu_dir, cache.path(), 0.02, 0.1);
     let mut system = System::load(&root().join("models/systems/base.ssd"), &opts).unwrap();

@@ -18,8 +18,7 @@ fn lib_entry() -> String {
 /// Writes a zip with the given (name, bytes) entries.
 fn write_zip(path: &Path, entries: &[(&str, &[u8])]) {
     let mut z = zip::ZipWriter::new(std::fs::File::create(path).unwrap());
-    let opts = zip::write::SimpleFileOptions::default()
-        .compression_method(zip::CompressionMethod::Deflated);
+    let opts = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
     for (name, data) in entries {
         z.start_file(*name, opts).unwrap();
         z.write_all(data).unwrap();
@@ -62,16 +61,11 @@ fn opens_and_exposes_paths() {
     assert_eq!(a.library_path, a.dir.join(lib_entry()));
     assert_eq!(std::fs::read(&a.library_path).unwrap(), b"not really ELF");
     assert_eq!(a.resources_dir, a.dir.join("resources"));
-    assert_eq!(
-        std::fs::read_to_string(a.resources_dir.join("lift.toml")).unwrap(),
-        "height = 1.0"
-    );
+    assert_eq!(std::fs::read_to_string(a.resources_dir.join("lift.toml")).unwrap(), "height = 1.0");
     assert!(a.dir.join("modelDescription.xml").is_file());
     // No temporary directories left behind.
-    let names: Vec<String> = std::fs::read_dir(&cache)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
+    let names: Vec<String> =
+        std::fs::read_dir(&cache).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
     assert_eq!(names.len(), 1, "{names:?}");
 }
 
@@ -97,13 +91,7 @@ fn complete_cache_is_reused_and_new_bytes_get_a_new_dir() {
     assert!(b.dir.join("sentinel").is_file());
 
     // Rebuilt FMU (different bytes): a different directory.
-    write_zip(
-        &fmu,
-        &[
-            ("modelDescription.xml", MD.as_bytes()),
-            (&lib_entry(), b"rebuilt"),
-        ],
-    );
+    write_zip(&fmu, &[("modelDescription.xml", MD.as_bytes()), (&lib_entry(), b"rebuilt")]);
     let c = FmuArchive::open(&fmu, &cache).unwrap();
     assert_ne!(c.dir, a.dir);
     assert_eq!(std::fs::read(&c.library_path).unwrap(), b"rebuilt");
@@ -133,14 +121,8 @@ fn assert_import_err(fmu: &Path, cache: &Path, expected: &str) {
     let e = FmuArchive::open(fmu, cache).unwrap_err();
     assert_eq!(e.fmu, fmu);
     let s = e.to_string();
-    assert!(
-        s.starts_with(&format!("FMU archive '{}': ", fmu.display())),
-        "{s}"
-    );
-    assert!(
-        s.contains(expected),
-        "error {s:?} does not contain {expected:?}"
-    );
+    assert!(s.starts_with(&format!("FMU archive '{}': ", fmu.display())), "{s}");
+    assert!(s.contains(expected), "error {s:?} does not contain {expected:?}");
 }
 
 /// Every file under `dir`, relative to it.
@@ -191,10 +173,7 @@ fn dot_dot_that_stays_inside_is_unpacked_where_it_resolves() {
     let fmu = tmp.path().join("Lift.fmu");
     minimal_fmu(&fmu, &[("resources/tmp/../lift.toml", b"height = 2.0")]);
     let a = FmuArchive::open(&fmu, &tmp.path().join("cache")).unwrap();
-    assert_eq!(
-        std::fs::read_to_string(a.resources_dir.join("lift.toml")).unwrap(),
-        "height = 2.0"
-    );
+    assert_eq!(std::fs::read_to_string(a.resources_dir.join("lift.toml")).unwrap(), "height = 2.0");
 }
 
 #[test]
@@ -214,10 +193,7 @@ fn corrupt_or_non_zip_file_is_rejected() {
 
     // Central directory intact, compressed data of an entry damaged.
     let mut damaged = bytes.clone();
-    let at = damaged
-        .windows(b"modelDescription.xml".len())
-        .position(|w| w == b"modelDescription.xml")
-        .unwrap();
+    let at = damaged.windows(b"modelDescription.xml".len()).position(|w| w == b"modelDescription.xml").unwrap();
     for b in &mut damaged[at + 40..at + 80] {
         *b ^= 0x5a;
     }
@@ -239,11 +215,7 @@ fn missing_model_description_is_rejected() {
     let tmp = tempfile::tempdir().unwrap();
     let fmu = tmp.path().join("NoMd.fmu");
     write_zip(&fmu, &[(&lib_entry(), b"x")]);
-    assert_import_err(
-        &fmu,
-        &tmp.path().join("cache"),
-        "no modelDescription.xml at the archive root",
-    );
+    assert_import_err(&fmu, &tmp.path().join("cache"), "no modelDescription.xml at the archive root");
 }
 
 #[test]
@@ -251,20 +223,11 @@ fn invalid_model_description_names_the_entry() {
     let tmp = tempfile::tempdir().unwrap();
     let fmu = tmp.path().join("Fmi2.fmu");
     let md = MD.replace(r#"fmiVersion="3.0""#, r#"fmiVersion="2.0""#);
-    write_zip(
-        &fmu,
-        &[
-            ("modelDescription.xml", md.as_bytes()),
-            (&lib_entry(), b"x"),
-        ],
-    );
+    write_zip(&fmu, &[("modelDescription.xml", md.as_bytes()), (&lib_entry(), b"x")]);
     assert_import_err(
         &fmu,
         &tmp.path().join("cache"),
-        &format!(
-            "{}!modelDescription.xml: fmiVersion is \"2.0\"",
-            fmu.display()
-        ),
+        &format!("{}!modelDescription.xml: fmiVersion is \"2.0\"", fmu.display()),
     );
 }
 
@@ -272,13 +235,7 @@ fn invalid_model_description_names_the_entry() {
 fn missing_binary_lists_the_platforms_present() {
     let tmp = tempfile::tempdir().unwrap();
     let fmu = tmp.path().join("WinOnly.fmu");
-    write_zip(
-        &fmu,
-        &[
-            ("modelDescription.xml", MD.as_bytes()),
-            ("binaries/x86_64-windows/agrisim_lift.dll", b"MZ"),
-        ],
-    );
+    write_zip(&fmu, &[("modelDescription.xml", MD.as_bytes()), ("binaries/x86_64-windows/agrisim_lift.dll", b"MZ")]);
     assert_import_err(
         &fmu,
         &tmp.path().join("cache"),
@@ -286,16 +243,6 @@ fn missing_binary_lists_the_platforms_present() {
     );
 
     let fmu = tmp.path().join("WrongName.fmu");
-    write_zip(
-        &fmu,
-        &[
-            ("modelDescription.xml", MD.as_bytes()),
-            (&format!("binaries/{PLATFORM}/lift.so"), b"x"),
-        ],
-    );
-    assert_import_err(
-        &fmu,
-        &tmp.path().join("cache"),
-        &format!("binaries/{PLATFORM}/agrisim_lift.so is missing"),
-    );
+    write_zip(&fmu, &[("modelDescription.xml", MD.as_bytes()), (&format!("binaries/{PLATFORM}/lift.so"), b"x")]);
+    assert_import_err(&fmu, &tmp.path().join("cache"), &format!("binaries/{PLATFORM}/agrisim_lift.so is missing"));
 }

@@ -179,19 +179,11 @@ fn compile(dir: &Path, extra: &[&str]) -> Option<PathBuf> {
     std::fs::write(&src, C_SOURCE).unwrap();
     let out = dir.join("testmodel.so");
     let cc = std::env::var("CC").unwrap_or_else(|_| "cc".to_string());
-    let res = Command::new(&cc)
-        .args(["-shared", "-fPIC", "-O1", "-o"])
-        .arg(&out)
-        .arg(&src)
-        .args(extra)
-        .output();
+    let res = Command::new(&cc).args(["-shared", "-fPIC", "-O1", "-o"]).arg(&out).arg(&src).args(extra).output();
     match res {
         Ok(o) if o.status.success() => Some(out),
         Ok(o) => {
-            eprintln!(
-                "SKIPPED: C compiler '{cc}' failed: {}",
-                String::from_utf8_lossy(&o.stderr)
-            );
+            eprintln!("SKIPPED: C compiler '{cc}' failed: {}", String::from_utf8_lossy(&o.stderr));
             None
         }
         Err(e) => {
@@ -204,12 +196,10 @@ fn compile(dir: &Path, extra: &[&str]) -> Option<PathBuf> {
 fn pack(fmu: &Path, md: &str, so: &Path) {
     let f = std::fs::File::create(fmu).unwrap();
     let mut z = zip::ZipWriter::new(f);
-    let opts = zip::write::SimpleFileOptions::default()
-        .compression_method(zip::CompressionMethod::Deflated);
+    let opts = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
     z.start_file("modelDescription.xml", opts).unwrap();
     z.write_all(md.as_bytes()).unwrap();
-    z.start_file(format!("binaries/{PLATFORM}/testmodel.so"), opts)
-        .unwrap();
+    z.start_file(format!("binaries/{PLATFORM}/testmodel.so"), opts).unwrap();
     z.write_all(&std::fs::read(so).unwrap()).unwrap();
     z.finish().unwrap();
 }
@@ -233,18 +223,13 @@ fn fixture_with(token: &str, extra_cflags: &[&str], can_get_and_set_state: bool)
     pack(&fmu, &model_description(token, can_get_and_set_state), &so);
     let archive = FmuArchive::open(&fmu, &tmp.path().join("cache")).unwrap();
     let lib = unsafe { libloading::Library::new(&archive.library_path) }.unwrap();
-    Some(Fixture {
-        lib,
-        archive,
-        _tmp: tmp,
-    })
+    Some(Fixture { lib, archive, _tmp: tmp })
 }
 
 /// Reads a counter the C model exports (same file, same loaded image, shared globals).
 fn counter(fx: &Fixture, name: &str) -> i32 {
     unsafe {
-        let f: libloading::Symbol<unsafe extern "C" fn() -> i32> =
-            fx.lib.get(name.as_bytes()).unwrap();
+        let f: libloading::Symbol<unsafe extern "C" fn() -> i32> = fx.lib.get(name.as_bytes()).unwrap();
         f()
     }
 }
@@ -308,14 +293,8 @@ fn two_instances_of_one_library_step_independently() {
     a.get_i64(&[K], &mut k).unwrap();
     assert_eq!(k[0], 5);
     // The instantiation message went to each instance's own log.
-    assert_eq!(
-        a.take_log().first().map(|m| m.message.as_str()),
-        Some("left")
-    );
-    assert_eq!(
-        b.take_log().first().map(|m| m.message.as_str()),
-        Some("right")
-    );
+    assert_eq!(a.take_log().first().map(|m| m.message.as_str()), Some("left"));
+    assert_eq!(b.take_log().first().map(|m| m.message.as_str()), Some("right"));
     assert!(a.take_log().is_empty());
     drop(a);
     assert_eq!(counter(&fx, "test_live_instances"), 1);
@@ -344,10 +323,7 @@ fn every_supported_type_round_trips() {
     i.set_binary(BIN, &[1, 2, 3, 0, 255]).unwrap();
     assert_eq!(i.get_binary(BIN).unwrap(), vec![1, 2, 3, 0, 255]);
     let r = i.do_step(0.0, 0.1).unwrap();
-    assert!(
-        r.terminate_simulation,
-        "flag=true asks to terminate in this model"
-    );
+    assert!(r.terminate_simulation, "flag=true asks to terminate in this model");
     assert_eq!(i.get_binary(BOUT).unwrap(), vec![255, 0, 3, 2, 1]);
     i.set_binary(BIN, &[]).unwrap();
     i.do_step(0.1, 0.1).unwrap();
@@ -355,10 +331,7 @@ fn every_supported_type_round_trips() {
     // resourcePath: absolute, native, trailing separator, pointing at the unpacked resources/.
     let res = i.get_string(RES).unwrap();
     assert!(res.ends_with("/resources/"), "{res}");
-    assert!(
-        Path::new(&res).is_absolute() && Path::new(&res).is_dir(),
-        "{res}"
-    );
+    assert!(Path::new(&res).is_absolute() && Path::new(&res).is_dir(), "{res}");
     // A NUL byte cannot cross the C API.
     let e = i.set_string(S, "a\0b").unwrap_err();
     assert!(e.to_string().contains("NUL"), "{e}");
@@ -392,11 +365,7 @@ fn errors_name_instance_model_function_variables_and_reason() {
     i.set_i32(&[FAIL], &[3]).unwrap();
     i.do_step(0.0, 0.02).unwrap();
     let log = i.take_log();
-    assert!(
-        log.iter()
-            .any(|m| m.status == Status::Warning && m.message == "commanded warning"),
-        "{log:?}"
-    );
+    assert!(log.iter().any(|m| m.status == Status::Warning && m.message == "commanded warning"), "{log:?}");
 
     // An error carries the time and the FMU's logged reason, and the state becomes Error.
     i.set_i32(&[FAIL], &[1]).unwrap();
@@ -423,11 +392,7 @@ fn errors_name_instance_model_function_variables_and_reason() {
     // Call-order errors reported by the FMU come through too.
     i.reset().unwrap();
     let e = i.do_step(0.0, 0.02).unwrap_err();
-    assert!(
-        e.to_string()
-            .ends_with("returned fmi3Error: fmi3DoStep called outside step mode"),
-        "{e}"
-    );
+    assert!(e.to_string().ends_with("returned fmi3Error: fmi3DoStep called outside step mode"), "{e}");
 }
 
 #[test]
@@ -440,11 +405,7 @@ fn fatal_makes_the_wrapper_refuse_everything_and_never_free() {
         i.set_i32(&[FAIL], &[2]).unwrap();
         let e = i.do_step(0.0, 0.02).unwrap_err();
         assert!(e.is_fatal());
-        assert!(
-            e.to_string()
-                .contains("returned fmi3Fatal: commanded fatal"),
-            "{e}"
-        );
+        assert!(e.to_string().contains("returned fmi3Fatal: commanded fatal"), "{e}");
         assert_eq!(i.state(), InstanceState::Fatal);
         let e = i.set_f64(&[U], &[1.0]).unwrap_err();
         assert_eq!(e.status, Some(Status::Fatal));
@@ -492,9 +453,7 @@ fn wrong_token_fails_with_the_fmus_reason() {
     let Some(fx) = fixture("{some-other-token}", &[]) else {
         return;
     };
-    let e = Instance::instantiate(&fx.archive, "chassis", false)
-        .err()
-        .unwrap();
+    let e = Instance::instantiate(&fx.archive, "chassis", false).err().unwrap();
     assert_eq!(
         e.to_string(),
         "FMU 'chassis' (TestModel): fmi3InstantiateCoSimulation failed: wrong instantiation token; returned NULL (instantiation failed)"
@@ -506,18 +465,10 @@ fn missing_symbol_is_named() {
     let Some(fx) = fixture("{agrisim-test-token}", &["-DOMIT_DOSTEP"]) else {
         return;
     };
-    let e = Instance::instantiate(&fx.archive, "lift", false)
-        .err()
-        .unwrap();
+    let e = Instance::instantiate(&fx.archive, "lift", false).err().unwrap();
     let s = e.to_string();
-    assert!(
-        s.starts_with("FMU 'lift' (TestModel): loading failed: shared library '"),
-        "{s}"
-    );
-    assert!(
-        s.ends_with("testmodel.so' does not export fmi3DoStep"),
-        "{s}"
-    );
+    assert!(s.starts_with("FMU 'lift' (TestModel): loading failed: shared library '"), "{s}");
+    assert!(s.ends_with("testmodel.so' does not export fmi3DoStep"), "{s}");
 }
 
 #[test]
@@ -545,10 +496,7 @@ fn debug_logging_is_off_unless_asked_and_chosen_by_category() {
         for k in 0..5 {
             i.do_step(k as f64 * 0.1, 0.1).unwrap();
         }
-        i.take_log()
-            .iter()
-            .filter(|m| m.category == "logCalls")
-            .count()
+        i.take_log().iter().filter(|m| m.category == "logCalls").count()
     };
     // Off by default: not a single callback while stepping.
     let mut off = Instance::instantiate(&fx.archive, "off", false).unwrap();
@@ -630,7 +578,12 @@ fn drop_and_terminate_call_fmi3_terminate_only_in_step_mode() {
     // terminate() in Initialization Mode is refused up front, the state unchanged.
     let e = init.terminate().unwrap_err();
     assert!(e.is_refused(), "{e}");
-    assert!(e.to_string().starts_with("FMU 'init' (TestModel): fmi3Terminate failed: refused: not allowed in state InitializationMode"), "{e}");
+    assert!(
+        e.to_string().starts_with(
+            "FMU 'init' (TestModel): fmi3Terminate failed: refused: not allowed in state InitializationMode"
+        ),
+        "{e}"
+    );
     assert_eq!(init.state(), InstanceState::InitializationMode);
     init.exit_initialization_mode().unwrap();
     init.reset().unwrap();
@@ -675,12 +628,17 @@ fn unsupported_fmu_state_is_refused_up_front_leaving_the_instance_usable() {
     let mut i = ready(&fx, "arm");
     let e = i.get_state().unwrap_err();
     assert!(
-        e.is_refused() && e.to_string().contains("fmi3GetFMUState failed: refused: the shared library does not export this function"),
+        e.is_refused()
+            && e.to_string()
+                .contains("fmi3GetFMUState failed: refused: the shared library does not export this function"),
         "{e}"
     );
     let e = i.set_debug_logging(true, &[]).unwrap_err();
     assert!(
-        e.is_refused() && e.to_string().starts_with("FMU 'arm' (TestModel): fmi3SetDebugLogging failed: refused: the shared library does not export"),
+        e.is_refused()
+            && e.to_string().starts_with(
+                "FMU 'arm' (TestModel): fmi3SetDebugLogging failed: refused: the shared library does not export"
+            ),
         "{e}"
     );
     assert_eq!(i.state(), InstanceState::StepMode);

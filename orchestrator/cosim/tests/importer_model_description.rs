@@ -70,25 +70,8 @@ fn parses_the_good_fixture() {
             Float64
         ]
     );
-    let supported: Vec<&str> = md
-        .variables
-        .iter()
-        .filter(|v| v.ty.is_supported())
-        .map(|v| v.name.as_str())
-        .collect();
-    assert_eq!(
-        supported,
-        [
-            "time",
-            "cmd_vx",
-            "mode",
-            "odom_seq",
-            "enabled",
-            "scenario",
-            "odom",
-            "wheel_base"
-        ]
-    );
+    let supported: Vec<&str> = md.variables.iter().filter(|v| v.ty.is_supported()).map(|v| v.name.as_str()).collect();
+    assert_eq!(supported, ["time", "cmd_vx", "mode", "odom_seq", "enabled", "scenario", "odom", "wheel_base"]);
 
     let v = md.variable("cmd_vx").unwrap();
     assert_eq!(v.value_reference, 1);
@@ -102,16 +85,10 @@ fn parses_the_good_fixture() {
     assert_eq!(s.causality, Causality::StructuralParameter);
     assert_eq!(s.start.as_deref(), Some("default.toml"));
     let b = md.variable("odom").unwrap();
-    assert_eq!(
-        b.mime_type.as_deref(),
-        Some("application/x-ros2-cdr; type=nav_msgs/msg/Odometry")
-    );
+    assert_eq!(b.mime_type.as_deref(), Some("application/x-ros2-cdr; type=nav_msgs/msg/Odometry"));
     assert_eq!(b.variability, Variability::Discrete);
     assert_eq!(md.variable("mode").unwrap().variability, Variability::Fixed);
-    assert_eq!(
-        md.variable("wheel_base").unwrap().causality,
-        Causality::CalculatedParameter
-    );
+    assert_eq!(md.variable("wheel_base").unwrap().causality, Causality::CalculatedParameter);
     assert!(md.variable("nope").is_none());
     assert_eq!(md.variable_by_vr(13).unwrap().name, "odom");
 }
@@ -122,50 +99,30 @@ fn replace(from: &str, to: &str) -> String {
 }
 
 fn error_of(xml: &str) -> String {
-    ModelDescription::parse(xml, "fmus/Chassis.fmu!modelDescription.xml")
-        .unwrap_err()
-        .to_string()
+    ModelDescription::parse(xml, "fmus/Chassis.fmu!modelDescription.xml").unwrap_err().to_string()
 }
 
 #[track_caller]
 fn assert_err(xml: &str, expected: &str) {
     let e = error_of(xml);
-    assert!(
-        e.starts_with("fmus/Chassis.fmu!modelDescription.xml: "),
-        "{e}"
-    );
-    assert!(
-        e.contains(expected),
-        "error {e:?} does not contain {expected:?}"
-    );
+    assert!(e.starts_with("fmus/Chassis.fmu!modelDescription.xml: "), "{e}");
+    assert!(e.contains(expected), "error {e:?} does not contain {expected:?}");
 }
 
 #[test]
 fn fmi2_is_rejected() {
-    assert_err(
-        &replace(r#"fmiVersion="3.0""#, r#"fmiVersion="2.0""#),
-        r#"fmiVersion is "2.0", only FMI 3.0"#,
-    );
+    assert_err(&replace(r#"fmiVersion="3.0""#, r#"fmiVersion="2.0""#), r#"fmiVersion is "2.0", only FMI 3.0"#);
 }
 
 #[test]
 fn missing_version_is_rejected() {
-    assert_err(
-        &replace(r#"fmiVersion="3.0""#, ""),
-        "<fmiModelDescription> has no attribute 'fmiVersion'",
-    );
+    assert_err(&replace(r#"fmiVersion="3.0""#, ""), "<fmiModelDescription> has no attribute 'fmiVersion'");
 }
 
 #[test]
 fn missing_model_name_and_token_are_rejected() {
-    assert_err(
-        &replace(r#"modelName="ChassisKinematic""#, ""),
-        "has no attribute 'modelName'",
-    );
-    assert_err(
-        &replace(r#"instantiationToken="{1234-abcd}""#, ""),
-        "has no attribute 'instantiationToken'",
-    );
+    assert_err(&replace(r#"modelName="ChassisKinematic""#, ""), "has no attribute 'modelName'");
+    assert_err(&replace(r#"instantiationToken="{1234-abcd}""#, ""), "has no attribute 'instantiationToken'");
 }
 
 #[test]
@@ -185,10 +142,7 @@ fn missing_model_identifier_is_rejected() {
         "<CoSimulation> has no attribute 'modelIdentifier'",
     );
     assert_err(
-        &replace(
-            r#"modelIdentifier="agrisim_chassis_kinematic""#,
-            r#"modelIdentifier="../x""#,
-        ),
+        &replace(r#"modelIdentifier="agrisim_chassis_kinematic""#, r#"modelIdentifier="../x""#),
         "not a valid file stem",
     );
 }
@@ -196,20 +150,14 @@ fn missing_model_identifier_is_rejected() {
 #[test]
 fn duplicate_value_reference_is_rejected() {
     assert_err(
-        &replace(
-            r#"name="f32" valueReference="2""#,
-            r#"name="f32" valueReference="1""#,
-        ),
+        &replace(r#"name="f32" valueReference="2""#, r#"name="f32" valueReference="1""#),
         "duplicate valueReference 1: used by 'cmd_vx' and 'f32'",
     );
 }
 
 #[test]
 fn duplicate_name_is_rejected() {
-    assert_err(
-        &replace(r#"name="f32""#, r#"name="cmd_vx""#),
-        "duplicate variable name 'cmd_vx'",
-    );
+    assert_err(&replace(r#"name="f32""#, r#"name="cmd_vx""#), "duplicate variable name 'cmd_vx'");
 }
 
 #[test]
@@ -218,10 +166,7 @@ fn missing_variable_attributes_are_rejected() {
         &replace(r#"name="i8" valueReference="3""#, r#"name="i8""#),
         "variable 'i8' has no attribute 'valueReference'",
     );
-    assert_err(
-        &replace(r#"<Int8 name="i8" "#, "<Int8 "),
-        "a <Int8> variable has no attribute 'name'",
-    );
+    assert_err(&replace(r#"<Int8 name="i8" "#, "<Int8 "), "a <Int8> variable has no attribute 'name'");
 }
 
 #[test]
@@ -231,47 +176,29 @@ fn bad_values_are_rejected() {
         r#"variable 'i8': valueReference="-3" is not"#,
     );
     assert_err(
-        &replace(
-            r#"causality="input" start="0""#,
-            r#"causality="sideways" start="0""#,
-        ),
+        &replace(r#"causality="input" start="0""#, r#"causality="sideways" start="0""#),
         r#"variable 'cmd_vx': unknown causality "sideways""#,
     );
     assert_err(
-        &replace(
-            r#"variability="fixed" start="2""#,
-            r#"variability="sometimes""#,
-        ),
+        &replace(r#"variability="fixed" start="2""#, r#"variability="sometimes""#),
         r#"variable 'mode': unknown variability "sometimes""#,
     );
     assert_err(
         &replace(r#"variability="fixed" start="2""#, r#"variability="continuous""#),
         "variable 'mode': variability \"continuous\" is only allowed for Float32/Float64, not Int32",
     );
+    assert_err(&replace(r#"stepSize="0.02""#, r#"stepSize="fast""#), r#"stepSize="fast" is not a number"#);
     assert_err(
-        &replace(r#"stepSize="0.02""#, r#"stepSize="fast""#),
-        r#"stepSize="fast" is not a number"#,
-    );
-    assert_err(
-        &replace(
-            r#"canGetAndSetFMUState="true""#,
-            r#"canGetAndSetFMUState="yes""#,
-        ),
+        &replace(r#"canGetAndSetFMUState="true""#, r#"canGetAndSetFMUState="yes""#),
         "canGetAndSetFMUState=\"yes\" is not a boolean",
     );
-    assert_err(
-        &replace("<UInt64 ", "<Float128 "),
-        "unknown variable element <Float128>",
-    );
+    assert_err(&replace("<UInt64 ", "<Float128 "), "unknown variable element <Float128>");
 }
 
 #[test]
 fn not_xml_and_wrong_root_are_rejected() {
     assert_err("this is not xml", "not well-formed XML");
-    assert_err(
-        "<fmiModelDescriptions/>",
-        "root element is <fmiModelDescriptions>",
-    );
+    assert_err("<fmiModelDescriptions/>", "root element is <fmiModelDescriptions>");
 }
 
 #[test]
@@ -279,16 +206,9 @@ fn from_file_names_the_file() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("modelDescription.xml");
     let e = ModelDescription::from_file(&p).unwrap_err();
-    assert!(
-        e.to_string()
-            .starts_with(&format!("{}: cannot read", p.display())),
-        "{e}"
-    );
+    assert!(e.to_string().starts_with(&format!("{}: cannot read", p.display())), "{e}");
     std::fs::write(&p, GOOD).unwrap();
-    assert_eq!(
-        ModelDescription::from_file(&p).unwrap().model_name,
-        "ChassisKinematic"
-    );
+    assert_eq!(ModelDescription::from_file(&p).unwrap().model_name, "ChassisKinematic");
 }
 
 #[test]

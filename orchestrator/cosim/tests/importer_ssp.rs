@@ -101,14 +101,8 @@ const LIFT_MD: &str = r#"<fmiModelDescription fmiVersion="3.0" modelName="Lift" 
 
 fn mds() -> BTreeMap<String, ModelDescription> {
     let mut m = BTreeMap::new();
-    m.insert(
-        "chassis".to_string(),
-        ModelDescription::parse(CHASSIS_MD, "chassis").unwrap(),
-    );
-    m.insert(
-        "lift".to_string(),
-        ModelDescription::parse(LIFT_MD, "lift").unwrap(),
-    );
+    m.insert("chassis".to_string(), ModelDescription::parse(CHASSIS_MD, "chassis").unwrap());
+    m.insert("lift".to_string(), ModelDescription::parse(LIFT_MD, "lift").unwrap());
     m
 }
 
@@ -123,19 +117,14 @@ fn parses_the_agrisim_subset() {
     assert_eq!(s.path, Path::new("models/systems/SystemStructure.ssd"));
     assert_eq!(s.components.len(), 2);
     let c = &s.components[0];
-    assert_eq!(
-        (c.name.as_str(), c.source.as_str()),
-        ("chassis", "fmus/Chassis.fmu")
-    );
+    assert_eq!((c.name.as_str(), c.source.as_str()), ("chassis", "fmus/Chassis.fmu"));
     assert_eq!(c.connectors.len(), 5);
     assert_eq!(c.connector("vx").unwrap().ty, Some(ConnectorType::Real));
     assert_eq!(c.connector("seq").unwrap().ty, Some(ConnectorType::Integer));
     assert_eq!(c.connector("cmd_vel").unwrap().kind, ConnectorKind::Input);
     assert_eq!(
         c.connector("cmd_vel").unwrap().ty,
-        Some(ConnectorType::Binary {
-            mime_type: Some("application/x-ros2-cdr; type=geometry_msgs/msg/Twist".into())
-        })
+        Some(ConnectorType::Binary { mime_type: Some("application/x-ros2-cdr; type=geometry_msgs/msg/Twist".into()) })
     );
     assert_eq!(
         c.parameters,
@@ -143,30 +132,15 @@ fn parses_the_agrisim_subset() {
             ("wheel_base".to_string(), ParamValue::Real(0.55)),
             ("seed".to_string(), ParamValue::Integer(42)),
             ("holonomic".to_string(), ParamValue::Boolean(true)),
-            (
-                "scenario".to_string(),
-                ParamValue::String("default.toml".into())
-            ),
+            ("scenario".to_string(), ParamValue::String("default.toml".into())),
         ]
     );
     assert_eq!(s.system_connectors.len(), 3);
     assert_eq!(s.system_connector("speed").unwrap().ty, None);
     assert_eq!(s.connections.len(), 5);
     let first = &s.connections[0];
-    assert_eq!(
-        first.start,
-        Endpoint {
-            element: None,
-            connector: "/cmd_vel".into()
-        }
-    );
-    assert_eq!(
-        first.end,
-        Endpoint {
-            element: Some("chassis".into()),
-            connector: "cmd_vel".into()
-        }
-    );
+    assert_eq!(first.start, Endpoint { element: None, connector: "/cmd_vel".into() });
+    assert_eq!(first.end, Endpoint { element: Some("chassis".into()), connector: "cmd_vel".into() });
     assert_eq!(first.period, Some(0.1));
     assert_eq!(s.connections[1].period, None);
     assert_eq!(s.connections[1].end.element, None);
@@ -189,52 +163,31 @@ fn validation_error(from: &str, to: &str) -> String {
 #[track_caller]
 fn assert_contains(e: &str, expected: &str) {
     assert!(e.starts_with("models/systems/SystemStructure.ssd: "), "{e}");
-    assert!(
-        e.contains(expected),
-        "error {e:?} does not contain {expected:?}"
-    );
+    assert!(e.contains(expected), "error {e:?} does not contain {expected:?}");
 }
 
 #[test]
 fn unknown_component_in_connection() {
-    let e = validation_error(
-        r#"endElement="lift" endConnector="vx_in""#,
-        r#"endElement="arm" endConnector="vx_in""#,
-    );
-    assert_contains(
-        &e,
-        "connection chassis.vx -> arm.vx_in: there is no component 'arm'",
-    );
+    let e = validation_error(r#"endElement="lift" endConnector="vx_in""#, r#"endElement="arm" endConnector="vx_in""#);
+    assert_contains(&e, "connection chassis.vx -> arm.vx_in: there is no component 'arm'");
 }
 
 #[test]
 fn undeclared_connector_in_connection() {
     let e = validation_error(r#"startConnector="h""#, r#"startConnector="height""#);
-    assert_contains(
-        &e,
-        "connection lift.height -> chassis.lift_h: component 'lift' declares no connector 'height'",
-    );
+    assert_contains(&e, "connection lift.height -> chassis.lift_h: component 'lift' declares no connector 'height'");
 }
 
 #[test]
 fn connector_without_fmu_variable() {
-    let e = validation_error(
-        r#"<ssd:Connector name="h" kind="output">"#,
-        r#"<ssd:Connector name="hh" kind="output">"#,
-    );
-    assert_contains(
-        &e,
-        "component 'lift' (FMU Lift): connector 'hh' names no variable of the FMU",
-    );
+    let e = validation_error(r#"<ssd:Connector name="h" kind="output">"#, r#"<ssd:Connector name="hh" kind="output">"#);
+    assert_contains(&e, "component 'lift' (FMU Lift): connector 'hh' names no variable of the FMU");
 }
 
 #[test]
 fn unknown_system_connector() {
     let e = validation_error(r#"endConnector="/odom""#, r#"endConnector="/odometry""#);
-    assert_contains(
-        &e,
-        "connection chassis.odom -> <system>./odometry: the system has no connector '/odometry'",
-    );
+    assert_contains(&e, "connection chassis.odom -> <system>./odometry: the system has no connector '/odometry'");
 }
 
 #[test]
@@ -244,31 +197,19 @@ fn wrong_direction_is_rejected() {
         r#"startElement="lift" startConnector="h" endElement="chassis" endConnector="lift_h""#,
         r#"startElement="chassis" startConnector="lift_h" endElement="lift" endConnector="h""#,
     );
-    assert_contains(
-        &e,
-        "start variable 'lift_h' of component 'chassis' has causality input, expected output",
-    );
-    assert_contains(
-        &e,
-        "end variable 'h' of component 'lift' has causality output, expected input",
-    );
+    assert_contains(&e, "start variable 'lift_h' of component 'chassis' has causality input, expected output");
+    assert_contains(&e, "end variable 'h' of component 'lift' has causality output, expected input");
     // a system output used as a source
     let e = validation_error(
         r#"startElement="chassis" startConnector="odom" endConnector="/odom""#,
         r#"startConnector="/odom" endElement="chassis" endConnector="lift_h""#,
     );
-    assert_contains(
-        &e,
-        "system connector '/odom' has kind output and cannot be the start of a connection",
-    );
+    assert_contains(&e, "system connector '/odom' has kind output and cannot be the start of a connection");
 }
 
 #[test]
 fn connector_kind_must_match_causality() {
-    let e = validation_error(
-        r#"<ssd:Connector name="vx" kind="output">"#,
-        r#"<ssd:Connector name="vx" kind="input">"#,
-    );
+    let e = validation_error(r#"<ssd:Connector name="vx" kind="output">"#, r#"<ssd:Connector name="vx" kind="input">"#);
     assert_contains(&e, "component 'chassis' (FMU ChassisKinematic): connector 'vx' has kind input but the FMU variable has causality output");
 }
 
@@ -281,20 +222,14 @@ fn type_mismatches_are_rejected() {
         1,
     ).replacen(r#"endElement="lift" endConnector="vx_in""#, r#"endElement="lift" endConnector="b_in""#, 1));
     let e = validate(&s, &mds()).unwrap_err().to_string();
-    assert_contains(
-        &e,
-        "connection chassis.vx -> lift.b_in: types differ: Real -> Boolean",
-    );
+    assert_contains(&e, "connection chassis.vx -> lift.b_in: types differ: Real -> Boolean");
 
     // Declared connector type disagrees with the FMU variable.
     let e = validation_error(
         r#"<ssd:Connector name="seq" kind="output"><ssc:Integer/>"#,
         r#"<ssd:Connector name="seq" kind="output"><ssc:Real/>"#,
     );
-    assert_contains(
-        &e,
-        "connector 'seq' is declared Real but the FMU variable is Int64 (Integer)",
-    );
+    assert_contains(&e, "connector 'seq' is declared Real but the FMU variable is Int64 (Integer)");
 
     // Binary mime types must agree: a Twist topic into the Odometry output.
     let e = validation_error(
@@ -333,28 +268,16 @@ fn input_driven_twice_is_rejected() {
 #[test]
 fn parameter_errors() {
     let e = validation_error(r#"name="wheel_base""#, r#"name="wheelbase""#);
-    assert_contains(&e, "component 'chassis' (FMU ChassisKinematic): parameter 'wheelbase' is not a variable of the FMU");
+    assert_contains(
+        &e,
+        "component 'chassis' (FMU ChassisKinematic): parameter 'wheelbase' is not a variable of the FMU",
+    );
     let e = validation_error(r#"name="wheel_base""#, r#"name="x""#);
-    assert_contains(
-        &e,
-        "'x' has causality output, not parameter, so it cannot be bound",
-    );
-    let e = validation_error(
-        r#"<ssv:Real value="0.55"/>"#,
-        r#"<ssv:String value="wide"/>"#,
-    );
-    assert_contains(
-        &e,
-        "parameter 'wheel_base' is Float64 but the value String(\"wide\") does not fit it",
-    );
-    let e = validation_error(
-        r#"<ssv:Integer value="42"/>"#,
-        r#"<ssv:Integer value="4294967296"/>"#,
-    );
-    assert_contains(
-        &e,
-        "parameter 'seed' is Int32 but the value Integer(4294967296) does not fit it",
-    );
+    assert_contains(&e, "'x' has causality output, not parameter, so it cannot be bound");
+    let e = validation_error(r#"<ssv:Real value="0.55"/>"#, r#"<ssv:String value="wide"/>"#);
+    assert_contains(&e, "parameter 'wheel_base' is Float64 but the value String(\"wide\") does not fit it");
+    let e = validation_error(r#"<ssv:Integer value="42"/>"#, r#"<ssv:Integer value="4294967296"/>"#);
+    assert_contains(&e, "parameter 'seed' is Int32 but the value Integer(4294967296) does not fit it");
 }
 
 #[test]
@@ -363,40 +286,27 @@ fn missing_model_description_is_reported() {
     let mut m = mds();
     m.remove("lift");
     let e = validate(&s, &m).unwrap_err();
-    assert!(
-        e.problems
-            .iter()
-            .any(|p| p == "component 'lift': no model description was loaded for it"),
-        "{e}"
-    );
+    assert!(e.problems.iter().any(|p| p == "component 'lift': no model description was loaded for it"), "{e}");
 }
 
 #[test]
 fn all_problems_are_listed() {
-    let s = parse(
-        &SSD.replacen(r#"name="wheel_base""#, r#"name="wheelbase""#, 1)
-            .replacen(r#"endConnector="/odom""#, r#"endConnector="/o""#, 1),
-    );
+    let s = parse(&SSD.replacen(r#"name="wheel_base""#, r#"name="wheelbase""#, 1).replacen(
+        r#"endConnector="/odom""#,
+        r#"endConnector="/o""#,
+        1,
+    ));
     let e = validate(&s, &mds()).unwrap_err();
     assert_eq!(e.problems.len(), 2, "{e}");
-    assert!(
-        e.to_string()
-            .starts_with("models/systems/SystemStructure.ssd: 2 problems:\n  - "),
-        "{e}"
-    );
+    assert!(e.to_string().starts_with("models/systems/SystemStructure.ssd: 2 problems:\n  - "), "{e}");
 }
 
 #[track_caller]
 fn parse_err(from: &str, to: &str, expected: &str) {
     assert!(SSD.contains(from), "fixture lacks {from:?}");
-    let e = SystemStructure::parse(&SSD.replacen(from, to, 1), Path::new("sys.ssd"))
-        .unwrap_err()
-        .to_string();
+    let e = SystemStructure::parse(&SSD.replacen(from, to, 1), Path::new("sys.ssd")).unwrap_err().to_string();
     assert!(e.starts_with("sys.ssd: "), "{e}");
-    assert!(
-        e.contains(expected),
-        "error {e:?} does not contain {expected:?}"
-    );
+    assert!(e.contains(expected), "error {e:?} does not contain {expected:?}");
 }
 
 #[test]
@@ -421,12 +331,12 @@ fn malformed_files_are_rejected_by_parse() {
         r#"name="speed" kind="sideways""#,
         "connector 'speed' of the system: unknown kind \"sideways\"",
     );
-    parse_err(r#"period="0.1""#, r#"period="-1""#, "connection <system>./cmd_vel -> chassis.cmd_vel: exchange period \"-1\" must be a positive number");
     parse_err(
         r#"period="0.1""#,
-        r#"every="0.1""#,
-        "the org.agrisim.exchange annotation has no period attribute",
+        r#"period="-1""#,
+        "connection <system>./cmd_vel -> chassis.cmd_vel: exchange period \"-1\" must be a positive number",
     );
+    parse_err(r#"period="0.1""#, r#"every="0.1""#, "the org.agrisim.exchange annotation has no period attribute");
     parse_err(
         r#"<ssv:Real value="0.55"/>"#,
         r#"<ssv:Real value="wide"/>"#,
@@ -437,26 +347,10 @@ fn malformed_files_are_rejected_by_parse() {
         r#"<ssd:ParameterBinding source="chassis.ssv">"#,
         "external parameter source \"chassis.ssv\" is not supported",
     );
-    parse_err(
-        r#"<ssd:System name="robot">"#,
-        r#"<ssd:System>"#,
-        "ssd:System has no attribute 'name'",
-    );
-    parse_err(
-        r#"startConnector="h""#,
-        "",
-        "an ssd:Connection has no attribute 'startConnector'",
-    );
-    parse_err(
-        r#"<ssc:Real unit="m/s"/>"#,
-        r#"<ssc:Float64/>"#,
-        "unknown type element ssc:Float64",
-    );
-    parse_err(
-        r#"stopTime="60""#,
-        r#"stopTime="forever""#,
-        "stopTime=\"forever\" is not a number",
-    );
+    parse_err(r#"<ssd:System name="robot">"#, r#"<ssd:System>"#, "ssd:System has no attribute 'name'");
+    parse_err(r#"startConnector="h""#, "", "an ssd:Connection has no attribute 'startConnector'");
+    parse_err(r#"<ssc:Real unit="m/s"/>"#, r#"<ssc:Float64/>"#, "unknown type element ssc:Float64");
+    parse_err(r#"stopTime="60""#, r#"stopTime="forever""#, "stopTime=\"forever\" is not a number");
     parse_err(
         r#"xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription""#,
         r#"xmlns:ssd="http://example.org/other""#,
@@ -488,18 +382,9 @@ fn sources_resolve_next_to_the_ssd_then_in_the_fmu_dir() {
     std::fs::create_dir_all(&fmu_dir).unwrap();
     let ssd = sys_dir.join("SystemStructure.ssd");
     std::fs::write(sys_dir.join("fmus/Chassis.fmu"), b"").unwrap();
-    assert_eq!(
-        resolve_source(&ssd, "fmus/Chassis.fmu", &fmu_dir),
-        sys_dir.join("fmus/Chassis.fmu")
-    );
-    assert_eq!(
-        resolve_source(&ssd, "resources/Lift.fmu", &fmu_dir),
-        fmu_dir.join("Lift.fmu")
-    );
-    assert_eq!(
-        resolve_source(&ssd, "file:fmus/Chassis.fmu", &fmu_dir),
-        sys_dir.join("fmus/Chassis.fmu")
-    );
+    assert_eq!(resolve_source(&ssd, "fmus/Chassis.fmu", &fmu_dir), sys_dir.join("fmus/Chassis.fmu"));
+    assert_eq!(resolve_source(&ssd, "resources/Lift.fmu", &fmu_dir), fmu_dir.join("Lift.fmu"));
+    assert_eq!(resolve_source(&ssd, "file:fmus/Chassis.fmu", &fmu_dir), sys_dir.join("fmus/Chassis.fmu"));
 }
 
 #[test]

@@ -18,24 +18,16 @@ const LIB: &str = "libagrisim_fmu_testmodel.so";
 fn find_library() -> Option<PathBuf> {
     let target = std::env::var_os("CARGO_TARGET_DIR")
         .map(PathBuf::from)
-        .unwrap_or_else(|| {
-            PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-                .join("../..")
-                .join("target")
-        });
-    ["debug", "release"]
-        .iter()
-        .map(|p| target.join(p).join(LIB))
-        .find(|p| p.is_file())
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..").join("target"));
+    ["debug", "release"].iter().map(|p| target.join(p).join(LIB)).find(|p| p.is_file())
 }
 
 /// The XML the library generates from its own variable table.
 fn description_of(lib_path: &std::path::Path) -> String {
     unsafe {
         let lib = libloading::Library::new(lib_path).unwrap();
-        let f: libloading::Symbol<unsafe extern "C" fn() -> *const c_char> = lib
-            .get(b"agrisim_model_description_fmi3")
-            .expect("the test model exports agrisim_model_description_fmi3");
+        let f: libloading::Symbol<unsafe extern "C" fn() -> *const c_char> =
+            lib.get(b"agrisim_model_description_fmi3").expect("the test model exports agrisim_model_description_fmi3");
         let p = f();
         assert!(!p.is_null());
         CStr::from_ptr(p).to_str().unwrap().to_string()
@@ -59,12 +51,10 @@ fn test_model() -> Option<(ModelDescription, FmuArchive, tempfile::TempDir)> {
     let fmu = tmp.path().join(format!("{}.fmu", md.model_name));
     {
         let mut z = zip::ZipWriter::new(std::fs::File::create(&fmu).unwrap());
-        let o = zip::write::SimpleFileOptions::default()
-            .compression_method(zip::CompressionMethod::Deflated);
+        let o = zip::write::SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
         z.start_file("modelDescription.xml", o).unwrap();
         z.write_all(xml.as_bytes()).unwrap();
-        z.start_file(format!("binaries/{PLATFORM}/{}.so", md.model_identifier), o)
-            .unwrap();
+        z.start_file(format!("binaries/{PLATFORM}/{}.so", md.model_identifier), o).unwrap();
         z.write_all(&std::fs::read(&lib_path).unwrap()).unwrap();
         z.finish().unwrap();
     }
@@ -85,11 +75,7 @@ fn test_model_imports_steps_and_exchanges_every_type() {
     for inst in [&mut a, &mut b] {
         inst.enter_initialization_mode(0.0, None).unwrap();
         // Set every settable input of a supported type and read it back.
-        for v in md
-            .variables
-            .iter()
-            .filter(|v| v.causality == Causality::Input)
-        {
+        for v in md.variables.iter().filter(|v| v.causality == Causality::Input) {
             let vr = v.value_reference;
             match v.ty {
                 VarType::Float64 => {
@@ -136,11 +122,7 @@ fn test_model_imports_steps_and_exchanges_every_type() {
         b.do_step(t, h).unwrap_or_else(|e| panic!("{e}"));
     }
     // Every output of a supported type can be read.
-    for v in md
-        .variables
-        .iter()
-        .filter(|v| v.causality == Causality::Output)
-    {
+    for v in md.variables.iter().filter(|v| v.causality == Causality::Output) {
         let vr = v.value_reference;
         let r = match v.ty {
             VarType::Float64 => a.get_f64(&[vr], &mut [0.0]),
@@ -163,13 +145,9 @@ fn test_model_imports_steps_and_exchanges_every_type() {
 /// run only when its variables are there, so the generic part above survives model changes.
 fn check_test_model_semantics(md: &ModelDescription, a: &mut Instance, b: &mut Instance, h: f64) {
     let vr = |n: &str| md.variable(n).map(|v| v.value_reference);
-    let (Some(msg_in), Some(msg_out), Some(msg_seq), Some(steps), Some(fault)) = (
-        vr("msg_in"),
-        vr("msg_out"),
-        vr("msg_seq"),
-        vr("steps"),
-        vr("fault"),
-    ) else {
+    let (Some(msg_in), Some(msg_out), Some(msg_seq), Some(steps), Some(fault)) =
+        (vr("msg_in"), vr("msg_out"), vr("msg_seq"), vr("steps"), vr("fault"))
+    else {
         eprintln!("NOTE: TestModel variables changed; semantic checks skipped");
         return;
     };
@@ -185,26 +163,15 @@ fn check_test_model_semantics(md: &ModelDescription, a: &mut Instance, b: &mut I
     assert_eq!(a.get_binary(msg_out).unwrap(), msg);
     let mut seq1 = [0i64];
     a.get_i64(&[msg_seq], &mut seq1).unwrap();
-    assert!(
-        seq1[0] > seq0[0],
-        "msg_seq did not advance: {} -> {}",
-        seq0[0],
-        seq1[0]
-    );
+    assert!(seq1[0] > seq0[0], "msg_seq did not advance: {} -> {}", seq0[0], seq1[0]);
     a.take_log();
 
     // An injected model error: one line naming instance, model, function, time and reason.
     a.set_i32(&[fault], &[1]).unwrap();
     let e = a.do_step(11.0 * h, h).unwrap_err();
     let line = e.to_string();
-    assert!(
-        line.starts_with("FMU 'first' (TestModel): fmi3DoStep at t=0.22"),
-        "{line}"
-    );
-    assert!(
-        line.contains("returned fmi3Error") && line.contains("injected failure at t=0.22"),
-        "{line}"
-    );
+    assert!(line.starts_with("FMU 'first' (TestModel): fmi3DoStep at t=0.22"), "{line}");
+    assert!(line.contains("returned fmi3Error") && line.contains("injected failure at t=0.22"), "{line}");
     a.reset().unwrap();
     a.enter_initialization_mode(0.0, None).unwrap();
     a.exit_initialization_mode().unwrap();

@@ -21,9 +21,14 @@ impl agrisim_cosim::Hooks for Scalar {
 fn first_step(x: f64) -> Result<()> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().unwrap();
     let fmu_dir: PathBuf = root.join("target/fmu");
-    assert!(fmu_dir.join("Greenhouse.fmu").exists(), "{} has no packed FMUs: run `target/release/agrisim fmu pack`", fmu_dir.display());
+    assert!(
+        fmu_dir.join("Greenhouse.fmu").exists(),
+        "{} has no packed FMUs: run `target/release/agrisim fmu pack`",
+        fmu_dir.display()
+    );
     let cache = tempfile::tempdir().unwrap();
-    let mut system = System::load(&root.join("models/systems/harvest.ssd"), &LoadOptions::new(&fmu_dir, cache.path(), 0.02, 0.1))?;
+    let mut system =
+        System::load(&root.join("models/systems/harvest.ssd"), &LoadOptions::new(&fmu_dir, cache.path(), 0.02, 0.1))?;
     system.apply_parameters(&Default::default(), 1, &Default::default())?;
     let mut master = Master::new(system, 0.02, 0.1)?;
     master.initialize()?;
@@ -33,7 +38,11 @@ fn first_step(x: f64) -> Result<()> {
 #[test]
 fn a_nan_or_fractional_target_id_is_refused() {
     first_step(3.0).unwrap();
-    for (x, why) in [(f64::NAN, "value NaN is not a finite number"), (2.5, "value 2.5 is not an integer"), (1e12, "out of range for Int32")] {
+    for (x, why) in [
+        (f64::NAN, "value NaN is not a finite number"),
+        (2.5, "value 2.5 is not an integer"),
+        (1e12, "out of range for Int32"),
+    ] {
         let e = first_step(x).unwrap_err().0;
         assert!(e.contains("target_fruit") && e.contains(why), "{x}: {e}");
     }

@@ -13,7 +13,11 @@ fn root() -> PathBuf {
 /// every component.
 fn run(fmu_log: Option<Vec<String>>) -> agrisim_error::Result<Vec<(String, agrisim_cosim::fmi3::LogMessage)>> {
     let fmu_dir = root().join("target/fmu");
-    assert!(fmu_dir.join("Lift.fmu").exists(), "{} has no packed FMUs: run `target/release/agrisim fmu pack`", fmu_dir.display());
+    assert!(
+        fmu_dir.join("Lift.fmu").exists(),
+        "{} has no packed FMUs: run `target/release/agrisim fmu pack`",
+        fmu_dir.display()
+    );
     let cache = tempfile::tempdir().unwrap();
     let opts = LoadOptions { fmu_log, ..LoadOptions::new(&fmu_dir, cache.path(), 0.02, 0.1) };
     let mut system = System::load(&root().join("models/systems/base.ssd"), &opts)?;
@@ -26,7 +30,12 @@ fn run(fmu_log: Option<Vec<String>>) -> agrisim_error::Result<Vec<(String, agris
     let mut log = vec![];
     for c in &mut master.system.components {
         let kept = c.instance.take_log();
-        assert_eq!(c.instance.log_count().min(4096), kept.len() as u64, "{}: every callback is kept, up to the queue's bound", c.name);
+        assert_eq!(
+            c.instance.log_count().min(4096),
+            kept.len() as u64,
+            "{}: every callback is kept, up to the queue's bound",
+            c.name
+        );
         log.extend(kept.into_iter().map(|m| (c.name.clone(), m)));
     }
     Ok(log)

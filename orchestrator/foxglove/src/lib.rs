@@ -43,7 +43,8 @@ impl FoxgloveView {
 
     fn log(&mut self, topic: &str, ros_type: &str, t_ns: i64, cdr: &[u8]) -> Result<()> {
         if !self.channels.contains_key(topic) {
-            let text = agrisim_msgs::ros2msg_schema(ros_type).ok_or_else(|| err!("Foxglove view: topic {topic}: no .msg definition for {ros_type}"))?;
+            let text = agrisim_msgs::ros2msg_schema(ros_type)
+                .ok_or_else(|| err!("Foxglove view: topic {topic}: no .msg definition for {ros_type}"))?;
             let channel = ChannelBuilder::new(topic)
                 .message_encoding("cdr")
                 .schema(Schema::new(ros_type, "ros2msg", text.into_bytes()))

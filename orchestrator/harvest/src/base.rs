@@ -36,7 +36,14 @@ pub struct BaseController {
 
 impl Default for BaseController {
     fn default() -> Self {
-        BaseController { crab: false, gain: 0.8, yaw_gain: 1.0, max_speed: 0.3, max_yaw_rate: 0.4, tolerance: (0.01, 0.01) }
+        BaseController {
+            crab: false,
+            gain: 0.8,
+            yaw_gain: 1.0,
+            max_speed: 0.3,
+            max_yaw_rate: 0.4,
+            tolerance: (0.01, 0.01),
+        }
     }
 }
 
@@ -70,12 +77,17 @@ impl BaseController {
         if n > self.max_speed {
             v = [v[0] * self.max_speed / n, v[1] * self.max_speed / n];
         }
-        let wz = if self.crab { 0.0 } else { (self.yaw_gain * wrap_angle(goal[2] - pose.yaw)).clamp(-self.max_yaw_rate, self.max_yaw_rate) };
+        let wz = if self.crab {
+            0.0
+        } else {
+            (self.yaw_gain * wrap_angle(goal[2] - pose.yaw)).clamp(-self.max_yaw_rate, self.max_yaw_rate)
+        };
         [v[0], v[1], wz]
     }
 
     pub fn in_place(&self, pose: Pose2, goal: [f64; 3]) -> bool {
-        (goal[0] - pose.x).hypot(goal[1] - pose.y) <= self.tolerance.0 && wrap_angle(goal[2] - pose.yaw).abs() <= self.tolerance.1
+        (goal[0] - pose.x).hypot(goal[1] - pose.y) <= self.tolerance.0
+            && wrap_angle(goal[2] - pose.yaw).abs() <= self.tolerance.1
     }
 }
 
@@ -142,7 +154,11 @@ mod tests {
                 let along = vx * self.steer.cos() + vy * self.steer.sin();
                 let (s, c) = self.pose.yaw.sin_cos();
                 let (bx, by) = (along * self.steer.cos(), along * self.steer.sin());
-                self.pose = Pose2::new(self.pose.x + dt * (c * bx - s * by), self.pose.y + dt * (s * bx + c * by), self.pose.yaw + dt * cmd[2]);
+                self.pose = Pose2::new(
+                    self.pose.x + dt * (c * bx - s * by),
+                    self.pose.y + dt * (s * bx + c * by),
+                    self.pose.yaw + dt * cmd[2],
+                );
             }
         }
     }
@@ -156,7 +172,10 @@ mod tests {
         for (ex, ey) in [(-0.035, 0.012), (0.035, -0.012), (-0.03, 0.02), (0.002, 0.3), (-0.6, 0.011)] {
             let mut ctl = BaseController::default();
             let goal = [10.0, 5.0, std::f64::consts::PI];
-            let mut base = SteeredBase { pose: Pose2::new(goal[0] + ex, goal[1] - ey, goal[2]), steer: -std::f64::consts::FRAC_PI_2 };
+            let mut base = SteeredBase {
+                pose: Pose2::new(goal[0] + ex, goal[1] - ey, goal[2]),
+                steer: -std::f64::consts::FRAC_PI_2,
+            };
             let mut steps = 0;
             while !ctl.in_place(base.pose, goal) {
                 let cmd = ctl.command(base.pose, goal);

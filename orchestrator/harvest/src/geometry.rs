@@ -138,7 +138,8 @@ pub fn grasp_candidates(c: [f64; 3], side: f64) -> Vec<TcpGoal> {
         .iter()
         .map(|&(yaw, tilt)| {
             let h = tilt.cos();
-            TcpGoal { position: c, approach: [h * yaw.sin(), side * h * yaw.cos(), tilt.sin()], x_axis: None }.along(GRASP_DEPTH)
+            TcpGoal { position: c, approach: [h * yaw.sin(), side * h * yaw.cos(), tilt.sin()], x_axis: None }
+                .along(GRASP_DEPTH)
         })
         .collect()
 }
@@ -175,8 +176,22 @@ pub const DROP_SPOTS: usize = 9;
 pub fn drop_goals() -> Vec<TcpGoal> {
     let mut v = vec![];
     for dz in [0.0, 0.1] {
-        for (dx, dy) in [(0.0, 0.0), (0.11, 0.19), (-0.11, -0.19), (0.11, -0.19), (-0.11, 0.19), (0.0, 0.19), (0.0, -0.19), (0.11, 0.0), (-0.11, 0.0)] {
-            v.push(TcpGoal { position: [BOX_TOP[0] + dx, BOX_TOP[1] + dy, BOX_TOP[2] + DROP_ABOVE + dz], approach: [0.0, 0.0, -1.0], x_axis: None });
+        for (dx, dy) in [
+            (0.0, 0.0),
+            (0.11, 0.19),
+            (-0.11, -0.19),
+            (0.11, -0.19),
+            (-0.11, 0.19),
+            (0.0, 0.19),
+            (0.0, -0.19),
+            (0.11, 0.0),
+            (-0.11, 0.0),
+        ] {
+            v.push(TcpGoal {
+                position: [BOX_TOP[0] + dx, BOX_TOP[1] + dy, BOX_TOP[2] + DROP_ABOVE + dz],
+                approach: [0.0, 0.0, -1.0],
+                x_axis: None,
+            });
         }
     }
     debug_assert_eq!(v.len(), 2 * DROP_SPOTS);
@@ -185,7 +200,10 @@ pub fn drop_goals() -> Vec<TcpGoal> {
 
 /// Whether a point (base frame) lies inside the harvest box's opening footprint, below its rim.
 pub fn in_box(p: [f64; 3]) -> bool {
-    (p[0] - BOX_TOP[0]).abs() < 0.19 && (p[1] - BOX_TOP[1]).abs() < 0.29 && p[2] < BOX_TOP[2] && p[2] > BOX_TOP[2] - 0.26
+    (p[0] - BOX_TOP[0]).abs() < 0.19
+        && (p[1] - BOX_TOP[1]).abs() < 0.29
+        && p[2] < BOX_TOP[2]
+        && p[2] > BOX_TOP[2] - 0.26
 }
 
 pub fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -212,11 +230,19 @@ mod tests {
         let robot = Robot::from_urdf_str(include_str!("../../../models/robot/agrisim_robot.urdf")).unwrap();
         let fk = robot.fk(&BTreeMap::new()).unwrap();
         let l0 = fk["left_link0"].trans;
-        assert!((l0[0] - SHOULDER_X).abs() < 1e-9 && (l0[1] - ARM_Y).abs() < 1e-9 && (l0[2] - ARM_Z0).abs() < 1e-9, "{l0:?}");
+        assert!(
+            (l0[0] - SHOULDER_X).abs() < 1e-9 && (l0[1] - ARM_Y).abs() < 1e-9 && (l0[2] - ARM_Z0).abs() < 1e-9,
+            "{l0:?}"
+        );
         let r0 = fk["right_link0"].trans;
         assert!((r0[1] + ARM_Y).abs() < 1e-9);
         let b = fk["harvest_box_link"].trans;
-        assert!((b[0] - BOX_TOP[0]).abs() < 1e-9 && (b[1] - BOX_TOP[1]).abs() < 1e-9 && (b[2] + 0.25 - BOX_TOP[2]).abs() < 1e-9, "{b:?}");
+        assert!(
+            (b[0] - BOX_TOP[0]).abs() < 1e-9
+                && (b[1] - BOX_TOP[1]).abs() < 1e-9
+                && (b[2] + 0.25 - BOX_TOP[2]).abs() < 1e-9,
+            "{b:?}"
+        );
     }
 
     /// Every grasp candidate is a unit approach into the row (toward the fruit's side), and
@@ -265,7 +291,10 @@ mod standoff_tests {
             let (s, c) = yaw.sin_cos();
             let (dx, dy) = (fruit[0] - x, fruit[1] - y);
             let (bx, by) = (c * dx + s * dy, -s * dx + c * dy);
-            assert!((bx - (SHOULDER_X + REACH_AHEAD)).abs() < 1e-12 && (by - side * (ARM_Y + REACH_LATERAL)).abs() < 1e-12, "{heading} {side}: ({bx}, {by})");
+            assert!(
+                (bx - (SHOULDER_X + REACH_AHEAD)).abs() < 1e-12 && (by - side * (ARM_Y + REACH_LATERAL)).abs() < 1e-12,
+                "{heading} {side}: ({bx}, {by})"
+            );
         }
         assert_eq!(standoff(fruit, 1.0), standoff_facing(fruit, 1.0, 0.0));
     }

@@ -10,14 +10,19 @@
 //! budgets); wall time is measured by the caller for statistics only.
 
 use super::geometry::TcpGoal;
-use agrisim_math::Pose2;
 use agrisim_manip::cartesian::cartesian_path;
-use agrisim_manip::{exact_check, ArmModel, Checker, Context, Ik, Meter, Obstacle, ObstacleKind, Planner, Rng, Scene, Shape, Side, Target, Work, DOF};
+use agrisim_manip::{
+    exact_check, ArmModel, Checker, Context, Ik, Meter, Obstacle, ObstacleKind, Planner, Rng, Scene, Shape, Side,
+    Target, Work, DOF,
+};
+use agrisim_math::Pose2;
 use agrisim_msgs::agrisim::PlanningScene;
 use agrisim_msgs::builtin_interfaces::Duration;
 use agrisim_msgs::shape_msgs::SolidPrimitive;
 use agrisim_msgs::trajectory_msgs::{JointTrajectory, JointTrajectoryPoint};
-use agrisim_trajectory::{time_state_to_state, time_waypoints, JointState, PathParam, PathShape, Sampled, TimingConfig};
+use agrisim_trajectory::{
+    time_state_to_state, time_waypoints, JointState, PathParam, PathShape, Sampled, TimingConfig,
+};
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
 /// Where both arms start and end (the harvest system's `q_init` of both Arm FMUs): Franka's
@@ -265,24 +270,37 @@ impl Motion {
         let n = ((to - from).abs() / 0.01).ceil().max(1.0) as usize;
         (0..=n).all(|i| {
             let lift = from + (to - from) * i as f64 / n as f64;
-            [Arm::Left, Arm::Right].iter().all(|&a| Checker::new(self.context(a, lift, q[a.other().index()])).is_valid(&q[a.index()]))
+            [Arm::Left, Arm::Right]
+                .iter()
+                .all(|&a| Checker::new(self.context(a, lift, q[a.other().index()])).is_valid(&q[a.index()]))
         })
     }
 
     /// Free-space motion to a TCP goal through the IK goal set.
-    pub fn plan_free(&mut self, arm: Arm, lift: f64, start: [f64; DOF], goal: &TcpGoal, other: [f64; DOF]) -> Result<Planned, String> {
+    pub fn plan_free(
+        &mut self,
+        arm: Arm,
+        lift: f64,
+        start: [f64; DOF],
+        goal: &TcpGoal,
+        other: [f64; DOF],
+    ) -> Result<Planned, String> {
         let target = target_of(goal);
         let goals = {
             let ctx = self.context(arm, lift, other);
             let checker = Checker::new(ctx);
             let ik = self.ik(arm, lift);
             let mut rng = self.rng.clone();
-            let g = ik.goal_set(&target, &start, &mut rng, GOAL_SET.0, GOAL_SET.1, IK_BUDGET.0, |q| checker.is_valid(q));
+            let g =
+                ik.goal_set(&target, &start, &mut rng, GOAL_SET.0, GOAL_SET.1, IK_BUDGET.0, |q| checker.is_valid(q));
             self.rng = rng;
             g
         };
         if goals.is_empty() {
-            return Err(format!("no collision-free IK solution for the TCP at ({:.3}, {:.3}, {:.3}) in base_link", goal.position[0], goal.position[1], goal.position[2]));
+            return Err(format!(
+                "no collision-free IK solution for the TCP at ({:.3}, {:.3}, {:.3}) in base_link",
+                goal.position[0], goal.position[1], goal.position[2]
+            ));
         }
         self.plan_to_configs(arm, lift, start, &goals, other)
     }
@@ -292,7 +310,15 @@ impl Motion {
     /// straight approach) is valid too, over rolls every 30 degrees when the roll is free
     /// (so fingers that would hit a neighbour are never chosen), else the given roll and its
     /// opposite.
-    pub fn plan_pregrasp(&mut self, arm: Arm, lift: f64, start: [f64; DOF], grasp: &TcpGoal, standoff: f64, other: [f64; DOF]) -> Result<Planned, String> {
+    pub fn plan_pregrasp(
+        &mut self,
+        arm: Arm,
+        lift: f64,
+        start: [f64; DOF],
+        grasp: &TcpGoal,
+        standoff: f64,
+        other: [f64; DOF],
+    ) -> Result<Planned, String> {
         let mut rng = std::mem::replace(&mut self.rng, Rng::new(0));
         let goals = {
             let ctx = self.context(arm, lift, other);
@@ -309,7 +335,10 @@ impl Motion {
                 None => (0..ROLLS)
                     .map(|k| {
                         let (sa, ca) = (k as f64 * std::f64::consts::TAU / ROLLS as f64).sin_cos();
-                        ((k * 360 / ROLLS) as u32, [ca * x0[0] + sa * y0[0], ca * x0[1] + sa * y0[1], ca * x0[2] + sa * y0[2]])
+                        (
+                            (k * 360 / ROLLS) as u32,
+                            [ca * x0[0] + sa * y0[0], ca * x0[1] + sa * y0[1], ca * x0[2] + sa * y0[2]],
+                        )
                     })
                     .collect(),
             };
@@ -318,7 +347,9 @@ impl Motion {
             let mut approaches: Vec<Vec<[f64; DOF]>> = vec![];
             for &(deg, x) in &rolls {
                 let g = TcpGoal { x_axis: Some(x), ..*grasp };
-                let at_grasp = ik.goal_set(&target_of(&g), &start, &mut rng, 2, GOAL_SET.1, 2 * IK_BUDGET.1, |q| checker.is_valid(q));
+                let at_grasp = ik.goal_set(&target_of(&g), &start, &mut rng, 2, GOAL_SET.1, 2 * IK_BUDGET.1, |q| {
+                    checker.is_valid(q)
+                });
                 for qg in at_grasp {
                     // Back out along the approach: the reverse of the approach move, so the
                     // pre-grasp and grasp configurations are joined by a valid straight line.
@@ -343,7 +374,10 @@ impl Motion {
                     let g = TcpGoal { x_axis: Some(x), ..*grasp };
                     match ik.solve(&target_of(&g), &start, &mut rng, IK_BUDGET.1) {
                         None => why.push(format!("roll {deg}: no IK")),
-                        Some(q) => why.push(format!("roll {deg}: {}", checker.contact(&q).map(|c| c.describe(&ctx)).unwrap_or_else(|| "free?".into()))),
+                        Some(q) => why.push(format!(
+                            "roll {deg}: {}",
+                            checker.contact(&q).map(|c| c.describe(&ctx)).unwrap_or_else(|| "free?".into())
+                        )),
                     }
                 }
                 why.extend(backout);
@@ -356,12 +390,17 @@ impl Motion {
         let (goals, why, approaches) = goals;
         self.rng = rng;
         if goals.is_empty() {
-            return Err(format!("no collision-free IK solution for a grasp at ({:.3}, {:.3}, {:.3}) in base_link with any roll ({why})", grasp.position[0], grasp.position[1], grasp.position[2]));
+            return Err(format!(
+                "no collision-free IK solution for a grasp at ({:.3}, {:.3}, {:.3}) in base_link with any roll ({why})",
+                grasp.position[0], grasp.position[1], grasp.position[2]
+            ));
         }
         // Nearest goals first: the planner tries the direct edge to them in order. The
         // approach from the goal reached is kept for plan_linear.
         let mut order: Vec<usize> = (0..goals.len()).collect();
-        order.sort_by(|&a, &b| agrisim_manip::ik::dist(&goals[a], &start).total_cmp(&agrisim_manip::ik::dist(&goals[b], &start)));
+        order.sort_by(|&a, &b| {
+            agrisim_manip::ik::dist(&goals[a], &start).total_cmp(&agrisim_manip::ik::dist(&goals[b], &start))
+        });
         let sorted: Vec<[f64; DOF]> = order.iter().map(|&i| goals[i]).collect();
         let planned = self.plan_to_configs(arm, lift, start, &sorted, other)?;
         let reached = order.iter().copied().find(|&i| goals[i] == planned.goal_q);
@@ -370,17 +409,39 @@ impl Motion {
     }
 
     /// The first of `goals` [`Self::plan_free`] reaches, with its index.
-    pub fn plan_free_any(&mut self, arm: Arm, lift: f64, start: [f64; DOF], goals: &[TcpGoal], other: [f64; DOF]) -> Result<(usize, Planned), String> {
+    pub fn plan_free_any(
+        &mut self,
+        arm: Arm,
+        lift: f64,
+        start: [f64; DOF],
+        goals: &[TcpGoal],
+        other: [f64; DOF],
+    ) -> Result<(usize, Planned), String> {
         first_ok(goals, "goal", |g| self.plan_free(arm, lift, start, g, other))
     }
 
     /// The first of `grasps` [`Self::plan_pregrasp`] reaches, with its index.
-    pub fn plan_pregrasp_any(&mut self, arm: Arm, lift: f64, start: [f64; DOF], grasps: &[TcpGoal], standoff: f64, other: [f64; DOF]) -> Result<(usize, Planned), String> {
+    pub fn plan_pregrasp_any(
+        &mut self,
+        arm: Arm,
+        lift: f64,
+        start: [f64; DOF],
+        grasps: &[TcpGoal],
+        standoff: f64,
+        other: [f64; DOF],
+    ) -> Result<(usize, Planned), String> {
         first_ok(grasps, "approach", |g| self.plan_pregrasp(arm, lift, start, g, standoff, other))
     }
 
     /// The first of `goals` [`Self::plan_linear`] reaches, with its index.
-    pub fn plan_linear_any(&mut self, arm: Arm, lift: f64, start: [f64; DOF], goals: &[TcpGoal], other: [f64; DOF]) -> Result<(usize, Planned), String> {
+    pub fn plan_linear_any(
+        &mut self,
+        arm: Arm,
+        lift: f64,
+        start: [f64; DOF],
+        goals: &[TcpGoal],
+        other: [f64; DOF],
+    ) -> Result<(usize, Planned), String> {
         first_ok(goals, "goal", |g| self.plan_linear(arm, lift, start, g, other))
     }
 
@@ -389,7 +450,14 @@ impl Motion {
         self.plan_to_configs(arm, lift, start, &[HOME], other)
     }
 
-    fn plan_to_configs(&mut self, arm: Arm, lift: f64, start: [f64; DOF], goals: &[[f64; DOF]], other: [f64; DOF]) -> Result<Planned, String> {
+    fn plan_to_configs(
+        &mut self,
+        arm: Arm,
+        lift: f64,
+        start: [f64; DOF],
+        goals: &[[f64; DOF]],
+        other: [f64; DOF],
+    ) -> Result<Planned, String> {
         let plan = {
             let ctx = self.context(arm, lift, other);
             let mut rng = self.rng.clone();
@@ -411,7 +479,14 @@ impl Motion {
     /// waypoints along the line (IK every centimetre, agrisim-manip's Cartesian path), timed
     /// by ruckig as one jerk-limited motion when that stays on the line, else by TOPP-RA on a
     /// spline through the waypoints; then the line, collision and exact checks.
-    pub fn plan_linear(&mut self, arm: Arm, lift: f64, start: [f64; DOF], goal: &TcpGoal, other: [f64; DOF]) -> Result<Planned, String> {
+    pub fn plan_linear(
+        &mut self,
+        arm: Arm,
+        lift: f64,
+        start: [f64; DOF],
+        goal: &TcpGoal,
+        other: [f64; DOF],
+    ) -> Result<Planned, String> {
         // The approach the pre-grasp plan checked, if this is it: the same joint path.
         if let Some((a, path)) = &self.approach {
             let same_start = path.first().is_some_and(|p| agrisim_manip::ik::dist(p, &start) < 1e-6);
@@ -435,7 +510,12 @@ impl Motion {
                 let last = *e.partial.last().unwrap_or(&start);
                 let what = self
                     .ik(arm, lift)
-                    .solve(&target_of(&TcpGoal { x_axis: Some(current_x(model, lift, &start)), ..*goal }), &last, &mut Rng::new(7), IK_BUDGET.1)
+                    .solve(
+                        &target_of(&TcpGoal { x_axis: Some(current_x(model, lift, &start)), ..*goal }),
+                        &last,
+                        &mut Rng::new(7),
+                        IK_BUDGET.1,
+                    )
                     .and_then(|q| checker.contact(&q))
                     .map(|c| format!(" (at the goal: {})", c.describe(&ctx)))
                     .unwrap_or_default();
@@ -447,7 +527,15 @@ impl Motion {
 
     /// Times joint waypoints that move the TCP along a straight line to `to` (ruckig when
     /// that stays on the line, else TOPP-RA), then the line, collision and exact checks.
-    fn time_line(&self, arm: Arm, lift: f64, start: [f64; DOF], wps: Vec<[f64; DOF]>, to: [f64; 3], other: [f64; DOF]) -> Result<Planned, String> {
+    fn time_line(
+        &self,
+        arm: Arm,
+        lift: f64,
+        start: [f64; DOF],
+        wps: Vec<[f64; DOF]>,
+        to: [f64; 3],
+        other: [f64; DOF],
+    ) -> Result<Planned, String> {
         let model = self.model(arm);
         let from = model.fk(lift, &start).trans;
         let ctx = self.context(arm, lift, other);
@@ -471,11 +559,14 @@ impl Motion {
                 let what = checker.contact(qs).map(|c| c.describe(&ctx)).unwrap_or_default();
                 return Err(format!("Cartesian move in collision: {what}"));
             }
-            exact_check(&ctx, &path, agrisim_manip::exact::EXACT_RESOLUTION).map_err(|c| format!("Cartesian move fails the exact check: {}", c.description))?;
+            exact_check(&ctx, &path, agrisim_manip::exact::EXACT_RESOLUTION)
+                .map_err(|c| format!("Cartesian move fails the exact check: {}", c.description))?;
             Ok(samples)
         };
         self.meter.add_timing();
-        let jerk_limited = time_state_to_state(&JointState::at_rest(start.to_vec()), &JointState::at_rest(end.to_vec()), &self.timing).map_err(|e| format!("jerk-limited motion: {e}"))?;
+        let jerk_limited =
+            time_state_to_state(&JointState::at_rest(start.to_vec()), &JointState::at_rest(end.to_vec()), &self.timing)
+                .map_err(|e| format!("jerk-limited motion: {e}"))?;
         let samples = match checked(jerk_limited) {
             Ok(s) => s,
             Err(_) => {
@@ -483,7 +574,9 @@ impl Motion {
                 let wv: Vec<Vec<f64>> = wps.iter().map(|q| q.to_vec()).collect();
                 let spline = TimingConfig { shape: PathShape::Spline(PathParam::ChordLength), ..self.timing.clone() };
                 let blended = TimingConfig { shape: PathShape::Blended { radius: 0.01 }, ..self.timing.clone() };
-                let s = time_waypoints(&wv, &spline).or_else(|_| time_waypoints(&wv, &blended)).map_err(|e| format!("time parameterization of the Cartesian path: {e}"))?;
+                let s = time_waypoints(&wv, &spline)
+                    .or_else(|_| time_waypoints(&wv, &blended))
+                    .map_err(|e| format!("time parameterization of the Cartesian path: {e}"))?;
                 checked(s)?
             }
         };
@@ -509,7 +602,11 @@ impl Motion {
 }
 
 /// The first item `plan` succeeds on, with its index; else every item's error, labelled.
-fn first_ok(items: &[TcpGoal], label: &str, mut plan: impl FnMut(&TcpGoal) -> Result<Planned, String>) -> Result<(usize, Planned), String> {
+fn first_ok(
+    items: &[TcpGoal],
+    label: &str,
+    mut plan: impl FnMut(&TcpGoal) -> Result<Planned, String>,
+) -> Result<(usize, Planned), String> {
     let mut errors = vec![];
     for (i, g) in items.iter().enumerate() {
         match plan(g) {
@@ -534,7 +631,11 @@ fn current_x(model: &ArmModel, lift: f64, q: &[f64; DOF]) -> [f64; 3] {
 fn target_of(goal: &TcpGoal) -> Target {
     let hint = goal.x_axis.unwrap_or_else(|| {
         // Any vector not parallel to the approach; the roll is free anyway.
-        if goal.approach[2].abs() < 0.9 { [0.0, 0.0, 1.0] } else { [1.0, 0.0, 0.0] }
+        if goal.approach[2].abs() < 0.9 {
+            [0.0, 0.0, 1.0]
+        } else {
+            [1.0, 0.0, 0.0]
+        }
     });
     let p = goal.pose_with_x(hint);
     Target::from_pose(&p, goal.x_axis.is_none())
@@ -545,7 +646,10 @@ fn shape_of(p: &SolidPrimitive) -> Option<Shape> {
     match p.r#type {
         SolidPrimitive::BOX if d.len() >= 3 => Some(Shape::Box { size: [d[0], d[1], d[2]] }),
         SolidPrimitive::SPHERE if !d.is_empty() => Some(Shape::Sphere { radius: d[0] }),
-        SolidPrimitive::CYLINDER if d.len() >= 2 => Some(Shape::Cylinder { radius: d[SolidPrimitive::CYLINDER_RADIUS], length: d[SolidPrimitive::CYLINDER_HEIGHT] }),
+        SolidPrimitive::CYLINDER if d.len() >= 2 => Some(Shape::Cylinder {
+            radius: d[SolidPrimitive::CYLINDER_RADIUS],
+            length: d[SolidPrimitive::CYLINDER_HEIGHT],
+        }),
         _ => None,
     }
 }
@@ -587,14 +691,22 @@ mod tests {
         use agrisim_msgs::agrisim::CollisionObject;
         use agrisim_msgs::geometry_msgs::{Point, Pose, Quaternion};
         let (r, lift) = (0.035, 0.3);
-        let c = [0.4, 0.85, crate::geometry::ARM_Z0 + lift + crate::geometry::SHOULDER_UP - crate::geometry::REACH_BELOW_SHOULDER];
+        let c = [
+            0.4,
+            0.85,
+            crate::geometry::ARM_Z0 + lift + crate::geometry::SHOULDER_UP - crate::geometry::REACH_BELOW_SHOULDER,
+        ];
         let fruit = |id: &str, y: f64| CollisionObject {
             id: id.into(),
             kind: "fruit".into(),
             primitive: SolidPrimitive::sphere(r),
-            pose: Pose { position: Point { x: c[0], y, z: c[2] }, orientation: Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 } },
+            pose: Pose {
+                position: Point { x: c[0], y, z: c[2] },
+                orientation: Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 },
+            },
         };
-        let scene = PlanningScene { objects: vec![fruit("1", c[1]), fruit("2", c[1] - 2.0 * r - 0.025)], ..Default::default() };
+        let scene =
+            PlanningScene { objects: vec![fruit("1", c[1]), fruit("2", c[1] - 2.0 * r - 0.025)], ..Default::default() };
         let plan = |candidates: &[TcpGoal]| {
             let mut m = Motion::new(1);
             m.set_target(c);
@@ -619,7 +731,10 @@ mod tests {
             id: id.into(),
             kind: "fruit".into(),
             primitive: SolidPrimitive::sphere(0.03),
-            pose: Pose { position: Point { x: p[0], y: p[1], z: p[2] }, orientation: Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 } },
+            pose: Pose {
+                position: Point { x: p[0], y: p[1], z: p[2] },
+                orientation: Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 },
+            },
         };
         let base = Pose2 { x: 0.0, y: 0.0, yaw: 0.0 };
         let (picked, next) = ([0.4, 0.85, 1.1], [0.4, -0.85, 1.1]);

@@ -25,10 +25,10 @@ use super::geometry::{self as geo, TcpGoal};
 use super::motion::{Arm, Motion, Planned};
 use super::stage::{Failure, Stage};
 use agrisim_bus::Bus;
+use agrisim_bus::Node;
 use agrisim_error::Result;
 use agrisim_manip::{CostModel, Work};
 use agrisim_math::Pose2;
-use agrisim_bus::Node;
 use agrisim_msgs::agrisim::{GripperState, HarvestStatus, PlanResult, PlanningScene, TrajectoryStatus};
 use agrisim_msgs::builtin_interfaces::Time;
 use agrisim_msgs::control_msgs::GripperCommand;
@@ -338,7 +338,15 @@ impl HarvestNode {
 
     /// Reports one plan on /harvest/plans; `optional`: its failure has a fallback (it does
     /// not fail the harvest).
-    fn record<T>(&mut self, arm: Arm, kind: &str, r: &std::result::Result<T, String>, optional: bool, t_ns: i64, bus: &mut Bus) {
+    fn record<T>(
+        &mut self,
+        arm: Arm,
+        kind: &str,
+        r: &std::result::Result<T, String>,
+        optional: bool,
+        t_ns: i64,
+        bus: &mut Bus,
+    ) {
         self.plans += 1;
         let work = self.motion.work();
         let planning_time = self.cost.seconds(&(work - self.work_mark));
@@ -360,7 +368,14 @@ impl HarvestNode {
     /// Plans one motion of `arm` with `plan` (given the motion planner, lift, start and the
     /// other arm's joints), reports it, and sends it; a planning failure ends the
     /// harvest. Returns the index of the goal reached (for planners with several).
-    fn plan_and_send(&mut self, arm: Arm, kind: &'static str, t_ns: i64, bus: &mut Bus, plan: impl FnOnce(&mut Motion, f64, [f64; 7], [f64; 7]) -> std::result::Result<(usize, Planned), String>) -> Option<usize> {
+    fn plan_and_send(
+        &mut self,
+        arm: Arm,
+        kind: &'static str,
+        t_ns: i64,
+        bus: &mut Bus,
+        plan: impl FnOnce(&mut Motion, f64, [f64; 7], [f64; 7]) -> std::result::Result<(usize, Planned), String>,
+    ) -> Option<usize> {
         let (start, other) = (self.q(arm), self.q(arm.other()));
         let r = plan(&mut self.motion, self.lift, start, other);
         let chosen = r.as_ref().ok().map(|(i, _)| *i);
@@ -382,23 +397,36 @@ impl HarvestNode {
     fn move_arm(&mut self, arm: Arm, goal: &TcpGoal, linear: bool, t_ns: i64, bus: &mut Bus) -> bool {
         let kind = if linear { "linear" } else { "free" };
         self.plan_and_send(arm, kind, t_ns, bus, |m, lift, start, other| {
-            if linear { m.plan_linear(arm, lift, start, goal, other) } else { m.plan_free(arm, lift, start, goal, other) }.map(|p| (0, p))
+            if linear {
+                m.plan_linear(arm, lift, start, goal, other)
+            } else {
+                m.plan_free(arm, lift, start, goal, other)
+            }
+            .map(|p| (0, p))
         })
         .is_some()
     }
 
     /// Plans to the stand-off of the first reachable grasp of `grasps`; returns its index.
     fn move_pregrasp(&mut self, arm: Arm, grasps: &[TcpGoal], t_ns: i64, bus: &mut Bus) -> Option<usize> {
-        self.plan_and_send(arm, "pregrasp", t_ns, bus, |m, lift, start, other| m.plan_pregrasp_any(arm, lift, start, grasps, geo::PRE_GRASP, other))
+        self.plan_and_send(arm, "pregrasp", t_ns, bus, |m, lift, start, other| {
+            m.plan_pregrasp_any(arm, lift, start, grasps, geo::PRE_GRASP, other)
+        })
     }
 
     /// Plans to the first reachable goal of `goals`.
     fn move_any(&mut self, arm: Arm, goals: &[TcpGoal], t_ns: i64, bus: &mut Bus) -> bool {
-        self.plan_and_send(arm, "free", t_ns, bus, |m, lift, start, other| m.plan_free_any(arm, lift, start, goals, other)).is_some()
+        self.plan_and_send(arm, "free", t_ns, bus, |m, lift, start, other| {
+            m.plan_free_any(arm, lift, start, goals, other)
+        })
+        .is_some()
     }
 
     fn move_home(&mut self, arm: Arm, t_ns: i64, bus: &mut Bus) -> bool {
-        self.plan_and_send(arm, "home", t_ns, bus, |m, lift, start, other| m.plan_home(arm, lift, start, other).map(|p| (0, p))).is_some()
+        self.plan_and_send(arm, "home", t_ns, bus, |m, lift, start, other| {
+            m.plan_home(arm, lift, start, other).map(|p| (0, p))
+        })
+        .is_some()
     }
 
     /// Sends a planned trajectory, stamped to start once this step's planning is done.
@@ -422,13 +450,17 @@ impl HarvestNode {
     fn arm_done(&mut self, arm: Arm, t_ns: i64, bus: &mut Bus) -> Option<bool> {
         let v = &self.arms[arm.index()];
         let Some((expect, t_end, goal)) = v.pending else { return Some(true) };
-        if v.status.rejected_count > 0 && v.status.trajectory_count < expect && v.status.state == TrajectoryStatus::REJECTED {
+        if v.status.rejected_count > 0
+            && v.status.trajectory_count < expect
+            && v.status.state == TrajectoryStatus::REJECTED
+        {
             let reason = v.status.reason.clone();
             self.fail(Failure::Planning, t_ns, bus, format!("{} arm rejected the trajectory: {reason}", arm.name()));
             return None;
         }
         let accepted_done = v.status.trajectory_count >= expect && v.status.state == TrajectoryStatus::SUCCEEDED;
-        let settled = t_ns >= t_end + 200_000_000 && v.q.is_some_and(|q| q.iter().zip(goal).all(|(a, b)| (a - b).abs() < 0.01));
+        let settled =
+            t_ns >= t_end + 200_000_000 && v.q.is_some_and(|q| q.iter().zip(goal).all(|(a, b)| (a - b).abs() < 0.01));
         if accepted_done || settled {
             self.arms[arm.index()].pending = None;
             Some(true)
@@ -473,7 +505,8 @@ impl HarvestNode {
         }
         let tcp = self.motion.model(arm).fk(self.lift, &start);
         let column = |k: usize| [tcp.rot[0][k], tcp.rot[1][k], tcp.rot[2][k]];
-        let back = TcpGoal { position: tcp.trans, approach: column(2), x_axis: Some(column(0)) }.along(-RECOVERY_BACKOFF);
+        let back =
+            TcpGoal { position: tcp.trans, approach: column(2), x_axis: Some(column(0)) }.along(-RECOVERY_BACKOFF);
         let r = self.motion.plan_linear(arm, self.lift, start, &back, other);
         self.record(arm, "linear", &r, false, t_ns, bus);
         match r {
@@ -515,13 +548,20 @@ impl HarvestNode {
                         self.attempts = 0;
                         self.enter(Stage::SelectTarget, t_ns, bus, "both arms home");
                     } else if self.attempts >= RECOVERY_MOTIONS {
-                        self.fail(Failure::Planning, t_ns, bus, format!("recover: the arms are not home after {RECOVERY_MOTIONS} motions"));
+                        self.fail(
+                            Failure::Planning,
+                            t_ns,
+                            bus,
+                            format!("recover: the arms are not home after {RECOVERY_MOTIONS} motions"),
+                        );
                     } else if self.go_home(arm, t_ns, bus) {
                         self.attempts += 1;
                         self.phase = 2;
                     }
                 }
-                2 if [Arm::Left, Arm::Right].iter().all(|&a| self.arm_done(a, t_ns, bus) == Some(true)) => self.phase = 1,
+                2 if [Arm::Left, Arm::Right].iter().all(|&a| self.arm_done(a, t_ns, bus) == Some(true)) => {
+                    self.phase = 1
+                }
                 _ => {}
             },
             Stage::SelectTarget => {
@@ -538,7 +578,12 @@ impl HarvestNode {
                     self.grasp = geo::grasp([0.0; 3], self.side);
                     self.base_goal = geo::standoff_facing(t, self.side, heading);
                     self.lift_target = geo::lift_for(t[2]);
-                    self.enter(Stage::PositionBase, t_ns, bus, &format!("fruit {} at ({:.3}, {:.3}, {:.3})", self.fruit_index, t[0], t[1], t[2]));
+                    self.enter(
+                        Stage::PositionBase,
+                        t_ns,
+                        bus,
+                        &format!("fruit {} at ({:.3}, {:.3}, {:.3})", self.fruit_index, t[0], t[1], t[2]),
+                    );
                 }
             }
             Stage::PositionBase => {
@@ -554,7 +599,11 @@ impl HarvestNode {
                 } else {
                     self.in_place_ticks = 0;
                     let [vx, vy, wz] = ctl.command(pose, self.base_goal);
-                    bus.publish(topics::CMD_VEL, t_ns, &Twist { linear: Vector3 { x: vx, y: vy, z: 0.0 }, angular: Vector3 { x: 0.0, y: 0.0, z: wz } });
+                    bus.publish(
+                        topics::CMD_VEL,
+                        t_ns,
+                        &Twist { linear: Vector3 { x: vx, y: vy, z: 0.0 }, angular: Vector3 { x: 0.0, y: 0.0, z: wz } },
+                    );
                 }
                 if self.in_place_ticks >= 5 && self.lift_at(self.lift_target) {
                     self.enter(Stage::PreGrasp, t_ns, bus, "base and lift in place");
@@ -587,16 +636,29 @@ impl HarvestNode {
                     let Some(c) = self.target_base() else { return };
                     // A later attempt whose aim cannot be reached goes on to the next aim.
                     let [x, z] = self.regrasp_axes;
-                    let shifts = if self.attempts == 0 { &[(0.0, 0.0)][..] } else { &REGRASP_SHIFTS[self.attempts as usize - 1..] };
-                    let mut goals: Vec<TcpGoal> =
-                        shifts.iter().map(|&(a, d)| TcpGoal { position: std::array::from_fn(|i| c[i] + a * x[i] + d * z[i]), ..self.grasp }.along(geo::GRASP_DEPTH)).collect();
+                    let shifts = if self.attempts == 0 {
+                        &[(0.0, 0.0)][..]
+                    } else {
+                        &REGRASP_SHIFTS[self.attempts as usize - 1..]
+                    };
+                    let mut goals: Vec<TcpGoal> = shifts
+                        .iter()
+                        .map(|&(a, d)| {
+                            TcpGoal { position: std::array::from_fn(|i| c[i] + a * x[i] + d * z[i]), ..self.grasp }
+                                .along(geo::GRASP_DEPTH)
+                        })
+                        .collect();
                     // The target as the localized base sees it now may have moved a few
                     // millimetres since the pre-grasp plan; where the straight line to it is
                     // blocked, the line the pre-grasp plan checked.
-                    if self.attempts == 0 && (0..3).any(|i| (goals[0].position[i] - self.grasp.position[i]).abs() > 1e-3) {
+                    if self.attempts == 0
+                        && (0..3).any(|i| (goals[0].position[i] - self.grasp.position[i]).abs() > 1e-3)
+                    {
                         goals.push(self.grasp);
                     }
-                    if let Some(i) = self.plan_and_send(giver, "linear", t_ns, bus, |m, lift, start, other| m.plan_linear_any(giver, lift, start, &goals, other)) {
+                    if let Some(i) = self.plan_and_send(giver, "linear", t_ns, bus, |m, lift, start, other| {
+                        m.plan_linear_any(giver, lift, start, &goals, other)
+                    }) {
                         if self.attempts > 0 {
                             self.attempts += i as u32;
                         }
@@ -610,12 +672,20 @@ impl HarvestNode {
                 if first {
                     self.gripper(giver, 0.0, GRASP_FORCE, t_ns, bus);
                 } else if self.holding(giver) && self.step_in_stage > 3 {
-                    let r = self.motion.target_radius().unwrap_or(0.5 * self.view(giver).gripper.as_ref().map_or(0.06, |g| g.position));
+                    let r = self
+                        .motion
+                        .target_radius()
+                        .unwrap_or(0.5 * self.view(giver).gripper.as_ref().map_or(0.06, |g| g.position));
                     self.motion.set_held(giver, Some(r));
                     self.enter(Stage::Retreat, t_ns, bus, "fruit held");
                 } else if self.view(giver).gripper.as_ref().is_some_and(|g| g.reached_goal && g.position < 0.005) {
                     if self.attempts as usize >= REGRASP_SHIFTS.len() {
-                        self.fail(Failure::Grasp, t_ns, bus, format!("the gripper closed on nothing ({} attempts)", self.attempts + 1));
+                        self.fail(
+                            Failure::Grasp,
+                            t_ns,
+                            bus,
+                            format!("the gripper closed on nothing ({} attempts)", self.attempts + 1),
+                        );
                     } else {
                         self.enter(Stage::Regrasp, t_ns, bus, "the gripper closed on nothing");
                     }
@@ -657,7 +727,9 @@ impl HarvestNode {
                         let g = grasp.along(-back);
                         TcpGoal { position: [g.position[0], g.position[1], g.position[2] + up], ..g }
                     });
-                    self.plan_and_send(giver, "linear", t_ns, bus, |m, lift, start, other| m.plan_linear_any(giver, lift, start, &goals, other));
+                    self.plan_and_send(giver, "linear", t_ns, bus, |m, lift, start, other| {
+                        m.plan_linear_any(giver, lift, start, &goals, other)
+                    });
                 } else if self.arm_done(giver, t_ns, bus) == Some(true) {
                     if !self.holding(giver) {
                         self.fail(Failure::Grasp, t_ns, bus, "the fruit slipped out during the retreat".into());
@@ -707,7 +779,13 @@ impl HarvestNode {
                 match self.phase_now() {
                     0 => {
                         self.motion.set_padding(HANDOVER_PADDING);
-                        let ok = self.move_arm(taker, &TcpGoal { x_axis: None, ..t.along(self.handover_offset) }, true, t_ns, bus);
+                        let ok = self.move_arm(
+                            taker,
+                            &TcpGoal { x_axis: None, ..t.along(self.handover_offset) },
+                            true,
+                            t_ns,
+                            bus,
+                        );
                         self.motion.set_padding(agrisim_manip::checker::DEFAULT_PADDING);
                         if ok {
                             self.phase = 1;
@@ -729,14 +807,23 @@ impl HarvestNode {
                         // Where the fruit sits between the giver's pads (along the approach)
                         // is not known: open, back off and try deeper / shallower.
                         if self.handover_attempts as usize >= HANDOVER_OFFSETS.len() {
-                            self.fail(Failure::Handover, t_ns, bus, format!("the taking gripper closed on nothing ({} attempts)", self.handover_attempts + 1));
+                            self.fail(
+                                Failure::Handover,
+                                t_ns,
+                                bus,
+                                format!(
+                                    "the taking gripper closed on nothing ({} attempts)",
+                                    self.handover_attempts + 1
+                                ),
+                            );
                         } else {
                             self.gripper(taker, geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
                             self.phase = 4;
                         }
                     }
                     3 => {
-                        let opened = self.view(giver).gripper.as_ref().is_some_and(|g| g.position > geo::OPEN_WIDTH - 0.005);
+                        let opened =
+                            self.view(giver).gripper.as_ref().is_some_and(|g| g.position > geo::OPEN_WIDTH - 0.005);
                         if opened && t_ns - self.release_ns > 500_000_000 {
                             if !self.holding(taker) {
                                 self.fail(Failure::Handover, t_ns, bus, "the fruit fell during the exchange".into());
@@ -763,7 +850,13 @@ impl HarvestNode {
                     5 if self.arm_done(taker, t_ns, bus) == Some(true) => {
                         self.handover_offset = HANDOVER_OFFSETS[self.handover_attempts as usize];
                         self.handover_attempts += 1;
-                        self.publish_status(t_ns, bus, "running", "", &format!("handover attempt {}", self.handover_attempts + 1));
+                        self.publish_status(
+                            t_ns,
+                            bus,
+                            "running",
+                            "",
+                            &format!("handover attempt {}", self.handover_attempts + 1),
+                        );
                         self.phase = 0;
                     }
                     _ => {}
@@ -807,7 +900,12 @@ impl HarvestNode {
                 if t_ns >= settled_ns && self.target_stamp_ns >= settled_ns {
                     match self.target_base() {
                         Some(p) if geo::in_box(p) => self.succeed(t_ns, bus),
-                        Some(p) => self.fail(Failure::Placement, t_ns, bus, format!("fruit at ({:.3}, {:.3}, {:.3}) in base_link, not in the box", p[0], p[1], p[2])),
+                        Some(p) => self.fail(
+                            Failure::Placement,
+                            t_ns,
+                            bus,
+                            format!("fruit at ({:.3}, {:.3}, {:.3}) in base_link, not in the box", p[0], p[1], p[2]),
+                        ),
                         None => {}
                     }
                 }

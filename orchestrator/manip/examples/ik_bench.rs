@@ -30,18 +30,7 @@ fn main() {
             (Target::pose(arm.fk_iso(lift, &q)), arm.random_q(&mut rng))
         })
         .collect();
-    let free: Vec<(Target, [f64; 7])> = cases
-        .iter()
-        .map(|(t, s)| {
-            (
-                Target {
-                    free_roll: true,
-                    ..*t
-                },
-                *s,
-            )
-        })
-        .collect();
+    let free: Vec<(Target, [f64; 7])> = cases.iter().map(|(t, s)| (Target { free_roll: true, ..*t }, *s)).collect();
     let ik = Ik::new(&arm, lift);
     let report = |name: &str, f: &mut Solver, cases: &[(Target, [f64; 7])]| {
         let mut ok = 0;
@@ -66,16 +55,8 @@ fn main() {
     };
     println!("IK benchmark: {n} reachable random targets, seed {seed}, lift {lift} m, left arm");
     let mut r2 = Rng::new(seed ^ 0xABCD);
-    report(
-        "ours (6-D)",
-        &mut |t, s| ik.solve(t, s, &mut r2, ik::DEFAULT_BUDGET),
-        &cases,
-    );
-    report(
-        "KDL NR_JL (6-D)",
-        &mut |t, s| kdl::kdl_nr_jl(&arm, lift, t, s),
-        &cases,
-    );
+    report("ours (6-D)", &mut |t, s| ik.solve(t, s, &mut r2, ik::DEFAULT_BUDGET), &cases);
+    report("KDL NR_JL (6-D)", &mut |t, s| kdl::kdl_nr_jl(&arm, lift, t, s), &cases);
     // Like for like, both ways: KDL with our tolerance (1 mm, 0.01 rad) and our budget of
     // iterations spent on random restarts; ours with KDL's tolerance (1e-5) and budget (100).
     let mut r4 = Rng::new(seed ^ 0x5678);
@@ -84,17 +65,10 @@ fn main() {
         &mut |t, s| kdl::kdl_nr_jl_restarts(&arm, lift, t, s, &mut r4, ik::DEFAULT_BUDGET),
         &cases,
     );
-    let strict: Vec<(Target, [f64; 7])> = cases.iter().map(|(t, s)| (Target { pos_tol: kdl::KDL_EPS, rot_tol: kdl::KDL_EPS, ..*t }, *s)).collect();
+    let strict: Vec<(Target, [f64; 7])> =
+        cases.iter().map(|(t, s)| (Target { pos_tol: kdl::KDL_EPS, rot_tol: kdl::KDL_EPS, ..*t }, *s)).collect();
     let mut r5 = Rng::new(seed ^ 0x9ABC);
-    report(
-        "ours, KDL tol+budget",
-        &mut |t, s| ik.solve(t, s, &mut r5, kdl::KDL_MAX_ITER),
-        &strict,
-    );
+    report("ours, KDL tol+budget", &mut |t, s| ik.solve(t, s, &mut r5, kdl::KDL_MAX_ITER), &strict);
     let mut r3 = Rng::new(seed ^ 0x1234);
-    report(
-        "ours (free roll, 5-D)",
-        &mut |t, s| ik.solve(t, s, &mut r3, ik::DEFAULT_BUDGET),
-        &free,
-    );
+    report("ours (free roll, 5-D)", &mut |t, s| ik.solve(t, s, &mut r3, ik::DEFAULT_BUDGET), &free);
 }

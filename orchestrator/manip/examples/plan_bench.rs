@@ -59,15 +59,7 @@ fn main() {
         };
         let t0 = Instant::now();
         let ikr = Ik::new(&left, lift);
-        let goals = ikr.goal_set(
-            &target,
-            &READY,
-            &mut rng,
-            6,
-            0.3,
-            6 * ik::DEFAULT_BUDGET,
-            |q| checker.is_valid(q),
-        );
+        let goals = ikr.goal_set(&target, &READY, &mut rng, 6, 0.3, 6 * ik::DEFAULT_BUDGET, |q| checker.is_valid(q));
         ik_times.push(t0.elapsed().as_secs_f64() * 1e3);
         goals_total += goals.len();
         if goals.is_empty() {
@@ -87,17 +79,12 @@ fn main() {
     times.sort_by(f64::total_cmp);
     ik_times.sort_by(f64::total_cmp);
     exact_times.sort_by(f64::total_cmp);
-    println!(
-        "planning benchmark: {n} trials, seed {seed}, left arm, lift {lift} m, tomato-row scenes"
-    );
+    println!("planning benchmark: {n} trials, seed {seed}, left arm, lift {lift} m, tomato-row scenes");
     println!(
         "planning success   {ok}/{n} = {:.1} %  (IK found no valid goal in {no_goal})",
         100.0 * ok as f64 / n as f64
     );
-    println!(
-        "goals per target   {:.2} (mean)",
-        goals_total as f64 / n as f64
-    );
+    println!("goals per target   {:.2} (mean)", goals_total as f64 / n as f64);
     println!(
         "plan time ms       p50 {:.2}  p95 {:.2}  max {:.2}  (incl. exact check p50 {:.2})",
         pct(&times, 0.5),

@@ -49,7 +49,12 @@ fn main() {
                 let q = left.random_q(&mut rng);
                 let t = left.fk_iso(lift, &q);
                 let (p, z) = (t.translation.vector, t.rotation * Vector3::z());
-                if (0.45..0.75).contains(&p.x) && p.y.abs() < 0.7 && (0.7..1.6).contains(&p.z) && z.x > 0.5 && checker.is_valid(&q) {
+                if (0.45..0.75).contains(&p.x)
+                    && p.y.abs() < 0.7
+                    && (0.7..1.6).contains(&p.z)
+                    && z.x > 0.5
+                    && checker.is_valid(&q)
+                {
                     break Target::free_roll(t);
                 }
             }
@@ -71,7 +76,10 @@ fn main() {
     let total: f64 = samples.iter().map(|s| s.1).sum();
     println!("planning cost calibration: {n} problems, seed {seed}, {:.3} s of planning measured", total);
     let show = |name: &str, c: Option<[f64; 3]>| match c {
-        Some(c) => println!("{name:<12} per check {:.3e} s, per IK iteration {:.3e} s, per exact check {:.3e} s", c[0], c[1], c[2]),
+        Some(c) => println!(
+            "{name:<12} per check {:.3e} s, per IK iteration {:.3e} s, per exact check {:.3e} s",
+            c[0], c[1], c[2]
+        ),
         None => println!("{name:<12} fit failed"),
     };
     let all = fit(&samples);
@@ -79,8 +87,12 @@ fn main() {
     show("first half", fit(&samples[..n / 2]));
     show("second half", fit(&samples[n / 2..]));
     if let Some(c) = all {
-        let predicted: Vec<f64> = samples.iter().map(|(w, _)| w.checks as f64 * c[0] + w.ik_iterations as f64 * c[1] + w.exact_checks as f64 * c[2]).collect();
-        let mut rel: Vec<f64> = samples.iter().zip(&predicted).filter(|(s, _)| s.1 > 1e-4).map(|(s, p)| (p - s.1) / s.1).collect();
+        let predicted: Vec<f64> = samples
+            .iter()
+            .map(|(w, _)| w.checks as f64 * c[0] + w.ik_iterations as f64 * c[1] + w.exact_checks as f64 * c[2])
+            .collect();
+        let mut rel: Vec<f64> =
+            samples.iter().zip(&predicted).filter(|(s, _)| s.1 > 1e-4).map(|(s, p)| (p - s.1) / s.1).collect();
         rel.sort_by(f64::total_cmp);
         let at = |q: f64| rel.get(((rel.len().max(1) - 1) as f64 * q).round() as usize).copied().unwrap_or(f64::NAN);
         println!("prediction error (model - measured) / measured: p5 {:+.0} %, p50 {:+.0} %, p95 {:+.0} %; total {:.3} s predicted vs {:.3} s measured", 100.0 * at(0.05), 100.0 * at(0.5), 100.0 * at(0.95), predicted.iter().sum::<f64>(), total);

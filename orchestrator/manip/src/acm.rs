@@ -55,10 +55,7 @@ impl Acm {
             for (i, p) in parts.iter().enumerate() {
                 let prim = p.prim(lift);
                 for b in 0..NBODIES {
-                    if buf[r(b)]
-                        .iter()
-                        .any(|(c, rad)| prim.overlaps_sphere(c, *rad))
-                    {
+                    if buf[r(b)].iter().any(|(c, rad)| prim.overlaps_sphere(c, *rad)) {
                         body_hits[i][b] += 1;
                     }
                 }
@@ -70,9 +67,7 @@ impl Acm {
                 let h = pair_hits[a][b];
                 // Adjacent: consecutive links, link7-hand, hand-finger; the two fingers are
                 // driven together by the gripper, not by the planner.
-                let adjacent = b == a + 1 && b <= HAND
-                    || (a == HAND && b > HAND)
-                    || (a == HAND + 1 && b == HAND + 2);
+                let adjacent = b == a + 1 && b <= HAND || (a == HAND && b > HAND) || (a == HAND + 1 && b == HAND + 2);
                 let on = !adjacent && h != 0 && h != n;
                 pair[a][b] = on;
                 pair[b][a] = on;
@@ -83,9 +78,7 @@ impl Acm {
             .iter()
             .zip(parts)
             .map(|(hits, p)| {
-                std::array::from_fn(|b| {
-                    !(b == 0 && p.link == "lift_link") && hits[b] != 0 && hits[b] != n
-                })
+                std::array::from_fn(|b| !(b == 0 && p.link == "lift_link") && hits[b] != 0 && hits[b] != n)
             })
             .collect();
         Acm { pair, body }
@@ -93,8 +86,6 @@ impl Acm {
 
     /// Number of checked arm-arm body pairs (for reports).
     pub fn enabled_pairs(&self) -> usize {
-        (0..NBODIES)
-            .map(|a| (a + 1..NBODIES).filter(|&b| self.pair[a][b]).count())
-            .sum()
+        (0..NBODIES).map(|a| (a + 1..NBODIES).filter(|&b| self.pair[a][b]).count()).sum()
     }
 }

@@ -50,9 +50,7 @@ pub fn body_parts(robot: &Robot) -> Result<Vec<BodyPart>, String> {
     let (f0, f1) = (at(0.0)?, at(1.0)?);
     let mut out = Vec::new();
     for l in BODY_LINKS {
-        let cols = robot
-            .colliders(l)
-            .ok_or_else(|| format!("robot has no link {l}"))?;
+        let cols = robot.colliders(l).ok_or_else(|| format!("robot has no link {l}"))?;
         let (p0, p1) = (to_iso(&f0[l]), to_iso(&f1[l]));
         for (i, c) in cols.iter().enumerate() {
             out.push(BodyPart {

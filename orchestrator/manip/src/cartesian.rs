@@ -23,12 +23,7 @@ pub struct CartesianError {
 
 impl std::fmt::Display for CartesianError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "cartesian motion stopped at {:.0} %: {}",
-            100.0 * self.fraction,
-            self.reason
-        )
+        write!(f, "cartesian motion stopped at {:.0} %: {}", 100.0 * self.fraction, self.reason)
     }
 }
 
@@ -63,17 +58,9 @@ pub fn cartesian_path(
         let Some(q) = ik.solve(&t, &prev, &mut rng, ATTEMPT_ITERS) else {
             return Err(fail(path, k, format!("IK failed at step {k}/{n}")));
         };
-        let jump = q
-            .iter()
-            .zip(&prev)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let jump = q.iter().zip(&prev).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
         if jump > max_jump {
-            return Err(fail(
-                path,
-                k,
-                format!("joint jump {jump:.3} rad at step {k}/{n}"),
-            ));
+            return Err(fail(path, k, format!("joint jump {jump:.3} rad at step {k}/{n}")));
         }
         if !checker.edge_valid(&prev, &q, resolution) {
             return Err(fail(path, k, format!("collision at step {k}/{n}")));

@@ -100,11 +100,7 @@ fn seg_of(j: &Joint, var: Option<usize>) -> Seg {
         JointKind::Revolute | JointKind::Continuous => Motion::Revolute(Unit::new_normalize(a)),
         JointKind::Prismatic => Motion::Prismatic(a),
     };
-    Seg {
-        origin: to_iso(&j.origin),
-        motion,
-        var,
-    }
+    Seg { origin: to_iso(&j.origin), motion, var }
 }
 
 impl Seg {
@@ -161,35 +157,23 @@ impl ArmModel {
             child_of_seg.push(j.child.clone());
         }
         if nvar != DOF || lift_limits.is_none() {
-            return Err(format!(
-                "{p}arm: expected lift + {DOF} joints, found {nvar} arm joints"
-            ));
+            return Err(format!("{p}arm: expected lift + {DOF} joints, found {nvar} arm joints"));
         }
         let mut body_seg = [0; NBODIES];
         for (b, name) in BODY_NAMES.iter().enumerate() {
-            let want = if b > HAND {
-                format!("{p}hand")
-            } else {
-                format!("{p}{name}")
-            };
-            body_seg[b] = child_of_seg
-                .iter()
-                .position(|c| *c == want)
-                .ok_or_else(|| format!("chain has no link {want}"))?;
+            let want = if b > HAND { format!("{p}hand") } else { format!("{p}{name}") };
+            body_seg[b] =
+                child_of_seg.iter().position(|c| *c == want).ok_or_else(|| format!("chain has no link {want}"))?;
         }
         let mut finger = [(Isometry3::identity(), Vector3::zeros()); 2];
         let mut finger_limits = None;
         for (k, f) in finger.iter_mut().enumerate() {
-            let j = robot
-                .joint(&format!("{p}finger_joint{}", k + 1))
-                .ok_or("no finger joint")?;
+            let j = robot.joint(&format!("{p}finger_joint{}", k + 1)).ok_or("no finger joint")?;
             *f = (to_iso(&j.origin), Vector3::from(j.axis));
             finger_limits = j.limits;
         }
-        let colliders: Vec<_> = BODY_NAMES
-            .iter()
-            .map(|n| robot.colliders(&format!("{p}{n}")).unwrap_or(&[]).to_vec())
-            .collect();
+        let colliders: Vec<_> =
+            BODY_NAMES.iter().map(|n| robot.colliders(&format!("{p}{n}")).unwrap_or(&[]).to_vec()).collect();
         let spheres = SphereModel::new(&colliders);
         let mut arm = ArmModel {
             side,
@@ -207,8 +191,7 @@ impl ArmModel {
         };
         arm.acm = Acm::sample(&arm.body, ACM_SAMPLES, arm.spheres.offsets, |rng, buf| {
             let q = arm.random_q(rng);
-            let lift = arm.lift_limits.lower
-                + (arm.lift_limits.upper - arm.lift_limits.lower) * rng.uniform();
+            let lift = arm.lift_limits.lower + (arm.lift_limits.upper - arm.lift_limits.lower) * rng.uniform();
             let finger = arm.finger_limits.upper * rng.uniform();
             let _ = world_spheres(&arm, lift, &q, finger, buf);
             lift
@@ -230,8 +213,7 @@ impl ArmModel {
 
     /// Uniform random configuration within the joint limits.
     pub fn random_q(&self, rng: &mut agrisim_math::Rng) -> [f64; DOF] {
-        self.limits
-            .map(|l| l.lower + (l.upper - l.lower) * rng.uniform())
+        self.limits.map(|l| l.lower + (l.upper - l.lower) * rng.uniform())
     }
 
     /// TCP pose in the planning frame (`base_link`).
@@ -281,11 +263,7 @@ impl ArmModel {
             let (o, a) = self.finger[k];
             bodies[HAND + 1 + k] = bodies[HAND] * o * Translation3::from(a * finger);
         }
-        Frames {
-            bodies,
-            tcp: f,
-            axes,
-        }
+        Frames { bodies, tcp: f, axes }
     }
 
     /// Geometric Jacobian (6 x 7: linear velocity over angular velocity of the TCP, planning
@@ -311,8 +289,7 @@ impl Frames {
             if v == 0 {
                 j.fixed_view_mut::<3, 1>(0, v).copy_from(a);
             } else {
-                j.fixed_view_mut::<3, 1>(0, v)
-                    .copy_from(&a.cross(&(p - o.coords)));
+                j.fixed_view_mut::<3, 1>(0, v).copy_from(&a.cross(&(p - o.coords)));
                 j.fixed_view_mut::<3, 1>(3, v).copy_from(a);
             }
         }
@@ -335,11 +312,6 @@ pub(crate) fn world_spheres(
             out.push((fr.bodies[b] * s.center, s.radius));
         }
     }
-    let bounds = std::array::from_fn(|b| {
-        (
-            fr.bodies[b] * arm.spheres.bounds[b].center,
-            arm.spheres.bounds[b].radius,
-        )
-    });
+    let bounds = std::array::from_fn(|b| (fr.bodies[b] * arm.spheres.bounds[b].center, arm.spheres.bounds[b].radius));
     (bounds, fr.tcp)
 }

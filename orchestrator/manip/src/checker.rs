@@ -75,29 +75,18 @@ impl<'a> Context<'a> {
         }
     }
     pub fn with_other(mut self, arm: &'a ArmModel, q: [f64; DOF], finger: f64) -> Context<'a> {
-        self.other = Some(OtherArm {
-            arm,
-            q,
-            finger,
-            held: None,
-        });
+        self.other = Some(OtherArm { arm, q, finger, held: None });
         self
     }
     /// This arm holds a sphere of `radius` at its TCP (fingers closed on it: set `finger`).
     pub fn holding(mut self, radius: f64) -> Context<'a> {
-        self.held = Some(Held {
-            radius,
-            offset: Vector3::zeros(),
-        });
+        self.held = Some(Held { radius, offset: Vector3::zeros() });
         self
     }
     /// The other arm (set by [`Context::with_other`]) holds a sphere of `radius` at its TCP.
     pub fn other_holding(mut self, radius: f64) -> Context<'a> {
         if let Some(o) = &mut self.other {
-            o.held = Some(Held {
-                radius,
-                offset: Vector3::zeros(),
-            });
+            o.held = Some(Held { radius, offset: Vector3::zeros() });
         }
         self
     }
@@ -221,12 +210,8 @@ impl<'a> Checker<'a> {
         let off = &arm.spheres.offsets;
         let rng = |b: usize| off[b]..off[b + 1];
         for &(a, b) in &self.self_pairs {
-            if spheres_touch(&bounds[a], &bounds[b], 0.0) && bodies_touch(s, rng(a), s, rng(b), 0.0)
-            {
-                return Some(Contact {
-                    body: a,
-                    hit: Hit::SelfBody(b),
-                });
+            if spheres_touch(&bounds[a], &bounds[b], 0.0) && bodies_touch(s, rng(a), s, rng(b), 0.0) {
+                return Some(Contact { body: a, hit: Hit::SelfBody(b) });
             }
         }
         for (i, p) in &self.body {
@@ -236,10 +221,7 @@ impl<'a> Checker<'a> {
                     && p.overlaps_sphere(&bounds[b].0, bounds[b].1 + pad)
                     && s[rng(b)].iter().any(|(c, r)| p.overlaps_sphere(c, r + pad))
                 {
-                    return Some(Contact {
-                        body: b,
-                        hit: Hit::RobotBody(*i),
-                    });
+                    return Some(Contact { body: b, hit: Hit::RobotBody(*i) });
                 }
             }
         }
@@ -250,10 +232,7 @@ impl<'a> Checker<'a> {
                     if spheres_touch(&bounds[a], &self.other_bounds[b], pad)
                         && bodies_touch(s, rng(a), &self.other, ooff[b]..ooff[b + 1], pad)
                     {
-                        return Some(Contact {
-                            body: a,
-                            hit: Hit::OtherArm(b),
-                        });
+                        return Some(Contact { body: a, hit: Hit::OtherArm(b) });
                     }
                 }
             }
@@ -263,8 +242,7 @@ impl<'a> Checker<'a> {
             let (c, r) = (&bounds[b].0, bounds[b].1 + pad);
             let hit = object_contact(scene, b, c, r, |i| {
                 let p = scene.prim(i);
-                p.overlaps_sphere(c, r)
-                    && s[rng(b)].iter().any(|(c, r)| p.overlaps_sphere(c, r + pad))
+                p.overlaps_sphere(c, r) && s[rng(b)].iter().any(|(c, r)| p.overlaps_sphere(c, r + pad))
             });
             if hit.is_some() {
                 return hit;
@@ -278,13 +256,8 @@ impl<'a> Checker<'a> {
         }
         if let Some(f) = &self.other_held {
             for b in 0..HAND {
-                if spheres_touch(f, &bounds[b], pad)
-                    && bodies_touch(std::slice::from_ref(f), 0..1, s, rng(b), pad)
-                {
-                    return Some(Contact {
-                        body: b,
-                        hit: Hit::OtherArm(HELD),
-                    });
+                if spheres_touch(f, &bounds[b], pad) && bodies_touch(std::slice::from_ref(f), 0..1, s, rng(b), pad) {
+                    return Some(Contact { body: b, hit: Hit::OtherArm(HELD) });
                 }
             }
         }
@@ -304,21 +277,13 @@ impl<'a> Checker<'a> {
         let off = &ctx.arm.spheres.offsets;
         let one = std::slice::from_ref(f);
         for b in 0..HAND {
-            if spheres_touch(f, &bounds[b], 0.0)
-                && bodies_touch(one, 0..1, s, off[b]..off[b + 1], 0.0)
-            {
-                return Some(Contact {
-                    body: HELD,
-                    hit: Hit::SelfBody(b),
-                });
+            if spheres_touch(f, &bounds[b], 0.0) && bodies_touch(one, 0..1, s, off[b]..off[b + 1], 0.0) {
+                return Some(Contact { body: HELD, hit: Hit::SelfBody(b) });
             }
         }
         for (i, p) in self.body_all.iter().enumerate() {
             if p.overlaps_sphere(&f.0, f.1 + pad) {
-                return Some(Contact {
-                    body: HELD,
-                    hit: Hit::RobotBody(i),
-                });
+                return Some(Contact { body: HELD, hit: Hit::RobotBody(i) });
             }
         }
         if let Some(o) = &ctx.other {
@@ -327,17 +292,12 @@ impl<'a> Checker<'a> {
                 if spheres_touch(f, &self.other_bounds[b], pad)
                     && bodies_touch(one, 0..1, &self.other, ooff[b]..ooff[b + 1], pad)
                 {
-                    return Some(Contact {
-                        body: HELD,
-                        hit: Hit::OtherArm(b),
-                    });
+                    return Some(Contact { body: HELD, hit: Hit::OtherArm(b) });
                 }
             }
         }
         let scene = ctx.scene;
-        object_contact(scene, HELD, &f.0, f.1 + pad, |i| {
-            scene.prim(i).overlaps_sphere(&f.0, f.1 + pad)
-        })
+        object_contact(scene, HELD, &f.0, f.1 + pad, |i| scene.prim(i).overlaps_sphere(&f.0, f.1 + pad))
     }
 
     /// Whether the straight joint-space segment a -> b is valid, sampled so that no joint
@@ -370,22 +330,13 @@ pub(crate) fn object_contact(
     mut touches: impl FnMut(usize) -> bool,
 ) -> Option<Contact> {
     scene
-        .near(c, r, |i| {
-            blocks(scene.objects()[i].kind, body) && touches(i)
-        })
-        .map(|i| Contact {
-            body,
-            hit: Hit::Object(i),
-        })
+        .near(c, r, |i| blocks(scene.objects()[i].kind, body) && touches(i))
+        .map(|i| Contact { body, hit: Hit::Object(i) })
 }
 
 /// Number of segments so that no joint moves more than `resolution` per segment.
 pub fn steps(a: &[f64; DOF], b: &[f64; DOF], resolution: f64) -> usize {
-    let m = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max);
+    let m = a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
     ((m / resolution).ceil() as usize).max(1)
 }
 

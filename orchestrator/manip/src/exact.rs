@@ -48,18 +48,13 @@ fn parry_part(shape: &Shape, origin: Isometry3<f64>) -> Part {
             ))),
             local: origin,
         },
-        Shape::Sphere { radius } => Part {
-            shape: SharedShape::new(Ball::new(radius as f32)),
-            local: origin,
-        },
-        Shape::Cylinder { radius, length } => Part {
-            shape: SharedShape::new(Cylinder::new(length as f32 * 0.5, radius as f32)),
-            local: origin * y_to_z,
-        },
-        Shape::Capsule { radius, length } => Part {
-            shape: SharedShape::new(Capsule::new_z(length as f32 * 0.5, radius as f32)),
-            local: origin,
-        },
+        Shape::Sphere { radius } => Part { shape: SharedShape::new(Ball::new(radius as f32)), local: origin },
+        Shape::Cylinder { radius, length } => {
+            Part { shape: SharedShape::new(Cylinder::new(length as f32 * 0.5, radius as f32)), local: origin * y_to_z }
+        }
+        Shape::Capsule { radius, length } => {
+            Part { shape: SharedShape::new(Capsule::new_z(length as f32 * 0.5, radius as f32)), local: origin }
+        }
     }
 }
 
@@ -75,24 +70,15 @@ pub(crate) fn to_parry(i: &Isometry3<f64>) -> PPose {
 fn touch(a: &Part, pa: &Isometry3<f64>, b: &Part, pb: &Isometry3<f64>) -> bool {
     // Every primitive pair is supported by parry's default dispatcher; treat the
     // impossible "unsupported" as contact (safe side).
-    intersection_test(
-        &to_parry(&(pa * a.local)),
-        &*a.shape,
-        &to_parry(&(pb * b.local)),
-        &*b.shape,
-    )
-    .map_or(true, |r| r.intersecting)
+    intersection_test(&to_parry(&(pa * a.local)), &*a.shape, &to_parry(&(pb * b.local)), &*b.shape)
+        .map_or(true, |r| r.intersecting)
 }
 
 /// The arm's link primitives as parry shapes, per body.
 fn arm_parts(arm: &ArmModel) -> Vec<Vec<Part>> {
     arm.colliders
         .iter()
-        .map(|cs| {
-            cs.iter()
-                .map(|c| parry_part(&c.shape, crate::iso::to_iso(&c.origin)))
-                .collect()
-        })
+        .map(|cs| cs.iter().map(|c| parry_part(&c.shape, crate::iso::to_iso(&c.origin))).collect())
         .collect()
 }
 
@@ -105,12 +91,8 @@ pub fn exact_contact(ctx: &Context, q: &[f64; DOF]) -> Option<Contact> {
 /// [`EXACT_RESOLUTION`]) and returns the first contact (no padding: real geometry).
 pub fn exact_check(ctx: &Context, path: &[[f64; DOF]], resolution: f64) -> Result<(), PathContact> {
     let ex = Exact::new(ctx);
-    let report = |c: Contact, q: [f64; DOF], segment| PathContact {
-        contact: c,
-        description: c.describe(ctx),
-        q,
-        segment,
-    };
+    let report =
+        |c: Contact, q: [f64; DOF], segment| PathContact { contact: c, description: c.describe(ctx), q, segment };
     if let Some(q) = path.first() {
         if let Some(c) = ex.contact(q) {
             return Err(report(c, *q, 0));
@@ -142,10 +124,7 @@ struct Exact<'a> {
 }
 
 fn ball(r: f64) -> Part {
-    Part {
-        shape: SharedShape::new(Ball::new(r as f32)),
-        local: Isometry3::identity(),
-    }
+    Part { shape: SharedShape::new(Ball::new(r as f32)), local: Isometry3::identity() }
 }
 
 impl<'a> Exact<'a> {
@@ -156,23 +135,15 @@ impl<'a> Exact<'a> {
             .body
             .iter()
             .enumerate()
-            .map(|(i, p)| {
-                (
-                    i,
-                    parry_part(&p.collider.shape, p.pose(ctx.lift)),
-                    p.prim(ctx.lift),
-                )
-            })
+            .map(|(i, p)| (i, parry_part(&p.collider.shape, p.pose(ctx.lift)), p.prim(ctx.lift)))
             .collect();
         let mut other = Vec::new();
         let mut other_held = None;
         if let Some(o) = &ctx.other {
             let fr = o.arm.frames_x(&join(ctx.lift, &o.q), o.finger);
             if let Some(h) = o.held {
-                other_held = Some((
-                    ball(h.radius),
-                    fr.tcp * Isometry3::translation(h.offset.x, h.offset.y, h.offset.z),
-                ));
+                other_held =
+                    Some((ball(h.radius), fr.tcp * Isometry3::translation(h.offset.x, h.offset.y, h.offset.z)));
             }
             for (b, parts) in arm_parts(o.arm).into_iter().enumerate() {
                 let bs = &o.arm.spheres.bounds[b];
@@ -181,20 +152,8 @@ impl<'a> Exact<'a> {
                 }
             }
         }
-        let objects = ctx
-            .scene
-            .objects()
-            .iter()
-            .map(|o| parry_part(&o.shape, o.pose))
-            .collect();
-        Exact {
-            ctx,
-            arm,
-            body,
-            other,
-            objects,
-            other_held,
-        }
+        let objects = ctx.scene.objects().iter().map(|o| parry_part(&o.shape, o.pose)).collect();
+        Exact { ctx, arm, body, other, objects, other_held }
     }
 
     // Body indices are the contact's identity and index several parallel arrays at once.
@@ -208,25 +167,16 @@ impl<'a> Exact<'a> {
         let fr = a.frames_x(&join(ctx.lift, q), ctx.finger);
         let pose = &fr.bodies;
         // Culling with the bounding spheres, which contain the bodies.
-        let bound: [(Point3<f64>, f64); NBODIES] = std::array::from_fn(|b| {
-            (
-                pose[b] * a.spheres.bounds[b].center,
-                a.spheres.bounds[b].radius,
-            )
-        });
+        let bound: [(Point3<f64>, f64); NBODIES] =
+            std::array::from_fn(|b| (pose[b] * a.spheres.bounds[b].center, a.spheres.bounds[b].radius));
         let near = |x: &(Point3<f64>, f64), c: &Point3<f64>, r: f64| (x.0 - c).norm() <= x.1 + r;
         for x in 0..NBODIES {
             for y in x + 1..NBODIES {
                 if a.acm.pair[x][y]
                     && near(&bound[x], &bound[y].0, bound[y].1)
-                    && self.arm[x]
-                        .iter()
-                        .any(|p| self.arm[y].iter().any(|r| touch(p, &pose[x], r, &pose[y])))
+                    && self.arm[x].iter().any(|p| self.arm[y].iter().any(|r| touch(p, &pose[x], r, &pose[y])))
                 {
-                    return Some(Contact {
-                        body: x,
-                        hit: Hit::SelfBody(y),
-                    });
+                    return Some(Contact { body: x, hit: Hit::SelfBody(y) });
                 }
             }
         }
@@ -237,22 +187,14 @@ impl<'a> Exact<'a> {
                     && prim.overlaps_sphere(&bound[b].0, bound[b].1)
                     && self.arm[b].iter().any(|p| touch(p, &pose[b], part, &id))
                 {
-                    return Some(Contact {
-                        body: b,
-                        hit: Hit::RobotBody(*i),
-                    });
+                    return Some(Contact { body: b, hit: Hit::RobotBody(*i) });
                 }
             }
         }
         for (ob, part, opose, oc, or) in &self.other {
             for b in 0..NBODIES {
-                if near(&bound[b], oc, *or)
-                    && self.arm[b].iter().any(|p| touch(p, &pose[b], part, opose))
-                {
-                    return Some(Contact {
-                        body: b,
-                        hit: Hit::OtherArm(*ob),
-                    });
+                if near(&bound[b], oc, *or) && self.arm[b].iter().any(|p| touch(p, &pose[b], part, opose)) {
+                    return Some(Contact { body: b, hit: Hit::OtherArm(*ob) });
                 }
             }
         }
@@ -262,9 +204,7 @@ impl<'a> Exact<'a> {
             let bs = &a.spheres.bounds[b];
             let c = pose[b] * bs.center;
             let hit = object_contact(ctx.scene, b, &c, bs.radius, |i| {
-                self.arm[b]
-                    .iter()
-                    .any(|p| touch(p, &pose[b], &self.objects[i], &id))
+                self.arm[b].iter().any(|p| touch(p, &pose[b], &self.objects[i], &id))
             });
             if hit.is_some() {
                 return hit;
@@ -273,10 +213,7 @@ impl<'a> Exact<'a> {
         if let Some((oh, opose)) = &self.other_held {
             for b in 0..HAND {
                 if self.arm[b].iter().any(|p| touch(p, &pose[b], oh, opose)) {
-                    return Some(Contact {
-                        body: b,
-                        hit: Hit::OtherArm(HELD),
-                    });
+                    return Some(Contact { body: b, hit: Hit::OtherArm(HELD) });
                 }
             }
         }
@@ -285,32 +222,21 @@ impl<'a> Exact<'a> {
             let f = ball(h.radius);
             for b in 0..HAND {
                 if self.arm[b].iter().any(|p| touch(&f, &hp, p, &pose[b])) {
-                    return Some(Contact {
-                        body: HELD,
-                        hit: Hit::SelfBody(b),
-                    });
+                    return Some(Contact { body: HELD, hit: Hit::SelfBody(b) });
                 }
             }
             for (i, part, _) in &self.body {
                 if touch(&f, &hp, part, &id) {
-                    return Some(Contact {
-                        body: HELD,
-                        hit: Hit::RobotBody(*i),
-                    });
+                    return Some(Contact { body: HELD, hit: Hit::RobotBody(*i) });
                 }
             }
             for (ob, part, opose, _, _) in &self.other {
                 if *ob < HAND && touch(&f, &hp, part, opose) {
-                    return Some(Contact {
-                        body: HELD,
-                        hit: Hit::OtherArm(*ob),
-                    });
+                    return Some(Contact { body: HELD, hit: Hit::OtherArm(*ob) });
                 }
             }
             let c = Point3::from(hp.translation.vector);
-            return object_contact(ctx.scene, HELD, &c, h.radius, |i| {
-                touch(&f, &hp, &self.objects[i], &id)
-            });
+            return object_contact(ctx.scene, HELD, &c, h.radius, |i| touch(&f, &hp, &self.objects[i], &id));
         }
         None
     }

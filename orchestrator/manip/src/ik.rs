@@ -56,12 +56,7 @@ struct Problem<'a> {
 
 impl<'a> Ik<'a> {
     pub fn new(arm: &'a ArmModel, lift: f64) -> Ik<'a> {
-        Ik {
-            arm,
-            lift,
-            free_lift: false,
-            meter: None,
-        }
+        Ik { arm, lift, free_lift: false, meter: None }
     }
 
     /// Counts this solver's iterations in `meter`.
@@ -71,23 +66,12 @@ impl<'a> Ik<'a> {
 
     /// Same, with the lift as an 8th joint ([`Ik::solve_lift`] returns its value).
     pub fn with_free_lift(arm: &'a ArmModel, lift: f64) -> Ik<'a> {
-        Ik {
-            arm,
-            lift,
-            free_lift: true,
-            meter: None,
-        }
+        Ik { arm, lift, free_lift: true, meter: None }
     }
 
     /// Joint configuration reaching `target` within its tolerances and the joint limits,
     /// starting from `seed` and then random restarts, within `budget` iterations in total.
-    pub fn solve(
-        &self,
-        target: &Target,
-        seed: &[f64; DOF],
-        rng: &mut Rng,
-        budget: usize,
-    ) -> Option<[f64; DOF]> {
+    pub fn solve(&self, target: &Target, seed: &[f64; DOF], rng: &mut Rng, budget: usize) -> Option<[f64; DOF]> {
         self.solve_lift(target, seed, rng, budget).map(|(_, q)| q)
     }
 
@@ -118,7 +102,13 @@ impl<'a> Ik<'a> {
         (r, used)
     }
 
-    fn search(&self, target: &Target, seed: &[f64; DOF], rng: &mut Rng, budget: usize) -> (Option<(f64, [f64; DOF])>, usize) {
+    fn search(
+        &self,
+        target: &Target,
+        seed: &[f64; DOF],
+        rng: &mut Rng,
+        budget: usize,
+    ) -> (Option<(f64, [f64; DOF])>, usize) {
         let pb = self.problem(target);
         let mut left = budget;
         let mut attempt = 0usize;
@@ -127,20 +117,13 @@ impl<'a> Ik<'a> {
                 join(self.lift, seed)
             } else {
                 let q = self.arm.random_q(rng);
-                let lift = if self.free_lift {
-                    pb.lo[0] + (pb.hi[0] - pb.lo[0]) * rng.uniform()
-                } else {
-                    self.lift
-                };
+                let lift = if self.free_lift { pb.lo[0] + (pb.hi[0] - pb.lo[0]) * rng.uniform() } else { self.lift };
                 join(lift, &q)
             };
             let x0 = pb.clamp(&Vec8::from(x0));
             let n = left.min(ATTEMPT_ITERS);
-            let (x, used, ok) = if attempt.is_multiple_of(2) {
-                pb.levenberg_marquardt(x0, n)
-            } else {
-                pb.active_set_gn(x0, n)
-            };
+            let (x, used, ok) =
+                if attempt.is_multiple_of(2) { pb.levenberg_marquardt(x0, n) } else { pb.active_set_gn(x0, n) };
             left -= used.max(1).min(left);
             if ok {
                 let x: [f64; 8] = x.into();
@@ -166,10 +149,7 @@ impl<'a> Ik<'a> {
         budget: usize,
         mut valid: impl FnMut(&[f64; DOF]) -> bool,
     ) -> Vec<[f64; DOF]> {
-        let fixed = Ik {
-            free_lift: false,
-            ..self.clone()
-        };
+        let fixed = Ik { free_lift: false, ..self.clone() };
         let mut out: Vec<[f64; DOF]> = Vec::new();
         let mut left = budget;
         let mut first = true;
@@ -208,23 +188,13 @@ impl<'a> Ik<'a> {
             lo[i + 1] = l.lower;
             hi[i + 1] = l.upper;
         }
-        Problem {
-            arm: self.arm,
-            target,
-            lo,
-            hi,
-            mask,
-        }
+        Problem { arm: self.arm, target, lo, hi, mask }
     }
 }
 
 /// Euclidean joint-space distance.
 pub fn dist(a: &[f64; DOF], b: &[f64; DOF]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y) * (x - y))
-        .sum::<f64>()
-        .sqrt()
+    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt()
 }
 
 impl Problem<'_> {
@@ -357,14 +327,7 @@ impl Problem<'_> {
 }
 
 fn weighted(e: &Vector6<f64>) -> Vector6<f64> {
-    Vector6::new(
-        e[0],
-        e[1],
-        e[2],
-        e[3] * ROT_WEIGHT,
-        e[4] * ROT_WEIGHT,
-        e[5] * ROT_WEIGHT,
-    )
+    Vector6::new(e[0], e[1], e[2], e[3] * ROT_WEIGHT, e[4] * ROT_WEIGHT, e[5] * ROT_WEIGHT)
 }
 
 /// Damped least-squares step J^T (J J^T + mu I)^-1 r (6x6 solve).

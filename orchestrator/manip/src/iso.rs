@@ -22,8 +22,5 @@ pub fn to_iso(p: &Pose) -> Isometry3<f64> {
 pub fn to_pose(i: &Isometry3<f64>) -> Pose {
     let m = i.rotation.to_rotation_matrix().into_inner();
     let t = i.translation.vector;
-    Pose {
-        rot: [0, 1, 2].map(|r| [m[(r, 0)], m[(r, 1)], m[(r, 2)]]),
-        trans: [t.x, t.y, t.z],
-    }
+    Pose { rot: [0, 1, 2].map(|r| [m[(r, 0)], m[(r, 1)], m[(r, 2)]]), trans: [t.x, t.y, t.z] }
 }

@@ -14,12 +14,7 @@ pub const KDL_MAX_ITER: usize = 100;
 pub const KDL_EPS: f64 = 1e-5;
 
 /// Solves a 6-D target from `seed` with KDL NR_JL semantics; `None` when not converged.
-pub fn kdl_nr_jl(
-    arm: &ArmModel,
-    lift: f64,
-    target: &Target,
-    seed: &[f64; DOF],
-) -> Option<[f64; DOF]> {
+pub fn kdl_nr_jl(arm: &ArmModel, lift: f64, target: &Target, seed: &[f64; DOF]) -> Option<[f64; DOF]> {
     nr_jl(arm, lift, target, seed, KDL_MAX_ITER, &|e| e.iter().all(|v| v.abs() < KDL_EPS)).0
 }
 
@@ -60,10 +55,7 @@ fn nr_jl(
     let lo = arm.lower();
     let hi = arm.upper();
     let mut x = join(lift, seed);
-    let full = Target {
-        free_roll: false,
-        ..*target
-    };
+    let full = Target { free_roll: false, ..*target };
     for it in 0..max_iter {
         let f = arm.fk_x(&x);
         let dtwist: Vector6<f64> = full.error(&f);

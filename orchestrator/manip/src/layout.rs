@@ -5,10 +5,8 @@
 pub const DOF: usize = 7;
 
 /// Collision bodies of one arm, in this order everywhere in the crate.
-pub const BODY_NAMES: [&str; NBODIES] = [
-    "link0", "link1", "link2", "link3", "link4", "link5", "link6", "link7", "hand", "finger1",
-    "finger2",
-];
+pub const BODY_NAMES: [&str; NBODIES] =
+    ["link0", "link1", "link2", "link3", "link4", "link5", "link6", "link7", "hand", "finger1", "finger2"];
 /// Number of collision bodies of one arm.
 pub const NBODIES: usize = 11;
 /// Index of the hand in [`BODY_NAMES`]; the fingers follow it.

@@ -41,7 +41,12 @@ impl Meter {
         self.timings.set(self.timings.get() + 1);
     }
     pub fn work(&self) -> Work {
-        Work { checks: self.checks.get(), ik_iterations: self.ik_iterations.get(), exact_checks: self.exact_checks.get(), timings: self.timings.get() }
+        Work {
+            checks: self.checks.get(),
+            ik_iterations: self.ik_iterations.get(),
+            exact_checks: self.exact_checks.get(),
+            timings: self.timings.get(),
+        }
     }
 }
 
@@ -78,19 +83,29 @@ impl CostModel {
     /// measured time, in total within 0.3 %. A time parameterization: TOPP-RA's 0.155 ms per
     /// 7-DoF path (`python/bench_toppra.py`). A real robot's computer may be slower: see
     /// [`CostModel::scaled`].
-    pub const CALIBRATED: CostModel = CostModel { per_check: 1.62e-6, per_ik_iteration: 1.31e-6, per_exact_check: 2.9e-6, per_timing: 1.55e-4 };
+    pub const CALIBRATED: CostModel =
+        CostModel { per_check: 1.62e-6, per_ik_iteration: 1.31e-6, per_exact_check: 2.9e-6, per_timing: 1.55e-4 };
 
     /// Free thinking (the behaviour before planning latency was modelled).
-    pub const FREE: CostModel = CostModel { per_check: 0.0, per_ik_iteration: 0.0, per_exact_check: 0.0, per_timing: 0.0 };
+    pub const FREE: CostModel =
+        CostModel { per_check: 0.0, per_ik_iteration: 0.0, per_exact_check: 0.0, per_timing: 0.0 };
 
     /// Every cost multiplied by `k` (e.g. 3 for a computer three times slower).
     pub fn scaled(self, k: f64) -> CostModel {
-        CostModel { per_check: self.per_check * k, per_ik_iteration: self.per_ik_iteration * k, per_exact_check: self.per_exact_check * k, per_timing: self.per_timing * k }
+        CostModel {
+            per_check: self.per_check * k,
+            per_ik_iteration: self.per_ik_iteration * k,
+            per_exact_check: self.per_exact_check * k,
+            per_timing: self.per_timing * k,
+        }
     }
 
     /// Seconds `w` costs.
     pub fn seconds(&self, w: &Work) -> f64 {
-        w.checks as f64 * self.per_check + w.ik_iterations as f64 * self.per_ik_iteration + w.exact_checks as f64 * self.per_exact_check + w.timings as f64 * self.per_timing
+        w.checks as f64 * self.per_check
+            + w.ik_iterations as f64 * self.per_ik_iteration
+            + w.exact_checks as f64 * self.per_exact_check
+            + w.timings as f64 * self.per_timing
     }
 }
 

@@ -83,18 +83,15 @@ impl std::fmt::Display for PlanError {
                 write!(f, "start configuration outside the joint limits")
             }
             PlanError::StartInCollision(c) => write!(f, "start configuration in collision: {c}"),
-            PlanError::NoValidGoal => write!(
-                f,
-                "no valid goal configuration (none, or all in collision or out of limits)"
-            ),
+            PlanError::NoValidGoal => {
+                write!(f, "no valid goal configuration (none, or all in collision or out of limits)")
+            }
             PlanError::NoPath { iterations } => {
                 write!(f, "no path found in {iterations} RRT-Connect iterations")
             }
-            PlanError::ExactCheckFailed(c) => write!(
-                f,
-                "final path fails the exact check at segment {}: {}",
-                c.segment, c.description
-            ),
+            PlanError::ExactCheckFailed(c) => {
+                write!(f, "final path fails the exact check at segment {}: {}", c.segment, c.description)
+            }
         }
     }
 }
@@ -113,13 +110,7 @@ impl Planner {
     }
 
     /// Plans from `start` to any of `goals` in `ctx`. Deterministic for a given `rng` state.
-    pub fn plan(
-        &self,
-        ctx: &Context,
-        start: &Q,
-        goals: &[Q],
-        rng: &mut Rng,
-    ) -> Result<Plan, PlanError> {
+    pub fn plan(&self, ctx: &Context, start: &Q, goals: &[Q], rng: &mut Rng) -> Result<Plan, PlanError> {
         let t0 = Instant::now();
         let checker = Checker::new(*ctx);
         let cfg = &self.config;
@@ -129,44 +120,26 @@ impl Planner {
         if let Some(c) = checker.contact(start) {
             return Err(PlanError::StartInCollision(c.describe(ctx)));
         }
-        let valid: Vec<(usize, Q)> = goals
-            .iter()
-            .copied()
-            .enumerate()
-            .filter(|(_, g)| checker.is_valid(g))
-            .collect();
+        let valid: Vec<(usize, Q)> = goals.iter().copied().enumerate().filter(|(_, g)| checker.is_valid(g)).collect();
         if valid.is_empty() {
             return Err(PlanError::NoValidGoal);
         }
-        let mut stats = PlanStats {
-            valid_goals: valid.len(),
-            ..Default::default()
-        };
+        let mut stats = PlanStats { valid_goals: valid.len(), ..Default::default() };
         // Direct connection first: in open space it is the whole answer.
-        let direct = valid
-            .iter()
-            .find(|(_, g)| checker.edge_valid(start, g, cfg.rrt.resolution));
+        let direct = valid.iter().find(|(_, g)| checker.edge_valid(start, g, cfg.rrt.resolution));
         let (mut path, goal_index) = if let Some((i, g)) = direct {
             (vec![*start, *g], *i)
         } else {
             let goal_qs: Vec<Q> = valid.iter().map(|(_, g)| *g).collect();
-            let r =
-                rrt_connect(&checker, start, &goal_qs, &cfg.rrt, rng).ok_or(PlanError::NoPath {
-                    iterations: cfg.rrt.max_iterations,
-                })?;
+            let r = rrt_connect(&checker, start, &goal_qs, &cfg.rrt, rng)
+                .ok_or(PlanError::NoPath { iterations: cfg.rrt.max_iterations })?;
             stats.iterations = r.iterations;
             stats.tree_nodes = r.nodes;
             (r.waypoints, valid[r.goal].0)
         };
         stats.raw_waypoints = path.len();
         stats.raw_length = path_length(&path);
-        shortcut(
-            &mut path,
-            &checker,
-            cfg.rrt.resolution,
-            cfg.shortcut_iterations,
-            rng,
-        );
+        shortcut(&mut path, &checker, cfg.rrt.resolution, cfg.shortcut_iterations, rng);
         stats.length = path_length(&path);
         stats.collision_checks = checker.checks();
         if cfg.exact_check {
@@ -176,10 +149,6 @@ impl Planner {
             r.map_err(PlanError::ExactCheckFailed)?;
         }
         stats.planning_time_s = t0.elapsed().as_secs_f64();
-        Ok(Plan {
-            waypoints: path,
-            goal_index,
-            stats,
-        })
+        Ok(Plan { waypoints: path, goal_index, stats })
     }
 }

@@ -18,13 +18,7 @@ pub struct Prim {
 impl Prim {
     pub fn new(shape: Shape, pose: Isometry3<f64>) -> Prim {
         let radius = bounding_radius(&shape);
-        Prim {
-            shape,
-            pose,
-            inv: pose.inverse(),
-            center: Point3::from(pose.translation.vector),
-            radius,
-        }
+        Prim { shape, pose, inv: pose.inverse(), center: Point3::from(pose.translation.vector), radius }
     }
 
     /// Axis-aligned bounds in the planning frame (exact for the rotated primitive's extent).
@@ -43,12 +37,7 @@ impl Prim {
                 // A disc of radius r normal to axis n spans r*sqrt(1 - n_i^2) along axis i.
                 let n = r.column(2);
                 Vector3::from_fn(|i, _| {
-                    a[i].abs()
-                        + if cap {
-                            radius
-                        } else {
-                            radius * (1.0 - n[i] * n[i]).max(0.0).sqrt()
-                        }
+                    a[i].abs() + if cap { radius } else { radius * (1.0 - n[i] * n[i]).max(0.0).sqrt() }
                 })
             }
         };
@@ -92,9 +81,7 @@ impl Prim {
 pub fn bounding_radius(s: &Shape) -> f64 {
     match *s {
         Shape::Sphere { radius } => radius,
-        Shape::Box { size } => {
-            0.5 * (size[0] * size[0] + size[1] * size[1] + size[2] * size[2]).sqrt()
-        }
+        Shape::Box { size } => 0.5 * (size[0] * size[0] + size[1] * size[1] + size[2] * size[2]).sqrt(),
         Shape::Cylinder { radius, length } => (radius * radius + 0.25 * length * length).sqrt(),
         Shape::Capsule { radius, length } => radius + 0.5 * length,
     }

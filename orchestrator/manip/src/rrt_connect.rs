@@ -21,11 +21,7 @@ pub struct RrtConfig {
 
 impl Default for RrtConfig {
     fn default() -> Self {
-        RrtConfig {
-            max_iterations: 20_000,
-            step: 0.4,
-            resolution: 0.02,
-        }
+        RrtConfig { max_iterations: 20_000, step: 0.4, resolution: 0.02 }
     }
 }
 
@@ -39,11 +35,7 @@ struct Tree {
 
 impl Tree {
     fn new(roots: &[Q]) -> Tree {
-        Tree {
-            nodes: roots.to_vec(),
-            parent: vec![usize::MAX; roots.len()],
-            root: (0..roots.len()).collect(),
-        }
+        Tree { nodes: roots.to_vec(), parent: vec![usize::MAX; roots.len()], root: (0..roots.len()).collect() }
     }
     fn nearest(&self, q: &Q) -> usize {
         let mut best = (f64::INFINITY, 0);
@@ -91,17 +83,8 @@ pub struct RrtPath {
 fn extend(tree: &mut Tree, q: &Q, cfg: &RrtConfig, checker: &Checker) -> Step {
     let near = tree.nearest(q);
     let from = tree.nodes[near];
-    let d = from
-        .iter()
-        .zip(q)
-        .map(|(a, b)| (a - b) * (a - b))
-        .sum::<f64>()
-        .sqrt();
-    let (to, reached) = if d <= cfg.step {
-        (*q, true)
-    } else {
-        (lerp(&from, q, cfg.step / d), false)
-    };
+    let d = from.iter().zip(q).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
+    let (to, reached) = if d <= cfg.step { (*q, true) } else { (lerp(&from, q, cfg.step / d), false) };
     if !checker.edge_valid(&from, &to, cfg.resolution) {
         return Step::Trapped;
     }
@@ -124,13 +107,7 @@ fn connect(tree: &mut Tree, q: &Q, cfg: &RrtConfig, checker: &Checker) -> Step {
 
 /// Searches a path from `start` to any of `goals` (all assumed valid). `None` when the
 /// iteration budget runs out.
-pub fn rrt_connect(
-    checker: &Checker,
-    start: &Q,
-    goals: &[Q],
-    cfg: &RrtConfig,
-    rng: &mut Rng,
-) -> Option<RrtPath> {
+pub fn rrt_connect(checker: &Checker, start: &Q, goals: &[Q], cfg: &RrtConfig, rng: &mut Rng) -> Option<RrtPath> {
     if goals.is_empty() {
         return None;
     }
@@ -144,11 +121,7 @@ pub fn rrt_connect(
         if let Step::Advanced(i) | Step::Reached(i) = extend(&mut a, &q_rand, cfg, checker) {
             let q_new = a.nodes[i];
             if let Step::Reached(j) = connect(&mut b, &q_new, cfg, checker) {
-                let (s, g, si, gi) = if a_is_start {
-                    (&a, &b, i, j)
-                } else {
-                    (&b, &a, j, i)
-                };
+                let (s, g, si, gi) = if a_is_start { (&a, &b, i, j) } else { (&b, &a, j, i) };
                 let mut path = s.branch(si);
                 path.reverse();
                 let to_goal = g.branch(gi);

@@ -28,18 +28,8 @@ pub struct Obstacle {
 }
 
 impl Obstacle {
-    pub fn new(
-        name: impl Into<String>,
-        shape: Shape,
-        pose: Isometry3<f64>,
-        kind: ObstacleKind,
-    ) -> Obstacle {
-        Obstacle {
-            name: name.into(),
-            shape,
-            pose,
-            kind,
-        }
+    pub fn new(name: impl Into<String>, shape: Shape, pose: Isometry3<f64>, kind: ObstacleKind) -> Obstacle {
+        Obstacle { name: name.into(), shape, pose, kind }
     }
 }
 
@@ -85,12 +75,7 @@ impl Scene {
             let cell = (ext.max() / (MAX_CELLS - 1) as f64).max(MIN_CELL);
             let dims = [0, 1, 2].map(|i| (ext[i] / cell).floor() as usize + 1);
             let mut cells = vec![Vec::new(); dims[0] * dims[1] * dims[2]];
-            let mut g = Grid {
-                origin: lo,
-                cell,
-                dims,
-                cells: Vec::new(),
-            };
+            let mut g = Grid { origin: lo, cell, dims, cells: Vec::new() };
             for (i, (o, p)) in objects.iter().zip(&prims).enumerate() {
                 if o.kind == ObstacleKind::Soft {
                     continue;
@@ -109,18 +94,9 @@ impl Scene {
             g.cells = cells;
             g
         } else {
-            Grid {
-                origin: Point3::origin(),
-                cell: 1.0,
-                dims: [0; 3],
-                cells: Vec::new(),
-            }
+            Grid { origin: Point3::origin(), cell: 1.0, dims: [0; 3], cells: Vec::new() }
         };
-        Scene {
-            objects,
-            prims,
-            grid,
-        }
+        Scene { objects, prims, grid }
     }
 
     /// An empty environment.
@@ -139,12 +115,7 @@ impl Scene {
     /// Calls `f` with the index of every non-soft object whose cells overlap the sphere's
     /// bounding box (possibly more than once) and returns the first index for which `f` is
     /// true (grid order, so deterministic), stopping there.
-    pub(crate) fn near(
-        &self,
-        c: &Point3<f64>,
-        r: f64,
-        mut f: impl FnMut(usize) -> bool,
-    ) -> Option<usize> {
+    pub(crate) fn near(&self, c: &Point3<f64>, r: f64, mut f: impl FnMut(usize) -> bool) -> Option<usize> {
         let g = &self.grid;
         let (c0, c1) = g.range(&(c - Vector3::repeat(r)), &(c + Vector3::repeat(r)))?;
         for z in c0[2]..=c1[2] {

@@ -18,13 +18,7 @@ pub fn path_length(p: &[Q]) -> f64 {
 
 /// Random shortcutting: `iterations` attempts, each between a random point of segment i and
 /// one of segment j > i.
-pub fn shortcut(
-    path: &mut Vec<Q>,
-    checker: &Checker,
-    resolution: f64,
-    iterations: usize,
-    rng: &mut Rng,
-) {
+pub fn shortcut(path: &mut Vec<Q>, checker: &Checker, resolution: f64, iterations: usize, rng: &mut Rng) {
     for _ in 0..iterations {
         let n = path.len();
         if n < 3 {

@@ -29,20 +29,13 @@ pub struct SphereModel {
 
 impl SphereModel {
     pub fn new(colliders: &[Vec<Collider>]) -> SphereModel {
-        let per: Vec<Vec<Sphere>> = colliders
-            .iter()
-            .map(|c| c.iter().flat_map(cover).collect())
-            .collect();
+        let per: Vec<Vec<Sphere>> = colliders.iter().map(|c| c.iter().flat_map(cover).collect()).collect();
         let bounds = std::array::from_fn(|b| enclose(&per[b]));
         let mut offsets = [0; NBODIES + 1];
         for b in 0..NBODIES {
             offsets[b + 1] = offsets[b] + per[b].len();
         }
-        SphereModel {
-            flat: per.concat(),
-            offsets,
-            bounds,
-        }
+        SphereModel { flat: per.concat(), offsets, bounds }
     }
 
     /// Spheres of body `b`.
@@ -61,10 +54,7 @@ pub fn cover(c: &Collider) -> Vec<Sphere> {
     // (half extents along the primitive's x, y, z; cross-section radius about each axis).
     let (half, round) = match c.shape {
         Shape::Sphere { radius } => {
-            return vec![Sphere {
-                center: Point3::from(c.origin.trans),
-                radius,
-            }];
+            return vec![Sphere { center: Point3::from(c.origin.trans), radius }];
         }
         Shape::Box { size } => (Vector3::from(size) * 0.5, false),
         Shape::Cylinder { radius, length } => (Vector3::new(radius, radius, length * 0.5), true),
@@ -74,21 +64,14 @@ pub fn cover(c: &Collider) -> Vec<Sphere> {
             return (0..=n)
                 .map(|i| {
                     let z = -length * 0.5 + length * i as f64 / n as f64;
-                    Sphere {
-                        center: Point3::from(c.origin.transform_point([0.0, 0.0, z])),
-                        radius,
-                    }
+                    Sphere { center: Point3::from(c.origin.transform_point([0.0, 0.0, z])), radius }
                 })
                 .collect();
         }
     };
     let axis = if round { 2 } else { half.imax() };
     let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
-    let rc = if round {
-        half[u]
-    } else {
-        (half[u] * half[u] + half[v] * half[v]).sqrt()
-    };
+    let rc = if round { half[u] } else { (half[u] * half[u] + half[v] * half[v]).sqrt() };
     let len = 2.0 * half[axis];
     let n = ((len / rc).ceil() as usize).max(1);
     let h = len / n as f64;
@@ -97,10 +80,7 @@ pub fn cover(c: &Collider) -> Vec<Sphere> {
         .map(|i| {
             let mut p = [0.0; 3];
             p[axis] = -half[axis] + h * (i as f64 + 0.5);
-            Sphere {
-                center: Point3::from(c.origin.transform_point(p)),
-                radius,
-            }
+            Sphere { center: Point3::from(c.origin.transform_point(p)), radius }
         })
         .collect()
 }
@@ -108,17 +88,11 @@ pub fn cover(c: &Collider) -> Vec<Sphere> {
 /// A sphere containing all of `s` (centroid-centred; not minimal, but cheap and safe).
 fn enclose(s: &[Sphere]) -> Sphere {
     if s.is_empty() {
-        return Sphere {
-            center: Point3::origin(),
-            radius: 0.0,
-        };
+        return Sphere { center: Point3::origin(), radius: 0.0 };
     }
     let c = s.iter().fold(Vector3::zeros(), |a, x| a + x.center.coords) / s.len() as f64;
     let center = Point3::from(c);
-    let radius = s
-        .iter()
-        .map(|x| (x.center - center).norm() + x.radius)
-        .fold(0.0, f64::max);
+    let radius = s.iter().map(|x| (x.center - center).norm() + x.radius).fold(0.0, f64::max);
     Sphere { center, radius }
 }
 
@@ -137,6 +111,5 @@ pub(crate) fn bodies_touch(
     b: std::ops::Range<usize>,
     pad: f64,
 ) -> bool {
-    s[a].iter()
-        .any(|x| t[b.clone()].iter().any(|y| spheres_touch(x, y, pad)))
+    s[a].iter().any(|x| t[b.clone()].iter().any(|y| spheres_touch(x, y, pad)))
 }

@@ -20,19 +20,11 @@ pub struct Target {
 impl Target {
     /// Full 6-D target with the default tolerances (1 mm, 0.01 rad).
     pub fn pose(pose: Isometry3<f64>) -> Target {
-        Target {
-            pose,
-            free_roll: false,
-            pos_tol: 1e-3,
-            rot_tol: 1e-2,
-        }
+        Target { pose, free_roll: false, pos_tol: 1e-3, rot_tol: 1e-2 }
     }
     /// 5-D target: position and approach axis (tool z), any roll about it.
     pub fn free_roll(pose: Isometry3<f64>) -> Target {
-        Target {
-            free_roll: true,
-            ..Target::pose(pose)
-        }
+        Target { free_roll: true, ..Target::pose(pose) }
     }
     /// From agrisim-robot's pose type.
     pub fn from_pose(p: &Pose, free_roll: bool) -> Target {

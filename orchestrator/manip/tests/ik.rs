@@ -4,23 +4,13 @@ use agrisim_manip::{ik, kdl, ArmModel, Ik, Rng, Side, Target};
 
 fn cases(arm: &ArmModel, lift: f64, n: usize, seed: u64) -> Vec<(Target, [f64; 7])> {
     let mut rng = Rng::new(seed);
-    (0..n)
-        .map(|_| {
-            (
-                Target::pose(arm.fk_iso(lift, &arm.random_q(&mut rng))),
-                arm.random_q(&mut rng),
-            )
-        })
-        .collect()
+    (0..n).map(|_| (Target::pose(arm.fk_iso(lift, &arm.random_q(&mut rng))), arm.random_q(&mut rng))).collect()
 }
 
 fn check(arm: &ArmModel, lift: f64, t: &Target, q: &[f64; 7]) {
     assert!(arm.within_limits(q), "solution outside limits: {q:?}");
     let e = t.error(&arm.fk_iso(lift, q));
-    assert!(
-        e.fixed_rows::<3>(0).norm() <= 1e-3 && e.fixed_rows::<3>(3).norm() <= 1e-2,
-        "residual {e:?}"
-    );
+    assert!(e.fixed_rows::<3>(0).norm() <= 1e-3 && e.fixed_rows::<3>(3).norm() <= 1e-2, "residual {e:?}");
 }
 
 #[test]
@@ -41,15 +31,9 @@ fn ours_solves_at_least_99_percent_of_reachable_6d_targets_and_beats_kdl() {
             kdl_ok += 1;
         }
     }
-    println!(
-        "IK success on {} reachable 6-D targets: ours {ours}, KDL NR_JL {kdl_ok}",
-        cs.len()
-    );
+    println!("IK success on {} reachable 6-D targets: ours {ours}, KDL NR_JL {kdl_ok}", cs.len());
     assert!(ours >= 990, "ours solved only {ours}/1000");
-    assert!(
-        ours > kdl_ok + 300,
-        "ours {ours} should be far above KDL {kdl_ok}"
-    );
+    assert!(ours > kdl_ok + 300, "ours {ours} should be far above KDL {kdl_ok}");
 }
 
 #[test]
@@ -62,10 +46,7 @@ fn free_roll_targets_are_solved_and_keep_the_approach_axis() {
     let cs = cases(&arm, lift, 500, 43);
     for (t, seed) in &cs {
         // Rotate the target about its own z: any roll must be acceptable.
-        let roll = nalgebra::UnitQuaternion::from_axis_angle(
-            &nalgebra::Vector3::z_axis(),
-            6.0 * rng.uniform(),
-        );
+        let roll = nalgebra::UnitQuaternion::from_axis_angle(&nalgebra::Vector3::z_axis(), 6.0 * rng.uniform());
         let mut t = Target::free_roll(t.pose);
         t.pose.rotation *= roll;
         if let Some(q) = ik.solve(&t, seed, &mut rng, ik::DEFAULT_BUDGET) {
@@ -90,9 +71,7 @@ fn free_lift_solves_targets_at_another_lift_height() {
         let q = arm.random_q(&mut rng);
         let t = Target::pose(arm.fk_iso(0.7, &q));
         let ik = Ik::with_free_lift(&arm, 0.0);
-        if let Some((lift, q)) =
-            ik.solve_lift(&t, &arm.random_q(&mut rng), &mut rng, ik::DEFAULT_BUDGET)
-        {
+        if let Some((lift, q)) = ik.solve_lift(&t, &arm.random_q(&mut rng), &mut rng, ik::DEFAULT_BUDGET) {
             assert!((0.0..=0.8).contains(&lift));
             check(&arm, lift, &t, &q);
             solved += 1;
@@ -107,9 +86,7 @@ fn unreachable_target_fails_within_budget() {
     let ik = Ik::new(&arm, 0.3);
     let t = Target::pose(nalgebra::Isometry3::translation(3.0, 0.0, 1.0));
     let mut rng = Rng::new(1);
-    assert!(ik
-        .solve(&t, &[0.0, 0.0, 0.0, -1.5, 0.0, 1.5, 0.0], &mut rng, 500)
-        .is_none());
+    assert!(ik.solve(&t, &[0.0, 0.0, 0.0, -1.5, 0.0, 1.5, 0.0], &mut rng, 500).is_none());
 }
 
 #[test]
@@ -143,9 +120,8 @@ fn kdl_baseline_converges_from_a_nearby_seed() {
     for _ in 0..100 {
         let q = arm.random_q(&mut rng);
         let t = Target::pose(arm.fk_iso(0.3, &q));
-        let seed: [f64; 7] = std::array::from_fn(|i| {
-            (q[i] + 0.02 * (rng.uniform() - 0.5)).clamp(arm.lower()[i], arm.upper()[i])
-        });
+        let seed: [f64; 7] =
+            std::array::from_fn(|i| (q[i] + 0.02 * (rng.uniform() - 0.5)).clamp(arm.lower()[i], arm.upper()[i]));
         let s = kdl::kdl_nr_jl(&arm, 0.3, &t, &seed).expect("converges from 0.01 rad away");
         let e = t.error(&arm.fk_iso(0.3, &s));
         assert!(e.amax() < kdl::KDL_EPS);

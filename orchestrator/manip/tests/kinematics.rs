@@ -18,15 +18,11 @@ const DH: [(f64, f64, f64); 7] = [
 
 fn rot_x(a: f64) -> Matrix4<f64> {
     let (s, c) = a.sin_cos();
-    Matrix4::new(
-        1.0, 0.0, 0.0, 0.0, 0.0, c, -s, 0.0, 0.0, s, c, 0.0, 0.0, 0.0, 0.0, 1.0,
-    )
+    Matrix4::new(1.0, 0.0, 0.0, 0.0, 0.0, c, -s, 0.0, 0.0, s, c, 0.0, 0.0, 0.0, 0.0, 1.0)
 }
 fn rot_z(a: f64) -> Matrix4<f64> {
     let (s, c) = a.sin_cos();
-    Matrix4::new(
-        c, -s, 0.0, 0.0, s, c, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0,
-    )
+    Matrix4::new(c, -s, 0.0, 0.0, s, c, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0)
 }
 fn tr(x: f64, y: f64, z: f64) -> Matrix4<f64> {
     Matrix4::new_translation(&Vector3::new(x, y, z))
@@ -86,9 +82,7 @@ fn body_frames_agree_with_the_generic_urdf_fk() {
         let fr = arm.frames(lift, &q, finger);
         for (b, name) in agrisim_manip::layout::BODY_NAMES.iter().enumerate() {
             let want = agrisim_manip::iso::to_iso(&all[&format!("right_{name}")]);
-            let d = (fr.bodies[b].to_homogeneous() - want.to_homogeneous())
-                .abs()
-                .max();
+            let d = (fr.bodies[b].to_homogeneous() - want.to_homogeneous()).abs().max();
             assert!(d < 1e-9, "{name}: {d}");
         }
     }
@@ -113,18 +107,8 @@ fn jacobian_matches_finite_differences() {
             let v = (fp.translation.vector - fm.translation.vector) / (2.0 * h);
             let w = (fp.rotation * fm.rotation.inverse()).scaled_axis() / (2.0 * h);
             for r in 0..3 {
-                assert!(
-                    (j[(r, c)] - v[r]).abs() < 1e-6,
-                    "linear r{r} c{c}: {} vs {}",
-                    j[(r, c)],
-                    v[r]
-                );
-                assert!(
-                    (j[(r + 3, c)] - w[r]).abs() < 1e-6,
-                    "angular r{r} c{c}: {} vs {}",
-                    j[(r + 3, c)],
-                    w[r]
-                );
+                assert!((j[(r, c)] - v[r]).abs() < 1e-6, "linear r{r} c{c}: {} vs {}", j[(r, c)], v[r]);
+                assert!((j[(r + 3, c)] - w[r]).abs() < 1e-6, "angular r{r} c{c}: {} vs {}", j[(r + 3, c)], w[r]);
             }
         }
         let _ = f0;
@@ -141,8 +125,5 @@ fn limits_are_the_franka_figures_and_random_q_respects_them() {
     for _ in 0..1000 {
         assert!(arm.within_limits(&arm.random_q(&mut rng)));
     }
-    assert!(
-        !arm.within_limits(&[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
-        "joint 4 upper limit is -0.0698"
-    );
+    assert!(!arm.within_limits(&[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]), "joint 4 upper limit is -0.0698");
 }

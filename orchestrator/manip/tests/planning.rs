@@ -19,28 +19,15 @@ fn clutter(rng: &mut Rng) -> Scene {
         let p = Isometry3::translation(0.55 + 0.4 * rng.uniform(), -0.6 + 1.4 * rng.uniform(), 1.2);
         v.push(Obstacle::new(
             format!("stem{i}"),
-            Shape::Cylinder {
-                radius: 0.015,
-                length: 2.4,
-            },
+            Shape::Cylinder { radius: 0.015, length: 2.4 },
             p,
             ObstacleKind::Solid,
         ));
     }
     for i in 0..4 {
-        let p = Isometry3::translation(
-            0.5 + 0.4 * rng.uniform(),
-            -0.5 + 1.3 * rng.uniform(),
-            0.7 + 0.9 * rng.uniform(),
-        );
-        v.push(Obstacle::new(
-            format!("box{i}"),
-            Shape::Box {
-                size: [0.1, 0.1, 0.1],
-            },
-            p,
-            ObstacleKind::Solid,
-        ));
+        let p =
+            Isometry3::translation(0.5 + 0.4 * rng.uniform(), -0.5 + 1.3 * rng.uniform(), 0.7 + 0.9 * rng.uniform());
+        v.push(Obstacle::new(format!("box{i}"), Shape::Box { size: [0.1, 0.1, 0.1] }, p, ObstacleKind::Solid));
     }
     Scene::new(v)
 }
@@ -71,9 +58,7 @@ fn rrt_connect_finds_exactly_valid_paths_in_cluttered_scenes() {
             continue;
         }
         n += 1;
-        let goals: Vec<[f64; 7]> = (0..3)
-            .map(|_| random_goal(&left, &checker, &mut rng))
-            .collect();
+        let goals: Vec<[f64; 7]> = (0..3).map(|_| random_goal(&left, &checker, &mut rng)).collect();
         match planner.plan(&ctx, &READY, &goals, &mut rng) {
             Ok(p) => {
                 ok += 1;
@@ -93,10 +78,7 @@ fn rrt_connect_finds_exactly_valid_paths_in_cluttered_scenes() {
     }
     println!("{ok}/{n} planned, {rrt_used} needed RRT-Connect");
     assert!(ok >= n * 95 / 100, "{ok}/{n}");
-    assert!(
-        rrt_used >= 10,
-        "scenes should not all be trivially direct ({rrt_used})"
-    );
+    assert!(rrt_used >= 10, "scenes should not all be trivially direct ({rrt_used})");
 }
 
 #[test]
@@ -127,10 +109,7 @@ fn shortcutting_never_lengthens_nor_collides() {
         assert!(path_length(&path) <= before + 1e-12);
         assert_eq!((path[0], *path.last().unwrap()), (first, last));
         for w in path.windows(2) {
-            assert!(
-                checker.edge_valid(&w[0], &w[1], 0.02),
-                "shortcut introduced a colliding edge"
-            );
+            assert!(checker.edge_valid(&w[0], &w[1], 0.02), "shortcut introduced a colliding edge");
         }
     }
 }
@@ -143,9 +122,7 @@ fn same_seed_same_plan() {
     let scene = clutter(&mut rng);
     let ctx = Context::new(&left, 0.3, &scene).with_other(&right, READY, 0.04);
     let checker = Checker::new(ctx);
-    let goals: Vec<[f64; 7]> = (0..3)
-        .map(|_| random_goal(&left, &checker, &mut rng))
-        .collect();
+    let goals: Vec<[f64; 7]> = (0..3).map(|_| random_goal(&left, &checker, &mut rng)).collect();
     let plan = |seed| {
         Planner::default()
             .plan(&ctx, &READY, &goals, &mut Rng::new(seed))
@@ -163,34 +140,15 @@ fn errors_are_reported() {
     let ctx = Context::new(&left, 0.3, &scene);
     let mut rng = Rng::new(1);
     let p = Planner::default();
-    assert_eq!(
-        p.plan(&ctx, &[0.0; 7], &[READY], &mut rng).unwrap_err(),
-        PlanError::StartOutOfLimits
-    );
-    assert_eq!(
-        p.plan(&ctx, &READY, &[], &mut rng).unwrap_err(),
-        PlanError::NoValidGoal
-    );
+    assert_eq!(p.plan(&ctx, &[0.0; 7], &[READY], &mut rng).unwrap_err(), PlanError::StartOutOfLimits);
+    assert_eq!(p.plan(&ctx, &READY, &[], &mut rng).unwrap_err(), PlanError::NoValidGoal);
     // A goal inside a box is invalid.
     let tcp = left.fk_iso(0.3, &READY);
-    let boxed = Scene::new(vec![Obstacle::new(
-        "wall",
-        Shape::Box {
-            size: [0.3, 0.3, 0.3],
-        },
-        tcp,
-        ObstacleKind::Solid,
-    )]);
+    let boxed = Scene::new(vec![Obstacle::new("wall", Shape::Box { size: [0.3, 0.3, 0.3] }, tcp, ObstacleKind::Solid)]);
     let ctx2 = Context::new(&left, 0.3, &boxed);
     let start = [0.0, -0.3, 0.0, -1.0, 0.0, 1.0, 0.785];
-    assert!(matches!(
-        p.plan(&ctx2, &READY, &[start], &mut rng),
-        Err(PlanError::StartInCollision(_))
-    ));
-    assert_eq!(
-        p.plan(&ctx2, &start, &[READY], &mut rng).unwrap_err(),
-        PlanError::NoValidGoal
-    );
+    assert!(matches!(p.plan(&ctx2, &READY, &[start], &mut rng), Err(PlanError::StartInCollision(_))));
+    assert_eq!(p.plan(&ctx2, &start, &[READY], &mut rng).unwrap_err(), PlanError::NoValidGoal);
 }
 
 #[test]
@@ -202,16 +160,7 @@ fn cartesian_approach_is_a_straight_line_and_stops_at_obstacles() {
     let checker = Checker::new(Context::new(&left, 0.3, &scene));
     let p0 = left.fk_iso(0.3, &READY);
     // 10 cm forward along x from the ready pose.
-    let forward = |checker: &Checker| {
-        cartesian_path(
-            checker,
-            &READY,
-            Vector3::new(0.1, 0.0, 0.0),
-            0.005,
-            0.2,
-            0.02,
-        )
-    };
+    let forward = |checker: &Checker| cartesian_path(checker, &READY, Vector3::new(0.1, 0.0, 0.0), 0.005, 0.2, 0.02);
     let path = forward(&checker).expect("free line");
     assert_eq!(path.len(), 21);
     for (k, q) in path.iter().enumerate() {
@@ -223,9 +172,7 @@ fn cartesian_approach_is_a_straight_line_and_stops_at_obstacles() {
     // A wall 5 cm ahead stops it part way.
     let wall = Scene::new(vec![Obstacle::new(
         "wall",
-        Shape::Box {
-            size: [0.02, 1.0, 1.0],
-        },
+        Shape::Box { size: [0.02, 1.0, 1.0] },
         Isometry3::translation(p0.translation.x + 0.1, 0.0, 1.0),
         ObstacleKind::Solid,
     )]);

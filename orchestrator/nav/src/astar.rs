@@ -35,7 +35,13 @@ pub struct PlannerConfig {
 
 impl Default for PlannerConfig {
     fn default() -> Self {
-        PlannerConfig { cost_weight: 3.0, smooth: true, max_shortcut: 3.0, path_spacing: 0.05, start_escape_radius: 0.6 }
+        PlannerConfig {
+            cost_weight: 3.0,
+            smooth: true,
+            max_shortcut: 3.0,
+            path_spacing: 0.05,
+            start_escape_radius: 0.6,
+        }
     }
 }
 
@@ -104,9 +110,23 @@ pub const MOVES: [(i64, i64, f64); 8] = [
 
 /// The neighbours of `cell` the planner may move to, with the move's cost (diagonals need
 /// both side cells traversable).
-pub fn neighbours(width: usize, height: usize, cost: &[u8], cell: usize, res: f64, w: f64, mut f: impl FnMut(usize, f64)) {
+pub fn neighbours(
+    width: usize,
+    height: usize,
+    cost: &[u8],
+    cell: usize,
+    res: f64,
+    w: f64,
+    mut f: impl FnMut(usize, f64),
+) {
     let (x, y) = ((cell % width) as i64, (cell / width) as i64);
-    let ok = |cx: i64, cy: i64| cx >= 0 && cy >= 0 && (cx as usize) < width && (cy as usize) < height && traversable(cost[cy as usize * width + cx as usize]);
+    let ok = |cx: i64, cy: i64| {
+        cx >= 0
+            && cy >= 0
+            && (cx as usize) < width
+            && (cy as usize) < height
+            && traversable(cost[cy as usize * width + cx as usize])
+    };
     for &(dx, dy, len) in &MOVES {
         let (nx, ny) = (x + dx, y + dy);
         if !ok(nx, ny) || (dx != 0 && dy != 0 && !(ok(x + dx, y) && ok(x, y + dy))) {
@@ -118,7 +138,15 @@ pub fn neighbours(width: usize, height: usize, cost: &[u8], cell: usize, res: f6
 }
 
 /// Cheapest 8-connected path between two traversable cells, or `None`.
-pub fn astar(width: usize, height: usize, res: f64, cost: &[u8], start: usize, goal: usize, w: f64) -> Option<GridPath> {
+pub fn astar(
+    width: usize,
+    height: usize,
+    res: f64,
+    cost: &[u8],
+    start: usize,
+    goal: usize,
+    w: f64,
+) -> Option<GridPath> {
     let n = width * height;
     if start >= n || goal >= n || !traversable(cost[goal]) {
         return None;
@@ -163,7 +191,12 @@ pub fn astar(width: usize, height: usize, res: f64, cost: &[u8], start: usize, g
 
 /// Plans from `start` to `goal` (map frame) on the global costmap: map-frame waypoints,
 /// start and goal positions exact.
-pub fn plan(costmap: &GlobalCostmap, start: &Pose2, goal: &Pose2, cfg: &PlannerConfig) -> Result<Vec<(f64, f64)>, PlanError> {
+pub fn plan(
+    costmap: &GlobalCostmap,
+    start: &Pose2,
+    goal: &Pose2,
+    cfg: &PlannerConfig,
+) -> Result<Vec<(f64, f64)>, PlanError> {
     let geom = &costmap.geom;
     let (w, h) = (geom.width, geom.height);
     let s = geom.index_of(start.x, start.y).ok_or(PlanError::StartOutside)?;
@@ -219,7 +252,12 @@ fn escape(geom: &GridGeom, cost: &[u8], start: usize, radius: f64) -> Option<Vec
         let (x, y) = ((cell % w) as i64, (cell / w) as i64);
         for &(dx, dy, len) in &MOVES {
             let (nx, ny) = (x + dx, y + dy);
-            if nx < 0 || ny < 0 || nx as usize >= w || ny as usize >= h || (((nx - sx).pow(2) + (ny - sy).pow(2)) as f64).sqrt() > r_cells {
+            if nx < 0
+                || ny < 0
+                || nx as usize >= w
+                || ny as usize >= h
+                || (((nx - sx).pow(2) + (ny - sy).pow(2)) as f64).sqrt() > r_cells
+            {
                 continue;
             }
             let nb = ny as usize * w + nx as usize;
@@ -305,7 +343,13 @@ fn densify(pts: &[(f64, f64)], spacing: f64) -> Vec<(f64, f64)> {
 pub fn to_path_msg(pts: &[(f64, f64)], goal_yaw: Option<f64>, header: &Header) -> Path {
     let mut poses = Vec::with_capacity(pts.len());
     for i in 0..pts.len() {
-        let (a, b) = if i + 1 < pts.len() { (pts[i], pts[i + 1]) } else if i > 0 { (pts[i - 1], pts[i]) } else { (pts[i], pts[i]) };
+        let (a, b) = if i + 1 < pts.len() {
+            (pts[i], pts[i + 1])
+        } else if i > 0 {
+            (pts[i - 1], pts[i])
+        } else {
+            (pts[i], pts[i])
+        };
         let mut yaw = (b.1 - a.1).atan2(b.0 - a.0);
         if i + 1 == pts.len() {
             if let Some(gy) = goal_yaw {

@@ -1,15 +1,16 @@
 //! sensor_msgs/PointCloud2 in and out: the x, y, z fields by name and offset (float32 or
 //! float64, either byte order), so clouds from any LiDAR driver layout decode.
 
-use agrisim_error::Result;
 use agrisim_error::err;
+use agrisim_error::Result;
 use agrisim_msgs::sensor_msgs::{PointCloud2, PointField};
 use agrisim_msgs::std_msgs::Header;
 
 /// The x, y, z of every finite point, in the cloud's frame.
 pub fn decode_xyz(cloud: &PointCloud2) -> Result<Vec<[f32; 3]>> {
     let field = |name: &str| -> Result<(usize, u8)> {
-        let f = cloud.fields.iter().find(|f| f.name == name).ok_or_else(|| err!("PointCloud2 has no field '{name}'"))?;
+        let f =
+            cloud.fields.iter().find(|f| f.name == name).ok_or_else(|| err!("PointCloud2 has no field '{name}'"))?;
         match f.datatype {
             PointField::FLOAT32 | PointField::FLOAT64 => Ok((f.offset as usize, f.datatype)),
             d => Err(err!("PointCloud2 field '{name}' has datatype {d}, expected float32 or float64")),
@@ -26,7 +27,13 @@ pub fn decode_xyz(cloud: &PointCloud2) -> Result<Vec<[f32; 3]>> {
     }
     // Sizes from the header are untrusted: every product is checked, so a crafted header is
     // an error, never an overflow or an out-of-bounds read.
-    let too_big = || err!("PointCloud2 of {width} x {rows} points of {step} bytes (row_step {}) does not fit in {} bytes of data", cloud.row_step, cloud.data.len());
+    let too_big = || {
+        err!(
+            "PointCloud2 of {width} x {rows} points of {step} bytes (row_step {}) does not fit in {} bytes of data",
+            cloud.row_step,
+            cloud.data.len()
+        )
+    };
     let row_bytes = width.checked_mul(step).ok_or_else(too_big)?;
     let row_step = (cloud.row_step as usize).max(row_bytes);
     let n = width.checked_mul(rows).ok_or_else(too_big)?;
@@ -38,7 +45,11 @@ pub fn decode_xyz(cloud: &PointCloud2) -> Result<Vec<[f32; 3]>> {
     let read = |p: &[u8], (off, dt): (usize, u8)| -> f32 {
         if dt == PointField::FLOAT32 {
             let b: [u8; 4] = p[off..off + 4].try_into().unwrap();
-            if big { f32::from_be_bytes(b) } else { f32::from_le_bytes(b) }
+            if big {
+                f32::from_be_bytes(b)
+            } else {
+                f32::from_le_bytes(b)
+            }
         } else {
             let b: [u8; 8] = p[off..off + 8].try_into().unwrap();
             (if big { f64::from_be_bytes(b) } else { f64::from_le_bytes(b) }) as f32
@@ -72,7 +83,17 @@ pub fn encode_xyzi(header: Header, points: &[[f32; 4]]) -> PointCloud2 {
             data.extend_from_slice(&v.to_le_bytes());
         }
     }
-    PointCloud2 { header, height: 1, width: points.len() as u32, fields, is_bigendian: false, point_step: 16, row_step: 16 * points.len() as u32, data, is_dense: true }
+    PointCloud2 {
+        header,
+        height: 1,
+        width: points.len() as u32,
+        fields,
+        is_bigendian: false,
+        point_step: 16,
+        row_step: 16 * points.len() as u32,
+        data,
+        is_dense: true,
+    }
 }
 
 #[cfg(test)]

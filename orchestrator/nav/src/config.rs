@@ -2,10 +2,10 @@
 //! defaults for the paper's robot (1.2 x 0.9 m omni base, LiDAR 1 m above base_link) in a
 //! greenhouse with 2 m aisles. All structs read from TOML/JSON with missing fields defaulted.
 
+use super::astar::PlannerConfig;
 use super::costmap::InflationConfig;
 use super::dwa::ControllerConfig;
 use super::footprint::Footprint;
-use super::astar::PlannerConfig;
 use super::lidar_odometry::LidarOdometryConfig;
 use super::local_costmap::LocalCostmapConfig;
 use super::scan_match::ScanMatchConfig;
@@ -36,7 +36,11 @@ impl SensorMount {
         let (sp, cp) = self.pitch.sin_cos();
         let (sy, cy) = self.yaw.sin_cos();
         (
-            [[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr], [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr], [-sp, cp * sr, cp * cr]],
+            [
+                [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+                [-sp, cp * sr, cp * cr],
+            ],
             [self.x, self.y, self.z],
         )
     }
@@ -88,7 +92,11 @@ pub struct CostmapConfig {
 
 impl Default for CostmapConfig {
     fn default() -> Self {
-        CostmapConfig { inflation: InflationConfig::default(), local: LocalCostmapConfig::default(), unknown_is_obstacle: true }
+        CostmapConfig {
+            inflation: InflationConfig::default(),
+            local: LocalCostmapConfig::default(),
+            unknown_is_obstacle: true,
+        }
     }
 }
 
@@ -277,7 +285,8 @@ mod tests {
 
     #[test]
     fn partial_toml_fills_defaults() {
-        let c: NavConfig = toml::from_str("[localization]\ninitial_pose = [1.0, 2.0, 0.5]\n[controller]\nmax_vx = 0.4\n").unwrap();
+        let c: NavConfig =
+            toml::from_str("[localization]\ninitial_pose = [1.0, 2.0, 0.5]\n[controller]\nmax_vx = 0.4\n").unwrap();
         assert_eq!(c.localization.initial_pose, [1.0, 2.0, 0.5]);
         assert_eq!(c.controller.max_vx, 0.4);
         assert_eq!(c.controller.max_vy, 0.8);

@@ -128,7 +128,8 @@ impl GlobalCostmap {
         self.dirty = false;
         let obst: Vec<bool> = self.static_occupied.iter().zip(&self.blocked).map(|(&s, &b)| s || b).collect();
         let res = self.geom.resolution as f32;
-        self.distance = distance_transform(&obst, self.geom.width, self.geom.height).into_iter().map(|d| d * res).collect();
+        self.distance =
+            distance_transform(&obst, self.geom.width, self.geom.height).into_iter().map(|d| d * res).collect();
         self.recompute_costs();
         true
     }

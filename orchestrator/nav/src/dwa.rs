@@ -123,7 +123,11 @@ fn window(current: f64, limit: f64, acc: f64, period: f64) -> (f64, f64) {
 }
 
 fn samples(lo: f64, hi: f64, n: usize) -> Vec<f64> {
-    let mut v: Vec<f64> = if n <= 1 || hi - lo < 1e-12 { vec![0.5 * (lo + hi)] } else { (0..n).map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64).collect() };
+    let mut v: Vec<f64> = if n <= 1 || hi - lo < 1e-12 {
+        vec![0.5 * (lo + hi)]
+    } else {
+        (0..n).map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64).collect()
+    };
     if lo <= 0.0 && hi >= 0.0 && v.iter().all(|x| x.abs() > 1e-9) {
         v.push(0.0);
     }
@@ -155,7 +159,11 @@ pub fn brake(cfg: &ControllerConfig, current: Velocity) -> Velocity {
 pub fn integrate(p: &Pose2, v: &Velocity, dt: f64) -> Pose2 {
     let yaw_mid = p.yaw + 0.5 * v.wz * dt;
     let (s, c) = yaw_mid.sin_cos();
-    Pose2 { x: p.x + (v.vx * c - v.vy * s) * dt, y: p.y + (v.vx * s + v.vy * c) * dt, yaw: wrap_angle(p.yaw + v.wz * dt) }
+    Pose2 {
+        x: p.x + (v.vx * c - v.vy * s) * dt,
+        y: p.y + (v.vx * s + v.vy * c) * dt,
+        yaw: wrap_angle(p.yaw + v.wz * dt),
+    }
 }
 
 /// How much closer than it is now a robot inside the collision margin may come [m].
@@ -163,7 +171,12 @@ pub const ESCAPE_SLACK: f64 = 0.005;
 
 /// One DWA step. `distance(x, y)` is the obstacle distance field (static, sensed and
 /// blocked obstacles combined), `outline` the footprint outline (base frame).
-pub fn dwa(cfg: &ControllerConfig, req: &Request, outline: &[(f64, f64)], distance: impl Fn(f64, f64) -> f64) -> Decision {
+pub fn dwa(
+    cfg: &ControllerConfig,
+    req: &Request,
+    outline: &[(f64, f64)],
+    distance: impl Fn(f64, f64) -> f64,
+) -> Decision {
     let (vx_lo, vx_hi) = window(req.current.vx, cfg.max_vx, cfg.acc_xy, cfg.period);
     let (vy_lo, vy_hi) = window(req.current.vy, cfg.max_vy, cfg.acc_xy, cfg.period);
     let (wz_lo, wz_hi) = window(req.current.wz, cfg.max_wz, cfg.acc_wz, cfg.period);
@@ -198,7 +211,11 @@ pub fn dwa(cfg: &ControllerConfig, req: &Request, outline: &[(f64, f64)], distan
                 let path = if path.is_finite() { path } else { 0.0 };
                 let heading = wrap_angle(p.yaw - req.desired_yaw).abs();
                 let obstacle = (-(clearance - margin) / cfg.clearance_scale).exp();
-                let score = cfg.w_progress * progress + cfg.w_path * path + cfg.w_heading * heading + cfg.w_obstacle * obstacle + cfg.w_spin * wz.abs();
+                let score = cfg.w_progress * progress
+                    + cfg.w_path * path
+                    + cfg.w_heading * heading
+                    + cfg.w_obstacle * obstacle
+                    + cfg.w_spin * wz.abs();
                 if best.is_none_or(|(b, _, _)| score < b) {
                     best = Some((score, v, clearance));
                 }
@@ -230,7 +247,13 @@ mod tests {
         let cfg = ControllerConfig::default();
         let outline = Footprint::default().outline(0.05);
         let path: Vec<(f64, f64)> = (0..60).map(|i| (0.05 * i as f64, 0.0)).collect();
-        let mut req = Request { pose: Pose2::default(), current: Velocity::ZERO, path: &path, carrot: (2.0, 0.0), desired_yaw: 0.0 };
+        let mut req = Request {
+            pose: Pose2::default(),
+            current: Velocity::ZERO,
+            path: &path,
+            carrot: (2.0, 0.0),
+            desired_yaw: 0.0,
+        };
         let mut v = Velocity::ZERO;
         for _ in 0..10 {
             req.current = v;
@@ -251,7 +274,13 @@ mod tests {
         let cfg = ControllerConfig::default();
         let outline = Footprint::default().outline(0.05);
         let path: Vec<(f64, f64)> = (0..60).map(|i| (0.05 * i as f64, 0.0)).collect();
-        let req = Request { pose: Pose2::default(), current: Velocity { vx: 0.3, vy: 0.0, wz: 0.0 }, path: &path, carrot: (2.0, 0.0), desired_yaw: 0.0 };
+        let req = Request {
+            pose: Pose2::default(),
+            current: Velocity { vx: 0.3, vy: 0.0, wz: 0.0 },
+            path: &path,
+            carrot: (2.0, 0.0),
+            desired_yaw: 0.0,
+        };
         // Wall at x = 1.0.
         let d = dwa(&cfg, &req, &outline, |x, _| (1.0 - x).max(0.0));
         assert!(!d.valid || d.cmd.vx < 0.3);

@@ -15,8 +15,8 @@ use super::config::NavConfig;
 use super::costmap::{ClearanceGrid, GlobalCostmap};
 use super::dwa::{self, Velocity};
 use super::local_costmap::LocalCostmap;
-use agrisim_math::pose2::{wrap_angle, Pose2};
 use super::tracking::TrackedPath;
+use agrisim_math::pose2::{wrap_angle, Pose2};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum State {
@@ -308,7 +308,8 @@ impl Executor {
         let can_replan = self.last_plan_ns.is_none_or(|t| (t_ns - t) as f64 * 1e-9 >= ec.replan_interval);
         if can_replan {
             let blocked = self.path_blocked(world.local);
-            let periodic = ec.periodic_replan > 0.0 && self.last_plan_ns.is_some_and(|t| (t_ns - t) as f64 * 1e-9 >= ec.periodic_replan);
+            let periodic = ec.periodic_replan > 0.0
+                && self.last_plan_ns.is_some_and(|t| (t_ns - t) as f64 * 1e-9 >= ec.periodic_replan);
             if blocked || deviation > ec.max_path_deviation || periodic {
                 if blocked {
                     self.stats.replans_blocked += 1;
@@ -324,17 +325,30 @@ impl Executor {
 
         let ia = self.path.index_ahead(self.cfg.controller.lookahead);
         let carrot = self.path.points[ia];
-        let near_goal = self.path.remaining() <= ec.goal_heading_distance.max(1e-9) || d_goal <= ec.goal_heading_distance;
+        let near_goal =
+            self.path.remaining() <= ec.goal_heading_distance.max(1e-9) || d_goal <= ec.goal_heading_distance;
         let desired_yaw = if near_goal {
-            if use_yaw { goal.pose.yaw } else { pose.yaw }
+            if use_yaw {
+                goal.pose.yaw
+            } else {
+                pose.yaw
+            }
         } else {
             self.travel_heading(self.path.tangent(ia), pose.yaw)
         };
         let c = &self.cfg.controller;
-        let req = dwa::Request { pose, current: self.last_cmd, path: self.path.ahead(c.lookahead + 0.5), carrot, desired_yaw };
+        let req = dwa::Request {
+            pose,
+            current: self.last_cmd,
+            path: self.path.ahead(c.lookahead + 0.5),
+            carrot,
+            desired_yaw,
+        };
         let (global, local) = (&*world.global, &*world.local);
         let grid = ClearanceGrid::from_costmaps(global, local);
-        let d = dwa::dwa(c, &req, &self.outline, |x, y| grid.get(x, y).unwrap_or_else(|| global.distance_at(x, y).min(local.distance_at(x, y))));
+        let d = dwa::dwa(c, &req, &self.outline, |x, y| {
+            grid.get(x, y).unwrap_or_else(|| global.distance_at(x, y).min(local.distance_at(x, y)))
+        });
         if !d.valid {
             self.stats.controller_failures += 1;
         }
@@ -355,7 +369,11 @@ impl Executor {
         if other + REVERSE_HYSTERESIS < now {
             self.reverse = !self.reverse;
         }
-        if self.reverse { wrap_angle(tangent + std::f64::consts::PI) } else { tangent }
+        if self.reverse {
+            wrap_angle(tangent + std::f64::consts::PI)
+        } else {
+            tangent
+        }
     }
 
     /// The rotate phase's command: turn in place if the footprint sweeps clear of obstacles
@@ -394,10 +412,19 @@ impl Executor {
         }
         let c = &self.cfg.controller;
         let path = [(pose.x, pose.y), (goal.pose.x, goal.pose.y)];
-        let req = dwa::Request { pose: *pose, current: self.last_cmd, path: &path, carrot: (goal.pose.x, goal.pose.y), desired_yaw: goal.pose.yaw };
+        let req = dwa::Request {
+            pose: *pose,
+            current: self.last_cmd,
+            path: &path,
+            carrot: (goal.pose.x, goal.pose.y),
+            desired_yaw: goal.pose.yaw,
+        };
         let grid = ClearanceGrid::from_costmaps(world.global, world.local);
         let (global, local) = (&*world.global, &*world.local);
-        dwa::dwa(c, &req, &self.outline, |x, y| grid.get(x, y).unwrap_or_else(|| global.distance_at(x, y).min(local.distance_at(x, y)))).cmd
+        dwa::dwa(c, &req, &self.outline, |x, y| {
+            grid.get(x, y).unwrap_or_else(|| global.distance_at(x, y).min(local.distance_at(x, y)))
+        })
+        .cmd
     }
 
     /// The command of a turn made at a spot beside the goal; fails "stuck" when it takes
@@ -446,7 +473,15 @@ impl Executor {
 
     /// Plans from `pose` after taking the sensed obstacles into the global costmap. Returns
     /// false (and fails the goal) when there is no path.
-    fn replan(&mut self, t_ns: i64, pose: &Pose2, goal: &Goal, global: &mut GlobalCostmap, local: &LocalCostmap, out: &mut TickOutput) -> bool {
+    fn replan(
+        &mut self,
+        t_ns: i64,
+        pose: &Pose2,
+        goal: &Goal,
+        global: &mut GlobalCostmap,
+        local: &LocalCostmap,
+        out: &mut TickOutput,
+    ) -> bool {
         sync_blocked(global, local);
         self.last_plan_ns = Some(t_ns);
         self.stats.plans += 1;
@@ -532,11 +567,18 @@ pub fn sync_blocked(global: &mut GlobalCostmap, local: &LocalCostmap) {
 }
 
 fn footprint_clearance(outline: &[(f64, f64)], p: &Pose2, world: &World) -> f64 {
-    super::footprint::Footprint::clearance(outline, p, |x, y| world.global.distance_at(x, y).min(world.local.distance_at(x, y)))
+    super::footprint::Footprint::clearance(outline, p, |x, y| {
+        world.global.distance_at(x, y).min(world.local.distance_at(x, y))
+    })
 }
 
 /// One acceleration-limited step from `current` towards `target`.
 fn step_towards(c: &dwa::ControllerConfig, current: Velocity, target: Velocity) -> Velocity {
-    let lim = |cur: f64, tgt: f64, max: f64, acc: f64| tgt.clamp(-max, max).clamp(cur - acc * c.period, cur + acc * c.period);
-    Velocity { vx: lim(current.vx, target.vx, c.max_vx, c.acc_xy), vy: lim(current.vy, target.vy, c.max_vy, c.acc_xy), wz: lim(current.wz, target.wz, c.max_wz, c.acc_wz) }
+    let lim =
+        |cur: f64, tgt: f64, max: f64, acc: f64| tgt.clamp(-max, max).clamp(cur - acc * c.period, cur + acc * c.period);
+    Velocity {
+        vx: lim(current.vx, target.vx, c.max_vx, c.acc_xy),
+        vy: lim(current.vy, target.vy, c.max_vy, c.acc_xy),
+        wz: lim(current.wz, target.wz, c.max_wz, c.acc_wz),
+    }
 }

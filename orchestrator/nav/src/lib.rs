@@ -37,13 +37,13 @@ pub mod turn_spot;
 pub use config::NavConfig;
 /// The name the benchmark harness uses for [`NavConfig`].
 pub type NavigatorConfig = NavConfig;
+pub use agrisim_math::pose2::{self, Pose2};
 pub use executor::{ExecutorStats, Goal, State};
 pub use localization::Localizer;
-pub use agrisim_math::pose2::{self, Pose2};
 
 use agrisim_bus::Bus;
-use agrisim_error::Result;
 use agrisim_bus::Node;
+use agrisim_error::Result;
 use agrisim_msgs::agrisim::NavigationStatus;
 use agrisim_msgs::builtin_interfaces::Time;
 use agrisim_msgs::geometry_msgs::{PoseStamped, Twist, Vector3};
@@ -170,10 +170,19 @@ impl Navigator {
     }
 
     fn integrate_cloud(&mut self, cloud: &PointCloud2) -> Result<()> {
-        let (Some(pose), Some(map), Some(local)) = (self.pose, self.map.as_ref(), self.local.as_mut()) else { return Ok(()) };
+        let (Some(pose), Some(map), Some(local)) = (self.pose, self.map.as_ref(), self.local.as_mut()) else {
+            return Ok(());
+        };
         let mount = self.cfg.robot.lidar_mount;
         let pts = mount.transform_all(&cloud::decode_xyz(cloud)?);
-        local.update(&pose, [mount.x, mount.y, mount.z], self.cfg.robot.base_link_height, &pts, map, &self.cfg.robot.footprint);
+        local.update(
+            &pose,
+            [mount.x, mount.y, mount.z],
+            self.cfg.robot.base_link_height,
+            &pts,
+            map,
+            &self.cfg.robot.footprint,
+        );
         Ok(())
     }
 
@@ -183,7 +192,12 @@ impl Navigator {
         if self.last_status.as_ref() == Some(&now) && t_ns - self.last_status_ns < period {
             return;
         }
-        let msg = NavigationStatus { header: Header::new(Time::from_nanos(t_ns), "map"), state: now.0.as_str().to_string(), detail: now.1.clone(), goal: self.goal_msg.clone() };
+        let msg = NavigationStatus {
+            header: Header::new(Time::from_nanos(t_ns), "map"),
+            state: now.0.as_str().to_string(),
+            detail: now.1.clone(),
+            goal: self.goal_msg.clone(),
+        };
         bus.publish(topics::STATUS, t_ns, &msg);
         self.last_status = Some(now);
         self.last_status_ns = t_ns;
@@ -235,7 +249,11 @@ impl Node for Navigator {
             bus.publish(topics::PLAN, t_ns, &astar::to_path_msg(plan, goal, &header));
         }
         if let Some(v) = out.cmd {
-            bus.publish(topics::CMD_VEL, t_ns, &Twist { linear: Vector3 { x: v.vx, y: v.vy, z: 0.0 }, angular: Vector3 { x: 0.0, y: 0.0, z: v.wz } });
+            bus.publish(
+                topics::CMD_VEL,
+                t_ns,
+                &Twist { linear: Vector3 { x: v.vx, y: v.vy, z: 0.0 }, angular: Vector3 { x: 0.0, y: 0.0, z: v.wz } },
+            );
         }
         self.publish_status(t_ns, bus);
         if self.publish_costmaps && t_ns - self.last_costmap_ns >= 1_000_000_000 {

@@ -60,7 +60,15 @@ impl Default for LidarOdometryConfig {
             map_range: 12.0,
             scan_range: 10.5,
             resolution: 0.05,
-            matcher: ScanMatchConfig { effective_points: 200.0, search_xy: 0.15, search_yaw: 0.035, min_std_xy: 0.002, min_std_yaw: 0.001, min_inlier_fraction: 0.5, ..ScanMatchConfig::default() },
+            matcher: ScanMatchConfig {
+                effective_points: 200.0,
+                search_xy: 0.15,
+                search_yaw: 0.035,
+                min_std_xy: 0.002,
+                min_std_yaw: 0.001,
+                min_inlier_fraction: 0.5,
+                ..ScanMatchConfig::default()
+            },
         }
     }
 }
@@ -129,7 +137,8 @@ impl LidarOdometry {
         // The match covariance is in the odometry frame's axes; the increment's in prev's.
         let (s, c) = prev.yaw.sin_cos();
         let r = Matrix3::new(c, s, 0.0, -s, c, 0.0, 0.0, 0.0, 1.0);
-        let inc = Increment { delta: prev.inverse().compose(&m.pose), cov: r * m.cov * r.transpose(), inliers: m.inliers };
+        let inc =
+            Increment { delta: prev.inverse().compose(&m.pose), cov: r * m.cov * r.transpose(), inliers: m.inliers };
         let last = self.keyframes.back().map_or(prev, |k| k.pose);
         let turned = agrisim_math::pose2::wrap_angle(m.pose.yaw - last.yaw).abs();
         if m.pose.dist(&last) >= self.cfg.keyframe_distance || turned >= self.cfg.keyframe_angle {
@@ -151,22 +160,34 @@ impl LidarOdometry {
     /// The keyframes' points in the odometry frame as an occupancy grid with its distance
     /// field, padded so the next slices' points near its edge still see the obstacles.
     fn rasterize(&self) -> Option<StaticMap> {
-        let pts: Vec<(f64, f64)> = self.keyframes.iter().flat_map(|k| k.points.iter().map(move |&(x, y)| k.pose.apply(x, y))).collect();
+        let pts: Vec<(f64, f64)> =
+            self.keyframes.iter().flat_map(|k| k.points.iter().map(move |&(x, y)| k.pose.apply(x, y))).collect();
         if pts.is_empty() {
             return None;
         }
         let res = self.cfg.resolution;
         let pad = 1.0 + self.cfg.matcher.search_xy;
-        let (x0, y0, x1, y1) = pts.iter().fold((f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY), |(a, b, c, d), &(x, y)| (a.min(x), b.min(y), c.max(x), d.max(y)));
+        let (x0, y0, x1, y1) = pts
+            .iter()
+            .fold((f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY), |(a, b, c, d), &(x, y)| {
+                (a.min(x), b.min(y), c.max(x), d.max(y))
+            });
         let (ox, oy) = (((x0 - pad) / res).floor() * res, ((y0 - pad) / res).floor() * res);
-        let geom = GridGeom { origin_x: ox, origin_y: oy, resolution: res, width: ((x1 + pad - ox) / res).ceil() as usize, height: ((y1 + pad - oy) / res).ceil() as usize };
+        let geom = GridGeom {
+            origin_x: ox,
+            origin_y: oy,
+            resolution: res,
+            width: ((x1 + pad - ox) / res).ceil() as usize,
+            height: ((y1 + pad - oy) / res).ceil() as usize,
+        };
         let mut occupied = vec![false; geom.len()];
         for &(x, y) in &pts {
             if let Some(i) = geom.index_of(x, y) {
                 occupied[i] = true;
             }
         }
-        let distance = distance_transform(&occupied, geom.width, geom.height).into_iter().map(|d| d * res as f32).collect();
+        let distance =
+            distance_transform(&occupied, geom.width, geom.height).into_iter().map(|d| d * res as f32).collect();
         Some(StaticMap { geom, frame_id: "lidar_odom".into(), occupied, distance })
     }
 }
@@ -191,7 +212,18 @@ mod tests {
             for &bx in bumps {
                 // The bump on the wall the beam heads for; slab test against its box.
                 let (y0, y1) = if wy > 0.0 { (0.85, 1.0) } else { (-1.0, -0.85) };
-                let slab = |o: f64, d: f64, lo: f64, hi: f64| if d.abs() < 1e-12 { if o >= lo && o <= hi { (f64::NEG_INFINITY, f64::INFINITY) } else { (1.0, -1.0) } } else { let (t0, t1) = ((lo - o) / d, (hi - o) / d); (t0.min(t1), t0.max(t1)) };
+                let slab = |o: f64, d: f64, lo: f64, hi: f64| {
+                    if d.abs() < 1e-12 {
+                        if o >= lo && o <= hi {
+                            (f64::NEG_INFINITY, f64::INFINITY)
+                        } else {
+                            (1.0, -1.0)
+                        }
+                    } else {
+                        let (t0, t1) = ((lo - o) / d, (hi - o) / d);
+                        (t0.min(t1), t0.max(t1))
+                    }
+                };
                 let (ax, bx_) = slab(truth.x, wx, bx - 0.05, bx + 0.05);
                 let (ay, by) = slab(truth.y, wy, y0, y1);
                 let (t0, t1) = (ax.max(ay), bx_.min(by));
@@ -253,7 +285,10 @@ mod tests {
         }
         assert!(increments >= 198, "{increments} registrations");
         assert!((wheel.x - truth.x).abs() > 0.9);
-        assert!((measured.x - truth.x).abs() < 0.1 && (measured.y - truth.y).abs() < 0.04 && measured.yaw.abs() < 0.005, "LiDAR odometry {measured:?} vs truth {truth:?}");
+        assert!(
+            (measured.x - truth.x).abs() < 0.1 && (measured.y - truth.y).abs() < 0.04 && measured.yaw.abs() < 0.005,
+            "LiDAR odometry {measured:?} vs truth {truth:?}"
+        );
         assert_eq!(lo.restarts, 0);
     }
 

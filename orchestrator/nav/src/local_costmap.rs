@@ -37,7 +37,16 @@ pub struct LocalCostmapConfig {
 
 impl Default for LocalCostmapConfig {
     fn default() -> Self {
-        LocalCostmapConfig { size: 32.0, min_z: 0.05, max_z: 1.5, max_range: 15.0, map_tolerance: 0.15, map_tolerance_per_m: 0.01, self_filter_margin: 0.1, clearing_bins: 720 }
+        LocalCostmapConfig {
+            size: 32.0,
+            min_z: 0.05,
+            max_z: 1.5,
+            max_range: 15.0,
+            map_tolerance: 0.15,
+            map_tolerance_per_m: 0.01,
+            self_filter_margin: 0.1,
+            clearing_bins: 720,
+        }
     }
 }
 
@@ -79,8 +88,17 @@ impl LocalCostmap {
     pub fn new(cfg: LocalCostmapConfig, map_geom: &GridGeom) -> LocalCostmap {
         let res = map_geom.resolution;
         let n = (cfg.size / res).round().max(2.0) as usize;
-        let geom = GridGeom { origin_x: map_geom.origin_x, origin_y: map_geom.origin_y, resolution: res, width: n, height: n };
-        LocalCostmap { cfg, geom, anchor: (map_geom.origin_x, map_geom.origin_y), state: vec![UNKNOWN; n * n], top: vec![0.0; n * n], distance: vec![f32::INFINITY; n * n], occupied_count: 0 }
+        let geom =
+            GridGeom { origin_x: map_geom.origin_x, origin_y: map_geom.origin_y, resolution: res, width: n, height: n };
+        LocalCostmap {
+            cfg,
+            geom,
+            anchor: (map_geom.origin_x, map_geom.origin_y),
+            state: vec![UNKNOWN; n * n],
+            top: vec![0.0; n * n],
+            distance: vec![f32::INFINITY; n * n],
+            occupied_count: 0,
+        }
     }
 
     /// Forgets everything (a recovery's "clear costmap").
@@ -130,7 +148,15 @@ impl LocalCostmap {
     /// Integrates one scan. `points` are in base_link (z above base_link), `robot` the map pose
     /// of base_link, `sensor` the base-frame position of the LiDAR, `base_height` the height of
     /// base_link above the floor.
-    pub fn update(&mut self, robot: &Pose2, sensor: [f64; 3], base_height: f64, points: &[[f32; 3]], map: &StaticMap, footprint: &Footprint) {
+    pub fn update(
+        &mut self,
+        robot: &Pose2,
+        sensor: [f64; 3],
+        base_height: f64,
+        points: &[[f32; 3]],
+        map: &StaticMap,
+        footprint: &Footprint,
+    ) {
         self.recentre(robot.x, robot.y);
         let (sx, sy) = robot.apply(sensor[0], sensor[1]);
         let sz = sensor[2] + base_height;
@@ -175,7 +201,9 @@ impl LocalCostmap {
         let (x0, y0, z0) = sensor;
         let (x1, y1) = (ray.x, ray.y);
         let g = &self.geom;
-        let c = |x: f64, y: f64| (((x - g.origin_x) / g.resolution).floor() as i64, ((y - g.origin_y) / g.resolution).floor() as i64);
+        let c = |x: f64, y: f64| {
+            (((x - g.origin_x) / g.resolution).floor() as i64, ((y - g.origin_y) / g.resolution).floor() as i64)
+        };
         let (mut cx, mut cy) = c(x0, y0);
         let (ex, ey) = c(x1, y1);
         let (w, h) = (g.width as i64, g.height as i64);
@@ -217,7 +245,8 @@ impl LocalCostmap {
             return;
         }
         let res = self.geom.resolution as f32;
-        self.distance = distance_transform(&occ, self.geom.width, self.geom.height).into_iter().map(|d| d * res).collect();
+        self.distance =
+            distance_transform(&occ, self.geom.width, self.geom.height).into_iter().map(|d| d * res).collect();
     }
 
     /// Distance to the nearest sensed obstacle, from the cell centre minus half a cell;
@@ -254,9 +283,21 @@ impl LocalCostmap {
     }
 
     /// As an OccupancyGrid for visualization (-1 unknown, 0 free, 100 occupied).
-    pub fn to_msg(&self, frame_id: &str, stamp: agrisim_msgs::builtin_interfaces::Time) -> agrisim_msgs::nav_msgs::OccupancyGrid {
+    pub fn to_msg(
+        &self,
+        frame_id: &str,
+        stamp: agrisim_msgs::builtin_interfaces::Time,
+    ) -> agrisim_msgs::nav_msgs::OccupancyGrid {
         let mut g = super::map::occupancy_grid(&self.geom, &[], frame_id, stamp);
-        g.data = self.state.iter().map(|&s| match s { UNKNOWN => -1, FREE => 0, _ => 100 }).collect();
+        g.data = self
+            .state
+            .iter()
+            .map(|&s| match s {
+                UNKNOWN => -1,
+                FREE => 0,
+                _ => 100,
+            })
+            .collect();
         g
     }
 }

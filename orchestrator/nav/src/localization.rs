@@ -13,14 +13,13 @@
 //! the odometry motion model of §5.4), with a Mahalanobis gate on the scan-match innovation.
 
 use super::config::{LocalizationConfig, NavConfig, RobotConfig};
-use agrisim_math::pose2::{wrap_angle, Pose2};
 use super::lidar_odometry::{Increment, LidarOdometry};
 use super::scan_match::{correlative_match, LikelihoodField, Match};
 use super::{cloud, map::StaticMap, topics};
-use agrisim_bus::{Bus, Reader};
-use std::collections::VecDeque;
-use agrisim_error::Result;
 use agrisim_bus::Node;
+use agrisim_bus::{Bus, Reader};
+use agrisim_error::Result;
+use agrisim_math::pose2::{wrap_angle, Pose2};
 use agrisim_msgs::builtin_interfaces::Time;
 use agrisim_msgs::geometry_msgs::{self, PoseStamped, Transform, TransformStamped};
 use agrisim_msgs::nav_msgs::{OccupancyGrid, Odometry};
@@ -28,6 +27,7 @@ use agrisim_msgs::sensor_msgs::{Imu, PointCloud2};
 use agrisim_msgs::std_msgs::Header;
 use agrisim_msgs::tf2_msgs::TFMessage;
 use nalgebra::{Matrix3, Vector3};
+use std::collections::VecDeque;
 
 /// `a p aᵀ + b r bᵀ`: a covariance `p` through the linear map `a`, plus noise `r` entering
 /// through `b` (EKF prediction; Joseph-form update).
@@ -315,7 +315,10 @@ impl Localizer {
         let tf = TransformStamped {
             header: Header::new(stamp, "map"),
             child_frame_id: "odom".into(),
-            transform: Transform { translation: geometry_msgs::Vector3 { x: map_odom.x, y: map_odom.y, z: 0.0 }, rotation: q },
+            transform: Transform {
+                translation: geometry_msgs::Vector3 { x: map_odom.x, y: map_odom.y, z: 0.0 },
+                rotation: q,
+            },
         };
         bus.publish(topics::TF, t_ns, &TFMessage { transforms: vec![tf] });
     }
@@ -343,7 +346,8 @@ impl Node for Localizer {
                 let mut d = prev.inverse().compose(&cur);
                 let dt = (stamp - t_prev) as f64 * 1e-9;
                 if let (Some((turned, mean)), true) = (self.integrate_gyro(t_prev, stamp), dt > 0.0) {
-                    let still = tw.linear.x.hypot(tw.linear.y) < 0.01 && tw.angular.z.abs() < 0.01 && d.x.hypot(d.y) < 1e-3;
+                    let still =
+                        tw.linear.x.hypot(tw.linear.y) < 0.01 && tw.angular.z.abs() < 0.01 && d.x.hypot(d.y) < 1e-3;
                     if still {
                         self.gyro_bias += 0.1 * (mean - self.gyro_bias);
                     }
@@ -415,7 +419,9 @@ mod tests {
         }
 
         pub fn inverse(a: &M3) -> Option<M3> {
-            let det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+            let det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+                - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+                + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
             if det.abs() < 1e-300 {
                 return None;
             }

@@ -3,8 +3,8 @@
 //! planner, localizer) works in this grid's geometry.
 
 use super::distance::distance_transform;
-use agrisim_error::Result;
 use agrisim_error::err;
+use agrisim_error::Result;
 use agrisim_msgs::nav_msgs::OccupancyGrid;
 
 /// Placement and size of a regular grid in the map frame (axis-aligned).
@@ -32,7 +32,8 @@ impl GridGeom {
     pub fn cell(&self, x: f64, y: f64) -> Option<(usize, usize)> {
         let cx = ((x - self.origin_x) / self.resolution).floor();
         let cy = ((y - self.origin_y) / self.resolution).floor();
-        (cx >= 0.0 && cy >= 0.0 && (cx as usize) < self.width && (cy as usize) < self.height).then_some((cx as usize, cy as usize))
+        (cx >= 0.0 && cy >= 0.0 && (cx as usize) < self.width && (cy as usize) < self.height)
+            .then_some((cx as usize, cy as usize))
     }
 
     pub fn index_of(&self, x: f64, y: f64) -> Option<usize> {
@@ -77,8 +78,15 @@ impl StaticMap {
         // The f32 resolution read back as the decimal it was written as (0.05, not 0.0500000007),
         // so cell boundaries land where the map's author put them.
         let resolution = info.resolution.to_string().parse::<f64>().unwrap_or(info.resolution as f64);
-        let geom = GridGeom { origin_x: info.origin.position.x, origin_y: info.origin.position.y, resolution, width: w, height: h };
-        let occupied: Vec<bool> = msg.data.iter().map(|&v| v >= OCCUPIED_THRESHOLD || (v < 0 && unknown_is_obstacle)).collect();
+        let geom = GridGeom {
+            origin_x: info.origin.position.x,
+            origin_y: info.origin.position.y,
+            resolution,
+            width: w,
+            height: h,
+        };
+        let occupied: Vec<bool> =
+            msg.data.iter().map(|&v| v >= OCCUPIED_THRESHOLD || (v < 0 && unknown_is_obstacle)).collect();
         Ok(StaticMap::from_cells(geom, occupied, msg.header.frame_id.clone()))
     }
 
@@ -97,7 +105,12 @@ impl StaticMap {
 
 /// Builds an OccupancyGrid message (0 free, 100 occupied) from cells, e.g. for tests or a
 /// map server that rasterized a scene itself.
-pub fn occupancy_grid(geom: &GridGeom, occupied: &[bool], frame_id: &str, stamp: agrisim_msgs::builtin_interfaces::Time) -> OccupancyGrid {
+pub fn occupancy_grid(
+    geom: &GridGeom,
+    occupied: &[bool],
+    frame_id: &str,
+    stamp: agrisim_msgs::builtin_interfaces::Time,
+) -> OccupancyGrid {
     let mut g = OccupancyGrid::default();
     g.header.frame_id = frame_id.to_string();
     g.header.stamp = stamp;

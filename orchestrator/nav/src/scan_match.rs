@@ -64,7 +64,8 @@ pub struct LikelihoodField {
 impl LikelihoodField {
     pub fn new(map: &StaticMap, cfg: &ScanMatchConfig) -> LikelihoodField {
         let s2 = 2.0 * cfg.sigma * cfg.sigma;
-        let logp = map.distance.iter().map(|&d| (((-(d as f64) * d as f64 / s2).exp()) + cfg.z_rand).ln() as f32).collect();
+        let logp =
+            map.distance.iter().map(|&d| (((-(d as f64) * d as f64 / s2).exp()) + cfg.z_rand).ln() as f32).collect();
         LikelihoodField { geom: map.geom, logp, floor: cfg.z_rand.ln() as f32, distance: map.distance.clone() }
     }
 
@@ -83,20 +84,31 @@ impl LikelihoodField {
                 self.logp[j as usize * g.width + i as usize] as f64
             }
         };
-        (1.0 - fv) * ((1.0 - fu) * get(i0, j0) + fu * get(i0 + 1, j0)) + fv * ((1.0 - fu) * get(i0, j0 + 1) + fu * get(i0 + 1, j0 + 1))
+        (1.0 - fv) * ((1.0 - fu) * get(i0, j0) + fu * get(i0 + 1, j0))
+            + fv * ((1.0 - fu) * get(i0, j0 + 1) + fu * get(i0 + 1, j0 + 1))
     }
 
     fn score(&self, pose: &Pose2, pts: &[(f64, f64)]) -> f64 {
-        pts.iter().map(|&(px, py)| {
-            let (x, y) = pose.apply(px, py);
-            self.at(x, y)
-        }).sum()
+        pts.iter()
+            .map(|&(px, py)| {
+                let (x, y) = pose.apply(px, py);
+                self.at(x, y)
+            })
+            .sum()
     }
 }
 
 /// Scores of poses around `centre`: translations of whole cells (±k) for each yaw sample
 /// (±ny steps), as (x, y, yaw, score), yaw-major then y then x.
-fn coarse_grid(field: &LikelihoodField, pts: &[(f64, f64)], centre: &Pose2, k: i64, ny: i64, yaw_step: f64, grid: &mut Vec<(f64, f64, f64, f64)>) {
+fn coarse_grid(
+    field: &LikelihoodField,
+    pts: &[(f64, f64)],
+    centre: &Pose2,
+    k: i64,
+    ny: i64,
+    yaw_step: f64,
+    grid: &mut Vec<(f64, f64, f64, f64)>,
+) {
     let g = &field.geom;
     let res = g.resolution;
     let n_side = (2 * k + 1) as usize;
@@ -131,7 +143,12 @@ fn coarse_grid(field: &LikelihoodField, pts: &[(f64, f64)], centre: &Pose2, k: i
         }
         for j in -k..=k {
             for i in -k..=k {
-                grid.push((centre.x + i as f64 * res, centre.y + j as f64 * res, yaw, acc[((j + k) as usize) * n_side + (i + k) as usize]));
+                grid.push((
+                    centre.x + i as f64 * res,
+                    centre.y + j as f64 * res,
+                    yaw,
+                    acc[((j + k) as usize) * n_side + (i + k) as usize],
+                ));
             }
         }
     }
@@ -148,7 +165,12 @@ pub struct Match {
 
 /// Mean (relative to `best`) and covariance of the tempered score distribution over the
 /// coarse `grid` (Olson 2009, eq. 15-17), plus `floors` on the covariance's diagonal.
-fn score_moments(grid: &[(f64, f64, f64, f64)], best: &(f64, f64, f64, f64), temper: f64, floors: &Vector3<f64>) -> (Vector3<f64>, Matrix3<f64>) {
+fn score_moments(
+    grid: &[(f64, f64, f64, f64)],
+    best: &(f64, f64, f64, f64),
+    temper: f64,
+    floors: &Vector3<f64>,
+) -> (Vector3<f64>, Matrix3<f64>) {
     let (mut w_sum, mut m, mut s) = (0.0, Vector3::zeros(), Matrix3::zeros());
     for &(x, y, yaw, sc) in grid {
         let w = ((sc - best.3) * temper).exp();
@@ -167,7 +189,12 @@ fn score_moments(grid: &[(f64, f64, f64, f64)], best: &(f64, f64, f64, f64), tem
 
 /// Matches base-frame 2-D points against the field around `prior`; `None` when too few
 /// points fit the map.
-pub fn correlative_match(field: &LikelihoodField, pts: &[(f64, f64)], prior: &Pose2, cfg: &ScanMatchConfig) -> Option<Match> {
+pub fn correlative_match(
+    field: &LikelihoodField,
+    pts: &[(f64, f64)],
+    prior: &Pose2,
+    cfg: &ScanMatchConfig,
+) -> Option<Match> {
     if pts.is_empty() {
         return None;
     }
@@ -189,13 +216,15 @@ pub fn correlative_match(field: &LikelihoodField, pts: &[(f64, f64)], prior: &Po
     for _ in 0..4 {
         grid.clear();
         coarse_grid(field, pts, &centre, k, ny, cfg.yaw_step, &mut grid);
-        let best = grid.iter().copied().fold((0.0, 0.0, 0.0, f64::NEG_INFINITY), |acc, c| if c.3 > acc.3 { c } else { acc });
+        let best =
+            grid.iter().copied().fold((0.0, 0.0, 0.0, f64::NEG_INFINITY), |acc, c| if c.3 > acc.3 { c } else { acc });
         let (mean, c) = score_moments(&grid, &best, temper, &floors);
         cov = c;
         est = Pose2::new(best.0 + mean[0], best.1 + mean[1], wrap_angle(best.2 + mean[2]));
         let off = [est.x - centre.x, est.y - centre.y, wrap_angle(est.yaw - centre.yaw)];
         let inside = |v: f64, lim: f64| lim == 0.0 || v.abs() < 0.5 * lim;
-        if inside(off[0], k as f64 * res) && inside(off[1], k as f64 * res) && inside(off[2], ny as f64 * cfg.yaw_step) {
+        if inside(off[0], k as f64 * res) && inside(off[1], k as f64 * res) && inside(off[2], ny as f64 * cfg.yaw_step)
+        {
             break;
         }
         centre = est;
@@ -253,7 +282,8 @@ mod tests {
         for y in 0..160 {
             for x in 0..200 {
                 let wall = x < 2 || y < 2 || x >= 198 || y >= 158;
-                let post = (60..64).contains(&x) && (50..54).contains(&y) || (140..144).contains(&x) && (100..104).contains(&y);
+                let post = (60..64).contains(&x) && (50..54).contains(&y)
+                    || (140..144).contains(&x) && (100..104).contains(&y);
                 occ[y * 200 + x] = wall || post;
             }
         }
@@ -277,7 +307,12 @@ mod tests {
 
     /// The hand-written code `score_covariance` replaced, kept as the reference its results
     /// are pinned to (benchmark logs are compared byte by byte).
-    fn score_covariance_reference(grid: &[(f64, f64, f64, f64)], best: &(f64, f64, f64, f64), temper: f64, floors: [f64; 3]) -> [[f64; 3]; 3] {
+    fn score_covariance_reference(
+        grid: &[(f64, f64, f64, f64)],
+        best: &(f64, f64, f64, f64),
+        temper: f64,
+        floors: [f64; 3],
+    ) -> [[f64; 3]; 3] {
         let (mut w_sum, mut m) = (0.0, [0.0; 3]);
         let mut s = [[0.0; 3]; 3];
         for &(x, y, yaw, sc) in grid {
@@ -316,7 +351,8 @@ mod tests {
             for a in -ny..=ny {
                 for j in -k..=k {
                     for i in -k..=k {
-                        let (x, y, yaw) = (centre.0 + i as f64 * res, centre.1 + j as f64 * res, centre.2 + a as f64 * yaw_step);
+                        let (x, y, yaw) =
+                            (centre.0 + i as f64 * res, centre.1 + j as f64 * res, centre.2 + a as f64 * yaw_step);
                         grid.push((x, y, yaw, -100.0 * rng.uniform() * rng.uniform()));
                     }
                 }
@@ -341,7 +377,11 @@ mod tests {
         let field = LikelihoodField::new(&map, &cfg);
         let m = correlative_match(&field, &pts, &Pose2::new(5.15, 3.88, 0.34), &cfg).unwrap();
         // The synthetic returns are quantized to map cells, so sub-cell accuracy is not expected.
-        assert!((m.pose.x - 5.0).abs() < 0.03 && (m.pose.y - 4.0).abs() < 0.03 && (m.pose.yaw - 0.3).abs() < 0.01, "{:?}", m.pose);
+        assert!(
+            (m.pose.x - 5.0).abs() < 0.03 && (m.pose.y - 4.0).abs() < 0.03 && (m.pose.yaw - 0.3).abs() < 0.01,
+            "{:?}",
+            m.pose
+        );
         assert!(m.inliers > 0.9);
         assert!(m.cov[(0, 0)] > 0.0 && m.cov[(0, 0)].sqrt() < 0.05);
     }

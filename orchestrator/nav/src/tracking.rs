@@ -74,7 +74,13 @@ impl TrackedPath {
     /// Direction of travel at point `i`.
     pub fn tangent(&self, i: usize) -> f64 {
         let n = self.points.len();
-        let (a, b) = if i + 1 < n { (self.points[i], self.points[i + 1]) } else if n >= 2 { (self.points[n - 2], self.points[n - 1]) } else { return 0.0 };
+        let (a, b) = if i + 1 < n {
+            (self.points[i], self.points[i + 1])
+        } else if n >= 2 {
+            (self.points[n - 2], self.points[n - 1])
+        } else {
+            return 0.0;
+        };
         (b.1 - a.1).atan2(b.0 - a.0)
     }
 

@@ -57,14 +57,22 @@ fn offsets() -> &'static [(i64, i64, i64)] {
 /// (ties in grid order).
 fn around(c: (f64, f64), radius: f64) -> impl Iterator<Item = (f64, f64)> {
     let n = (radius / STEP).round() as i64;
-    offsets().iter().take_while(move |&&(d2, _, _)| d2 <= n * n).map(move |&(_, i, j)| (c.0 + i as f64 * STEP, c.1 + j as f64 * STEP))
+    offsets()
+        .iter()
+        .take_while(move |&&(d2, _, _)| d2 <= n * n)
+        .map(move |&(_, i, j)| (c.0 + i as f64 * STEP, c.1 + j as f64 * STEP))
 }
 
 /// The spot nearest `goal` (within [`RADIUS`]) that the robot at `pose` reaches by a straight
 /// shift at its heading and where it can turn to the goal's heading, with the point where it
 /// then ends: the nearest to the goal (within [`END_RADIUS`]) whose footprint at the goal's
 /// heading keeps `margin`, reached from the spot by a straight shift at that heading.
-pub fn find(pose: &Pose2, goal: &Pose2, margin: f64, clearance: impl Fn(&Pose2) -> f64) -> Option<((f64, f64), (f64, f64))> {
+pub fn find(
+    pose: &Pose2,
+    goal: &Pose2,
+    margin: f64,
+    clearance: impl Fn(&Pose2) -> f64,
+) -> Option<((f64, f64), (f64, f64))> {
     let end = around((goal.x, goal.y), END_RADIUS).find(|e| clearance(&Pose2::new(e.0, e.1, goal.yaw)) >= margin)?;
     let spot = around((goal.x, goal.y), RADIUS).find(|&s| {
         shift_clear((pose.x, pose.y), s, pose.yaw, margin, &clearance)

@@ -8,11 +8,8 @@
 //! Run with `--nocapture` to see success counts, localization error and timing.
 
 use agrisim_bus::Bus;
-use agrisim_nav::cloud::encode_xyzi;
-use agrisim_nav::dwa::{integrate, Velocity};
-use agrisim_nav::map::{occupancy_grid, GridGeom};
-use agrisim_nav::{topics, Localizer, NavConfig, Navigator, Pose2, State};
 use agrisim_bus::Node;
+use agrisim_math::Rng;
 use agrisim_msgs::agrisim::NavigationStatus;
 use agrisim_msgs::builtin_interfaces::Time;
 use agrisim_msgs::geometry_msgs::{PoseStamped, Quaternion, Twist};
@@ -20,7 +17,10 @@ use agrisim_msgs::nav_msgs::{Odometry, Path};
 use agrisim_msgs::sensor_msgs::Imu;
 use agrisim_msgs::std_msgs::Header;
 use agrisim_msgs::Message;
-use agrisim_math::Rng;
+use agrisim_nav::cloud::encode_xyzi;
+use agrisim_nav::dwa::{integrate, Velocity};
+use agrisim_nav::map::{occupancy_grid, GridGeom};
+use agrisim_nav::{topics, Localizer, NavConfig, Navigator, Pose2, State};
 
 const RES: f64 = 0.05;
 const WALL: f64 = 0.1;
@@ -58,7 +58,13 @@ fn gauss(rng: &mut Rng) -> f64 {
 /// The greenhouse: walls, `ROWS` crop rows along x with 2 m aisles, headland at x < 3.5,
 /// back path at x > 15.5.
 fn greenhouse() -> (GridGeom, Vec<bool>) {
-    let geom = GridGeom { origin_x: 0.0, origin_y: 0.0, resolution: RES, width: (LENGTH / RES).round() as usize, height: (width_y() / RES).round() as usize };
+    let geom = GridGeom {
+        origin_x: 0.0,
+        origin_y: 0.0,
+        resolution: RES,
+        width: (LENGTH / RES).round() as usize,
+        height: (width_y() / RES).round() as usize,
+    };
     let mut occ = vec![false; geom.len()];
     for cy in 0..geom.height {
         for cx in 0..geom.width {
@@ -141,7 +147,11 @@ impl Sim {
             let dt = STEP_NS as f64 * 1e-9;
             let target = if self.t_ns - self.cmd_ns > 500_000_000 { Velocity::ZERO } else { self.cmd };
             let lim = |v: f64, t: f64, a: f64| v + (t - v).clamp(-a * dt, a * dt);
-            self.vel = Velocity { vx: lim(self.vel.vx, target.vx, 1.0), vy: lim(self.vel.vy, target.vy, 1.0), wz: lim(self.vel.wz, target.wz, 2.0) };
+            self.vel = Velocity {
+                vx: lim(self.vel.vx, target.vx, 1.0),
+                vy: lim(self.vel.vy, target.vy, 1.0),
+                wz: lim(self.vel.wz, target.wz, 2.0),
+            };
             let next = integrate(&self.truth, &self.vel, dt);
             let blocked = self.glass.as_ref().is_some_and(|g| {
                 self.outline.iter().any(|&(px, py)| {
@@ -181,7 +191,8 @@ impl Sim {
     /// Publishes /odom, /imu and /points for the current instant.
     fn publish_sensors(&mut self, bus: &mut Bus) {
         let stamp = Time::from_nanos(self.t_ns);
-        let mut o = Odometry { header: Header::new(stamp, "odom"), child_frame_id: "base_link".into(), ..Default::default() };
+        let mut o =
+            Odometry { header: Header::new(stamp, "odom"), child_frame_id: "base_link".into(), ..Default::default() };
         o.pose.pose = self.odom.to_msg();
         o.twist.twist.linear.x = self.odom_vel.vx;
         o.twist.twist.linear.y = self.odom_vel.vy;
@@ -208,7 +219,11 @@ impl Sim {
             }
             let b = a - self.truth.yaw;
             for l in 0..self.layers {
-                let e: f64 = if self.layers == 1 { 0.0 } else { (-7.0 + 59.0 * l as f64 / (self.layers - 1) as f64).to_radians() };
+                let e: f64 = if self.layers == 1 {
+                    0.0
+                } else {
+                    (-7.0 + 59.0 * l as f64 / (self.layers - 1) as f64).to_radians()
+                };
                 let t = e.tan();
                 // Horizontal distance and height (relative to the sensor) of the return.
                 let floor = if t < -1e-9 { Some(1.0 / -t) } else { None };
@@ -230,7 +245,10 @@ impl Sim {
 }
 
 fn goal_msg(t_ns: i64, x: f64, y: f64, yaw: Option<f64>) -> PoseStamped {
-    let mut g = PoseStamped { header: Header::new(Time::from_nanos(t_ns), "map"), pose: Pose2::new(x, y, yaw.unwrap_or(0.0)).to_msg() };
+    let mut g = PoseStamped {
+        header: Header::new(Time::from_nanos(t_ns), "map"),
+        pose: Pose2::new(x, y, yaw.unwrap_or(0.0)).to_msg(),
+    };
     if yaw.is_none() {
         g.pose.orientation = Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 0.0 };
     }
@@ -262,12 +280,27 @@ impl Harness {
 
     /// `embedded`: one Navigator node running its own localizer (as the benchmark does),
     /// else a Localizer node and a Navigator node.
-    fn with_nodes(map_occ: &[bool], truth_occ: Vec<bool>, geom: GridGeom, start: Pose2, seed: u64, embedded: bool) -> Harness {
+    fn with_nodes(
+        map_occ: &[bool],
+        truth_occ: Vec<bool>,
+        geom: GridGeom,
+        start: Pose2,
+        seed: u64,
+        embedded: bool,
+    ) -> Harness {
         Harness::with_config(map_occ, truth_occ, geom, start, seed, embedded, |_| {})
     }
 
     /// [`Harness::with_nodes`] with the navigation configuration changed by `tweak`.
-    fn with_config(map_occ: &[bool], truth_occ: Vec<bool>, geom: GridGeom, start: Pose2, seed: u64, embedded: bool, tweak: impl Fn(&mut NavConfig)) -> Harness {
+    fn with_config(
+        map_occ: &[bool],
+        truth_occ: Vec<bool>,
+        geom: GridGeom,
+        start: Pose2,
+        seed: u64,
+        embedded: bool,
+        tweak: impl Fn(&mut NavConfig),
+    ) -> Harness {
         let mut cfg = NavConfig::for_start([start.x, start.y, start.yaw]);
         cfg.embedded_localizer = embedded;
         tweak(&mut cfg);
@@ -317,7 +350,8 @@ impl Harness {
         }
         let est = self.localizer().pose();
         self.max_loc_err = self.max_loc_err.max(est.dist(&self.sim.truth));
-        self.max_loc_yaw_err = self.max_loc_yaw_err.max(agrisim_nav::pose2::wrap_angle(est.yaw - self.sim.truth.yaw).abs());
+        self.max_loc_yaw_err =
+            self.max_loc_yaw_err.max(agrisim_nav::pose2::wrap_angle(est.yaw - self.sim.truth.yaw).abs());
         self.truth_track.push(self.sim.truth);
         self.sim.advance();
     }
@@ -494,7 +528,13 @@ fn gives_up_with_stuck_after_recoveries() {
             break;
         }
     }
-    println!("glass wall: states {states:?}, detail {:?}, stats {:?}, after {:.1} s, max localization error {:.3} m", h.status.detail, h.nav.stats(), (h.sim.t_ns - t0) as f64 * 1e-9, h.max_loc_err);
+    println!(
+        "glass wall: states {states:?}, detail {:?}, stats {:?}, after {:.1} s, max localization error {:.3} m",
+        h.status.detail,
+        h.nav.stats(),
+        (h.sim.t_ns - t0) as f64 * 1e-9,
+        h.max_loc_err
+    );
     assert_eq!((h.status.state.as_str(), h.status.detail.as_str()), ("failed", "stuck"));
     assert_eq!(h.nav.stats().recoveries, 3);
     assert!(states.iter().any(|s| s == "recovering"));
@@ -546,7 +586,8 @@ fn scan_matcher_converges_in_an_aisle() {
         let cloud = agrisim_msgs::sensor_msgs::PointCloud2::from_cdr(&bus.latest(topics::POINTS).unwrap().cdr).unwrap();
         let pts = loc.slice(&cloud).unwrap();
         for &(dx, dy, da) in &[(-0.1, 0.05, 0.05), (0.1, -0.05, -0.05), (0.0, 0.1, 0.0)] {
-            let m = correlative_match(&field, &pts, &Pose2::new(truth.x + dx, truth.y + dy, truth.yaw + da), &cfg).unwrap();
+            let m =
+                correlative_match(&field, &pts, &Pose2::new(truth.x + dx, truth.y + dy, truth.yaw + da), &cfg).unwrap();
             worst.0 = worst.0.max(m.pose.dist(&truth));
             worst.1 = worst.1.max(agrisim_nav::pose2::wrap_angle(m.pose.yaw - truth.yaw).abs());
         }
@@ -588,7 +629,13 @@ fn navigates_with_a_3d_mid360_sized_cloud() {
 /// the map has no feature along the aisle. Returns the final localization error and the
 /// localizer's counters.
 fn aisle_with_plants_not_in_the_map(lidar_odometry: bool) -> (f64, agrisim_nav::localization::LocalizerStats) {
-    let geom = GridGeom { origin_x: 0.0, origin_y: 0.0, resolution: RES, width: (60.0 / RES) as usize, height: (4.0 / RES) as usize };
+    let geom = GridGeom {
+        origin_x: 0.0,
+        origin_y: 0.0,
+        resolution: RES,
+        width: (60.0 / RES) as usize,
+        height: (4.0 / RES) as usize,
+    };
     let (mut map, mut truth) = (vec![false; geom.len()], vec![false; geom.len()]);
     let mut rng = raw(11);
     // Stems every 0.5 m along both row faces, 5-15 cm into the aisle, 2-6 cm thick.

@@ -7,11 +7,16 @@ use agrisim_nav::Pose2;
 use proptest::prelude::*;
 
 fn within_limits(c: &ControllerConfig, v: &Velocity) -> bool {
-    v.vx.abs() <= c.max_vx + 1e-9 && v.vy.abs() <= c.max_vy + 1e-9 && v.wz.abs() <= c.max_wz + 1e-9 && v.vx.hypot(v.vy) <= c.max_speed_xy + 1e-9
+    v.vx.abs() <= c.max_vx + 1e-9
+        && v.vy.abs() <= c.max_vy + 1e-9
+        && v.wz.abs() <= c.max_wz + 1e-9
+        && v.vx.hypot(v.vy) <= c.max_speed_xy + 1e-9
 }
 
 fn within_window(c: &ControllerConfig, from: &Velocity, to: &Velocity) -> bool {
-    (to.vx - from.vx).abs() <= c.acc_xy * c.period + 1e-9 && (to.vy - from.vy).abs() <= c.acc_xy * c.period + 1e-9 && (to.wz - from.wz).abs() <= c.acc_wz * c.period + 1e-9
+    (to.vx - from.vx).abs() <= c.acc_xy * c.period + 1e-9
+        && (to.vy - from.vy).abs() <= c.acc_xy * c.period + 1e-9
+        && (to.wz - from.wz).abs() <= c.acc_wz * c.period + 1e-9
 }
 
 proptest! {

@@ -2,16 +2,18 @@
 //! Dijkstra on random small grids (same move rules, written separately here), and the
 //! inflation gradient (monotone, centred in an aisle).
 
+use agrisim_math::Rng;
 use agrisim_nav::astar::{astar, plan, PlannerConfig};
 use agrisim_nav::costmap::{inflation_cost, GlobalCostmap, InflationConfig, INSCRIBED, LETHAL};
 use agrisim_nav::map::{GridGeom, StaticMap};
 use agrisim_nav::Pose2;
-use agrisim_math::Rng;
 
 /// Reference: Dijkstra by repeated linear scan for the cheapest open cell (no heap, no
 /// heuristic), 8-connected, diagonal moves need both side cells enterable.
 fn dijkstra(w: usize, h: usize, res: f64, cost: &[u8], s: usize, g: usize, wt: f64) -> Option<f64> {
-    let ok = |x: i64, y: i64| x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h && cost[y as usize * w + x as usize] < INSCRIBED;
+    let ok = |x: i64, y: i64| {
+        x >= 0 && y >= 0 && (x as usize) < w && (y as usize) < h && cost[y as usize * w + x as usize] < INSCRIBED
+    };
     let mut dist = vec![f64::INFINITY; w * h];
     let mut done = vec![false; w * h];
     dist[s] = 0.0;
@@ -57,7 +59,11 @@ fn astar_is_optimal_against_dijkstra() {
         let cost: Vec<u8> = (0..w * h)
             .map(|_| {
                 if rng.below(100) < density {
-                    if rng.below(2) == 0 { LETHAL } else { INSCRIBED }
+                    if rng.below(2) == 0 {
+                        LETHAL
+                    } else {
+                        INSCRIBED
+                    }
                 } else {
                     rng.below(253) as u8 * (rng.below(2) as u8)
                 }

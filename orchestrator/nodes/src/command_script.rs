@@ -5,8 +5,8 @@
 use super::Node;
 use agrisim_bus::Bus;
 use agrisim_error::Result;
-use serde::Deserialize;
 use agrisim_msgs::geometry_msgs::{Twist, Vector3};
+use serde::Deserialize;
 
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -30,7 +30,6 @@ pub struct LiftCommand {
     pub t: f64,
     pub position: f64,
 }
-
 
 pub const CMD_VEL: &str = "/cmd_vel";
 pub const LIFT_SETPOINT: &str = "/lift/setpoint";
@@ -59,7 +58,10 @@ impl Node for CommandScript {
     fn step(&mut self, t_ns: i64, bus: &mut Bus) -> Result<()> {
         if let Some(c) = current(&self.base, t_ns, |c| c.t) {
             if !c.silent {
-                let msg = Twist { linear: Vector3 { x: c.vx, y: c.vy, z: 0.0 }, angular: Vector3 { x: 0.0, y: 0.0, z: c.wz } };
+                let msg = Twist {
+                    linear: Vector3 { x: c.vx, y: c.vy, z: 0.0 },
+                    angular: Vector3 { x: 0.0, y: 0.0, z: c.wz },
+                };
                 bus.publish(CMD_VEL, t_ns, &msg);
             }
         }

@@ -23,12 +23,16 @@ impl Injection {
     pub fn bytes(&self) -> Result<Vec<u8>> {
         let h = self.hex.trim();
         if h.len() % 2 != 0 || !h.bytes().all(|b| b.is_ascii_hexdigit()) {
-            return Err(agrisim_error::err!("inject on {} at t={}: hex {:?} is not an even number of hex digits", self.topic, self.t, self.hex));
+            return Err(agrisim_error::err!(
+                "inject on {} at t={}: hex {:?} is not an even number of hex digits",
+                self.topic,
+                self.t,
+                self.hex
+            ));
         }
         Ok((0..h.len()).step_by(2).map(|i| u8::from_str_radix(&h[i..i + 2], 16).expect("checked hex")).collect())
     }
 }
-
 
 pub struct FaultInjector {
     pending: Vec<(i64, Injection)>,
@@ -36,7 +40,8 @@ pub struct FaultInjector {
 
 impl FaultInjector {
     pub fn new(injections: &[Injection]) -> FaultInjector {
-        let mut pending: Vec<(i64, Injection)> = injections.iter().map(|i| ((i.t * 1e9).round() as i64, i.clone())).collect();
+        let mut pending: Vec<(i64, Injection)> =
+            injections.iter().map(|i| ((i.t * 1e9).round() as i64, i.clone())).collect();
         pending.sort_by_key(|(t, _)| *t);
         FaultInjector { pending }
     }

@@ -32,7 +32,10 @@ impl Node for GoalPublisher {
                 let (s, c) = (yaw / 2.0).sin_cos();
                 let msg = PoseStamped {
                     header: Header { stamp: Time::from_nanos(t_ns), frame_id: "map".into() },
-                    pose: Pose { position: Point { x, y, z: 0.0 }, orientation: Quaternion { x: 0.0, y: 0.0, z: s, w: c } },
+                    pose: Pose {
+                        position: Point { x, y, z: 0.0 },
+                        orientation: Quaternion { x: 0.0, y: 0.0, z: s, w: c },
+                    },
                 };
                 bus.publish(GOAL, t_ns, &msg);
                 self.goal = None;

@@ -27,7 +27,10 @@ impl Node for OdomTf {
             let tf = TransformStamped {
                 header: odom.header.clone(),
                 child_frame_id: odom.child_frame_id.clone(),
-                transform: Transform { translation: Vector3 { x: p.position.x, y: p.position.y, z: p.position.z }, rotation: p.orientation },
+                transform: Transform {
+                    translation: Vector3 { x: p.position.x, y: p.position.y, z: p.position.z },
+                    rotation: p.orientation,
+                },
             };
             bus.publish(TF, t_ns, &TFMessage { transforms: vec![tf] });
         }

@@ -40,7 +40,8 @@ impl RobotStatePublisher {
 
     /// The robot of models/robot/agrisim_robot.urdf (compiled in).
     pub fn agrisim() -> RobotStatePublisher {
-        let robot = Robot::from_urdf_str(include_str!("../../../models/robot/agrisim_robot.urdf")).expect("the project's URDF loads (tested in agrisim-robot)");
+        let robot = Robot::from_urdf_str(include_str!("../../../models/robot/agrisim_robot.urdf"))
+            .expect("the project's URDF loads (tested in agrisim-robot)");
         RobotStatePublisher::new(&robot)
     }
 
@@ -49,7 +50,9 @@ impl RobotStatePublisher {
             .joints
             .iter()
             .filter(|j| j.kind.is_movable() == movable)
-            .map(|j| stamped(t_ns, &j.parent, &j.child, &j.transform(self.positions.get(&j.name).copied().unwrap_or(0.0))))
+            .map(|j| {
+                stamped(t_ns, &j.parent, &j.child, &j.transform(self.positions.get(&j.name).copied().unwrap_or(0.0)))
+            })
             .collect();
         TFMessage { transforms }
     }
@@ -110,10 +113,17 @@ mod tests {
         let mut node = RobotStatePublisher::new(&robot);
         let mut bus = Bus::default();
         let q = [0.3, -0.5, 0.2, -2.0, 0.4, 1.8, -0.6];
-        let names: Vec<String> = (1..=7).map(|i| format!("left_joint{i}")).chain(["left_finger_joint1".into(), "left_finger_joint2".into()]).collect();
+        let names: Vec<String> = (1..=7)
+            .map(|i| format!("left_joint{i}"))
+            .chain(["left_finger_joint1".into(), "left_finger_joint2".into()])
+            .collect();
         let mut pos = q.to_vec();
         pos.extend([0.02, 0.02]);
-        bus.publish(JOINT_STATES[0], 0, &JointState { name: names.clone(), position: pos.clone(), ..Default::default() });
+        bus.publish(
+            JOINT_STATES[0],
+            0,
+            &JointState { name: names.clone(), position: pos.clone(), ..Default::default() },
+        );
         bus.set_scalar(LIFT.0, 0.37);
         node.step(100_000_000, &mut bus).unwrap();
         let mut tf: BTreeMap<String, (String, Pose)> = BTreeMap::new();

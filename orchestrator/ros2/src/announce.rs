@@ -50,8 +50,12 @@ pub fn listen(domain: u16) -> Option<UdpSocket> {
 
 /// The IPv4 addresses of this machine's up, non-loopback interfaces.
 pub fn lan_addresses() -> Vec<Ipv4Addr> {
-    let mut out: Vec<Ipv4Addr> =
-        netdev::get_interfaces().iter().filter(|i| i.is_up() && !i.is_loopback()).flat_map(|i| i.ipv4.iter().map(|n| n.addr())).filter(|a| !a.is_loopback()).collect();
+    let mut out: Vec<Ipv4Addr> = netdev::get_interfaces()
+        .iter()
+        .filter(|i| i.is_up() && !i.is_loopback())
+        .flat_map(|i| i.ipv4.iter().map(|n| n.addr()))
+        .filter(|a| !a.is_loopback())
+        .collect();
     out.sort();
     out.dedup();
     out
@@ -61,7 +65,9 @@ impl Announcer {
     /// Repeats, from `socket` (see [`listen`]), the announcements of the participant whose
     /// GUID prefix is `prefix` to `targets`' SPDP ports of `domain`.
     pub fn start(socket: UdpSocket, domain: u16, prefix: [u8; 12], targets: Vec<Ipv4Addr>) -> Result<Announcer> {
-        socket.set_read_timeout(Some(Duration::from_millis(100))).map_err(|e| err!("ROS 2 bridge: announcement repeater: {e}"))?;
+        socket
+            .set_read_timeout(Some(Duration::from_millis(100)))
+            .map_err(|e| err!("ROS 2 bridge: announcement repeater: {e}"))?;
         let stop = Arc::new(AtomicBool::new(false));
         let flag = stop.clone();
         let thread = std::thread::Builder::new()
@@ -138,7 +144,9 @@ mod tests {
         let domain = 77;
         let catch = listen(domain).expect("the SPDP port of participant 11 in domain 77 is free");
         let targets = vec![Ipv4Addr::new(127, 0, 0, 2)];
-        let seen: Vec<UdpSocket> = (0..3).filter_map(|pid| UdpSocket::bind((Ipv4Addr::new(127, 0, 0, 2), spdp_port(domain, pid))).ok()).collect();
+        let seen: Vec<UdpSocket> = (0..3)
+            .filter_map(|pid| UdpSocket::bind((Ipv4Addr::new(127, 0, 0, 2), spdp_port(domain, pid))).ok())
+            .collect();
         assert_eq!(seen.len(), 3);
         let prefix = [9u8; 12];
         let a = Announcer::start(catch, domain, prefix, targets).unwrap();

@@ -141,8 +141,10 @@ impl Ros2Bridge {
             }
             _ => None,
         };
-        let publisher = participant.create_publisher(&qos::writer(qos::Kind::Default)).map_err(|e| dds_err("publisher", e))?;
-        let subscriber: Subscriber = participant.create_subscriber(&qos::reader()).map_err(|e| dds_err("subscriber", e))?;
+        let publisher =
+            participant.create_publisher(&qos::writer(qos::Kind::Default)).map_err(|e| dds_err("publisher", e))?;
+        let subscriber: Subscriber =
+            participant.create_subscriber(&qos::reader()).map_err(|e| dds_err("subscriber", e))?;
         for t in &config.lockstep {
             if !config.inbound.iter().any(|(i, _)| i == t) {
                 return Err(err!("ROS 2 bridge: lockstep topic {t} is not an inbound topic"));
@@ -151,18 +153,34 @@ impl Ros2Bridge {
         let mut inbound = vec![];
         let scalars = config.inbound_scalars.iter().map(|t| (t, Float64::TYPE_NAME));
         for (topic, ros_type) in config.inbound.iter().map(|(t, ty)| (t, ty.as_str())).chain(scalars) {
-            let ty = dds_type(ros_type).ok_or_else(|| err!("ROS 2 bridge: topic {topic}: '{ros_type}' is not a pkg/msg/Type name"))?;
+            let ty = dds_type(ros_type)
+                .ok_or_else(|| err!("ROS 2 bridge: topic {topic}: '{ros_type}' is not a pkg/msg/Type name"))?;
             let name = dds_topic(config.remap.apply(topic));
-            let t = participant.create_topic(name.clone(), ty, &qos::reader(), TopicKind::NoKey).map_err(|e| dds_err(&format!("topic {name}"), e))?;
-            let reader = subscriber.create_datareader_no_key::<RawCdr, RawAdapter>(&t, Some(qos::reader())).map_err(|e| dds_err(&format!("reader of {name}"), e))?;
+            let t = participant
+                .create_topic(name.clone(), ty, &qos::reader(), TopicKind::NoKey)
+                .map_err(|e| dds_err(&format!("topic {name}"), e))?;
+            let reader = subscriber
+                .create_datareader_no_key::<RawCdr, RawAdapter>(&t, Some(qos::reader()))
+                .map_err(|e| dds_err(&format!("reader of {name}"), e))?;
             let scalar = config.inbound_scalars.contains(topic);
-            inbound.push(Inbound { topic: topic.clone(), ros_type: ros_type.to_string(), scalar, pending: vec![] , reader });
+            inbound.push(Inbound {
+                topic: topic.clone(),
+                ros_type: ros_type.to_string(),
+                scalar,
+                pending: vec![],
+                reader,
+            });
         }
-        let inbound_topics = config.inbound.iter().map(|(t, _)| t.clone()).chain(config.inbound_scalars.iter().cloned()).collect();
+        let inbound_topics =
+            config.inbound.iter().map(|(t, _)| t.clone()).chain(config.inbound_scalars.iter().cloned()).collect();
         let stats = Arc::new(Mutex::new(Stats::default()));
         let q = qos::writer(qos::Kind::Latched);
-        let t = participant.create_topic(graph::TOPIC.to_string(), graph::TYPE.to_string(), &q, TopicKind::NoKey).map_err(|e| dds_err(graph::TOPIC, e))?;
-        let graph = publisher.create_datawriter_no_key::<RawCdr, RawAdapter>(&t, Some(q)).map_err(|e| dds_err(&format!("writer of {}", graph::TOPIC), e))?;
+        let t = participant
+            .create_topic(graph::TOPIC.to_string(), graph::TYPE.to_string(), &q, TopicKind::NoKey)
+            .map_err(|e| dds_err(graph::TOPIC, e))?;
+        let graph = publisher
+            .create_datawriter_no_key::<RawCdr, RawAdapter>(&t, Some(q))
+            .map_err(|e| dds_err(&format!("writer of {}", graph::TOPIC), e))?;
         let mut bridge = Ros2Bridge {
             publisher,
             config,
@@ -178,7 +196,8 @@ impl Ros2Bridge {
             started: false,
             _announcer: announcer,
         };
-        let outbound: Vec<(String, String)> = bridge.config.outbound.iter().filter(|(t, _)| !bridge.inbound_topics.contains(t)).cloned().collect();
+        let outbound: Vec<(String, String)> =
+            bridge.config.outbound.iter().filter(|(t, _)| !bridge.inbound_topics.contains(t)).cloned().collect();
         for (t, ty) in outbound.iter().chain([&("/clock".to_string(), Clock::TYPE_NAME.to_string())]) {
             bridge.add_writer(t, ty)?;
         }
@@ -205,11 +224,18 @@ impl Ros2Bridge {
 
     fn add_writer(&mut self, topic: &str, ros_type: &str) -> Result<()> {
         if !self.writers.contains_key(topic) {
-            let ty = dds_type(ros_type).ok_or_else(|| err!("ROS 2 bridge: topic {topic}: '{ros_type}' is not a pkg/msg/Type name"))?;
+            let ty = dds_type(ros_type)
+                .ok_or_else(|| err!("ROS 2 bridge: topic {topic}: '{ros_type}' is not a pkg/msg/Type name"))?;
             let name = dds_topic(self.config.remap.apply(topic));
             let q = qos::writer(qos::kind_of(topic, ros_type));
-            let t = self.participant.create_topic(name.clone(), ty, &q, TopicKind::NoKey).map_err(|e| dds_err(&format!("topic {name}"), e))?;
-            let w = self.publisher.create_datawriter_no_key::<RawCdr, RawAdapter>(&t, Some(q)).map_err(|e| dds_err(&format!("writer of {name}"), e))?;
+            let t = self
+                .participant
+                .create_topic(name.clone(), ty, &q, TopicKind::NoKey)
+                .map_err(|e| dds_err(&format!("topic {name}"), e))?;
+            let w = self
+                .publisher
+                .create_datawriter_no_key::<RawCdr, RawAdapter>(&t, Some(q))
+                .map_err(|e| dds_err(&format!("writer of {name}"), e))?;
             self.writers.insert(topic.to_string(), w);
         }
         Ok(())
@@ -254,7 +280,11 @@ impl Ros2Bridge {
     /// Lockstep start: writers for what the bus has now, then wait until the peers are there
     /// (a writer on every lockstep topic, a reader of /clock) or the startup timeout passes.
     fn await_peers(&mut self, bus: &mut Bus) -> Result<()> {
-        let topics: Vec<(String, String)> = bus.topics().filter(|(t, _)| !self.inbound_topics.contains(*t)).map(|(t, ty)| (t.to_string(), ty.to_string())).collect();
+        let topics: Vec<(String, String)> = bus
+            .topics()
+            .filter(|(t, _)| !self.inbound_topics.contains(*t))
+            .map(|(t, ty)| (t.to_string(), ty.to_string()))
+            .collect();
         for (t, ty) in &topics {
             self.writer(t, ty)?;
         }
@@ -262,9 +292,15 @@ impl Ros2Bridge {
         let wanted: Vec<String> = self.config.lockstep.iter().map(|t| dds_topic(self.config.remap.apply(t))).collect();
         let deadline = Instant::now() + self.config.startup_timeout;
         loop {
-            let writers: BTreeSet<String> = self.participant.discovered_writers().into_iter().map(|w| w.publication_topic_data.topic_name).collect();
+            let writers: BTreeSet<String> = self
+                .participant
+                .discovered_writers()
+                .into_iter()
+                .map(|w| w.publication_topic_data.topic_name)
+                .collect();
             let clock = dds_topic(self.config.remap.apply("/clock"));
-            let clock_heard = self.participant.discovered_readers().iter().any(|r| r.subscription_topic_data.topic_name() == &clock);
+            let clock_heard =
+                self.participant.discovered_readers().iter().any(|r| r.subscription_topic_data.topic_name() == &clock);
             if clock_heard && wanted.iter().all(|t| writers.contains(t)) {
                 // The peers' readers of our other topics are announced with the same
                 // discovery round; give their acknowledgements a moment.
@@ -272,7 +308,11 @@ impl Ros2Bridge {
                 return Ok(());
             }
             if Instant::now() >= deadline {
-                bus.reject(format!("ROS 2 bridge: no peer after {:?} (wanted writers on {}, a reader of /clock); starting anyway", self.config.startup_timeout, self.config.lockstep.join(", ")));
+                bus.reject(format!(
+                    "ROS 2 bridge: no peer after {:?} (wanted writers on {}, a reader of /clock); starting anyway",
+                    self.config.startup_timeout,
+                    self.config.lockstep.join(", ")
+                ));
                 return Ok(());
             }
             std::thread::sleep(Duration::from_millis(10));
@@ -314,7 +354,12 @@ impl Node for Ros2Bridge {
                 let _ = self.writers[topic].wait_for_acknowledgments(timeout);
             }
         }
-        let scalars: Vec<(String, f64)> = bus.scalars().iter().filter(|(t, _)| !self.inbound_topics.contains(*t)).map(|(t, v)| (t.clone(), *v)).collect();
+        let scalars: Vec<(String, f64)> = bus
+            .scalars()
+            .iter()
+            .filter(|(t, _)| !self.inbound_topics.contains(*t))
+            .map(|(t, v)| (t.clone(), *v))
+            .collect();
         for (topic, data) in scalars {
             self.write(&topic, Float64::TYPE_NAME, Float64 { data }.to_cdr())?;
         }

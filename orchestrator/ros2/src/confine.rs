@@ -73,7 +73,7 @@ fn loopback_only(lo_index: u32) -> [SockFilter; 4] {
     const LD_W_ABS: u16 = 0x20; // BPF_LD | BPF_W | BPF_ABS
     const JEQ_K: u16 = 0x15; // BPF_JMP | BPF_JEQ | BPF_K
     const RET_K: u16 = 0x06; // BPF_RET | BPF_K
-    // The ancillary load SKF_AD_OFF + SKF_AD_IFINDEX: the receiving device's index.
+                             // The ancillary load SKF_AD_OFF + SKF_AD_IFINDEX: the receiving device's index.
     const IFINDEX: u32 = (-0x1000i32 + 8) as u32;
     [
         SockFilter::new(LD_W_ABS, 0, 0, IFINDEX),
@@ -115,7 +115,9 @@ mod tests {
     /// Instructions in the socket's filter (0: none), by SO_GET_FILTER with no buffer.
     fn filter_len(s: &UdpSocket) -> u32 {
         let mut len: libc::socklen_t = 0;
-        let r = unsafe { libc::getsockopt(s.as_raw_fd(), libc::SOL_SOCKET, libc::SO_ATTACH_FILTER, std::ptr::null_mut(), &mut len) };
+        let r = unsafe {
+            libc::getsockopt(s.as_raw_fd(), libc::SOL_SOCKET, libc::SO_ATTACH_FILTER, std::ptr::null_mut(), &mut len)
+        };
         assert_eq!(r, 0, "{}", std::io::Error::last_os_error());
         len
     }

@@ -24,7 +24,10 @@ pub fn kind_of(topic: &str, ros_type: &str) -> Kind {
         return Kind::Latched;
     }
     match ros_type {
-        "sensor_msgs/msg/Image" | "sensor_msgs/msg/PointCloud2" | "sensor_msgs/msg/Imu" | "sensor_msgs/msg/LaserScan" => Kind::Sensor,
+        "sensor_msgs/msg/Image"
+        | "sensor_msgs/msg/PointCloud2"
+        | "sensor_msgs/msg/Imu"
+        | "sensor_msgs/msg/LaserScan" => Kind::Sensor,
         _ => Kind::Default,
     }
 }
@@ -37,9 +40,16 @@ fn reliable() -> Reliability {
 pub fn writer(kind: Kind) -> QosPolicies {
     let b = QosPolicyBuilder::new();
     match kind {
-        Kind::Sensor => b.reliability(Reliability::BestEffort).durability(Durability::Volatile).history(History::KeepLast { depth: 5 }),
-        Kind::Latched => b.reliability(reliable()).durability(Durability::TransientLocal).history(History::KeepLast { depth: 1 }),
-        Kind::Default => b.reliability(reliable()).durability(Durability::Volatile).history(History::KeepLast { depth: 10 }),
+        Kind::Sensor => b
+            .reliability(Reliability::BestEffort)
+            .durability(Durability::Volatile)
+            .history(History::KeepLast { depth: 5 }),
+        Kind::Latched => {
+            b.reliability(reliable()).durability(Durability::TransientLocal).history(History::KeepLast { depth: 1 })
+        }
+        Kind::Default => {
+            b.reliability(reliable()).durability(Durability::Volatile).history(History::KeepLast { depth: 10 })
+        }
     }
     .build()
 }

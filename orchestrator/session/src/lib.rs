@@ -13,7 +13,7 @@ pub mod scenario;
 pub mod scene;
 pub mod session;
 
-pub use run::{prepare, RunOptions, RunSummary};
 pub use agrisim_bus::{Profile, RecordPolicy};
+pub use run::{prepare, RunOptions, RunSummary};
 pub use scenario::{PriorMap, Scenario};
 pub use session::{Session, SessionSnapshot};

@@ -105,7 +105,14 @@ fn load_options(s: &Scenario, o: &RunOptions) -> LoadOptions {
     let mut fmu_overrides = s.system.fmus.clone();
     fmu_overrides.extend(o.fmu_overrides.clone());
     let fmu_log = o.fmu_log.clone().or_else(|| s.logging.fmu.categories());
-    LoadOptions { fmu_dir: o.fmu_dir.clone(), cache_dir: o.cache_dir.clone(), fmu_overrides, step: s.timing.step, message_period: 1.0 / s.timing.message_rate, fmu_log }
+    LoadOptions {
+        fmu_dir: o.fmu_dir.clone(),
+        cache_dir: o.cache_dir.clone(),
+        fmu_overrides,
+        step: s.timing.step,
+        message_period: 1.0 / s.timing.message_rate,
+        fmu_log,
+    }
 }
 
 /// Start-pose parameters of a mobile base (REP 103, map frame).
@@ -132,7 +139,11 @@ fn parameters(s: &Scenario, system: &System) -> Result<BTreeMap<String, BTreeMap
 
 /// The nodes of a plain `agrisim run`: the scenario's command script, odom TF, fault injection.
 pub fn default_nodes(s: &Scenario) -> Vec<Box<dyn Node>> {
-    vec![Box::new(CommandScript::new(s.base_commands.clone(), s.lift_commands.clone())), Box::new(OdomTf::default()), Box::new(FaultInjector::new(&s.inject))]
+    vec![
+        Box::new(CommandScript::new(s.base_commands.clone(), s.lift_commands.clone())),
+        Box::new(OdomTf::default()),
+        Box::new(FaultInjector::new(&s.inject)),
+    ]
 }
 
 /// Builds the session for a scenario with the algorithm layer's `nodes`, recording to `mcap`.
@@ -159,7 +170,8 @@ pub fn prepare(s: &Scenario, o: &RunOptions, mcap: &Path, nodes: Vec<Box<dyn Nod
     }
     // Camera images are megabytes each: large chunks (see `Chunks`).
     let chunks = if types.iter().flatten().any(|t| t == Image::TYPE_NAME) { Chunks::Large } else { Chunks::Small };
-    let mut recorder = Recorder::with_chunks(mcap, policy, chunks).map_err(|e| err!("scenario {}: {e}", s.path.display()))?;
+    let mut recorder =
+        Recorder::with_chunks(mcap, policy, chunks).map_err(|e| err!("scenario {}: {e}", s.path.display()))?;
     let mut run_info = BTreeMap::from([
         ("scenario".to_string(), s.name.clone()),
         ("scenario_file".to_string(), s.path.display().to_string()),
@@ -185,7 +197,11 @@ pub fn prepare(s: &Scenario, o: &RunOptions, mcap: &Path, nodes: Vec<Box<dyn Nod
             _ => false,
         };
     }
-    let inputs = SystemIo { messages: messages.into_iter().collect(), scalars: scalars.into_iter().collect(), outputs: outputs.into_iter().collect() };
+    let inputs = SystemIo {
+        messages: messages.into_iter().collect(),
+        scalars: scalars.into_iter().collect(),
+        outputs: outputs.into_iter().collect(),
+    };
     let nodes = o.nodes.apply(nodes, &inputs)?;
     let mut session = Session::new(master, nodes, recorder, types);
     session.master.initialize()?;
@@ -206,7 +222,9 @@ pub fn run(s: &Scenario, o: &RunOptions, out_dir: &Path, progress: impl FnMut(u6
     std::fs::create_dir_all(out_dir).context(|| format!("cannot create {}", out_dir.display()))?;
     let mcap = out_dir.join("run.mcap");
     let duration = o.duration.unwrap_or(s.duration);
-    let steps = ticks_of(duration, s.timing.step, "duration").or_else(|_| -> Result<u64> { Err(err!("duration {duration} s is not a whole number of {} s steps", s.timing.step)) })?;
+    let steps = ticks_of(duration, s.timing.step, "duration").or_else(|_| -> Result<u64> {
+        Err(err!("duration {duration} s is not a whole number of {} s steps", s.timing.step))
+    })?;
     let mut session = prepare(s, o, &mcap, default_nodes(s))?;
     let mut progress = progress;
     let result = session.run(steps, |k| progress(k, steps));

@@ -4,8 +4,8 @@
 //! Unknown keys are errors (a typo must not silently fall back to a default).
 
 use agrisim_error::{Context, Result};
-use serde::Deserialize;
 pub use agrisim_nodes::{BaseCommand, Injection, LiftCommand};
+use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -248,15 +248,21 @@ impl Scenario {
         }
         for (i, c) in self.base_commands.iter().enumerate() {
             if !(c.t.is_finite() && c.t >= 0.0 && c.vx.is_finite() && c.vy.is_finite() && c.wz.is_finite()) {
-                return Err(agrisim_error::err!("scenario {file}: base_commands[{i}] has a negative or non-finite value"));
+                return Err(agrisim_error::err!(
+                    "scenario {file}: base_commands[{i}] has a negative or non-finite value"
+                ));
             }
             if i > 0 && c.t < self.base_commands[i - 1].t {
                 return Err(agrisim_error::err!("scenario {file}: base_commands[{i}].t goes back in time"));
             }
         }
         for (i, c) in self.lift_commands.iter().enumerate() {
-            if !(c.t.is_finite() && c.t >= 0.0 && c.position.is_finite()) || (i > 0 && c.t < self.lift_commands[i - 1].t) {
-                return Err(agrisim_error::err!("scenario {file}: lift_commands[{i}] is not finite, negative or out of order"));
+            if !(c.t.is_finite() && c.t >= 0.0 && c.position.is_finite())
+                || (i > 0 && c.t < self.lift_commands[i - 1].t)
+            {
+                return Err(agrisim_error::err!(
+                    "scenario {file}: lift_commands[{i}] is not finite, negative or out of order"
+                ));
             }
         }
         if self.environment.is_some() {
@@ -322,9 +328,14 @@ mod tests {
 
     #[test]
     fn environment_is_validated_naming_the_key() {
-        let e = Scenario::parse("[system]\nfile = \"a.ssd\"\n[environment]\nweather = \"fog\"\nhumidity = 140.0\n", Path::new("x.toml")).unwrap_err();
+        let e = Scenario::parse(
+            "[system]\nfile = \"a.ssd\"\n[environment]\nweather = \"fog\"\nhumidity = 140.0\n",
+            Path::new("x.toml"),
+        )
+        .unwrap_err();
         assert!(e.0.contains("x.toml") && e.0.contains("environment") && e.0.contains("humidity"), "{e}");
-        let s = Scenario::parse("[system]\nfile = \"a.ssd\"\n[environment]\nweather = \"fog\"\n", Path::new("x.toml")).unwrap();
+        let s = Scenario::parse("[system]\nfile = \"a.ssd\"\n[environment]\nweather = \"fog\"\n", Path::new("x.toml"))
+            .unwrap();
         assert_eq!(s.environment_toml().trim(), "weather = \"fog\"");
         let s = Scenario::parse("[system]\nfile = \"a.ssd\"\n", Path::new("x.toml")).unwrap();
         assert_eq!(s.environment_toml(), "");

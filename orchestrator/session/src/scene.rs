@@ -7,7 +7,8 @@ use agrisim_error::Result;
 use agrisim_greenhouse::{generate, Greenhouse, GreenhouseConfig, Layout};
 
 fn config(s: &Scenario) -> Result<GreenhouseConfig> {
-    GreenhouseConfig::from_toml_str(&s.scene_toml()).map_err(|e| agrisim_error::err!("scenario {}: [greenhouse]: {e}", s.path.display()))
+    GreenhouseConfig::from_toml_str(&s.scene_toml())
+        .map_err(|e| agrisim_error::err!("scenario {}: [greenhouse]: {e}", s.path.display()))
 }
 
 pub fn generate_scene(s: &Scenario) -> Result<Greenhouse> {

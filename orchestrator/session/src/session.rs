@@ -8,13 +8,13 @@
 
 use agrisim_bus::check::{check_message, message_type};
 use agrisim_bus::{Bus, Node, Reader, Recorder};
-use std::collections::BTreeMap;
 use agrisim_cosim::{Hooks, Master, Port, System};
 use agrisim_error::{err, Error, Result};
 use agrisim_msgs::agrisim::{FmuStatus, Signals};
 use agrisim_msgs::builtin_interfaces::Time;
 use agrisim_msgs::rosgraph_msgs::Clock;
 use agrisim_msgs::std_msgs::Header;
+use std::collections::BTreeMap;
 
 pub const STATUS_TOPIC: &str = "/agrisim/status";
 /// Scalar system connectors (set by nodes or FMU outputs) recorded every step.
@@ -52,9 +52,28 @@ impl Session {
             .system
             .components
             .iter()
-            .map(|c| (format!("/fmu/{}/signals", c.name), Signals { header: Header::default(), names: c.signals.iter().map(|v| v.name.clone()).collect(), values: Vec::new() }))
+            .map(|c| {
+                (
+                    format!("/fmu/{}/signals", c.name),
+                    Signals {
+                        header: Header::default(),
+                        names: c.signals.iter().map(|v| v.name.clone()).collect(),
+                        values: Vec::new(),
+                    },
+                )
+            })
             .collect();
-        Session { master, bus: Bus::default(), nodes, recorder, types, node_wall, signals, scalars: Signals::default(), readers: BTreeMap::new() }
+        Session {
+            master,
+            bus: Bus::default(),
+            nodes,
+            recorder,
+            types,
+            node_wall,
+            signals,
+            scalars: Signals::default(),
+            readers: BTreeMap::new(),
+        }
     }
 
     pub fn time(&self) -> f64 {
@@ -81,7 +100,19 @@ impl Session {
     }
 
     fn split(&mut self) -> (&mut Master, Link<'_>) {
-        (&mut self.master, Link { bus: &mut self.bus, nodes: &mut self.nodes, recorder: &mut self.recorder, types: &self.types, node_wall: &mut self.node_wall, signals: &mut self.signals, scalars: &mut self.scalars, readers: &mut self.readers })
+        (
+            &mut self.master,
+            Link {
+                bus: &mut self.bus,
+                nodes: &mut self.nodes,
+                recorder: &mut self.recorder,
+                types: &self.types,
+                node_wall: &mut self.node_wall,
+                signals: &mut self.signals,
+                scalars: &mut self.scalars,
+                readers: &mut self.readers,
+            },
+        )
     }
 
     /// One communication point and one step of every FMU. Callers that drive the session
@@ -127,7 +158,12 @@ impl Session {
     /// Records an error on /agrisim/status (the MCAP stays complete and readable).
     pub fn record_failure(&mut self, e: &Error) {
         let t_ns = self.master.time_ns();
-        let msg = FmuStatus { header: Header { stamp: Time::from_nanos(t_ns), frame_id: String::new() }, instance: String::new(), status: "error".into(), message: e.to_string() };
+        let msg = FmuStatus {
+            header: Header { stamp: Time::from_nanos(t_ns), frame_id: String::new() },
+            instance: String::new(),
+            status: "error".into(),
+            message: e.to_string(),
+        };
         let _ = self.recorder.publish(STATUS_TOPIC, t_ns, &msg);
     }
 }
@@ -147,7 +183,10 @@ impl Session {
     /// (a restored run records its messages again, at their simulated times).
     pub fn snapshot(&mut self) -> Result<SessionSnapshot> {
         if let Some(n) = self.nodes.first() {
-            return Err(err!("cannot snapshot a session with nodes (node '{}' keeps state the snapshot would not hold)", n.name()));
+            return Err(err!(
+                "cannot snapshot a session with nodes (node '{}' keeps state the snapshot would not hold)",
+                n.name()
+            ));
         }
         Ok(SessionSnapshot { engine: self.master.snapshot()?, bus: self.bus.clone(), readers: self.readers.clone() })
     }
@@ -220,13 +259,23 @@ impl Hooks for Link<'_> {
         let header = Header { stamp: Time::from_nanos(t_ns), frame_id: String::new() };
         for c in &mut system.components {
             for m in c.instance.take_log().into_iter().filter(|m| m.status >= agrisim_cosim::fmi3::Status::Warning) {
-                let msg = FmuStatus { header: header.clone(), instance: c.name.clone(), status: "warning".into(), message: m.message };
+                let msg = FmuStatus {
+                    header: header.clone(),
+                    instance: c.name.clone(),
+                    status: "warning".into(),
+                    message: m.message,
+                };
                 self.recorder.publish(STATUS_TOPIC, t_ns, &msg)?;
             }
         }
         for reason in self.bus.take_rejected() {
             eprintln!("warning: {reason}");
-            let msg = FmuStatus { header: header.clone(), instance: String::new(), status: "warning".into(), message: reason };
+            let msg = FmuStatus {
+                header: header.clone(),
+                instance: String::new(),
+                status: "warning".into(),
+                message: reason,
+            };
             self.recorder.publish(STATUS_TOPIC, t_ns, &msg)?;
         }
         for m in self.bus.drain() {

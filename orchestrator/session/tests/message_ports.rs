@@ -145,7 +145,13 @@ fn a_route_that_drops_messages_is_an_error_naming_the_fmu_and_port() {
     let mut s = setup(&[("imu", "port_window", 0.02)]).unwrap();
     let mut probe = Probe::new(|_| (0.0, 0.0));
     let e = run(&mut s.master, &mut probe, 10).unwrap_err().0;
-    assert!(e.contains("FMU 'imu'") && e.contains("message port 'imu'") && e.contains("were lost (sequence gap)") && e.contains("port_window"), "{e}");
+    assert!(
+        e.contains("FMU 'imu'")
+            && e.contains("message port 'imu'")
+            && e.contains("were lost (sequence gap)")
+            && e.contains("port_window"),
+        "{e}"
+    );
     // With a window as long as the route's period nothing is lost.
     let mut s = setup(&[("imu", "port_window", 0.1)]).unwrap();
     run(&mut s.master, &mut Probe::new(|_| (0.0, 0.0)), 10).unwrap();
@@ -173,7 +179,8 @@ fn a_contact_lasting_one_step_is_reported_as_onset_and_end() {
     let mut s = setup(&[]).unwrap();
     let mut probe = Probe::new(move |k| (10.0, if k == 7 { y_hit } else { y_free }));
     run(&mut s.master, &mut probe, 20).unwrap();
-    let states: Vec<(i64, CollisionState)> = probe.messages["collision"].iter().map(|(t, b)| (*t, CollisionState::from_cdr(b).unwrap())).collect();
+    let states: Vec<(i64, CollisionState)> =
+        probe.messages["collision"].iter().map(|(t, b)| (*t, CollisionState::from_cdr(b).unwrap())).collect();
     let base_contact = |c: &CollisionState| c.contacts.iter().any(|c| c.robot_link == "base_link");
     // The world starts from its inputs' start values (the origin), before the first
     // system input reaches it: look after the base is placed clear.
@@ -192,11 +199,16 @@ fn the_world_sees_the_lift_after_its_step() {
     // world's lift input equals the lift's position at the same time.
     let dir = tempfile::tempdir().unwrap();
     let s = Scenario::load(&root().join("models/scenarios/harvest.toml")).unwrap();
-    let mut system = System::load(&root().join("models/systems/harvest.ssd"), &LoadOptions::new(fmu_dir(), dir.path(), 0.02, 0.1)).unwrap();
+    let mut system =
+        System::load(&root().join("models/systems/harvest.ssd"), &LoadOptions::new(fmu_dir(), dir.path(), 0.02, 0.1))
+            .unwrap();
     system.apply_parameters(&BTreeMap::new(), 1, &BTreeMap::from([("scene".to_string(), s.scene_toml())])).unwrap();
     let mut master = Master::new(system, 0.02, 0.1).unwrap();
     let names = |m: &Master, rs: &[usize]| rs.iter().map(|&r| m.system.routes[r].label.clone()).collect::<Vec<_>>();
-    assert_eq!(names(&master, &master.order().delayed), ["world.left_grasp_width -> arm_left.grasp_width", "world.right_grasp_width -> arm_right.grasp_width"]);
+    assert_eq!(
+        names(&master, &master.order().delayed),
+        ["world.left_grasp_width -> arm_left.grasp_width", "world.right_grasp_width -> arm_right.grasp_width"]
+    );
     assert!(master.order().init_loops.is_empty());
     master.initialize().unwrap();
     struct Lift;
@@ -205,7 +217,8 @@ fn the_world_sees_the_lift_after_its_step() {
             (connector == "lift_setpoint").then_some(0.5)
         }
     }
-    let (lift, world) = (master.system.component_index("lift").unwrap(), master.system.component_index("world").unwrap());
+    let (lift, world) =
+        (master.system.component_index("lift").unwrap(), master.system.component_index("world").unwrap());
     let mut moved = 0.0;
     for _ in 0..50 {
         master.advance(&mut Lift).unwrap();

@@ -59,11 +59,20 @@ impl Hooks for Drive {
 }
 
 fn drive() -> Drive {
-    let twist = agrisim_msgs::geometry_msgs::Twist { linear: agrisim_msgs::geometry_msgs::Vector3 { x: 0.3, y: 0.05, z: 0.0 }, angular: agrisim_msgs::geometry_msgs::Vector3 { x: 0.0, y: 0.0, z: 0.1 } };
+    let twist = agrisim_msgs::geometry_msgs::Twist {
+        linear: agrisim_msgs::geometry_msgs::Vector3 { x: 0.3, y: 0.05, z: 0.0 },
+        angular: agrisim_msgs::geometry_msgs::Vector3 { x: 0.0, y: 0.0, z: 0.1 },
+    };
     Drive { log: vec![], cmd_vel: twist.to_cdr(), grip: GripperCommand { position: 0.02, max_effort: 20.0 }.to_cdr() }
 }
 
-fn master(system_file: &str, scenario: &str, params: &[(&str, &str, toml::Value)], fmus: &[(&str, &str)], cache: &Path) -> Master {
+fn master(
+    system_file: &str,
+    scenario: &str,
+    params: &[(&str, &str, toml::Value)],
+    fmus: &[(&str, &str)],
+    cache: &Path,
+) -> Master {
     let s = Scenario::load(&root().join("models/scenarios").join(scenario)).unwrap();
     let mut opts = LoadOptions::new(root().join("target/fmu"), cache, 0.02, 0.1);
     opts.fmu_overrides = fmus.iter().map(|(c, f)| (c.to_string(), f.to_string())).collect();

@@ -9,12 +9,8 @@ use std::io::Read;
 use std::time::Instant;
 
 use agrisim_trajectory::jerk_limited::{self, JointState, KinematicLimits};
-use agrisim_trajectory::toppra::{
-    parameterize, parameterize_within_limits, Discretization, ToppraProblem,
-};
-use agrisim_trajectory::{
-    check, sample, CheckError, CubicSplinePath, GridSpec, JointLimits, SplineEnd, Trajectory,
-};
+use agrisim_trajectory::toppra::{parameterize, parameterize_within_limits, Discretization, ToppraProblem};
+use agrisim_trajectory::{check, sample, CheckError, CubicSplinePath, GridSpec, JointLimits, SplineEnd, Trajectory};
 use serde::Deserialize;
 use serde_json::{json, Value};
 
@@ -95,9 +91,7 @@ fn check_json(r: Result<(), CheckError>) -> Value {
         Ok(()) => json!({"ok": true}),
         Err(CheckError::Malformed(m)) => json!({"ok": false, "malformed": m}),
         Err(e @ CheckError::Violation(_)) => {
-            let CheckError::Violation(v) = &e else {
-                unreachable!()
-            };
+            let CheckError::Violation(v) = &e else { unreachable!() };
             json!({"ok": false, "joint": v.joint, "time": v.time, "quantity": v.quantity.to_string(),
                    "value": v.value, "limit": v.limit, "message": e.to_string()})
         }
@@ -111,19 +105,12 @@ fn toppra_one(p: ToppraIn) -> Value {
         Some("natural") => SplineEnd::Natural,
         Some(other) => return json!({"error": format!("unknown bc {other}")}),
     };
-    let grid = p
-        .gridpoints
-        .clone()
-        .map_or(GridSpec::Auto, GridSpec::Points);
+    let grid = p.gridpoints.clone().map_or(GridSpec::Auto, GridSpec::Points);
     let problem = ToppraProblem {
         max_velocity: p.vmax.clone(),
         max_acceleration: p.amax.clone(),
         grid,
-        discretization: if p.collocation {
-            Discretization::Collocation
-        } else {
-            Discretization::Interpolation
-        },
+        discretization: if p.collocation { Discretization::Collocation } else { Discretization::Interpolation },
     };
     let solve = || -> Result<_, String> {
         let path = CubicSplinePath::new(&p.ss, &p.waypoints, end).map_err(|e| e.to_string())?;
@@ -147,20 +134,15 @@ fn toppra_one(p: ToppraIn) -> Value {
         Ok(t) => t,
         Err(e) => return json!({"error": e, "seconds": seconds}),
     };
-    let mut out =
-        json!({"duration": traj.duration(), "n_grid": traj.gridpoints().len(), "seconds": seconds});
+    let mut out = json!({"duration": traj.duration(), "n_grid": traj.gridpoints().len(), "seconds": seconds});
     if p.return_grid {
         out["gridpoints"] = json!(traj.gridpoints());
         out["sd_squared"] = json!(traj.sd_squared());
     }
     if let Some(dt) = p.sample_dt {
         let s = sample(&traj, dt);
-        let lim = JointLimits {
-            position: vec![],
-            velocity: p.vmax.clone(),
-            acceleration: p.amax.clone(),
-            jerk: vec![],
-        };
+        let lim =
+            JointLimits { position: vec![], velocity: p.vmax.clone(), acceleration: p.amax.clone(), jerk: vec![] };
         out["check"] = check_json(check(&s, &lim, p.rel_tol));
         // Largest |qd|/vmax and |qdd|/amax seen in the samples.
         let mut vr = 0.0_f64;
@@ -179,21 +161,9 @@ fn toppra_one(p: ToppraIn) -> Value {
 }
 
 fn ruckig_one(p: RuckigIn) -> Value {
-    let start = JointState {
-        q: p.q0,
-        qd: p.v0,
-        qdd: p.a0,
-    };
-    let goal = JointState {
-        q: p.q1,
-        qd: p.v1,
-        qdd: p.a1,
-    };
-    let lim = KinematicLimits {
-        velocity: p.vmax.clone(),
-        acceleration: p.amax.clone(),
-        jerk: p.jmax.clone(),
-    };
+    let start = JointState { q: p.q0, qd: p.v0, qdd: p.a0 };
+    let goal = JointState { q: p.q1, qd: p.v1, qdd: p.a1 };
+    let lim = KinematicLimits { velocity: p.vmax.clone(), acceleration: p.amax.clone(), jerk: p.jmax.clone() };
     let t0 = Instant::now();
     let motion = match jerk_limited::plan(&start, &goal, &lim) {
         Ok(m) => m,
@@ -214,12 +184,7 @@ fn ruckig_one(p: RuckigIn) -> Value {
     out["probes"] = json!(probes);
     if let Some(dt) = p.sample_dt {
         let s = sample(&motion, dt);
-        let jl = JointLimits {
-            position: vec![],
-            velocity: p.vmax,
-            acceleration: p.amax,
-            jerk: p.jmax,
-        };
+        let jl = JointLimits { position: vec![], velocity: p.vmax, acceleration: p.amax, jerk: p.jmax };
         out["check"] = check_json(check(&s, &jl, p.rel_tol));
     }
     out
@@ -227,30 +192,16 @@ fn ruckig_one(p: RuckigIn) -> Value {
 
 fn check_one(p: CheckIn) -> Value {
     let nan = |m: Vec<Vec<Option<f64>>>| -> Vec<Vec<f64>> {
-        m.into_iter()
-            .map(|r| r.into_iter().map(|v| v.unwrap_or(f64::NAN)).collect())
-            .collect()
+        m.into_iter().map(|r| r.into_iter().map(|v| v.unwrap_or(f64::NAN)).collect()).collect()
     };
-    let s = agrisim_trajectory::Sampled {
-        t: p.t,
-        q: nan(p.q),
-        qd: nan(p.qd),
-        qdd: nan(p.qdd),
-    };
-    let lim = JointLimits {
-        position: p.position,
-        velocity: p.velocity,
-        acceleration: p.acceleration,
-        jerk: p.jerk,
-    };
+    let s = agrisim_trajectory::Sampled { t: p.t, q: nan(p.q), qd: nan(p.qd), qdd: nan(p.qdd) };
+    let lim = JointLimits { position: p.position, velocity: p.velocity, acceleration: p.acceleration, jerk: p.jerk };
     check_json(check(&s, &lim, p.rel_tol))
 }
 
 fn main() {
     let mut text = String::new();
-    std::io::stdin()
-        .read_to_string(&mut text)
-        .expect("read stdin");
+    std::io::stdin().read_to_string(&mut text).expect("read stdin");
     let req: Request = serde_json::from_str(&text).expect("request JSON");
     let results: Vec<Value> = req
         .problems

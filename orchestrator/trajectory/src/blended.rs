@@ -34,31 +34,23 @@ impl BlendedPolylinePath {
     /// Consecutive identical waypoints are dropped.
     pub fn new(waypoints: &[Vec<f64>], radius: f64) -> Result<Self, PathError> {
         if !(radius > 0.0 && radius.is_finite()) {
-            return Err(PathError::BadParameters(format!(
-                "blend radius {radius} must be positive"
-            )));
+            return Err(PathError::BadParameters(format!("blend radius {radius} must be positive")));
         }
         let dof = waypoints.first().map_or(0, |w| w.len());
         if dof == 0 {
-            return Err(PathError::BadWaypoints(
-                "no waypoints or zero joints".into(),
-            ));
+            return Err(PathError::BadWaypoints("no waypoints or zero joints".into()));
         }
         let mut pts: Vec<&Vec<f64>> = Vec::new();
         for (k, w) in waypoints.iter().enumerate() {
             if w.len() != dof || w.iter().any(|v| !v.is_finite()) {
-                return Err(PathError::BadWaypoints(format!(
-                    "waypoint {k} has wrong length or is not finite"
-                )));
+                return Err(PathError::BadWaypoints(format!("waypoint {k} has wrong length or is not finite")));
             }
             if pts.last().is_none_or(|p| *p != w) {
                 pts.push(w);
             }
         }
         if pts.len() < 2 {
-            return Err(PathError::BadWaypoints(
-                "need at least 2 distinct waypoints".into(),
-            ));
+            return Err(PathError::BadWaypoints("need at least 2 distinct waypoints".into()));
         }
         let seg_len: Vec<f64> = pts.windows(2).map(|w| dist(w[0], w[1])).collect();
         let dirs: Vec<Vec<f64>> = pts
@@ -69,40 +61,20 @@ impl BlendedPolylinePath {
         // Blend half-length at each interior corner.
         let m = pts.len();
         let ell: Vec<f64> = (0..m)
-            .map(|k| {
-                if k == 0 || k == m - 1 {
-                    0.0
-                } else {
-                    radius.min(0.5 * seg_len[k - 1]).min(0.5 * seg_len[k])
-                }
-            })
+            .map(|k| if k == 0 || k == m - 1 { 0.0 } else { radius.min(0.5 * seg_len[k - 1]).min(0.5 * seg_len[k]) })
             .collect();
         let mut pieces = Vec::new();
         let mut s = 0.0;
         for k in 0..m - 1 {
             // Straight part of segment k, then the blend at corner k+1.
-            let start: Vec<f64> = pts[k]
-                .iter()
-                .zip(&dirs[k])
-                .map(|(p, d)| p + ell[k] * d)
-                .collect();
+            let start: Vec<f64> = pts[k].iter().zip(&dirs[k]).map(|(p, d)| p + ell[k] * d).collect();
             let straight = seg_len[k] - ell[k] - ell[k + 1];
             if straight > 0.0 {
-                pieces.push(Piece {
-                    s0: s,
-                    len: straight,
-                    p0: start,
-                    d_in: dirs[k].clone(),
-                    d_out: dirs[k].clone(),
-                });
+                pieces.push(Piece { s0: s, len: straight, p0: start, d_in: dirs[k].clone(), d_out: dirs[k].clone() });
                 s += straight;
             }
             if k + 1 < m - 1 && ell[k + 1] > 0.0 {
-                let a: Vec<f64> = pts[k + 1]
-                    .iter()
-                    .zip(&dirs[k])
-                    .map(|(p, d)| p - ell[k + 1] * d)
-                    .collect();
+                let a: Vec<f64> = pts[k + 1].iter().zip(&dirs[k]).map(|(p, d)| p - ell[k + 1] * d).collect();
                 pieces.push(Piece {
                     s0: s,
                     len: 2.0 * ell[k + 1],
@@ -114,20 +86,12 @@ impl BlendedPolylinePath {
             }
         }
         let breakpoints = pieces.iter().skip(1).map(|p| p.s0).collect();
-        Ok(BlendedPolylinePath {
-            dof,
-            pieces,
-            breakpoints,
-        })
+        Ok(BlendedPolylinePath { dof, pieces, breakpoints })
     }
 }
 
 fn dist(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (y - x) * (y - x))
-        .sum::<f64>()
-        .sqrt()
+    a.iter().zip(b).map(|(x, y)| (y - x) * (y - x)).sum::<f64>().sqrt()
 }
 
 impl JointPath for BlendedPolylinePath {
@@ -177,16 +141,13 @@ mod tests {
         let p = BlendedPolylinePath::new(&w, 0.2).unwrap();
         assert!(p.interval().0 == 0.0 && (p.interval().1 - 3.0).abs() < 1e-12);
         assert!(
-            (JointPath::breakpoints(&p)[0] - 0.8).abs() < 1e-12
-                && (JointPath::breakpoints(&p)[1] - 1.2).abs() < 1e-12
+            (JointPath::breakpoints(&p)[0] - 0.8).abs() < 1e-12 && (JointPath::breakpoints(&p)[1] - 1.2).abs() < 1e-12
         );
         assert_eq!(JointPath::breakpoints(&p).len(), 2);
         // Ends and straight parts exact, unit speed there.
         assert_eq!(at(&p, 0.0).0, vec![0.0, 0.0]);
         let (q, dq, _) = at(&p, 3.0);
-        assert!(
-            (q[0] - 1.0).abs() < 1e-12 && (q[1] - 2.0).abs() < 1e-12 && (dq[1] - 1.0).abs() < 1e-12
-        );
+        assert!((q[0] - 1.0).abs() < 1e-12 && (q[1] - 2.0).abs() < 1e-12 && (dq[1] - 1.0).abs() < 1e-12);
         let (q, _, _) = at(&p, 0.5);
         assert!((q[0] - 0.5).abs() < 1e-12 && q[1] == 0.0);
         // Continuous position and velocity across the blend ends; corner deviation radius/2·|Δd|/2.

@@ -32,17 +32,13 @@ pub fn gridpoints<P: JointPath + ?Sized>(path: &P, spec: &GridSpec) -> Result<Ve
             if *n < 2 {
                 return Err(format!("uniform grid needs at least 2 points, got {n}"));
             }
-            let mut v: Vec<f64> = (0..*n)
-                .map(|k| s0 + (s1 - s0) * k as f64 / (*n - 1) as f64)
-                .collect();
+            let mut v: Vec<f64> = (0..*n).map(|k| s0 + (s1 - s0) * k as f64 / (*n - 1) as f64).collect();
             v[*n - 1] = s1;
             v
         }
         GridSpec::Points(v) => {
             if v.len() < 2 || v[0] != s0 || v[v.len() - 1] != s1 {
-                return Err(
-                    "explicit gridpoints must start and end at the path interval ends".into(),
-                );
+                return Err("explicit gridpoints must start and end at the path interval ends".into());
             }
             v.clone()
         }
@@ -78,9 +74,7 @@ fn propose<P: JointPath + ?Sized>(
                 continue;
             }
             path.eval(mid, &mut q, &mut dq, &mut ddq);
-            let err = ddq
-                .iter()
-                .fold(0.0_f64, |m, v| m.max((0.5 * v * len * len).abs()));
+            let err = ddq.iter().fold(0.0_f64, |m, v| m.max((0.5 * v * len * len).abs()));
             if err > max_err {
                 added.push(mid);
             }
@@ -93,9 +87,7 @@ fn propose<P: JointPath + ?Sized>(
         grid.sort_by(f64::total_cmp);
     }
     if !converged {
-        return Err(format!(
-            "no adequate grid after {max_iteration} refinement passes"
-        ));
+        return Err(format!("no adequate grid after {max_iteration} refinement passes"));
     }
     while grid.len() < min_points {
         let mids: Vec<f64> = grid.windows(2).map(|w| 0.5 * (w[0] + w[1])).collect();

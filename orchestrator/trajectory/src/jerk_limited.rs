@@ -26,11 +26,7 @@ impl JointState {
     /// At rest at `q`.
     pub fn at_rest(q: Vec<f64>) -> Self {
         let n = q.len();
-        JointState {
-            q,
-            qd: vec![0.0; n],
-            qdd: vec![0.0; n],
-        }
+        JointState { q, qd: vec![0.0; n], qdd: vec![0.0; n] }
     }
 }
 
@@ -100,10 +96,7 @@ pub fn plan(
     }
     for (name, v) in vectors {
         if v.len() != dof {
-            return Err(JerkLimitedError::BadInput(format!(
-                "{name} has {} entries, expected {dof}",
-                v.len()
-            )));
+            return Err(JerkLimitedError::BadInput(format!("{name} has {} entries, expected {dof}", v.len())));
         }
         if v.iter().any(|x| !x.is_finite()) {
             return Err(JerkLimitedError::BadInput(format!("{name} is not finite")));
@@ -111,9 +104,7 @@ pub fn plan(
     }
     for (name, v) in &vectors[6..] {
         if v.iter().any(|x| *x <= 0.0) {
-            return Err(JerkLimitedError::BadInput(format!(
-                "{name} must be positive"
-            )));
+            return Err(JerkLimitedError::BadInput(format!("{name} must be positive")));
         }
     }
     let mut input = InputParameter::<0>::new(Some(dof));
@@ -137,9 +128,7 @@ pub fn plan(
     match result {
         Err(_) => Err(JerkLimitedError::Ruckig("panicked".into())),
         Ok(Err(e)) => Err(JerkLimitedError::Ruckig(e.to_string())),
-        Ok(Ok((RuckigResult::Working | RuckigResult::Finished, traj))) => {
-            Ok(JerkLimitedMotion { dof, traj })
-        }
+        Ok(Ok((RuckigResult::Working | RuckigResult::Finished, traj))) => Ok(JerkLimitedMotion { dof, traj }),
         Ok(Ok((r, _))) => Err(JerkLimitedError::Ruckig(format!("{r:?}"))),
     }
 }
@@ -159,14 +148,7 @@ impl Trajectory for JerkLimitedMotion {
         let mut v = DataArrayOrVec::<f64, 0>::new(Some(self.dof), 0.0);
         let mut a = DataArrayOrVec::<f64, 0>::new(Some(self.dof), 0.0);
         let mut section = None;
-        self.traj.at_time(
-            t,
-            &mut Some(&mut p),
-            &mut Some(&mut v),
-            &mut Some(&mut a),
-            &mut None,
-            &mut section,
-        );
+        self.traj.at_time(t, &mut Some(&mut p), &mut Some(&mut v), &mut Some(&mut a), &mut None, &mut section);
         for j in 0..self.dof {
             q[j] = p[j];
             qd[j] = v[j];
@@ -188,19 +170,11 @@ mod tests {
         let m = plan(
             &JointState::at_rest(vec![0.0]),
             &JointState::at_rest(vec![d]),
-            &KinematicLimits {
-                velocity: vec![v],
-                acceleration: vec![a],
-                jerk: vec![j],
-            },
+            &KinematicLimits { velocity: vec![v], acceleration: vec![a], jerk: vec![j] },
         )
         .unwrap();
         let want = d / v + v / a + a / j;
-        assert!(
-            (m.duration() - want).abs() < 1e-9,
-            "{} vs {want}",
-            m.duration()
-        );
+        assert!((m.duration() - want).abs() < 1e-9, "{} vs {want}", m.duration());
     }
 
     #[test]
@@ -210,20 +184,13 @@ mod tests {
             acceleration: vec![3.0, 5.0, 2.0],
             jerk: vec![30.0, 50.0, 20.0],
         };
-        let start = JointState {
-            q: vec![0.0, 0.3, -0.2],
-            qd: vec![0.2, 0.0, -0.1],
-            qdd: vec![0.0, 0.5, 0.0],
-        };
+        let start = JointState { q: vec![0.0, 0.3, -0.2], qd: vec![0.2, 0.0, -0.1], qdd: vec![0.0, 0.5, 0.0] };
         let goal = JointState::at_rest(vec![1.0, -0.7, 0.4]);
         let m = plan(&start, &goal, &lim).unwrap();
         let s = sample(&m, 0.001);
         let end = s.q.last().unwrap();
         assert!(end.iter().zip(&goal.q).all(|(a, b)| (a - b).abs() < 1e-9));
-        assert!(s.q[0]
-            .iter()
-            .zip(&start.q)
-            .all(|(a, b)| (a - b).abs() < 1e-12));
+        assert!(s.q[0].iter().zip(&start.q).all(|(a, b)| (a - b).abs() < 1e-12));
         let jl = JointLimits {
             position: vec![],
             velocity: lim.velocity.clone(),
@@ -231,14 +198,6 @@ mod tests {
             jerk: lim.jerk.clone(),
         };
         check(&s, &jl, 1e-6).unwrap();
-        assert!(plan(
-            &start,
-            &goal,
-            &KinematicLimits {
-                jerk: vec![1.0, 0.0, 1.0],
-                ..lim.clone()
-            }
-        )
-        .is_err());
+        assert!(plan(&start, &goal, &KinematicLimits { jerk: vec![1.0, 0.0, 1.0], ..lim.clone() }).is_err());
     }
 }

@@ -24,12 +24,9 @@ pub use grid::GridSpec;
 pub use jerk_limited::{JerkLimitedMotion, JointState, KinematicLimits};
 pub use limits::{check, CheckError, JointLimits, LimitViolation, Quantity};
 pub use path::{JointPath, PathError};
-pub use pipeline::{
-    time_path, time_state_to_state, time_waypoints, PathShape, PlanError, TimingConfig,
-};
+pub use pipeline::{time_path, time_state_to_state, time_waypoints, PathShape, PlanError, TimingConfig};
 pub use sampled::{sample, Sampled, Trajectory};
 pub use spline::{CubicSplinePath, PathParam, SplineEnd};
 pub use toppra::{
-    parameterize, parameterize_within_limits, Discretization, ToppraError, ToppraProblem,
-    ToppraTrajectory,
+    parameterize, parameterize_within_limits, Discretization, ToppraError, ToppraProblem, ToppraTrajectory,
 };

@@ -117,32 +117,19 @@ pub fn check(traj: &Sampled, limits: &JointLimits, rel_tol: f64) -> Result<(), C
         ("jerk", limits.jerk.len()),
     ] {
         if len != 0 && len != dof {
-            return Err(CheckError::Malformed(format!(
-                "{len} {name} limits for {dof} joints"
-            )));
+            return Err(CheckError::Malformed(format!("{len} {name} limits for {dof} joints")));
         }
     }
     for k in 0..n {
         if !traj.t[k].is_finite() || (k > 0 && traj.t[k] <= traj.t[k - 1]) {
-            return Err(CheckError::Malformed(format!(
-                "time {k} ({}) not finite or not increasing",
-                traj.t[k]
-            )));
+            return Err(CheckError::Malformed(format!("time {k} ({}) not finite or not increasing", traj.t[k])));
         }
         if traj.q[k].len() != dof || traj.qd[k].len() != dof || traj.qdd[k].len() != dof {
-            return Err(CheckError::Malformed(format!(
-                "sample {k} does not have {dof} joints"
-            )));
+            return Err(CheckError::Malformed(format!("sample {k} does not have {dof} joints")));
         }
     }
     let fail = |joint, k: usize, quantity, value, limit| {
-        Err(CheckError::Violation(LimitViolation {
-            joint,
-            time: traj.t[k],
-            quantity,
-            value,
-            limit,
-        }))
+        Err(CheckError::Violation(LimitViolation { joint, time: traj.t[k], quantity, value, limit }))
     };
     let over = |value: f64, limit: f64| value.is_nan() || value.abs() > limit * (1.0 + rel_tol);
     for k in 0..n {
@@ -151,11 +138,7 @@ pub fn check(traj: &Sampled, limits: &JointLimits, rel_tol: f64) -> Result<(), C
                 let q = traj.q[k][j];
                 let slack = rel_tol * (hi - lo);
                 if !(q >= lo - slack && q <= hi + slack) {
-                    let limit = if (q - lo).abs() < (q - hi).abs() {
-                        lo
-                    } else {
-                        hi
-                    };
+                    let limit = if (q - lo).abs() < (q - hi).abs() { lo } else { hi };
                     return fail(j, k, Quantity::Position, q, limit);
                 }
             }
@@ -215,40 +198,21 @@ mod tests {
                 limit: 0.5
             }))
         );
-        let ok = JointLimits {
-            velocity: vec![0.9],
-            ..lim.clone()
-        };
+        let ok = JointLimits { velocity: vec![0.9], ..lim.clone() };
         assert_eq!(check(&ramp(), &ok, 0.0), Ok(()));
         // Jerk: an acceleration step of 1 over 0.1 s is 10 rad/s³.
         let mut s = ramp();
         s.qdd[5][0] = 2.0;
-        let tight = JointLimits {
-            jerk: vec![5.0],
-            ..ok.clone()
-        };
+        let tight = JointLimits { jerk: vec![5.0], ..ok.clone() };
         let e = check(&s, &tight, 0.0).unwrap_err();
-        assert!(matches!(
-            e,
-            CheckError::Violation(LimitViolation {
-                quantity: Quantity::Jerk,
-                ..
-            })
-        ));
-        assert!(
-            e.to_string()
-                .contains("joint 0 jerk limit violated at t = 0.5000 s"),
-            "{e}"
-        );
+        assert!(matches!(e, CheckError::Violation(LimitViolation { quantity: Quantity::Jerk, .. })));
+        assert!(e.to_string().contains("joint 0 jerk limit violated at t = 0.5000 s"), "{e}");
         // NaN is a violation, non-monotonic time is malformed.
         let mut s = ramp();
         s.q[3][0] = f64::NAN;
         assert!(matches!(
             check(&s, &ok, 0.0),
-            Err(CheckError::Violation(LimitViolation {
-                quantity: Quantity::Position,
-                ..
-            }))
+            Err(CheckError::Violation(LimitViolation { quantity: Quantity::Position, .. }))
         ));
         let mut s = ramp();
         s.t[4] = s.t[3];

@@ -55,12 +55,7 @@ pub(crate) fn maximize(c: [f64; 2], rows: &[Row], lo: [f64; 2], hi: [f64; 2]) ->
             }
             true
         };
-        let box_rows = [
-            (-1.0, 0.0, -lo[0]),
-            (1.0, 0.0, hi[0]),
-            (0.0, -1.0, -lo[1]),
-            (0.0, 1.0, hi[1]),
-        ];
+        let box_rows = [(-1.0, 0.0, -lo[0]), (1.0, 0.0, hi[0]), (0.0, -1.0, -lo[1]), (0.0, 1.0, hi[1])];
         for &(a, b, g) in &box_rows {
             if !bound(a, b, g) {
                 return None;
@@ -74,11 +69,7 @@ pub(crate) fn maximize(c: [f64; 2], rows: &[Row], lo: [f64; 2], hi: [f64; 2]) ->
         if tmin > tmax {
             return None;
         }
-        let t = if c[0] * d[0] + c[1] * d[1] > 0.0 {
-            tmax
-        } else {
-            tmin
-        };
+        let t = if c[0] * d[0] + c[1] * d[1] > 0.0 { tmax } else { tmin };
         v = [p0[0] + t * d[0], p0[1] + t * d[1]];
     }
     Some(v)
@@ -111,26 +102,10 @@ mod tests {
     /// Brute force: best feasible vertex among all pairwise intersections (box included).
     fn brute(c: [f64; 2], rows: &[Row], lo: [f64; 2], hi: [f64; 2]) -> Option<f64> {
         let mut all: Vec<Row> = rows.to_vec();
-        all.push(Row {
-            a: -1.0,
-            b: 0.0,
-            g: -lo[0],
-        });
-        all.push(Row {
-            a: 1.0,
-            b: 0.0,
-            g: hi[0],
-        });
-        all.push(Row {
-            a: 0.0,
-            b: -1.0,
-            g: -lo[1],
-        });
-        all.push(Row {
-            a: 0.0,
-            b: 1.0,
-            g: hi[1],
-        });
+        all.push(Row { a: -1.0, b: 0.0, g: -lo[0] });
+        all.push(Row { a: 1.0, b: 0.0, g: hi[0] });
+        all.push(Row { a: 0.0, b: -1.0, g: -lo[1] });
+        all.push(Row { a: 0.0, b: 1.0, g: hi[1] });
         let mut best: Option<f64> = None;
         for i in 0..all.len() {
             for j in i + 1..all.len() {
@@ -153,21 +128,13 @@ mod tests {
     fn matches_vertex_enumeration_on_random_problems() {
         let mut state = 0x1234_5678_u64;
         let mut rnd = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             ((state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
         };
         let (mut feasible, mut infeasible) = (0, 0);
         for _ in 0..3000 {
             let m = 2 + (rnd().abs() * 12.0) as usize;
-            let rows: Vec<Row> = (0..m)
-                .map(|_| Row {
-                    a: rnd(),
-                    b: rnd(),
-                    g: rnd() + 0.3,
-                })
-                .collect();
+            let rows: Vec<Row> = (0..m).map(|_| Row { a: rnd(), b: rnd(), g: rnd() + 0.3 }).collect();
             let c = [rnd(), rnd()];
             let (lo, hi) = ([-5.0, -5.0], [5.0, 5.0]);
             let got = maximize(c, &rows, lo, hi);
@@ -182,9 +149,6 @@ mod tests {
                 (g, w) => panic!("disagree: {g:?} vs {w:?}"),
             }
         }
-        assert!(
-            feasible > 1000 && infeasible > 50,
-            "{feasible} {infeasible}"
-        );
+        assert!(feasible > 1000 && infeasible > 50, "{feasible} {infeasible}");
     }
 }

@@ -9,9 +9,7 @@ use crate::limits::JointLimits;
 /// Number of arm joints.
 pub const DOF: usize = 7;
 /// Lower joint position limits, rad.
-pub const POSITION_MIN: [f64; DOF] = [
-    -2.8973, -1.7628, -2.8973, -3.0718, -2.8973, -0.0175, -2.8973,
-];
+pub const POSITION_MIN: [f64; DOF] = [-2.8973, -1.7628, -2.8973, -3.0718, -2.8973, -0.0175, -2.8973];
 /// Upper joint position limits, rad.
 pub const POSITION_MAX: [f64; DOF] = [2.8973, 1.7628, 2.8973, -0.0698, 2.8973, 3.7525, 2.8973];
 /// Maximum joint velocity, rad/s.

@@ -81,25 +81,19 @@ const ROUNDS: usize = 8;
 /// `cfg.dt`, within the planning limits at every sample and checked against `cfg.hardware`.
 pub fn time_waypoints(waypoints: &[Vec<f64>], cfg: &TimingConfig) -> Result<Sampled, PlanError> {
     match cfg.shape {
-        PathShape::Spline(param) => time_path(
-            CubicSplinePath::through_waypoints(waypoints, param).map_err(PlanError::Path)?,
-            cfg,
-        ),
-        PathShape::Blended { radius } => time_path(
-            BlendedPolylinePath::new(waypoints, radius).map_err(PlanError::Path)?,
-            cfg,
-        ),
+        PathShape::Spline(param) => {
+            time_path(CubicSplinePath::through_waypoints(waypoints, param).map_err(PlanError::Path)?, cfg)
+        }
+        PathShape::Blended { radius } => {
+            time_path(BlendedPolylinePath::new(waypoints, radius).map_err(PlanError::Path)?, cfg)
+        }
     }
 }
 
 /// Any path → TOPP-RA → samples at `cfg.dt` → hardware check.
 pub fn time_path<P: JointPath + Clone>(path: P, cfg: &TimingConfig) -> Result<Sampled, PlanError> {
-    let problem = ToppraProblem::new(
-        cfg.planning.velocity.clone(),
-        cfg.planning.acceleration.clone(),
-    );
-    let traj = parameterize_within_limits(path, &problem, cfg.dt, CHECK_TOL, ROUNDS)
-        .map_err(PlanError::Toppra)?;
+    let problem = ToppraProblem::new(cfg.planning.velocity.clone(), cfg.planning.acceleration.clone());
+    let traj = parameterize_within_limits(path, &problem, cfg.dt, CHECK_TOL, ROUNDS).map_err(PlanError::Toppra)?;
     let samples = sample(&traj, cfg.dt);
     check(&samples, &cfg.hardware, CHECK_TOL).map_err(PlanError::Check)?;
     Ok(samples)
@@ -107,11 +101,7 @@ pub fn time_path<P: JointPath + Clone>(path: P, cfg: &TimingConfig) -> Result<Sa
 
 /// Jerk-limited, time-synchronized motion from `start` to `goal` (ruckig) with the planning
 /// velocity, acceleration and jerk limits, sampled at `cfg.dt` and checked against `cfg.hardware`.
-pub fn time_state_to_state(
-    start: &JointState,
-    goal: &JointState,
-    cfg: &TimingConfig,
-) -> Result<Sampled, PlanError> {
+pub fn time_state_to_state(start: &JointState, goal: &JointState, cfg: &TimingConfig) -> Result<Sampled, PlanError> {
     let lim = KinematicLimits {
         velocity: cfg.planning.velocity.clone(),
         acceleration: cfg.planning.acceleration.clone(),
@@ -135,46 +125,22 @@ mod tests {
             vec![0.5, -0.3, 0.2, -2.0, 0.1, 1.9, 0.5],
             vec![1.0, 0.2, -0.3, -1.5, 0.4, 2.2, 0.0],
         ];
-        for shape in [
-            PathShape::Blended { radius: 0.1 },
-            PathShape::Spline(PathParam::ChordLength),
-        ] {
-            let cfg = TimingConfig {
-                shape,
-                ..TimingConfig::panda(0.05)
-            };
+        for shape in [PathShape::Blended { radius: 0.1 }, PathShape::Spline(PathParam::ChordLength)] {
+            let cfg = TimingConfig { shape, ..TimingConfig::panda(0.05) };
             let s = time_waypoints(&wps, &cfg).unwrap();
-            assert!(s
-                .t
-                .windows(2)
-                .all(|w| w[1] > w[0] && w[1] - w[0] <= 0.05 + 1e-12));
+            assert!(s.t.windows(2).all(|w| w[1] > w[0] && w[1] - w[0] <= 0.05 + 1e-12));
             assert_eq!(s.q[0], wps[0]);
-            assert!(s
-                .q
-                .last()
-                .unwrap()
-                .iter()
-                .zip(&wps[2])
-                .all(|(a, b)| (a - b).abs() < 1e-9));
+            assert!(s.q.last().unwrap().iter().zip(&wps[2]).all(|(a, b)| (a - b).abs() < 1e-9));
             check(&s, &cfg.planning.scaled(1.0, 1.0, 1e6), 1e-6).unwrap();
         }
         let cfg = TimingConfig::panda(0.01);
-        let s = time_state_to_state(
-            &JointState::at_rest(wps[0].clone()),
-            &JointState::at_rest(wps[2].clone()),
-            &cfg,
-        )
-        .unwrap();
+        let s = time_state_to_state(&JointState::at_rest(wps[0].clone()), &JointState::at_rest(wps[2].clone()), &cfg)
+            .unwrap();
         check(&s, &cfg.planning, 1e-6).unwrap();
         // A target outside joint 4's range is caught by the hardware check.
         let mut bad = wps[2].clone();
         bad[3] = 0.3;
-        let e = time_state_to_state(
-            &JointState::at_rest(wps[0].clone()),
-            &JointState::at_rest(bad),
-            &cfg,
-        )
-        .unwrap_err();
+        let e = time_state_to_state(&JointState::at_rest(wps[0].clone()), &JointState::at_rest(bad), &cfg).unwrap_err();
         assert!(
             matches!(e, PlanError::Check(CheckError::Violation(ref v)) if v.joint == 3 && v.quantity == Quantity::Position),
             "{e}"
@@ -185,9 +151,7 @@ mod tests {
     fn random_panda_waypoint_paths_all_time_and_check() {
         let mut state = 99u64;
         let mut uniform = move || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
         let mut total_time = 0.0;
@@ -206,20 +170,12 @@ mod tests {
                 })
                 .collect();
             let cfg = TimingConfig {
-                shape: PathShape::Blended {
-                    radius: 0.05 + 0.2 * uniform(),
-                },
+                shape: PathShape::Blended { radius: 0.05 + 0.2 * uniform() },
                 ..TimingConfig::panda(0.05)
             };
             let s = time_waypoints(&wps, &cfg).unwrap_or_else(|e| panic!("case {case}: {e}"));
             check(&s, &cfg.planning.scaled(1.0, 1.0, 1e6), 1e-6).unwrap();
-            assert!(s
-                .q
-                .last()
-                .unwrap()
-                .iter()
-                .zip(&wps[n - 1])
-                .all(|(a, b)| (a - b).abs() < 1e-9));
+            assert!(s.q.last().unwrap().iter().zip(&wps[n - 1]).all(|(a, b)| (a - b).abs() < 1e-9));
             total_time += s.t.last().unwrap();
         }
         assert!(total_time > 100.0 * 0.5);

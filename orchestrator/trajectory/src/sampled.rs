@@ -68,11 +68,7 @@ impl Trajectory for Sampled {
         let x = ((t - self.t[k]) / h).clamp(0.0, 1.0);
         for j in 0..q.len() {
             let (p0, v0, a0) = (self.q[k][j], self.qd[k][j] * h, self.qdd[k][j] * h * h);
-            let (p1, v1, a1) = (
-                self.q[k + 1][j],
-                self.qd[k + 1][j] * h,
-                self.qdd[k + 1][j] * h * h,
-            );
+            let (p1, v1, a1) = (self.q[k + 1][j], self.qd[k + 1][j] * h, self.qdd[k + 1][j] * h * h);
             let (p, v, a) = quintic_hermite(x, p0, v0, a0, p1, v1, a1);
             q[j] = p;
             qd[j] = v / h;
@@ -82,15 +78,7 @@ impl Trajectory for Sampled {
 }
 
 /// Quintic Hermite on the unit interval: value, first and second derivative at `x`.
-fn quintic_hermite(
-    x: f64,
-    p0: f64,
-    v0: f64,
-    a0: f64,
-    p1: f64,
-    v1: f64,
-    a1: f64,
-) -> (f64, f64, f64) {
+fn quintic_hermite(x: f64, p0: f64, v0: f64, a0: f64, p1: f64, v1: f64, a1: f64) -> (f64, f64, f64) {
     let c3 = 10.0 * (p1 - p0) - 6.0 * v0 - 4.0 * v1 - 1.5 * a0 + 0.5 * a1;
     let c4 = -15.0 * (p1 - p0) + 8.0 * v0 + 7.0 * v1 + 1.5 * a0 - a1;
     let c5 = 6.0 * (p1 - p0) - 3.0 * (v0 + v1) - 0.5 * a0 + 0.5 * a1;
@@ -110,20 +98,13 @@ pub fn sample<T: Trajectory + ?Sized>(traj: &T, dt: f64) -> Sampled {
     let mut times: Vec<f64> = Vec::new();
     if dt > 0.0 && dt.is_finite() {
         let steps = (duration / dt).floor() as usize;
-        times.extend(
-            (0..=steps)
-                .map(|k| k as f64 * dt)
-                .filter(|&t| t < duration - 1e-9),
-        );
+        times.extend((0..=steps).map(|k| k as f64 * dt).filter(|&t| t < duration - 1e-9));
     }
     times.push(duration);
     if times[0] != 0.0 {
         times.insert(0, 0.0);
     }
-    let mut out = Sampled {
-        t: times,
-        ..Default::default()
-    };
+    let mut out = Sampled { t: times, ..Default::default() };
     for &t in &out.t {
         let (mut q, mut qd, mut qdd) = (vec![0.0; dof], vec![0.0; dof], vec![0.0; dof]);
         traj.state_at(t, &mut q, &mut qd, &mut qdd);

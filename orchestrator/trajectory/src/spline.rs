@@ -45,15 +45,10 @@ impl CubicSplinePath {
     pub fn new(ss: &[f64], waypoints: &[Vec<f64>], end: SplineEnd) -> Result<Self, PathError> {
         let n = waypoints.len();
         if n < 2 {
-            return Err(PathError::BadWaypoints(format!(
-                "need at least 2 waypoints, got {n}"
-            )));
+            return Err(PathError::BadWaypoints(format!("need at least 2 waypoints, got {n}")));
         }
         if ss.len() != n {
-            return Err(PathError::BadParameters(format!(
-                "{} path parameters for {n} waypoints",
-                ss.len()
-            )));
+            return Err(PathError::BadParameters(format!("{} path parameters for {n} waypoints", ss.len())));
         }
         let dof = waypoints[0].len();
         if dof == 0 {
@@ -61,21 +56,14 @@ impl CubicSplinePath {
         }
         for (k, w) in waypoints.iter().enumerate() {
             if w.len() != dof {
-                return Err(PathError::BadWaypoints(format!(
-                    "waypoint {k} has {} joints, expected {dof}",
-                    w.len()
-                )));
+                return Err(PathError::BadWaypoints(format!("waypoint {k} has {} joints, expected {dof}", w.len())));
             }
             if w.iter().any(|v| !v.is_finite()) {
-                return Err(PathError::BadWaypoints(format!(
-                    "waypoint {k} is not finite"
-                )));
+                return Err(PathError::BadWaypoints(format!("waypoint {k} is not finite")));
             }
         }
         if ss.iter().any(|v| !v.is_finite()) || ss.windows(2).any(|w| w[1] <= w[0]) {
-            return Err(PathError::BadParameters(
-                "path parameters must be finite and strictly increasing".into(),
-            ));
+            return Err(PathError::BadParameters("path parameters must be finite and strictly increasing".into()));
         }
         let h: Vec<f64> = ss.windows(2).map(|w| w[1] - w[0]).collect();
         let mut coeffs = vec![[0.0; 4]; (n - 1) * dof];
@@ -87,19 +75,11 @@ impl CubicSplinePath {
             let m = second_derivatives(&h, &y, end);
             for k in 0..n - 1 {
                 let d = (y[k + 1] - y[k]) / h[k];
-                coeffs[k * dof + j] = [
-                    y[k],
-                    d - h[k] * (2.0 * m[k] + m[k + 1]) / 6.0,
-                    0.5 * m[k],
-                    (m[k + 1] - m[k]) / (6.0 * h[k]),
-                ];
+                coeffs[k * dof + j] =
+                    [y[k], d - h[k] * (2.0 * m[k] + m[k + 1]) / 6.0, 0.5 * m[k], (m[k + 1] - m[k]) / (6.0 * h[k])];
             }
         }
-        Ok(CubicSplinePath {
-            knots: ss.to_vec(),
-            dof,
-            coeffs,
-        })
+        Ok(CubicSplinePath { knots: ss.to_vec(), dof, coeffs })
     }
 
     /// Spline through planner waypoints with the given parameterization and not-a-knot ends.
@@ -112,9 +92,7 @@ impl CubicSplinePath {
             }
         }
         if kept.len() < 2 {
-            return Err(PathError::BadWaypoints(
-                "need at least 2 distinct waypoints".into(),
-            ));
+            return Err(PathError::BadWaypoints("need at least 2 distinct waypoints".into()));
         }
         let ss = path_parameters(&kept, param);
         Self::new(&ss, &kept, SplineEnd::NotAKnot)
@@ -138,26 +116,13 @@ impl CubicSplinePath {
 pub fn path_parameters(waypoints: &[Vec<f64>], param: PathParam) -> Vec<f64> {
     let n = waypoints.len();
     match param {
-        PathParam::Uniform => (0..n)
-            .map(|k| {
-                if n > 1 {
-                    k as f64 / (n - 1) as f64
-                } else {
-                    0.0
-                }
-            })
-            .collect(),
+        PathParam::Uniform => (0..n).map(|k| if n > 1 { k as f64 / (n - 1) as f64 } else { 0.0 }).collect(),
         PathParam::ChordLength => {
             let mut ss = Vec::with_capacity(n);
             let mut acc = 0.0;
             ss.push(0.0);
             for w in waypoints.windows(2) {
-                acc += w[0]
-                    .iter()
-                    .zip(&w[1])
-                    .map(|(a, b)| (b - a) * (b - a))
-                    .sum::<f64>()
-                    .sqrt();
+                acc += w[0].iter().zip(&w[1]).map(|(a, b)| (b - a) * (b - a)).sum::<f64>().sqrt();
                 ss.push(acc);
             }
             ss
@@ -231,12 +196,7 @@ impl Tridiagonal {
     /// and slopes, n - 1 each); every end condition shares them.
     fn push_interior(&mut self, h: &[f64], d: &[f64]) {
         for k in 1..h.len() {
-            self.push(
-                h[k - 1],
-                2.0 * (h[k - 1] + h[k]),
-                h[k],
-                6.0 * (d[k] - d[k - 1]),
-            );
+            self.push(h[k - 1], 2.0 * (h[k - 1] + h[k]), h[k], 6.0 * (d[k] - d[k - 1]));
         }
     }
 
@@ -311,34 +271,22 @@ mod tests {
     #[test]
     fn special_cases_and_continuity() {
         // Three points: the parabola; two points: the line.
-        let p = CubicSplinePath::new(
-            &[0.0, 1.0, 3.0],
-            &[vec![0.0], vec![1.0], vec![9.0]],
-            SplineEnd::NotAKnot,
-        )
-        .unwrap();
+        let p =
+            CubicSplinePath::new(&[0.0, 1.0, 3.0], &[vec![0.0], vec![1.0], vec![9.0]], SplineEnd::NotAKnot).unwrap();
         let (q, _, ddq) = eval1(&p, 2.0);
         assert!((q[0] - 4.0).abs() < 1e-12 && (ddq[0] - 2.0).abs() < 1e-12);
-        let p = CubicSplinePath::new(&[0.0, 2.0], &[vec![1.0], vec![3.0]], SplineEnd::NotAKnot)
-            .unwrap();
+        let p = CubicSplinePath::new(&[0.0, 2.0], &[vec![1.0], vec![3.0]], SplineEnd::NotAKnot).unwrap();
         let (q, dq, _) = eval1(&p, 0.5);
         assert!((q[0] - 1.5).abs() < 1e-12 && (dq[0] - 1.0).abs() < 1e-12);
         // C² at interior knots for all end conditions; clamped has zero end slope.
         let ss = [0.0, 0.2, 0.9, 1.0, 1.6];
-        let w: Vec<Vec<f64>> = [0.1, -0.4, 0.8, 0.3, 1.0]
-            .iter()
-            .map(|&v| vec![v, 2.0 * v])
-            .collect();
+        let w: Vec<Vec<f64>> = [0.1, -0.4, 0.8, 0.3, 1.0].iter().map(|&v| vec![v, 2.0 * v]).collect();
         for end in [SplineEnd::NotAKnot, SplineEnd::Clamped, SplineEnd::Natural] {
             let p = CubicSplinePath::new(&ss, &w, end).unwrap();
             for &k in &ss[1..4] {
                 let (a, da, dda) = eval1(&p, k - 1e-12);
                 let (b, db, ddb) = eval1(&p, k + 1e-12);
-                assert!(
-                    (a[1] - b[1]).abs() < 1e-7
-                        && (da[1] - db[1]).abs() < 1e-6
-                        && (dda[1] - ddb[1]).abs() < 1e-6
-                );
+                assert!((a[1] - b[1]).abs() < 1e-7 && (da[1] - db[1]).abs() < 1e-6 && (dda[1] - ddb[1]).abs() < 1e-6);
             }
             let (q, dq, ddq) = eval1(&p, ss[0]);
             assert!((q[0] - 0.1).abs() < 1e-12);
@@ -353,27 +301,11 @@ mod tests {
 
     #[test]
     fn chord_length_and_rejections() {
-        let w = vec![
-            vec![0.0, 0.0],
-            vec![3.0, 4.0],
-            vec![3.0, 4.0],
-            vec![3.0, 5.0],
-        ];
+        let w = vec![vec![0.0, 0.0], vec![3.0, 4.0], vec![3.0, 4.0], vec![3.0, 5.0]];
         let p = CubicSplinePath::through_waypoints(&w, PathParam::ChordLength).unwrap();
         assert_eq!(p.knots(), &[0.0, 5.0, 6.0]);
-        assert!(
-            CubicSplinePath::through_waypoints(&[vec![1.0], vec![1.0]], PathParam::Uniform)
-                .is_err()
-        );
-        assert!(
-            CubicSplinePath::new(&[0.0, 0.0], &[vec![1.0], vec![2.0]], SplineEnd::NotAKnot)
-                .is_err()
-        );
-        assert!(CubicSplinePath::new(
-            &[0.0, 1.0],
-            &[vec![1.0], vec![2.0, 3.0]],
-            SplineEnd::NotAKnot
-        )
-        .is_err());
+        assert!(CubicSplinePath::through_waypoints(&[vec![1.0], vec![1.0]], PathParam::Uniform).is_err());
+        assert!(CubicSplinePath::new(&[0.0, 0.0], &[vec![1.0], vec![2.0]], SplineEnd::NotAKnot).is_err());
+        assert!(CubicSplinePath::new(&[0.0, 1.0], &[vec![1.0], vec![2.0, 3.0]], SplineEnd::NotAKnot).is_err());
     }
 }

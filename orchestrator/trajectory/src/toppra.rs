@@ -90,16 +90,11 @@ impl fmt::Display for ToppraError {
         match self {
             ToppraError::BadLimits(m) => write!(f, "TOPP-RA: bad limits: {m}"),
             ToppraError::BadGrid(m) => write!(f, "TOPP-RA: bad grid: {m}"),
-            ToppraError::Uncontrollable { stage } => write!(
-                f,
-                "TOPP-RA: path not controllable (empty set at stage {stage})"
-            ),
+            ToppraError::Uncontrollable { stage } => {
+                write!(f, "TOPP-RA: path not controllable (empty set at stage {stage})")
+            }
             ToppraError::StartNotControllable { k0 } => {
-                write!(
-                    f,
-                    "TOPP-RA: rest start not controllable, K0 = [{}, {}]",
-                    k0.0, k0.1
-                )
+                write!(f, "TOPP-RA: rest start not controllable, K0 = [{}, {}]", k0.0, k0.1)
             }
             ToppraError::ForwardPassFailed { stage } => {
                 write!(f, "TOPP-RA: forward pass failed at stage {stage}")
@@ -108,10 +103,7 @@ impl fmt::Display for ToppraError {
                 write!(f, "TOPP-RA: path velocity vanishes on segment {stage}")
             }
             ToppraError::LimitsNotMet { rounds } => {
-                write!(
-                    f,
-                    "TOPP-RA: samples still beyond the limits after {rounds} rounds"
-                )
+                write!(f, "TOPP-RA: samples still beyond the limits after {rounds} rounds")
             }
         }
     }
@@ -158,26 +150,14 @@ impl<P> ToppraTrajectory<P> {
 }
 
 /// Time-optimal rest-to-rest parameterization of `path` under `problem`'s limits.
-pub fn parameterize<P: JointPath>(
-    path: P,
-    problem: &ToppraProblem,
-) -> Result<ToppraTrajectory<P>, ToppraError> {
+pub fn parameterize<P: JointPath>(path: P, problem: &ToppraProblem) -> Result<ToppraTrajectory<P>, ToppraError> {
     let dof = path.dof();
-    for (name, lim) in [
-        ("velocity", &problem.max_velocity),
-        ("acceleration", &problem.max_acceleration),
-    ] {
+    for (name, lim) in [("velocity", &problem.max_velocity), ("acceleration", &problem.max_acceleration)] {
         if lim.len() != dof {
-            return Err(ToppraError::BadLimits(format!(
-                "{} {name} limits for {dof} joints",
-                lim.len()
-            )));
+            return Err(ToppraError::BadLimits(format!("{} {name} limits for {dof} joints", lim.len())));
         }
         if let Some(j) = lim.iter().position(|v| !(v.is_finite() && *v > 0.0)) {
-            return Err(ToppraError::BadLimits(format!(
-                "{name} limit of joint {j} is {}",
-                lim[j]
-            )));
+            return Err(ToppraError::BadLimits(format!("{name} limit of joint {j} is {}", lim[j])));
         }
     }
     let s = gridpoints(&path, &problem.grid).map_err(ToppraError::BadGrid)?;
@@ -203,46 +183,23 @@ pub fn parameterize<P: JointPath>(
     // Stage rows: 2 slots for the K_{i+1} constraint first, then the acceleration rows.
     let per_point = 2 * dof;
     let stride = 2 + 2 * per_point;
-    let mut rows = vec![
-        Row {
-            a: 0.0,
-            b: 0.0,
-            g: 1.0
-        };
-        (n + 1) * stride
-    ];
+    let mut rows = vec![Row { a: 0.0, b: 0.0, g: 1.0 }; (n + 1) * stride];
     let mut nrows = vec![0usize; n + 1];
     for i in 0..=n {
         let base = i * stride;
         let mut k = 2;
         for j in 0..dof {
-            let (a, b, lim) = (
-                d1[i * dof + j],
-                d2[i * dof + j],
-                problem.max_acceleration[j],
-            );
+            let (a, b, lim) = (d1[i * dof + j], d2[i * dof + j], problem.max_acceleration[j]);
             rows[base + k] = Row { a, b, g: lim };
-            rows[base + k + 1] = Row {
-                a: -a,
-                b: -b,
-                g: lim,
-            };
+            rows[base + k + 1] = Row { a: -a, b: -b, g: lim };
             k += 2;
         }
         if i < n && problem.discretization == Discretization::Interpolation {
             for j in 0..dof {
-                let (a1, b1, lim) = (
-                    d1[(i + 1) * dof + j],
-                    d2[(i + 1) * dof + j],
-                    problem.max_acceleration[j],
-                );
+                let (a1, b1, lim) = (d1[(i + 1) * dof + j], d2[(i + 1) * dof + j], problem.max_acceleration[j]);
                 let a = a1 + 2.0 * delta[i] * b1;
                 rows[base + k] = Row { a, b: b1, g: lim };
-                rows[base + k + 1] = Row {
-                    a: -a,
-                    b: -b1,
-                    g: lim,
-                };
+                rows[base + k + 1] = Row { a: -a, b: -b1, g: lim };
                 k += 2;
             }
         }
@@ -250,16 +207,8 @@ pub fn parameterize<P: JointPath>(
     }
     let set_next = |rows: &mut [Row], i: usize, lo: f64, hi: f64| {
         let base = i * stride;
-        rows[base] = Row {
-            a: 2.0 * delta[i],
-            b: 1.0,
-            g: hi,
-        };
-        rows[base + 1] = Row {
-            a: -2.0 * delta[i],
-            b: -1.0,
-            g: -lo,
-        };
+        rows[base] = Row { a: 2.0 * delta[i], b: 1.0, g: hi };
+        rows[base + 1] = Row { a: -2.0 * delta[i], b: -1.0, g: -lo };
     };
 
     // Backward pass: controllable sets, ending at rest.
@@ -269,10 +218,8 @@ pub fn parameterize<P: JointPath>(
         set_next(&mut rows, i, lo_next, hi_next);
         let stage = &rows[i * stride..i * stride + nrows[i]];
         let (blo, bhi) = ([-VAR_MAX, 0.0], [VAR_MAX, x_max[i]]);
-        let up = maximize([-1e-9, 1.0], stage, blo, bhi)
-            .ok_or(ToppraError::Uncontrollable { stage: i })?;
-        let down = maximize([1e-9, -1.0], stage, blo, bhi)
-            .ok_or(ToppraError::Uncontrollable { stage: i })?;
+        let up = maximize([-1e-9, 1.0], stage, blo, bhi).ok_or(ToppraError::Uncontrollable { stage: i })?;
+        let down = maximize([1e-9, -1.0], stage, blo, bhi).ok_or(ToppraError::Uncontrollable { stage: i })?;
         kset[i] = (down[1].max(0.0), up[1]);
     }
 
@@ -287,11 +234,7 @@ pub fn parameterize<P: JointPath>(
         let (lo_next, hi_next) = kset[i + 1];
         set_next(&mut rows, i, lo_next, hi_next);
         let stage = &rows[i * stride..i * stride + nrows[i]];
-        let step = if x[i] <= x_max[i] {
-            max_u_at_x(x[i], stage, -VAR_MAX, VAR_MAX)
-        } else {
-            None
-        };
+        let step = if x[i] <= x_max[i] { max_u_at_x(x[i], stage, -VAR_MAX, VAR_MAX) } else { None };
         match step {
             None => {
                 if tries >= MAX_TRIES {
@@ -311,9 +254,7 @@ pub fn parameterize<P: JointPath>(
     }
 
     // Segment accelerations consistent with the (clamped) x, and grid times.
-    let u: Vec<f64> = (0..n)
-        .map(|i| (x[i + 1] - x[i]) / (2.0 * delta[i]))
-        .collect();
+    let u: Vec<f64> = (0..n).map(|i| (x[i + 1] - x[i]) / (2.0 * delta[i])).collect();
     let mut t = vec![0.0; n + 1];
     for i in 0..n {
         let sd_avg = 0.5 * (x[i].max(0.0).sqrt() + x[i + 1].max(0.0).sqrt());
@@ -322,14 +263,7 @@ pub fn parameterize<P: JointPath>(
         }
         t[i + 1] = t[i] + delta[i] / sd_avg;
     }
-    Ok(ToppraTrajectory {
-        path,
-        s,
-        x,
-        u,
-        t,
-        controllable: kset,
-    })
+    Ok(ToppraTrajectory { path, s, x, u, t, controllable: kset })
 }
 
 /// TOPP-RA constrains the gridpoints only; between them a joint may exceed its velocity or
@@ -420,32 +354,15 @@ mod tests {
 
     #[test]
     fn straight_line_matches_closed_form_trapezoid_and_triangle() {
-        for &(d, v, a) in &[
-            (1.0, 0.5, 2.0),
-            (2.0, 2.175, 15.0),
-            (0.1, 2.0, 1.0),
-            (3.0, 1.0, 0.7),
-        ] {
-            let path =
-                CubicSplinePath::new(&[0.0, 1.0], &[vec![0.0], vec![d]], SplineEnd::NotAKnot)
-                    .unwrap();
-            for (grid, tol) in [
-                (GridSpec::Uniform(101), 2e-2),
-                (GridSpec::Uniform(1001), 2e-3),
-            ] {
-                let problem = ToppraProblem {
-                    grid: grid.clone(),
-                    ..ToppraProblem::new(vec![v], vec![a])
-                };
+        for &(d, v, a) in &[(1.0, 0.5, 2.0), (2.0, 2.175, 15.0), (0.1, 2.0, 1.0), (3.0, 1.0, 0.7)] {
+            let path = CubicSplinePath::new(&[0.0, 1.0], &[vec![0.0], vec![d]], SplineEnd::NotAKnot).unwrap();
+            for (grid, tol) in [(GridSpec::Uniform(101), 2e-2), (GridSpec::Uniform(1001), 2e-3)] {
+                let problem = ToppraProblem { grid: grid.clone(), ..ToppraProblem::new(vec![v], vec![a]) };
                 let tr = parameterize(path.clone(), &problem).unwrap();
                 let want = bang_bang_time(d, v, a);
                 let rel = (tr.duration() - want) / want;
                 // Grid discretization only makes TOPP-RA slower (never faster than optimal).
-                assert!(
-                    rel > -1e-9 && rel < tol,
-                    "d={d} v={v} a={a} {grid:?}: {} vs {want}",
-                    tr.duration()
-                );
+                assert!(rel > -1e-9 && rel < tol, "d={d} v={v} a={a} {grid:?}: {} vs {want}", tr.duration());
             }
         }
     }
@@ -453,22 +370,14 @@ mod tests {
     #[test]
     fn sampled_trajectory_respects_limits_and_reaches_the_end() {
         let ss = [0.0, 0.4, 1.0, 1.3];
-        let w = vec![
-            vec![0.0, 1.0],
-            vec![0.5, 0.2],
-            vec![0.9, -0.4],
-            vec![1.5, 0.0],
-        ];
+        let w = vec![vec![0.0, 1.0], vec![0.5, 0.2], vec![0.9, -0.4], vec![1.5, 0.0]];
         let path = CubicSplinePath::new(&ss, &w, SplineEnd::NotAKnot).unwrap();
         let problem = ToppraProblem::new(vec![1.0, 0.8], vec![3.0, 2.0]);
         let tr = parameterize(path, &problem).unwrap();
         let smp = crate::sampled::sample(&tr, 0.001);
         let last = smp.q.last().unwrap();
         assert!((last[0] - 1.5).abs() < 1e-9 && last[1].abs() < 1e-9);
-        assert!(smp.qd[0]
-            .iter()
-            .chain(smp.qd.last().unwrap())
-            .all(|v| v.abs() < 1e-9));
+        assert!(smp.qd[0].iter().chain(smp.qd.last().unwrap()).all(|v| v.abs() < 1e-9));
         let mut vmax_seen = 0.0_f64;
         for k in 0..smp.len() {
             for j in 0..2 {
@@ -484,12 +393,7 @@ mod tests {
     #[test]
     fn within_limits_variant_passes_the_checker_at_its_sample_rate() {
         let ss = [0.0, 0.3, 0.5, 1.0];
-        let w = vec![
-            vec![0.0, 1.0, -0.5],
-            vec![1.2, 0.2, 0.4],
-            vec![0.3, -0.9, 1.1],
-            vec![1.5, 0.0, 0.2],
-        ];
+        let w = vec![vec![0.0, 1.0, -0.5], vec![1.2, 0.2, 0.4], vec![0.3, -0.9, 1.1], vec![1.5, 0.0, 0.2]];
         let path = CubicSplinePath::new(&ss, &w, SplineEnd::NotAKnot).unwrap();
         let problem = ToppraProblem {
             grid: GridSpec::Uniform(40),
@@ -511,8 +415,7 @@ mod tests {
 
     #[test]
     fn bad_limits_are_rejected() {
-        let path = CubicSplinePath::new(&[0.0, 1.0], &[vec![0.0], vec![1.0]], SplineEnd::NotAKnot)
-            .unwrap();
+        let path = CubicSplinePath::new(&[0.0, 1.0], &[vec![0.0], vec![1.0]], SplineEnd::NotAKnot).unwrap();
         assert!(matches!(
             parameterize(path.clone(), &ToppraProblem::new(vec![1.0, 1.0], vec![1.0])),
             Err(ToppraError::BadLimits(_))

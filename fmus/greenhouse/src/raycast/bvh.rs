@@ -70,8 +70,10 @@ impl Bvh {
                 }
             })
             .collect();
-        let centroids: Vec<[f64; 3]> =
-            aabbs.iter().map(|b| [0.5 * (b.min[0] + b.max[0]), 0.5 * (b.min[1] + b.max[1]), 0.5 * (b.min[2] + b.max[2])]).collect();
+        let centroids: Vec<[f64; 3]> = aabbs
+            .iter()
+            .map(|b| [0.5 * (b.min[0] + b.max[0]), 0.5 * (b.min[1] + b.max[1]), 0.5 * (b.min[2] + b.max[2])])
+            .collect();
         let mut order: Vec<u32> = (0..n as u32).collect();
         let mut nodes = Vec::with_capacity(2 * n.max(1));
         nodes.push(Node { min: [0.0; 3], max: [0.0; 3], start: 0, count: 0 });
@@ -143,7 +145,13 @@ fn widest(cb: &Aabb) -> usize {
 
 #[allow(clippy::needless_range_loop)]
 /// Binned SAH over all three axes: (axis, split position) if splitting beats a leaf.
-fn best_split(aabbs: &[Aabb], centroids: &[[f64; 3]], prims: &[u32], cb: &Aabb, parent_area: f64) -> Option<(usize, f64)> {
+fn best_split(
+    aabbs: &[Aabb],
+    centroids: &[[f64; 3]],
+    prims: &[u32],
+    cb: &Aabb,
+    parent_area: f64,
+) -> Option<(usize, f64)> {
     let leaf_cost = prims.len() as f64;
     let mut best: Option<(usize, f64)> = None;
     let mut best_cost = leaf_cost;
@@ -177,7 +185,8 @@ fn best_split(aabbs: &[Aabb], centroids: &[[f64; 3]], prims: &[u32], cb: &Aabb, 
             if cnt == 0 || rc == 0 {
                 continue;
             }
-            let cost = TRAVERSAL_COST + (acc.area() * cnt as f64 + right_area[i + 1] * rc as f64) / parent_area.max(1e-300);
+            let cost =
+                TRAVERSAL_COST + (acc.area() * cnt as f64 + right_area[i + 1] * rc as f64) / parent_area.max(1e-300);
             if cost < best_cost {
                 best_cost = cost;
                 best = Some((axis, lo + (i + 1) as f64 / scale));

@@ -9,14 +9,14 @@ mod primitives;
 mod sun_columns;
 mod wide;
 
-pub use packet::MAX_PACKET;
-pub use sun_columns::{Shadow, SunColumns};
-use packet::{traverse_packet, Packet, PacketVisit};
 use crate::scene::{Object, Placement};
 use bvh::Bvh;
+pub use packet::MAX_PACKET;
+use packet::{traverse_packet, Packet, PacketVisit};
 use primitives::Prim;
-use wide::{far, traverse, Node4, Visit};
 use std::mem::MaybeUninit;
+pub use sun_columns::{Shadow, SunColumns};
+use wide::{far, traverse, Node4, Visit};
 
 /// A ray hit: distance along the (unit) direction, the object's id, outward surface normal.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -109,14 +109,35 @@ impl RayCaster {
     /// [`RayCaster::cast_among`] for up to [`MAX_PACKET`] rays from one origin (a camera
     /// tile), traversing together: `out[i]` is exactly what `cast_among` gives for `dirs[i]`,
     /// at a fraction of the node work when the rays are coherent.
-    pub fn cast_packet(&self, origin: [f64; 3], dirs: &[[f64; 3]], min: f64, max: f64, movers: &RayCaster, out: &mut [Option<Hit>]) {
+    pub fn cast_packet(
+        &self,
+        origin: [f64; 3],
+        dirs: &[[f64; 3]],
+        min: f64,
+        max: f64,
+        movers: &RayCaster,
+        out: &mut [Option<Hit>],
+    ) {
         self.cast_packet_beyond(origin, dirs, &[min], max, movers, out);
     }
 
     /// [`RayCaster::cast_packet`] with a near limit per ray (`mins[i]`, or one for all): rays
     /// going on past the surfaces they met (a camera tile's rays seeing through glass).
-    pub fn cast_packet_beyond(&self, origin: [f64; 3], dirs: &[[f64; 3]], mins: &[f64], max: f64, movers: &RayCaster, out: &mut [Option<Hit>]) {
-        assert!(dirs.len() <= MAX_PACKET && (mins.len() == 1 || mins.len() == dirs.len()), "a packet of {} rays (at most {MAX_PACKET}) with {} near limits", dirs.len(), mins.len());
+    pub fn cast_packet_beyond(
+        &self,
+        origin: [f64; 3],
+        dirs: &[[f64; 3]],
+        mins: &[f64],
+        max: f64,
+        movers: &RayCaster,
+        out: &mut [Option<Hit>],
+    ) {
+        assert!(
+            dirs.len() <= MAX_PACKET && (mins.len() == 1 || mins.len() == dirs.len()),
+            "a packet of {} rays (at most {MAX_PACKET}) with {} near limits",
+            dirs.len(),
+            mins.len()
+        );
         let mut best = [Best { t: max, id: u32::MAX, normal: [0.0; 3] }; MAX_PACKET];
         // The packet culls from the nearest limit; each ray's primitive tests keep its own.
         let min = mins.iter().fold(f64::INFINITY, |m, &v| m.min(v));
@@ -146,8 +167,23 @@ impl RayCaster {
     /// origins and mover poses (a run of LiDAR firings while the base moves): `out[i]` is
     /// exactly the single-ray answer for ray i.
     #[allow(clippy::too_many_arguments)]
-    pub fn cast_packet_posed(&self, origins: &[[f64; 3]], dirs: &[[f64; 3]], min: f64, max: f64, movers: &RayCaster, poses: &[RigidPose], out: &mut [Option<Hit>]) {
-        assert!(origins.len() == dirs.len() && poses.len() == dirs.len(), "cast_packet_posed: {} origins, {} rays, {} poses", origins.len(), dirs.len(), poses.len());
+    pub fn cast_packet_posed(
+        &self,
+        origins: &[[f64; 3]],
+        dirs: &[[f64; 3]],
+        min: f64,
+        max: f64,
+        movers: &RayCaster,
+        poses: &[RigidPose],
+        out: &mut [Option<Hit>],
+    ) {
+        assert!(
+            origins.len() == dirs.len() && poses.len() == dirs.len(),
+            "cast_packet_posed: {} origins, {} rays, {} poses",
+            origins.len(),
+            dirs.len(),
+            poses.len()
+        );
         let n = dirs.len();
         assert!(n <= MAX_PACKET, "a packet of {n} rays (at most {MAX_PACKET})");
         let mut best = [Best { t: max, id: u32::MAX, normal: [0.0; 3] }; MAX_PACKET];
@@ -180,7 +216,15 @@ impl RayCaster {
     /// that sits at `pose` (robot links in base_link, the base at its pose): the ray is taken
     /// into that frame instead of the objects out of it, so a moving set is built once, not
     /// at every pose. Distances are those of the map-frame ray; normals come back in the map.
-    pub fn cast_among_posed(&self, origin: [f64; 3], dir: [f64; 3], min: f64, max: f64, movers: &RayCaster, pose: &RigidPose) -> Option<Hit> {
+    pub fn cast_among_posed(
+        &self,
+        origin: [f64; 3],
+        dir: [f64; 3],
+        min: f64,
+        max: f64,
+        movers: &RayCaster,
+        pose: &RigidPose,
+    ) -> Option<Hit> {
         let mut best = Best { t: max, id: u32::MAX, normal: [0.0; 3] };
         self.nearest(origin, dir, min, &mut best, &mut ());
         let before = (best.t, best.id);
@@ -197,10 +241,27 @@ impl RayCaster {
     /// of surfaces of other (translucent: glass, film) objects it crosses, counted as a walk
     /// from hit to hit restarting 0.1 mm past each would count them. One traversal that stops
     /// at the first opaque object found: a shadow ray.
-    pub fn pass_through(&self, origin: [f64; 3], dir: [f64; 3], min: f64, max: f64, movers: &RayCaster, opaque: impl Fn(u32) -> bool) -> Option<u32> {
+    pub fn pass_through(
+        &self,
+        origin: [f64; 3],
+        dir: [f64; 3],
+        min: f64,
+        max: f64,
+        movers: &RayCaster,
+        opaque: impl Fn(u32) -> bool,
+    ) -> Option<u32> {
         let (mut t, mut len) = ([MaybeUninit::uninit(); MAX_CROSSINGS], 0);
         for set in [self, movers] {
-            let mut v = Through { caster: set, o: origin, d: dir, tmin: min, tmax: max, far: far(max), opaque: &opaque, at: Crossings { t: &mut t, len: &mut len } };
+            let mut v = Through {
+                caster: set,
+                o: origin,
+                d: dir,
+                tmin: min,
+                tmax: max,
+                far: far(max),
+                opaque: &opaque,
+                at: Crossings { t: &mut t, len: &mut len },
+            };
             if traverse(&set.nodes, origin, dir, min, &mut v) {
                 return None;
             }
@@ -212,7 +273,16 @@ impl RayCaster {
     /// common direction (shadow rays toward the sun from a camera tile's surface points):
     /// `out[i]` is exactly the single-ray answer for origin i.
     #[allow(clippy::too_many_arguments)]
-    pub fn pass_through_packet(&self, origins: &[[f64; 3]], dir: [f64; 3], min: f64, max: f64, movers: &RayCaster, opaque: impl Fn(u32) -> bool, out: &mut [Option<u32>]) {
+    pub fn pass_through_packet(
+        &self,
+        origins: &[[f64; 3]],
+        dir: [f64; 3],
+        min: f64,
+        max: f64,
+        movers: &RayCaster,
+        opaque: impl Fn(u32) -> bool,
+        out: &mut [Option<u32>],
+    ) {
         self.pass_through_cached(origins, dir, min, max, movers, opaque, &mut Occluders::default(), out);
     }
 
@@ -221,7 +291,17 @@ impl RayCaster {
     /// shadow whatever else lies on it, so it needs no traversal. Neighbouring surface points
     /// are often shaded by the same leaf. The answers are the same whatever `recent` holds.
     #[allow(clippy::too_many_arguments)]
-    pub fn pass_through_cached(&self, origins: &[[f64; 3]], dir: [f64; 3], min: f64, max: f64, movers: &RayCaster, opaque: impl Fn(u32) -> bool, recent: &mut Occluders, out: &mut [Option<u32>]) {
+    pub fn pass_through_cached(
+        &self,
+        origins: &[[f64; 3]],
+        dir: [f64; 3],
+        min: f64,
+        max: f64,
+        movers: &RayCaster,
+        opaque: impl Fn(u32) -> bool,
+        recent: &mut Occluders,
+        out: &mut [Option<u32>],
+    ) {
         let n = origins.len();
         assert!(n <= MAX_PACKET && out.len() == n, "pass_through_packet: {n} rays, {} results", out.len());
         // Rays not blocked by a recent occluder go on, compacted into one packet.
@@ -260,7 +340,18 @@ impl RayCaster {
         // The scene, then the movers with the same packet (blocked rays have left it), each
         // ray continuing its crossing list.
         for (in_movers, set) in [(false, self), (true, movers)] {
-            let mut v = PacketThrough { caster: set, origins: sub, d: dir, tmin: min, tmax: max, opaque: &opaque, ts: &mut ts, lens: &mut lens, blocked: &mut blocked, blocker: None };
+            let mut v = PacketThrough {
+                caster: set,
+                origins: sub,
+                d: dir,
+                tmin: min,
+                tmax: max,
+                opaque: &opaque,
+                ts: &mut ts,
+                lens: &mut lens,
+                blocked: &mut blocked,
+                blocker: None,
+            };
             traverse_packet(&set.nodes, &mut packet, min, &mut v);
             if let Some(k) = v.blocker {
                 recent.remember(in_movers, k);
@@ -370,7 +461,14 @@ impl<S: Stats> Visit for Nearest<'_, S> {
 /// directions (a packet whose directions have both signs on an axis has an interval bound
 /// that culls nothing; a quarter of the LiDAR's packets straddle an axis), a lone ray alone.
 /// Each ray's answer is its single-ray answer whatever packet it goes in.
-fn nearest_in_packets(set: &RayCaster, origins: &[[f64; 3]], dirs: &[[f64; 3]], min: f64, max: f64, best: &mut [Best; MAX_PACKET]) {
+fn nearest_in_packets(
+    set: &RayCaster,
+    origins: &[[f64; 3]],
+    dirs: &[[f64; 3]],
+    min: f64,
+    max: f64,
+    best: &mut [Best; MAX_PACKET],
+) {
     if packet_nearest(set, origins, dirs, min, max, best) {
         return;
     }
@@ -407,7 +505,14 @@ fn nearest_in_packets(set: &RayCaster, origins: &[[f64; 3]], dirs: &[[f64; 3]], 
 
 /// [`nearest_in_packets`] as one packet; false (nothing done) when the rays' directions do not
 /// share their signs on some axis.
-fn packet_nearest(set: &RayCaster, origins: &[[f64; 3]], dirs: &[[f64; 3]], min: f64, max: f64, best: &mut [Best; MAX_PACKET]) -> bool {
+fn packet_nearest(
+    set: &RayCaster,
+    origins: &[[f64; 3]],
+    dirs: &[[f64; 3]],
+    min: f64,
+    max: f64,
+    best: &mut [Best; MAX_PACKET],
+) -> bool {
     let Some(mut packet) = Packet::new(origins, dirs, max) else { return false };
     for i in 0..dirs.len() {
         packet.far[i] = far(best[i].t);
@@ -492,7 +597,14 @@ impl<F: Fn(u32) -> bool> PacketVisit for PacketThrough<'_, F> {
             while m != 0 {
                 let i = m.trailing_zeros() as usize;
                 m &= m - 1;
-                if cross(&along, self.origins[i], self.tmin, self.tmax, || *opaque.get_or_insert_with(|| (self.opaque)(self.caster.ids[k])), &mut Crossings { t: &mut self.ts[i], len: &mut self.lens[i] }) {
+                if cross(
+                    &along,
+                    self.origins[i],
+                    self.tmin,
+                    self.tmax,
+                    || *opaque.get_or_insert_with(|| (self.opaque)(self.caster.ids[k])),
+                    &mut Crossings { t: &mut self.ts[i], len: &mut self.lens[i] },
+                ) {
                     self.blocker = Some(k as u32);
                     self.blocked[i] = true;
                     packet.far[i] = f32::NEG_INFINITY;
@@ -607,14 +719,31 @@ impl<F: Fn(u32) -> bool> Visit for Through<'_, F> {
 /// One shadow ray through the primitives `start..start + count` of a leaf: true at an opaque
 /// hit, else the translucent ones' surface crossings (in and out) go to `at`.
 #[allow(clippy::too_many_arguments)]
-fn cross_leaf(caster: &RayCaster, start: usize, count: usize, o: [f64; 3], d: [f64; 3], tmin: f64, tmax: f64, opaque: &impl Fn(u32) -> bool, at: &mut Crossings) -> bool {
+fn cross_leaf(
+    caster: &RayCaster,
+    start: usize,
+    count: usize,
+    o: [f64; 3],
+    d: [f64; 3],
+    tmin: f64,
+    tmax: f64,
+    opaque: &impl Fn(u32) -> bool,
+    at: &mut Crossings,
+) -> bool {
     (start..start + count).any(|k| cross(&caster.prims[k].along(d), o, tmin, tmax, || opaque(caster.ids[k]), at))
 }
 
 /// One shadow ray from `o` across one primitive: true if it meets it and the primitive is
 /// opaque (asked only then), else the translucent surfaces it crosses (in and out) go to `at`.
 #[inline(always)]
-fn cross(along: &primitives::Along<'_>, o: [f64; 3], tmin: f64, tmax: f64, opaque: impl FnOnce() -> bool, at: &mut Crossings) -> bool {
+fn cross(
+    along: &primitives::Along<'_>,
+    o: [f64; 3],
+    tmin: f64,
+    tmax: f64,
+    opaque: impl FnOnce() -> bool,
+    at: &mut Crossings,
+) -> bool {
     let Some((t, _)) = along.intersect(o, tmin, tmax) else { return false };
     if opaque() {
         return true;

@@ -62,7 +62,9 @@ impl Packet {
     #[inline(always)]
     pub(crate) fn new(origins: &[[f64; 3]], dirs: &[[f64; 3]], tmax: f64) -> Option<Packet> {
         let n = origins.len().max(dirs.len());
-        debug_assert!(n <= MAX_PACKET && (origins.len() == 1 || origins.len() == n) && (dirs.len() == 1 || dirs.len() == n));
+        debug_assert!(
+            n <= MAX_PACKET && (origins.len() == 1 || origins.len() == n) && (dirs.len() == 1 || dirs.len() == n)
+        );
         let mut p = Packet::idle(n);
         for a in 0..3 {
             let o = &mut p.o[a][..n];

@@ -10,13 +10,33 @@ use crate::scene::{Object, Shape};
 /// An object ready for intersection: centre, map->local rotation (rows of R^T), sizes.
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum Prim {
-    Sphere { c: [f64; 3], r: f64 },
+    Sphere {
+        c: [f64; 3],
+        r: f64,
+    },
     /// Box with identity rotation (floor, walls, gutters, most obstacles): no transform.
-    AaBox { c: [f64; 3], half: [f64; 3] },
+    AaBox {
+        c: [f64; 3],
+        half: [f64; 3],
+    },
     /// Cylinder whose axis is map axis `axis` (stems, posts, heating pipes): no transform.
-    AxisCylinder { c: [f64; 3], axis: usize, r: f64, h: f64 },
-    Box { c: [f64; 3], rt: [[f64; 3]; 3], half: [f64; 3] },
-    Cylinder { c: [f64; 3], rt: [[f64; 3]; 3], r: f64, h: f64 },
+    AxisCylinder {
+        c: [f64; 3],
+        axis: usize,
+        r: f64,
+        h: f64,
+    },
+    Box {
+        c: [f64; 3],
+        rt: [[f64; 3]; 3],
+        half: [f64; 3],
+    },
+    Cylinder {
+        c: [f64; 3],
+        rt: [[f64; 3]; 3],
+        r: f64,
+        h: f64,
+    },
 }
 
 #[inline(always)]
@@ -128,7 +148,18 @@ impl Prim {
                 // cyclic permutation (a proper rotation).
                 let (i, j) = ((axis + 1) % 3, (axis + 2) % 3);
                 let (t, n) = cylinder_local(r, h, [lo[i], lo[j], lo[axis]], [ld[i], ld[j], ld[axis]], tmin, tmax)?;
-                Some((t, [0, 1, 2].map(|k| if k == axis { n[2] } else if k == i { n[0] } else { n[1] })))
+                Some((
+                    t,
+                    [0, 1, 2].map(|k| {
+                        if k == axis {
+                            n[2]
+                        } else if k == i {
+                            n[0]
+                        } else {
+                            n[1]
+                        }
+                    }),
+                ))
             }
             Prim::Cylinder { ref rt, r, h, .. } => {
                 let (t, n) = cylinder_local(r, h, lo, ld, tmin, tmax)?;

@@ -76,7 +76,13 @@ impl SunColumns {
     /// The grid for rays along `dir` (unit, toward the light) over `caster`'s objects for
     /// which `opaque(id)` holds, with cells of `cell` metres (larger if the grid would
     /// exceed `max_cells`). None for a light below [`MIN_SIN_ELEVATION`].
-    pub fn new(caster: &RayCaster, dir: [f64; 3], opaque: impl Fn(u32) -> bool, cell: f64, max_cells: usize) -> Option<SunColumns> {
+    pub fn new(
+        caster: &RayCaster,
+        dir: [f64; 3],
+        opaque: impl Fn(u32) -> bool,
+        cell: f64,
+        max_cells: usize,
+    ) -> Option<SunColumns> {
         if !(dir[2] >= MIN_SIN_ELEVATION && cell > 0.0 && max_cells > 0) {
             return None;
         }
@@ -96,13 +102,39 @@ impl SunColumns {
         }
         let translucent = caster.subset(|id| !opaque(id));
         if boxes.is_empty() {
-            return Some(SunColumns { dir, w, origin: [0.0; 2], cell, per_metre: 1.0 / cell, nx: 0, ny: 0, top: vec![], lists: Lists::default(), scene_prims: caster.prims.len(), opaque: bits, translucent });
+            return Some(SunColumns {
+                dir,
+                w,
+                origin: [0.0; 2],
+                cell,
+                per_metre: 1.0 / cell,
+                nx: 0,
+                ny: 0,
+                top: vec![],
+                lists: Lists::default(),
+                scene_prims: caster.prims.len(),
+                opaque: bits,
+                translucent,
+            });
         }
         let area = (hi[0] - lo[0]) * (hi[1] - lo[1]);
         let cell = cell.max((area / max_cells as f64).sqrt() * 1.01);
         let nx = ((hi[0] - lo[0]) / cell).ceil().max(1.0) as usize;
         let ny = ((hi[1] - lo[1]) / cell).ceil().max(1.0) as usize;
-        let mut grid = SunColumns { dir, w, origin: lo, cell, per_metre: 1.0 / cell, nx, ny, top: vec![f32::NEG_INFINITY; nx * ny], lists: Lists::default(), scene_prims: caster.prims.len(), opaque: bits, translucent };
+        let mut grid = SunColumns {
+            dir,
+            w,
+            origin: lo,
+            cell,
+            per_metre: 1.0 / cell,
+            nx,
+            ny,
+            top: vec![f32::NEG_INFINITY; nx * ny],
+            lists: Lists::default(),
+            scene_prims: caster.prims.len(),
+            opaque: bits,
+            translucent,
+        };
         match grid.lists(caster, &opaque_prims, ENTRIES_PER_CELL * max_cells) {
             Some(lists) => {
                 // A cell's top is its list's first.
@@ -174,7 +206,8 @@ impl SunColumns {
         let rows = self.index(mn[1] - sy0.max(sy1) - PAD, 1)..=self.index(mx[1] - sy0.min(sy1) + PAD, 1);
         for j in rows {
             // The heights whose shifted rectangle meets this row's band of y.
-            let (b0, b1) = (self.origin[1] + j as f64 * self.cell - PAD, self.origin[1] + (j + 1) as f64 * self.cell + PAD);
+            let (b0, b1) =
+                (self.origin[1] + j as f64 * self.cell - PAD, self.origin[1] + (j + 1) as f64 * self.cell + PAD);
             let (mut z0, mut z1) = (mn[2], mx[2]);
             if wy > 0.0 {
                 z0 = z0.max((mn[1] - b1) / wy);
@@ -234,7 +267,8 @@ impl SunColumns {
         };
         let stops = |k: u32| scene.prims[k as usize].along(self.dir).intersect(p, tmin, tmax).is_some();
         // An opaque object that stops the ray decides it, listed here or not.
-        let hint = hint.filter(|&k| (k as usize) < self.scene_prims && self.opaque[k as usize / 64] >> (k % 64) & 1 == 1);
+        let hint =
+            hint.filter(|&k| (k as usize) < self.scene_prims && self.opaque[k as usize / 64] >> (k % 64) & 1 == 1);
         if let Some(k) = hint.filter(|&k| stops(k)) {
             return Shadow::Blocked(k);
         }
@@ -307,6 +341,14 @@ fn up_f32(v: f64) -> f32 {
 
 impl std::fmt::Debug for SunColumns {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "SunColumns({}x{} cells of {} m toward {:?}, {} listed)", self.nx, self.ny, self.cell, self.dir, self.lists.entries.len())
+        write!(
+            f,
+            "SunColumns({}x{} cells of {} m toward {:?}, {} listed)",
+            self.nx,
+            self.ny,
+            self.cell,
+            self.dir,
+            self.lists.entries.len()
+        )
     }
 }

@@ -84,7 +84,8 @@ pub(crate) fn collapse(bin: &[Node], prims: usize) -> Vec<Node4> {
     while let Some((b, at)) = work.pop() {
         // The slots: start from the node itself (a leaf root becomes one leaf slot), then open
         // the interior slot with the largest surface area until four are filled.
-        let mut slots: Vec<usize> = if bin[b].count > 0 { vec![b] } else { vec![bin[b].start as usize, bin[b].start as usize + 1] };
+        let mut slots: Vec<usize> =
+            if bin[b].count > 0 { vec![b] } else { vec![bin[b].start as usize, bin[b].start as usize + 1] };
         while slots.len() < 4 {
             let open = slots
                 .iter()
@@ -293,7 +294,16 @@ fn walk<V: Visit>(nodes: &[Node4], root: u32, r: &Ray32, tmin: f32, v: &mut V) -
 /// False when the traversal was stopped.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn push<V: Visit>(stack: &mut [MaybeUninit<(u32, f32)>; STACK], sp: &mut usize, c: u32, t: f32, nodes: &[Node4], r: &Ray32, tmin: f32, v: &mut V) -> bool {
+fn push<V: Visit>(
+    stack: &mut [MaybeUninit<(u32, f32)>; STACK],
+    sp: &mut usize,
+    c: u32,
+    t: f32,
+    nodes: &[Node4],
+    r: &Ray32,
+    tmin: f32,
+    v: &mut V,
+) -> bool {
     if *sp < STACK {
         stack[*sp].write((c, t));
         *sp += 1;

@@ -19,10 +19,22 @@ pub fn random_solids(rng: &mut Rng, n: usize) -> Vec<Object> {
             };
             let axis = unit([rng.scene_normal(), rng.scene_normal(), rng.scene_normal()]);
             // A third stay axis-aligned (the specialised code paths).
-            let angle = if i % 7 < 2 { 0.0 } else if i % 7 == 2 { std::f64::consts::FRAC_PI_2 } else { rng.range(-3.2, 3.2) };
+            let angle = if i % 7 < 2 {
+                0.0
+            } else if i % 7 == 2 {
+                std::f64::consts::FRAC_PI_2
+            } else {
+                rng.range(-3.2, 3.2)
+            };
             let axis = if i % 7 == 2 { [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]][i % 3] } else { axis };
             let t = [rng.range(0.0, 10.0), rng.range(0.0, 10.0), rng.range(0.0, 10.0)];
-            Object { id: i as u32, name: format!("s{i}"), kind: Kind::Obstacle, shape, placement: Placement::axis_angle(t, axis, angle) }
+            Object {
+                id: i as u32,
+                name: format!("s{i}"),
+                kind: Kind::Obstacle,
+                shape,
+                placement: Placement::axis_angle(t, axis, angle),
+            }
         })
         .collect()
 }

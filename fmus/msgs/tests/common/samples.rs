@@ -5,21 +5,19 @@
 #![allow(dead_code)]
 
 use agrisim_msgs::agrisim::{
-    CollisionObject, CollisionState, Contact, FmuStatus, GripperState, HarvestStatus, PlanResult,
-    NavigationStatus, PlanningScene, Signals, TrajectoryStatus,
+    CollisionObject, CollisionState, Contact, FmuStatus, GripperState, HarvestStatus, NavigationStatus, PlanResult,
+    PlanningScene, Signals, TrajectoryStatus,
 };
 use agrisim_msgs::builtin_interfaces::{Duration, Time};
 use agrisim_msgs::control_msgs::GripperCommand;
-use agrisim_msgs::shape_msgs::SolidPrimitive;
-use agrisim_msgs::trajectory_msgs::{JointTrajectory, JointTrajectoryPoint};
 use agrisim_msgs::geometry_msgs::*;
 use agrisim_msgs::nav_msgs::{MapMetaData, OccupancyGrid, Odometry, Path};
 use agrisim_msgs::rosgraph_msgs::Clock;
-use agrisim_msgs::sensor_msgs::{
-    CameraInfo, Image, Imu, JointState, PointCloud2, PointField, RegionOfInterest,
-};
+use agrisim_msgs::sensor_msgs::{CameraInfo, Image, Imu, JointState, PointCloud2, PointField, RegionOfInterest};
+use agrisim_msgs::shape_msgs::SolidPrimitive;
 use agrisim_msgs::std_msgs::{Float64, Header};
 use agrisim_msgs::tf2_msgs::TFMessage;
+use agrisim_msgs::trajectory_msgs::{JointTrajectory, JointTrajectoryPoint};
 use agrisim_msgs::{CdrError, Message};
 use std::fmt::Debug;
 
@@ -74,17 +72,11 @@ fn q(x: f64, y: f64, z: f64, w: f64) -> Quaternion {
 }
 
 fn pose(x: f64, y: f64, z: f64, o: Quaternion) -> Pose {
-    Pose {
-        position: Point { x, y, z },
-        orientation: o,
-    }
+    Pose { position: Point { x, y, z }, orientation: o }
 }
 
 fn twist() -> Twist {
-    Twist {
-        linear: v3(0.5, 0.0, 0.0),
-        angular: v3(0.0, 0.0, -0.25),
-    }
+    Twist { linear: v3(0.5, 0.0, 0.0), angular: v3(0.0, 0.0, -0.25) }
 }
 
 fn pose_cov() -> PoseWithCovariance {
@@ -92,10 +84,7 @@ fn pose_cov() -> PoseWithCovariance {
     for (i, c) in covariance.iter_mut().enumerate() {
         *c = i as f64 * 0.5;
     }
-    PoseWithCovariance {
-        pose: pose(1.0, 2.0, 3.0, q(0.5, 0.5, 0.5, 0.5)),
-        covariance,
-    }
+    PoseWithCovariance { pose: pose(1.0, 2.0, 3.0, q(0.5, 0.5, 0.5, 0.5)), covariance }
 }
 
 fn twist_cov() -> TwistWithCovariance {
@@ -103,30 +92,19 @@ fn twist_cov() -> TwistWithCovariance {
     for i in 0..6 {
         covariance[i * 7] = (i + 1) as f64 * 0.01;
     }
-    TwistWithCovariance {
-        twist: twist(),
-        covariance,
-    }
+    TwistWithCovariance { twist: twist(), covariance }
 }
 
 fn tf(sec: i32, parent: &str, child: &str, x: f64) -> TransformStamped {
     TransformStamped {
         header: hdr(sec, 2, parent),
         child_frame_id: child.into(),
-        transform: Transform {
-            translation: v3(x, 0.0, 0.45),
-            rotation: Quaternion::IDENTITY,
-        },
+        transform: Transform { translation: v3(x, 0.0, 0.45), rotation: Quaternion::IDENTITY },
     }
 }
 
 fn field(name: &str, offset: u32, datatype: u8) -> PointField {
-    PointField {
-        name: name.into(),
-        offset,
-        datatype,
-        count: 1,
-    }
+    PointField { name: name.into(), offset, datatype, count: 1 }
 }
 
 /// Two points of (x, y, z, intensity) float32, little-endian: 32 bytes.
@@ -166,11 +144,7 @@ fn contact(id: u32, name: &str, link: &str) -> Contact {
         object_name: name.into(),
         object_kind: "post".into(),
         robot_link: link.into(),
-        position: Point {
-            x: 2.5,
-            y: -1.0,
-            z: 0.25,
-        },
+        position: Point { x: 2.5, y: -1.0, z: 0.25 },
         normal: v3(-1.0, 0.0, 0.0),
         depth: 0.125,
     }
@@ -236,10 +210,7 @@ fn manipulation_samples() -> Vec<Sample> {
         sample("joint_trajectory_empty", JointTrajectory::default()),
         sample("gripper_command", GripperCommand { position: 0.04, max_effort: 70.0 }),
         sample("point32", p32(1.5, -0.25, 0.125)),
-        sample(
-            "polygon",
-            Polygon { points: vec![p32(0.0, 0.0, 0.0), p32(1.0, 0.0, 0.5), p32(0.0, -1.0, 0.25)] },
-        ),
+        sample("polygon", Polygon { points: vec![p32(0.0, 0.0, 0.0), p32(1.0, 0.0, 0.5), p32(0.0, -1.0, 0.25)] }),
         sample("solid_primitive_box", SolidPrimitive::new_box(0.1, 0.2, 0.3)),
         sample("solid_primitive_prism", prism()),
         sample(
@@ -331,44 +302,19 @@ fn base_samples() -> Vec<Sample> {
         sample("header_empty_frame", hdr(0, 1, "")),
         sample("float64", Float64 { data: -0.125 }),
         sample("vector3", v3(1.5, -2.25, 1e-300)),
-        sample(
-            "point",
-            Point {
-                x: 0.1,
-                y: 0.2,
-                z: 0.3,
-            },
-        ),
+        sample("point", Point { x: 0.1, y: 0.2, z: 0.3 }),
         sample("quaternion", q(0.0, 0.0, h, h)),
         sample("pose", pose(1.0, 2.0, 3.0, q(0.5, 0.5, 0.5, 0.5))),
         sample(
             "pose_stamped",
-            PoseStamped {
-                header: hdr(3, 0, "map"),
-                pose: pose(-1.0, 0.5, 0.0, Quaternion::IDENTITY),
-            },
+            PoseStamped { header: hdr(3, 0, "map"), pose: pose(-1.0, 0.5, 0.0, Quaternion::IDENTITY) },
         ),
         sample("pose_with_covariance", pose_cov()),
         sample("twist", twist()),
-        sample(
-            "twist_stamped",
-            TwistStamped {
-                header: hdr(7, 20_000_000, "base_link"),
-                twist: twist(),
-            },
-        ),
+        sample("twist_stamped", TwistStamped { header: hdr(7, 20_000_000, "base_link"), twist: twist() }),
         sample("twist_with_covariance", twist_cov()),
-        sample(
-            "transform",
-            Transform {
-                translation: v3(0.2, 0.0, 0.45),
-                rotation: Quaternion::IDENTITY,
-            },
-        ),
-        sample(
-            "transform_stamped",
-            tf(1, "base_link", "camera_optical_frame", 0.2),
-        ),
+        sample("transform", Transform { translation: v3(0.2, 0.0, 0.45), rotation: Quaternion::IDENTITY }),
+        sample("transform_stamped", tf(1, "base_link", "camera_optical_frame", 0.2)),
         sample(
             "odometry",
             Odometry {
@@ -383,44 +329,19 @@ fn base_samples() -> Vec<Sample> {
             Path {
                 header: hdr(5, 0, "map"),
                 poses: vec![
-                    PoseStamped {
-                        header: hdr(5, 0, "map"),
-                        pose: pose(0.0, 0.0, 0.0, Quaternion::IDENTITY),
-                    },
-                    PoseStamped {
-                        header: hdr(5, 1, "m"),
-                        pose: pose(1.0, 0.0, 0.0, q(0.0, 0.0, h, h)),
-                    },
-                    PoseStamped {
-                        header: hdr(6, 2, ""),
-                        pose: pose(1.0, 1.0, 0.0, q(0.0, 0.0, 1.0, 0.0)),
-                    },
+                    PoseStamped { header: hdr(5, 0, "map"), pose: pose(0.0, 0.0, 0.0, Quaternion::IDENTITY) },
+                    PoseStamped { header: hdr(5, 1, "m"), pose: pose(1.0, 0.0, 0.0, q(0.0, 0.0, h, h)) },
+                    PoseStamped { header: hdr(6, 2, ""), pose: pose(1.0, 1.0, 0.0, q(0.0, 0.0, 1.0, 0.0)) },
                 ],
             },
         ),
-        sample(
-            "path_empty",
-            Path {
-                header: hdr(0, 0, "map"),
-                poses: vec![],
-            },
-        ),
+        sample("path_empty", Path { header: hdr(0, 0, "map"), poses: vec![] }),
         sample(
             "tf_message",
-            TFMessage {
-                transforms: vec![
-                    tf(1, "odom", "base_link", 1.25),
-                    tf(1, "base_link", "lift_link", -0.125),
-                ],
-            },
+            TFMessage { transforms: vec![tf(1, "odom", "base_link", 1.25), tf(1, "base_link", "lift_link", -0.125)] },
         ),
         sample("tf_message_empty", TFMessage::default()),
-        sample(
-            "clock",
-            Clock {
-                clock: Time::new(42, 999_999_999),
-            },
-        ),
+        sample("clock", Clock { clock: Time::new(42, 999_999_999) }),
         sample(
             "joint_state",
             JointState {
@@ -450,13 +371,7 @@ fn base_samples() -> Vec<Sample> {
         ),
         sample("point_field", field("intensity", 12, PointField::FLOAT32)),
         sample("point_cloud2", cloud()),
-        sample(
-            "point_cloud2_empty",
-            PointCloud2 {
-                header: hdr(0, 0, "l"),
-                ..Default::default()
-            },
-        ),
+        sample("point_cloud2_empty", PointCloud2 { header: hdr(0, 0, "l"), ..Default::default() }),
         sample(
             "imu",
             Imu {
@@ -473,20 +388,13 @@ fn base_samples() -> Vec<Sample> {
             "pose_array",
             PoseArray {
                 header: hdr(8, 0, "map"),
-                poses: vec![
-                    pose(1.0, 2.0, 0.75, Quaternion::IDENTITY),
-                    pose(-0.5, 0.0, 1.25, q(0.0, 0.0, h, h)),
-                ],
+                poses: vec![pose(1.0, 2.0, 0.75, Quaternion::IDENTITY), pose(-0.5, 0.0, 1.25, q(0.0, 0.0, h, h))],
             },
         ),
         sample("map_meta_data", map_meta()),
         sample(
             "occupancy_grid",
-            OccupancyGrid {
-                header: hdr(0, 0, "map"),
-                info: map_meta(),
-                data: vec![0, 100, -1, 0, 50, 100],
-            },
+            OccupancyGrid { header: hdr(0, 0, "map"), info: map_meta(), data: vec![0, 100, -1, 0, 50, 100] },
         ),
         sample("contact", contact(7, "row3/post2", "base_link")),
         sample(
@@ -500,12 +408,7 @@ fn base_samples() -> Vec<Sample> {
         ),
         sample(
             "collision_state_empty",
-            CollisionState {
-                header: hdr(0, 0, "map"),
-                in_collision: false,
-                count: 0,
-                contacts: vec![],
-            },
+            CollisionState { header: hdr(0, 0, "map"), in_collision: false, count: 0, contacts: vec![] },
         ),
         sample(
             "navigation_status",

@@ -25,7 +25,18 @@ impl I3 {
         let env = (&mut *logs as *mut Logs).cast();
         let p = unsafe {
             fmi3::instantiate_co_simulation::<TestModel>(
-                c"t".as_ptr(), token.as_ptr(), std::ptr::null(), 0, 0, 0, 0, std::ptr::null(), 0, env, Some(capture), None,
+                c"t".as_ptr(),
+                token.as_ptr(),
+                std::ptr::null(),
+                0,
+                0,
+                0,
+                0,
+                std::ptr::null(),
+                0,
+                env,
+                Some(capture),
+                None,
             )
         };
         assert!(!p.is_null());

@@ -75,22 +75,11 @@ impl FmiErrorInfo {
 
     /// The FMU's reason: its warning-or-worse messages of the call, else all of them.
     fn reason(&self) -> String {
-        let serious: Vec<&str> = self
-            .messages
-            .iter()
-            .filter(|m| m.status >= Status::Warning)
-            .map(|m| m.message.as_str())
-            .collect();
-        let msgs: Vec<&str> = if serious.is_empty() {
-            self.messages.iter().map(|m| m.message.as_str()).collect()
-        } else {
-            serious
-        };
-        let mut parts: Vec<String> = msgs
-            .into_iter()
-            .map(|m| m.trim().to_string())
-            .filter(|m| !m.is_empty())
-            .collect();
+        let serious: Vec<&str> =
+            self.messages.iter().filter(|m| m.status >= Status::Warning).map(|m| m.message.as_str()).collect();
+        let msgs: Vec<&str> =
+            if serious.is_empty() { self.messages.iter().map(|m| m.message.as_str()).collect() } else { serious };
+        let mut parts: Vec<String> = msgs.into_iter().map(|m| m.trim().to_string()).filter(|m| !m.is_empty()).collect();
         if let Some(d) = &self.detail {
             parts.push(d.clone());
         }
@@ -130,24 +119,13 @@ pub(crate) fn write_call(
 
 impl fmt::Display for FmiErrorInfo {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write_call(
-            f,
-            &self.instance,
-            &self.model,
-            &self.function,
-            &self.variables,
-            self.context.as_deref(),
-        )?;
+        write_call(f, &self.instance, &self.model, &self.function, &self.variables, self.context.as_deref())?;
         match self.status {
             Some(s) => write!(f, " returned {s}: {}", self.reason())?,
             None => write!(f, " failed: {}", self.reason())?,
         }
         match self.step {
-            Some(r) if self.is_discard() => write!(
-                f,
-                " (the step ended early, at t={})",
-                r.last_successful_time
-            ),
+            Some(r) if self.is_discard() => write!(f, " (the step ended early, at t={})", r.last_successful_time),
             _ => Ok(()),
         }
     }

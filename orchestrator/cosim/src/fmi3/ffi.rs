@@ -112,12 +112,9 @@ pub type SetBinary = unsafe extern "C" fn(
     n_values: usize,
 ) -> Fmi3Status;
 
-pub type GetFmuState =
-    unsafe extern "C" fn(instance: Fmi3Instance, state: *mut Fmi3FmuState) -> Fmi3Status;
-pub type SetFmuState =
-    unsafe extern "C" fn(instance: Fmi3Instance, state: Fmi3FmuState) -> Fmi3Status;
-pub type FreeFmuState =
-    unsafe extern "C" fn(instance: Fmi3Instance, state: *mut Fmi3FmuState) -> Fmi3Status;
+pub type GetFmuState = unsafe extern "C" fn(instance: Fmi3Instance, state: *mut Fmi3FmuState) -> Fmi3Status;
+pub type SetFmuState = unsafe extern "C" fn(instance: Fmi3Instance, state: Fmi3FmuState) -> Fmi3Status;
+pub type FreeFmuState = unsafe extern "C" fn(instance: Fmi3Instance, state: *mut Fmi3FmuState) -> Fmi3Status;
 pub type SerializedFmuStateSize =
     unsafe extern "C" fn(instance: Fmi3Instance, state: Fmi3FmuState, size: *mut usize) -> Fmi3Status;
 pub type SerializeFmuState = unsafe extern "C" fn(

@@ -108,11 +108,7 @@ impl Instance {
     ///
     /// `resourcePath` is passed as the FMI 3.0 standard defines it: the absolute native path
     /// of `resources/` with a trailing separator (not the FMI 2.0 `file://` URI).
-    pub fn instantiate(
-        archive: &FmuArchive,
-        instance_name: &str,
-        logging_on: bool,
-    ) -> Result<Instance, FmiError> {
+    pub fn instantiate(archive: &FmuArchive, instance_name: &str, logging_on: bool) -> Result<Instance, FmiError> {
         let md = &archive.md;
         let fail = |function: &str, detail: String, messages: Vec<LogMessage>| -> FmiError {
             FmiErrorInfo {
@@ -128,43 +124,21 @@ impl Instance {
             }
             .into()
         };
-        let lib =
-            Fmi3Library::load(&archive.library_path).map_err(|e| fail("loading", e, Vec::new()))?;
+        let lib = Fmi3Library::load(&archive.library_path).map_err(|e| fail("loading", e, Vec::new()))?;
         let version = lib.version();
         if !version.starts_with("3.") {
-            return Err(fail(
-                "fmi3GetVersion",
-                format!("reports FMI version \"{version}\", expected 3.0"),
-                Vec::new(),
-            ));
+            return Err(fail("fmi3GetVersion", format!("reports FMI version \"{version}\", expected 3.0"), Vec::new()));
         }
         let lib = Arc::new(lib);
-        let names: BTreeMap<Vr, String> = md
-            .variables
-            .iter()
-            .map(|v| (v.value_reference, v.name.clone()))
-            .collect();
+        let names: BTreeMap<Vr, String> = md.variables.iter().map(|v| (v.value_reference, v.name.clone())).collect();
 
-        let c_name = CString::new(instance_name).map_err(|_| {
-            fail(
-                "fmi3InstantiateCoSimulation",
-                "instance name contains a NUL byte".into(),
-                Vec::new(),
-            )
-        })?;
+        let c_name = CString::new(instance_name)
+            .map_err(|_| fail("fmi3InstantiateCoSimulation", "instance name contains a NUL byte".into(), Vec::new()))?;
         let c_token = CString::new(md.instantiation_token.as_str()).map_err(|_| {
-            fail(
-                "fmi3InstantiateCoSimulation",
-                "instantiationToken contains a NUL byte".into(),
-                Vec::new(),
-            )
+            fail("fmi3InstantiateCoSimulation", "instantiationToken contains a NUL byte".into(), Vec::new())
         })?;
         let c_resources = CString::new(resource_path(&archive.resources_dir)).map_err(|_| {
-            fail(
-                "fmi3InstantiateCoSimulation",
-                "resources path contains a NUL byte".into(),
-                Vec::new(),
-            )
+            fail("fmi3InstantiateCoSimulation", "resources path contains a NUL byte".into(), Vec::new())
         })?;
 
         let sink = Box::new(LogSink::default());
@@ -219,14 +193,15 @@ impl Instance {
     pub fn set_debug_logging(&mut self, on: bool, categories: &[&str]) -> Result<(), FmiError> {
         const F: &str = "fmi3SetDebugLogging";
         let Some(set) = self.lib.f.set_debug_logging else {
-            return Err(self.refuse(F, &[], "refused: the shared library does not export this function (not called; instance state unchanged)"));
+            return Err(self.refuse(
+                F,
+                &[],
+                "refused: the shared library does not export this function (not called; instance state unchanged)",
+            ));
         };
         if !self.log_categories.is_empty() {
-            let unknown: Vec<&str> = categories
-                .iter()
-                .copied()
-                .filter(|c| !self.log_categories.iter().any(|k| k == c))
-                .collect();
+            let unknown: Vec<&str> =
+                categories.iter().copied().filter(|c| !self.log_categories.iter().any(|k| k == c)).collect();
             if !unknown.is_empty() {
                 let detail = format!(
                     "refused: unknown log categor{} {} (the FMU declares: {})",
@@ -243,14 +218,8 @@ impl Instance {
             .collect::<Result<_, _>>()
             .map_err(|_| self.refuse(F, &[], "a category name contains a NUL byte"))?;
         let ptrs: Vec<*const c_char> = c.iter().map(|c| c.as_ptr()).collect();
-        let p = if ptrs.is_empty() {
-            ptr::null()
-        } else {
-            ptrs.as_ptr()
-        };
-        self.call(F, &[], Ctx::None, |_, h| unsafe {
-            set(h, on, ptrs.len(), p)
-        })?;
+        let p = if ptrs.is_empty() { ptr::null() } else { ptrs.as_ptr() };
+        self.call(F, &[], Ctx::None, |_, h| unsafe { set(h, on, ptrs.len(), p) })?;
         self.debug_logging = on;
         Ok(())
     }
@@ -279,37 +248,16 @@ impl Instance {
         self.sink.take()
     }
 
-    pub fn enter_initialization_mode(
-        &mut self,
-        start_time: f64,
-        stop_time: Option<f64>,
-    ) -> Result<(), FmiError> {
-        self.call(
-            "fmi3EnterInitializationMode",
-            &[],
-            Ctx::At(start_time),
-            |f, h| unsafe {
-                (f.enter_initialization_mode)(
-                    h,
-                    false,
-                    0.0,
-                    start_time,
-                    stop_time.is_some(),
-                    stop_time.unwrap_or(0.0),
-                )
-            },
-        )?;
+    pub fn enter_initialization_mode(&mut self, start_time: f64, stop_time: Option<f64>) -> Result<(), FmiError> {
+        self.call("fmi3EnterInitializationMode", &[], Ctx::At(start_time), |f, h| unsafe {
+            (f.enter_initialization_mode)(h, false, 0.0, start_time, stop_time.is_some(), stop_time.unwrap_or(0.0))
+        })?;
         self.state = InstanceState::InitializationMode;
         Ok(())
     }
 
     pub fn exit_initialization_mode(&mut self) -> Result<(), FmiError> {
-        self.call(
-            "fmi3ExitInitializationMode",
-            &[],
-            Ctx::None,
-            |f, h| unsafe { (f.exit_initialization_mode)(h) },
-        )?;
+        self.call("fmi3ExitInitializationMode", &[], Ctx::None, |f, h| unsafe { (f.exit_initialization_mode)(h) })?;
         self.state = InstanceState::StepMode;
         Ok(())
     }
@@ -358,9 +306,7 @@ impl Instance {
             );
             return Err(self.refuse("fmi3Terminate", &[], &detail));
         }
-        self.call("fmi3Terminate", &[], Ctx::None, |f, h| unsafe {
-            (f.terminate)(h)
-        })?;
+        self.call("fmi3Terminate", &[], Ctx::None, |f, h| unsafe { (f.terminate)(h) })?;
         self.state = InstanceState::Terminated;
         Ok(())
     }
@@ -383,13 +329,7 @@ impl Instance {
     pub fn get_f64(&mut self, vrs: &[Vr], values: &mut [f64]) -> Result<(), FmiError> {
         self.check_len("fmi3GetFloat64", vrs, values.len())?;
         self.call("fmi3GetFloat64", vrs, Ctx::None, |f, h| unsafe {
-            (f.get_float64)(
-                h,
-                vrs.as_ptr(),
-                vrs.len(),
-                values.as_mut_ptr(),
-                values.len(),
-            )
+            (f.get_float64)(h, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len())
         })
         .map(drop)
     }
@@ -405,13 +345,7 @@ impl Instance {
     pub fn get_i32(&mut self, vrs: &[Vr], values: &mut [i32]) -> Result<(), FmiError> {
         self.check_len("fmi3GetInt32", vrs, values.len())?;
         self.call("fmi3GetInt32", vrs, Ctx::None, |f, h| unsafe {
-            (f.get_int32)(
-                h,
-                vrs.as_ptr(),
-                vrs.len(),
-                values.as_mut_ptr(),
-                values.len(),
-            )
+            (f.get_int32)(h, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len())
         })
         .map(drop)
     }
@@ -427,13 +361,7 @@ impl Instance {
     pub fn get_i64(&mut self, vrs: &[Vr], values: &mut [i64]) -> Result<(), FmiError> {
         self.check_len("fmi3GetInt64", vrs, values.len())?;
         self.call("fmi3GetInt64", vrs, Ctx::None, |f, h| unsafe {
-            (f.get_int64)(
-                h,
-                vrs.as_ptr(),
-                vrs.len(),
-                values.as_mut_ptr(),
-                values.len(),
-            )
+            (f.get_int64)(h, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len())
         })
         .map(drop)
     }
@@ -449,33 +377,22 @@ impl Instance {
     pub fn get_bool(&mut self, vrs: &[Vr], values: &mut [bool]) -> Result<(), FmiError> {
         self.check_len("fmi3GetBoolean", vrs, values.len())?;
         self.call("fmi3GetBoolean", vrs, Ctx::None, |f, h| unsafe {
-            (f.get_boolean)(
-                h,
-                vrs.as_ptr(),
-                vrs.len(),
-                values.as_mut_ptr(),
-                values.len(),
-            )
+            (f.get_boolean)(h, vrs.as_ptr(), vrs.len(), values.as_mut_ptr(), values.len())
         })
         .map(drop)
     }
 
     pub fn set_string(&mut self, vr: Vr, value: &str) -> Result<(), FmiError> {
-        let c = CString::new(value)
-            .map_err(|_| self.refuse("fmi3SetString", &[vr], "the string contains a NUL byte"))?;
+        let c =
+            CString::new(value).map_err(|_| self.refuse("fmi3SetString", &[vr], "the string contains a NUL byte"))?;
         let p = c.as_ptr();
-        self.call("fmi3SetString", &[vr], Ctx::None, |f, h| unsafe {
-            (f.set_string)(h, &vr, 1, &p, 1)
-        })
-        .map(drop)
+        self.call("fmi3SetString", &[vr], Ctx::None, |f, h| unsafe { (f.set_string)(h, &vr, 1, &p, 1) }).map(drop)
     }
 
     /// Copies the string out of FMU-owned memory.
     pub fn get_string(&mut self, vr: Vr) -> Result<String, FmiError> {
         let mut p: *const c_char = ptr::null();
-        self.call("fmi3GetString", &[vr], Ctx::None, |f, h| unsafe {
-            (f.get_string)(h, &vr, 1, &mut p, 1)
-        })?;
+        self.call("fmi3GetString", &[vr], Ctx::None, |f, h| unsafe { (f.get_string)(h, &vr, 1, &mut p, 1) })?;
         if p.is_null() {
             return Err(self.refuse("fmi3GetString", &[vr], "the FMU returned a NULL string"));
         }
@@ -486,10 +403,8 @@ impl Instance {
     pub fn set_binary(&mut self, vr: Vr, value: &[u8]) -> Result<(), FmiError> {
         let size = value.len();
         let p = value.as_ptr();
-        self.call("fmi3SetBinary", &[vr], Ctx::None, |f, h| unsafe {
-            (f.set_binary)(h, &vr, 1, &size, &p, 1)
-        })
-        .map(drop)
+        self.call("fmi3SetBinary", &[vr], Ctx::None, |f, h| unsafe { (f.set_binary)(h, &vr, 1, &size, &p, 1) })
+            .map(drop)
     }
 
     /// Copies the bytes out of FMU-owned memory (valid only until the FMU's next call).
@@ -509,11 +424,7 @@ impl Instance {
             return Ok(&[]);
         }
         if p.is_null() {
-            return Err(self.refuse(
-                "fmi3GetBinary",
-                &[vr],
-                &format!("the FMU returned NULL for {size} bytes"),
-            ));
+            return Err(self.refuse("fmi3GetBinary", &[vr], &format!("the FMU returned NULL for {size} bytes")));
         }
         // SAFETY: the FMU guarantees `size` readable bytes at `p` until its next call, and
         // every call takes `&mut self`, which the returned borrow holds.
@@ -524,17 +435,12 @@ impl Instance {
     pub fn get_state(&mut self) -> Result<FmuState, FmiError> {
         let get = self.state_fn("fmi3GetFMUState", |f| f.get_fmu_state)?;
         let mut s: Fmi3FmuState = ptr::null_mut();
-        self.call("fmi3GetFMUState", &[], Ctx::None, |_, h| unsafe {
-            get(h, &mut s)
-        })?;
+        self.call("fmi3GetFMUState", &[], Ctx::None, |_, h| unsafe { get(h, &mut s) })?;
         if s.is_null() {
             return Err(self.refuse("fmi3GetFMUState", &[], "the FMU returned a NULL state"));
         }
         self.fmu_states.push(Some((s, self.state)));
-        Ok(FmuState {
-            slot: self.fmu_states.len() - 1,
-            owner: self.id,
-        })
+        Ok(FmuState { slot: self.fmu_states.len() - 1, owner: self.id })
     }
 
     /// Restores a state saved by this instance (and with it the state-machine state it was
@@ -542,9 +448,7 @@ impl Instance {
     pub fn set_state(&mut self, state: &FmuState) -> Result<(), FmiError> {
         let set = self.state_fn("fmi3SetFMUState", |f| f.set_fmu_state)?;
         let (s, saved_in) = self.own_state("fmi3SetFMUState", state)?;
-        self.call("fmi3SetFMUState", &[], Ctx::None, |_, h| unsafe {
-            set(h, s)
-        })?;
+        self.call("fmi3SetFMUState", &[], Ctx::None, |_, h| unsafe { set(h, s) })?;
         self.state = saved_in;
         Ok(())
     }
@@ -552,16 +456,13 @@ impl Instance {
     /// The bytes of a saved state (needs canSerializeFMUState), and the wrapper's state it
     /// was saved in (give both back to [`Instance::deserialize_state`]).
     pub fn serialize_state(&mut self, state: &FmuState) -> Result<(Vec<u8>, InstanceState), FmiError> {
-        let (size_fn, ser) = self.serial_fns("fmi3SerializeFMUState", |f| Some((f.serialized_fmu_state_size?, f.serialize_fmu_state?)))?;
+        let (size_fn, ser) =
+            self.serial_fns("fmi3SerializeFMUState", |f| Some((f.serialized_fmu_state_size?, f.serialize_fmu_state?)))?;
         let (s, saved_in) = self.own_state("fmi3SerializeFMUState", state)?;
         let mut size = 0usize;
-        self.call("fmi3SerializedFMUStateSize", &[], Ctx::None, |_, h| unsafe {
-            size_fn(h, s, &mut size)
-        })?;
+        self.call("fmi3SerializedFMUStateSize", &[], Ctx::None, |_, h| unsafe { size_fn(h, s, &mut size) })?;
         let mut bytes = vec![0u8; size];
-        self.call("fmi3SerializeFMUState", &[], Ctx::None, |_, h| unsafe {
-            ser(h, s, bytes.as_mut_ptr(), size)
-        })?;
+        self.call("fmi3SerializeFMUState", &[], Ctx::None, |_, h| unsafe { ser(h, s, bytes.as_mut_ptr(), size) })?;
         Ok((bytes, saved_in))
     }
 
@@ -577,10 +478,7 @@ impl Instance {
             return Err(self.refuse("fmi3DeserializeFMUState", &[], "the FMU returned a NULL state"));
         }
         self.fmu_states.push(Some((s, saved_in)));
-        Ok(FmuState {
-            slot: self.fmu_states.len() - 1,
-            owner: self.id,
-        })
+        Ok(FmuState { slot: self.fmu_states.len() - 1, owner: self.id })
     }
 
     /// Frees a saved state now (otherwise it is freed with the instance).
@@ -588,10 +486,7 @@ impl Instance {
         let free = self.state_fn("fmi3FreeFMUState", |f| f.free_fmu_state)?;
         let (mut s, _) = self.own_state("fmi3FreeFMUState", &state)?;
         self.fmu_states[state.slot] = None;
-        self.call("fmi3FreeFMUState", &[], Ctx::None, |_, h| unsafe {
-            free(h, &mut s)
-        })
-        .map(drop)
+        self.call("fmi3FreeFMUState", &[], Ctx::None, |_, h| unsafe { free(h, &mut s) }).map(drop)
     }
 
     // ---- internals ----
@@ -607,11 +502,7 @@ impl Instance {
         f: impl FnOnce(&Functions, Fmi3Instance) -> ffi::Fmi3Status,
     ) -> Result<Status, FmiError> {
         if self.state == InstanceState::Fatal {
-            let mut e = self.refuse(
-                function,
-                vrs,
-                "refused: this instance returned fmi3Fatal earlier and is unusable",
-            );
+            let mut e = self.refuse(function, vrs, "refused: this instance returned fmi3Fatal earlier and is unusable");
             e.status = Some(Status::Fatal);
             e.context = context.text();
             return Err(e);
@@ -656,23 +547,11 @@ impl Instance {
         }
         let mut call = String::new();
         let context = context.text();
-        let _ = write_call(
-            &mut call,
-            &self.name,
-            &self.model,
-            function,
-            &self.var_names(vrs),
-            context.as_deref(),
-        );
+        let _ = write_call(&mut call, &self.name, &self.model, function, &self.var_names(vrs), context.as_deref());
         // eprintln! (not a locked handle) so test harnesses capture it.
         for m in &messages {
             if m.status >= Status::Warning {
-                eprintln!(
-                    "warning: {call} logged {} [{}]: {}",
-                    m.status,
-                    m.category,
-                    m.message.trim()
-                );
+                eprintln!("warning: {call} logged {} [{}]: {}", m.status, m.category, m.message.trim());
             } else if self.debug_logging {
                 eprintln!("FMU '{}' [{}]: {}", self.name, m.category, m.message.trim());
             }
@@ -702,41 +581,23 @@ impl Instance {
         if vrs.len() == n {
             Ok(())
         } else {
-            Err(self.refuse(
-                function,
-                vrs,
-                &format!("{} value references but {n} values", vrs.len()),
-            ))
+            Err(self.refuse(function, vrs, &format!("{} value references but {n} values", vrs.len())))
         }
     }
 
     fn var_names(&self, vrs: &[Vr]) -> Vec<String> {
-        vrs.iter()
-            .map(|vr| {
-                self.names
-                    .get(vr)
-                    .cloned()
-                    .unwrap_or_else(|| format!("vr {vr}"))
-            })
-            .collect()
+        vrs.iter().map(|vr| self.names.get(vr).cloned().unwrap_or_else(|| format!("vr {vr}"))).collect()
     }
 
     /// An optional FMU-state function, refused up front (not called) when a capability flag
     /// it needs is not declared or the library does not export it.
-    fn state_fn<T>(
-        &self,
-        function: &str,
-        pick: impl FnOnce(&Functions) -> Option<T>,
-    ) -> Result<T, FmiError> {
+    fn state_fn<T>(&self, function: &str, pick: impl FnOnce(&Functions) -> Option<T>) -> Result<T, FmiError> {
         self.optional_fn(function, &[(self.can_get_and_set_state, "canGetAndSetFMUState")], pick)
     }
 
-    fn serial_fns<T>(
-        &self,
-        function: &str,
-        pick: impl FnOnce(&Functions) -> Option<T>,
-    ) -> Result<T, FmiError> {
-        let needs = [(self.can_serialize_state, "canSerializeFMUState"), (self.can_get_and_set_state, "canGetAndSetFMUState")];
+    fn serial_fns<T>(&self, function: &str, pick: impl FnOnce(&Functions) -> Option<T>) -> Result<T, FmiError> {
+        let needs =
+            [(self.can_serialize_state, "canSerializeFMUState"), (self.can_get_and_set_state, "canGetAndSetFMUState")];
         self.optional_fn(function, &needs, pick)
     }
 
@@ -750,7 +611,9 @@ impl Instance {
             return Err(self.refuse(
                 function,
                 &[],
-                &format!("refused: not supported, the FMU declares {flag}=\"false\" (not called; instance state unchanged)"),
+                &format!(
+                    "refused: not supported, the FMU declares {flag}=\"false\" (not called; instance state unchanged)"
+                ),
             ));
         }
         pick(&self.lib.f).ok_or_else(|| {
@@ -762,18 +625,10 @@ impl Instance {
         })
     }
 
-    fn own_state(
-        &self,
-        function: &str,
-        state: &FmuState,
-    ) -> Result<(Fmi3FmuState, InstanceState), FmiError> {
+    fn own_state(&self, function: &str, state: &FmuState) -> Result<(Fmi3FmuState, InstanceState), FmiError> {
         match self.fmu_states.get(state.slot) {
             Some(Some(s)) if state.owner == self.id => Ok(*s),
-            _ => Err(self.refuse(
-                function,
-                &[],
-                "the FMU state belongs to another instance or was freed",
-            )),
+            _ => Err(self.refuse(function, &[], "the FMU state belongs to another instance or was freed")),
         }
     }
 }

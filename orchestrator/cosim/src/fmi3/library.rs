@@ -77,22 +77,14 @@ impl Fmi3Library {
                 // SAFETY: the type is the FMI 3.0 signature of this symbol.
                 match unsafe { lib.get(concat!($name, "\0").as_bytes()) } {
                     Ok(s) => *s,
-                    Err(_) => {
-                        return Err(format!(
-                            "shared library '{}' does not export {}",
-                            path.display(),
-                            $name
-                        ))
-                    }
+                    Err(_) => return Err(format!("shared library '{}' does not export {}", path.display(), $name)),
                 }
             };
         }
         macro_rules! opt_sym {
             ($name:literal) => {
                 // SAFETY: as above.
-                unsafe { lib.get(concat!($name, "\0").as_bytes()) }
-                    .ok()
-                    .map(|s| *s)
+                unsafe { lib.get(concat!($name, "\0").as_bytes()) }.ok().map(|s| *s)
             };
         }
         let f = Functions {
@@ -124,11 +116,7 @@ impl Fmi3Library {
             serialize_fmu_state: opt_sym!("fmi3SerializeFMUState"),
             deserialize_fmu_state: opt_sym!("fmi3DeserializeFMUState"),
         };
-        Ok(Fmi3Library {
-            f,
-            path: path.to_path_buf(),
-            _lib: lib,
-        })
+        Ok(Fmi3Library { f, path: path.to_path_buf(), _lib: lib })
     }
 
     /// What `fmi3GetVersion` returns (should be "3.0").

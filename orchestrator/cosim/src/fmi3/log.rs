@@ -60,10 +60,7 @@ impl LogSink {
             return Vec::new();
         }
         let g = self.inner.lock().unwrap_or_else(|p| p.into_inner());
-        g.iter()
-            .filter(|(s, _)| *s >= mark)
-            .map(|(_, m)| m.clone())
-            .collect()
+        g.iter().filter(|(s, _)| *s >= mark).map(|(_, m)| m.clone()).collect()
     }
 
     pub(crate) fn take(&self) -> Vec<LogMessage> {
@@ -100,11 +97,7 @@ pub(crate) unsafe extern "C" fn log_callback(
         // SAFETY: env is the address of a LogSink boxed by the Instance, which outlives the
         // FMU instance (freed before the box is dropped); strings are NUL-terminated per FMI.
         let sink = &*(env as *const LogSink);
-        sink.push(LogMessage {
-            status: Status::from_raw(status),
-            category: lossy(category),
-            message: lossy(message),
-        });
+        sink.push(LogMessage { status: Status::from_raw(status), category: lossy(category), message: lossy(message) });
     });
 }
 
@@ -115,11 +108,7 @@ mod tests {
     #[test]
     fn marks_select_one_calls_messages() {
         let sink = LogSink::default();
-        let m = |s: &str| LogMessage {
-            status: Status::Ok,
-            category: "c".into(),
-            message: s.into(),
-        };
+        let m = |s: &str| LogMessage { status: Status::Ok, category: "c".into(), message: s.into() };
         sink.push(m("a"));
         let mark = sink.mark();
         sink.push(m("b"));
@@ -132,11 +121,7 @@ mod tests {
     fn capacity_bounds_memory() {
         let sink = LogSink::default();
         for i in 0..CAPACITY + 10 {
-            sink.push(LogMessage {
-                status: Status::Ok,
-                category: String::new(),
-                message: i.to_string(),
-            });
+            sink.push(LogMessage { status: Status::Ok, category: String::new(), message: i.to_string() });
         }
         let all = sink.take();
         assert_eq!(all.len(), CAPACITY);
