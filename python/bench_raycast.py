@@ -108,7 +108,7 @@ def main():
         print("$", " ".join(cmd), flush=True)
         subprocess.run(cmd, cwd=ROOT, check=True)
     elif not args.no_run:
-        cmd = ["cargo", "run", "--release", "-q", "-p", "agrisim-greenhouse", "--example", "raycast_bench", "--",
+        cmd = ["cargo", "run", "--release", "-q", "-p", "agrisim-raycast", "--example", "raycast_bench", "--",
                "--rays", str(args.rays), "--out", args.out]
         if args.config:
             cmd += ["--config", args.config]

@@ -1,4 +1,4 @@
-"""The camera's sun position (NREL SPA in fmus/greenhouse/src/solar.rs, read from the Camera
+"""The camera's sun position (NREL SPA in fmus/lib/sky/src/solar.rs, read from the Camera
 FMU's solar_zenith / solar_azimuth outputs) against pvlib's independent SPA implementation,
 over random dates, times, time zones and places; and the FMU's refusal of bad [environment]
 keys. pvlib gets the same instant in UTC, the same pressure, temperature and elevation, and

@@ -1,6 +1,6 @@
 """Cross-check agrisim-msgs (Rust) against ROS 2 CDR/msg code that no one here wrote.
 
-The Rust example `write_samples` writes sample messages (fmus/msgs/tests/common/samples.rs)
+The Rust example `write_samples` writes sample messages (fmus/lib/msgs/tests/common/samples.rs)
 as CDR files plus their `ros2msg` schema texts. Here they are decoded by
 
 * mcap-ros2-support's dynamic decoder built from our schema text (what Foxglove-style

@@ -6,7 +6,7 @@ four wheel modules differ only by position; writing them once avoids copy-paste 
 
 Sources of figures:
 - Base: 4-wheel-steering, wheel base 1.0 m, track 0.8 m, wheel radius 0.1 m, steer +-90 deg,
-  steer rate 3 rad/s, wheel speed 15 rad/s (fmus/chassis/src/ports.rs defaults).
+  steer rate 3 rad/s, wheel speed 15 rad/s (fmus/lib/chassis/src/ports.rs defaults).
 - Lift: prismatic 0..0.8 m, 0.2 m/s; carriage centre 0.45 m above the floor at 0
   (fmus/lift/src/lib.rs: position_max, velocity_max, base_height).
 - Arms: Franka Emika Panda kinematic parameters (modified DH, Craig convention) and joint

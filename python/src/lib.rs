@@ -52,8 +52,10 @@ fn _agrisim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(convert::message_types, m)?)?;
     m.add_function(wrap_pyfunction!(paths::root, m)?)?;
     m.add_function(wrap_pyfunction!(paths::scenario_path, m)?)?;
-    m.add_function(wrap_pyfunction!(bench::bench_nav, m)?)?;
-    m.add_function(wrap_pyfunction!(bench::bench_harvest, m)?)?;
+    m.add_function(wrap_pyfunction!(bench::benchmarks, m)?)?;
+    m.add_function(wrap_pyfunction!(bench::bench_run, m)?)?;
     m.add_function(wrap_pyfunction!(bench::run_trial, m)?)?;
+    // Not in `__all__` (which `add` extends): the package re-exports it by name.
+    m.setattr("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -5,8 +5,7 @@
 
 use crate::paths::scenario_path;
 use crate::{py_err, OnThisThread};
-use agrisim_bench::nav::NavSetup;
-use agrisim_bench::targets::draw_target;
+use agrisim_bench::nav::{draw_target, NavSetup};
 use agrisim_math::Rng;
 use agrisim_session::Scenario;
 use pyo3::prelude::*;

@@ -9,7 +9,6 @@ use crate::ports::*;
 use crate::reference::{Reference, Setpoint};
 use crate::validate::{check, decode};
 use agrisim_fmi::{InPort, Log, Model, OutPort, Store, Var};
-use agrisim_fmu_util::{to_ns, Schedule};
 use agrisim_math::Rng;
 use agrisim_msgs::agrisim::{GripperState, TrajectoryStatus};
 use agrisim_msgs::builtin_interfaces::Time;
@@ -17,6 +16,7 @@ use agrisim_msgs::control_msgs::GripperCommand;
 use agrisim_msgs::sensor_msgs::JointState;
 use agrisim_msgs::std_msgs::Header;
 use agrisim_msgs::Message;
+use agrisim_schedule::{to_ns, Schedule};
 
 /// Franka's "ready" pose (franka_ros / MoveIt panda config), inside every joint's limits.
 pub const READY_POSE: [f64; N] = [

@@ -3,6 +3,7 @@
 //! joints move with their inertials (for [`crate::inertia`]). The URDF is the single source,
 //! so the FMU, the world FMU and the planner agree on names and limits.
 
+use agrisim_math::vec3::{mat_mul, transpose};
 use agrisim_robot::{Joint, JointKind, Limits, Pose, Robot};
 
 /// The robot description, compiled into the FMU (no file lookup at run time).
@@ -48,26 +49,6 @@ fn limits_of(j: &Joint) -> Result<Limits, String> {
         return Err(format!("joint {}: unusable limits {l:?}", j.name));
     }
     Ok(l)
-}
-
-fn mat_mul(a: &[[f64; 3]; 3], b: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    let mut m = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            m[i][j] = (0..3).map(|k| a[i][k] * b[k][j]).sum();
-        }
-    }
-    m
-}
-
-fn transpose(a: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    let mut m = [[0.0; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            m[i][j] = a[j][i];
-        }
-    }
-    m
 }
 
 /// `R I R^T`: an inertia tensor expressed in a rotated frame.

@@ -10,6 +10,7 @@
 //! which is exactly the diagonal of `sum_k m_k Jv_k^T Jv_k + Jw_k^T I_k Jw_k`.
 
 use crate::description::{rotate_inertia, ArmDescription, Body, N};
+use agrisim_math::vec3::{cross, dot, mat_vec, sub, Mat3};
 use agrisim_robot::Pose;
 
 /// Reflected rotor (motor + gear) inertia per joint [kg m^2], as Franka gives it for the FR3
@@ -17,24 +18,6 @@ use agrisim_robot::Pose;
 /// values are not published; the FR3's are used as the closest available figure.
 pub const ROTOR_INERTIA: [f64; N] =
     [0.605721456, 0.605721456, 0.462474144, 0.462474144, 0.205544064, 0.205544064, 0.205544064];
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn mat_vec(m: &[[f64; 3]; 3], v: [f64; 3]) -> [f64; 3] {
-    [dot(m[0], v), dot(m[1], v), dot(m[2], v)]
-}
-
-type Mat3 = [[f64; 3]; 3];
 
 /// A body's centre and inertia in the arm base frame.
 fn placed(pose: &Pose, b: &Body) -> (f64, [f64; 3], [[f64; 3]; 3]) {

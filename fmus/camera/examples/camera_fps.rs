@@ -9,7 +9,7 @@
 use agrisim_fmi::{Model, Quiet, Store, Value};
 use agrisim_fmu_camera::ports::*;
 use agrisim_fmu_camera::Camera;
-use agrisim_greenhouse::{generate, GreenhouseConfig};
+use agrisim_scene::{generate, GreenhouseConfig};
 use std::time::Instant;
 
 fn main() {

@@ -8,9 +8,11 @@
 //! With --out: DIR/scene.glb, DIR/rays.npy (float32 origin + direction), DIR/dist.npy (float64
 //! hit distance, inf = none) and DIR/rust.json, the files bench_raycast.py reads.
 
-use agrisim_fmu_camera::optics::{mat_vec, CameraPose, Intrinsics, Mount};
-use agrisim_greenhouse::{generate, gltf, GreenhouseConfig, RayCaster};
-#[path = "../../greenhouse/examples/common/mod.rs"]
+use agrisim_fmu_camera::optics::{CameraPose, Intrinsics, Mount};
+use agrisim_math::vec3::mat_vec;
+use agrisim_raycast::RayCaster;
+use agrisim_scene::{generate, GreenhouseConfig};
+#[path = "../../lib/raycast/examples/common/mod.rs"]
 mod common;
 
 const FAR: f64 = 1000.0;
@@ -88,7 +90,7 @@ fn main() {
     if let Some(dir) = common::arg("--out") {
         let dir = std::path::PathBuf::from(dir);
         std::fs::create_dir_all(&dir).expect("out dir");
-        gltf::write_glb(&gh.objects, &dir.join("scene.glb")).expect("glb");
+        agrisim_gltf::write_glb(&gh.objects, &dir.join("scene.glb")).expect("glb");
         let rb: Vec<u8> = rays.iter().flat_map(|r| r.iter().flat_map(|v| v.to_le_bytes())).collect();
         common::write_npy(&dir.join("rays.npy"), "<f4", &[n, 6], &rb).expect("npy");
         let db: Vec<u8> = dist.iter().flat_map(|v| v.to_le_bytes()).collect();

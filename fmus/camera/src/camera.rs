@@ -13,13 +13,13 @@ use crate::ports::*;
 use crate::render::{self, DepthModel, DepthNoise, Frame, Shot};
 use crate::scene::Scene;
 use agrisim_fmi::{Log, Model, OutPort, Store, Var};
-use agrisim_fmu_util::{to_ns, Schedule};
-use agrisim_greenhouse::environment::Environment;
-use agrisim_greenhouse::raycast::SunColumns;
-use agrisim_greenhouse::weather::Conditions;
 use agrisim_math::Rng;
 use agrisim_msgs::Message;
+use agrisim_raycast::SunColumns;
+use agrisim_schedule::{to_ns, Schedule};
 use agrisim_sensor_ports::robot::{Coords, RobotBody};
+use agrisim_sky::environment::Environment;
+use agrisim_sky::weather::Conditions;
 use std::sync::Arc;
 
 pub use crate::ports::MAX_SIDE;

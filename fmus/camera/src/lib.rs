@@ -9,7 +9,7 @@
 //!   the irradiance sum on a surface;
 //! - [`shading`]: albedo by kind (tomatoes by USDA ripeness stage), the fixed exposure, sRGB;
 //! - light and weather come from the `environment` parameter through
-//!   `agrisim_greenhouse::{environment, weather, solar}` (NREL SPA sun position);
+//!   `agrisim_sky::{environment, weather, solar}` (NREL SPA sun position);
 //! - [`image`]: sensor_msgs/Image encodings; [`datasheet`]: the D435i figures and sources;
 //! - [`camera`]: the FMI model; [`ports`]: its variable table.
 

@@ -5,8 +5,8 @@
 
 use crate::optics::Vec3;
 use crate::shading::{self, Palette};
-use agrisim_greenhouse::environment::{Quality, Weather};
-use agrisim_greenhouse::weather::Conditions;
+use agrisim_sky::environment::{Quality, Weather};
+use agrisim_sky::weather::Conditions;
 
 /// How shadows of the direct beam are computed (render quality).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -98,7 +98,7 @@ impl Lighting {
         let diffuse = c.tau_diffuse * c.dhi / e;
         let global_inside = c.tau_direct * direct * cos_z + diffuse;
         let p = Palette::default();
-        let floor = p.albedo(agrisim_greenhouse::Kind::Floor);
+        let floor = p.albedo(agrisim_scene::Kind::Floor);
         let floor_albedo = (floor[0] + floor[1] + floor[2]) / 3.0;
         // The sky outside, seen through the cover: an isotropic sky of diffuse irradiance DHI
         // has radiance DHI / pi, which a white Lambertian surface under the whole sky matches:

@@ -9,8 +9,8 @@ use agrisim_msgs::builtin_interfaces::Time;
 use agrisim_msgs::sensor_msgs::{CameraInfo, RegionOfInterest};
 use agrisim_msgs::std_msgs::Header;
 
-pub type Vec3 = [f64; 3];
-pub type Mat3 = [[f64; 3]; 3];
+use agrisim_math::vec3::{mat_mul, mat_vec};
+pub use agrisim_math::vec3::{Mat3, Vec3};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Intrinsics {
@@ -71,24 +71,6 @@ impl Intrinsics {
             roi: RegionOfInterest::default(),
         }
     }
-}
-
-pub fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
-    let mut m = [[0.0; 3]; 3];
-    for (i, row) in m.iter_mut().enumerate() {
-        for (j, v) in row.iter_mut().enumerate() {
-            *v = a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j];
-        }
-    }
-    m
-}
-
-pub fn mat_vec(m: &Mat3, v: Vec3) -> Vec3 {
-    [
-        m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2],
-        m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2],
-        m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2],
-    ]
 }
 
 /// Rz(yaw) Ry(pitch) Rx(roll): URDF fixed-axis roll-pitch-yaw.

@@ -4,13 +4,14 @@
 //! result (noise included) depends on the pixel alone, so frames are bit-reproducible.
 
 use crate::lighting::{self, Lighting};
-use crate::optics::{mat_vec, ray_through, CameraPose, Intrinsics, Vec3};
+use crate::optics::{ray_through, CameraPose, Intrinsics, Vec3};
 use crate::scene::Scene;
 use crate::shading::{self, Palette};
-use agrisim_fmu_util::on_threads;
-use agrisim_greenhouse::raycast::{Occluders, Shadow, SunColumns, MAX_PACKET};
-use agrisim_greenhouse::{Hit, Object, RayCaster};
+use agrisim_math::vec3::{cross, mat_vec, normalize};
 use agrisim_math::Rng;
+use agrisim_raycast::{Hit, Occluders, RayCaster, Shadow, SunColumns, MAX_PACKET};
+use agrisim_scene::Object;
+use agrisim_schedule::on_threads;
 
 /// Depth noise (issue 5 item 2).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -175,7 +176,7 @@ struct Layers {
 impl Layers {
     /// If the current hit is a pane (an object casting no shadow), counts it and gives the
     /// near limit to cast on from; None when the ray is done.
-    fn pane(&mut self, kind: &impl Fn(u32) -> agrisim_greenhouse::Kind, tau: f64) -> Option<f64> {
+    fn pane(&mut self, kind: &impl Fn(u32) -> agrisim_scene::Kind, tau: f64) -> Option<f64> {
         match self.hit {
             Some(h) if !shading::casts_shadow(kind(h.object)) => {
                 self.through *= tau;
@@ -531,15 +532,6 @@ fn sun_disc_sample(s: Vec3, i: u32, n: u32) -> Vec3 {
     let r = 0.7 * SUN_RADIUS;
     let (sp, cp) = phi.sin_cos();
     normalize([0, 1, 2].map(|k| s[k] + r * (cp * e1[k] + sp * e2[k])))
-}
-
-fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
-fn normalize(v: Vec3) -> Vec3 {
-    let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-    [v[0] / n, v[1] / n, v[2] / n]
 }
 
 /// The shadow ray: 0 if something opaque lies between `p` and the sun, else `tau` per glass

@@ -11,7 +11,7 @@
 //! with one, it is fixed at [`EXPOSURE`] W/m2, so dusk and cloud darken the image. Shading is
 //! done on linear values and encoded with the sRGB transfer curve (IEC 61966-2-1).
 
-use agrisim_greenhouse::Kind;
+use agrisim_scene::Kind;
 
 /// Colour of rays that hit nothing (sky), sRGB.
 pub const SKY: [u8; 3] = [170, 200, 235];

@@ -10,12 +10,12 @@ use agrisim_fmu_camera::ports::*;
 use agrisim_fmu_camera::render::{self, DepthModel, DepthNoise};
 use agrisim_fmu_camera::scene::Scene;
 use agrisim_fmu_camera::{image, Camera};
-use agrisim_greenhouse::environment::Environment;
-use agrisim_greenhouse::weather::Conditions;
-use agrisim_greenhouse::{generate, GreenhouseConfig, Kind, Object, Placement, Shape};
 use agrisim_math::Rng;
 use agrisim_msgs::sensor_msgs::Image;
 use agrisim_msgs::Message;
+use agrisim_scene::{generate, GreenhouseConfig, Kind, Object, Placement, Shape};
+use agrisim_sky::environment::Environment;
+use agrisim_sky::weather::Conditions;
 
 const NOON: &str = "date = \"2025-06-21\"\ntime = \"13:40\"";
 const DUSK: &str = "date = \"2025-06-21\"\ntime = \"21:15\"";

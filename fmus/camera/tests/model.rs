@@ -8,10 +8,10 @@ use agrisim_fmu_camera::ports::*;
 use agrisim_fmu_camera::render::{self, invalid_band_width, DepthModel, DepthNoise, Shot};
 use agrisim_fmu_camera::scene::Scene;
 use agrisim_fmu_camera::{image, Camera};
-use agrisim_greenhouse::{generate, GreenhouseConfig, Kind, Object, Placement, Shape};
 use agrisim_math::Rng;
 use agrisim_msgs::sensor_msgs::{CameraInfo, Image};
 use agrisim_msgs::Message;
+use agrisim_scene::{generate, GreenhouseConfig, Kind, Object, Placement, Shape};
 
 const MOUNT: Mount = Mount { translation: [0.6, 0.0, 1.2], roll: 0.0, pitch: 0.0, yaw: 0.0 };
 

@@ -1,4 +1,4 @@
 //! Random FMI call sequences (illegal orders, NULLs, bad value references, wrong sizes, NaN,
 //! odd step sizes) into the ChassisDynamic FMU's C API layer: no panic escapes, statuses stay valid.
 
-agrisim_fmi::fmu_conformance_tests!(agrisim_chassis::ChassisDynamic, seeds = 4, cases = 300);
+agrisim_fmi_testing::fmu_conformance_tests!(agrisim_chassis::ChassisDynamic, seeds = 4, cases = 300);

@@ -1,35 +1,30 @@
-//! Tomato greenhouse scene for agrisim: configuration (`[greenhouse]` of a scenario), a
-//! deterministic generator, the layout the navigation stack uses, exact ray casting over a
-//! BVH, a static occupancy map, and glTF export; for the sensors also the sun's position (NREL
-//! SPA, [`solar`]), the scenario's `[environment]` ([`environment`]) and what it means for
-//! light and visibility ([`weather`]).
+//! The Greenhouse world FMU: the tomato greenhouse held in a rapier world, the robot moving
+//! through it (base box plus the URDF links as kinematic bodies following base pose, lift,
+//! arm joints and fingers: [`robot_model`], [`robot_links`]), harvest physics (grasp, carry,
+//! handover, release, fall, place: [`harvest`]), and what the rest of agrisim needs to know
+//! of it: robot contacts by category ([`contacts`], reported by [`collision_report`]), the
+//! clearance the navigation benchmark scores ([`clearance`]), ground-truth fruit poses
+//! ([`ground_truth`]) and the planning scene for the manipulation planner ([`planning_scene`]).
 //!
-//! ```
-//! use agrisim_greenhouse::{generate, GreenhouseConfig, RayCaster};
-//! let cfg = GreenhouseConfig::from_toml_str("rows = 3\nactive_rows = 3\nrow_length = 5.0").unwrap();
-//! let gh = generate(&cfg, cfg.seed);
-//! let rc = RayCaster::new(&gh.objects);
-//! let [x, y, _] = gh.layout.start_pose;
-//! let hit = rc.cast([x, y, 0.5], [1.0, 0.0, 0.0], 0.1, 100.0, &[]).unwrap();
-//! assert!(hit.distance > 0.1);
-//! ```
+//! The scene itself comes from `agrisim_scene` (same TOML + seed as every other consumer),
+//! so collisions happen against exactly the geometry the LiDAR sees and the map is drawn from;
+//! the robot from models/robot/agrisim_robot.urdf, compiled in.
 
-pub mod cast_scene;
-pub mod config;
-pub mod environment;
-pub mod generate;
-pub mod gltf;
-pub mod layout;
-pub mod mesh;
-pub mod occupancy;
-pub mod raycast;
-pub mod scene;
-pub mod solar;
-pub mod solar_terms;
-pub mod weather;
+pub mod base_box;
+pub mod clearance;
+pub mod collision_report;
+pub mod contacts;
+pub mod geometry;
+pub mod ground_truth;
+pub mod harvest;
+pub mod planning_scene;
+pub mod ports;
+pub mod robot_links;
+pub mod robot_model;
+pub mod robot_parts;
+pub mod scene_world;
+pub mod world;
 
-pub use config::{GreenhouseConfig, ObstacleConfig};
-pub use generate::{generate, Greenhouse};
-pub use layout::{Aisle, Layout, Row};
-pub use raycast::{Hit, RayCaster, RigidPose};
-pub use scene::{Kind, Object, Placement, Shape};
+pub use world::GreenhouseWorld;
+
+agrisim_fmi::export_fmu!(GreenhouseWorld);

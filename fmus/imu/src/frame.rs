@@ -1,6 +1,7 @@
-//! Rotations for the mount pose: unit quaternions (x, y, z, w) and 3-vectors.
+//! Rotations for the mount pose: unit quaternions (x, y, z, w) acting on 3-vectors.
 
-pub type Vec3 = [f64; 3];
+pub use agrisim_math::vec3::Vec3;
+use agrisim_math::vec3::{add, cross, scale};
 
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Quat {
@@ -64,18 +65,6 @@ impl Quat {
     pub fn inverse_rotate(self, v: Vec3) -> Vec3 {
         self.conjugate().rotate(v)
     }
-}
-
-pub fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
-pub fn add(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-pub fn scale(a: Vec3, k: f64) -> Vec3 {
-    [a[0] * k, a[1] * k, a[2] * k]
 }
 
 #[cfg(test)]

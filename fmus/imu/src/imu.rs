@@ -7,12 +7,12 @@ use crate::noise::NoiseParams;
 use crate::ports::*;
 use crate::sensor::{ImuSensor, Sample};
 use agrisim_fmi::{Log, Model, OutPort, Store, Var};
-use agrisim_fmu_util::to_ns;
 use agrisim_msgs::builtin_interfaces::Time;
 use agrisim_msgs::geometry_msgs::{Quaternion, Vector3};
 use agrisim_msgs::sensor_msgs;
 use agrisim_msgs::std_msgs::Header;
 use agrisim_msgs::Message;
+use agrisim_schedule::to_ns;
 
 #[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Imu {

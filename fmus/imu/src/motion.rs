@@ -11,7 +11,8 @@
 //! exact for constant accelerations, half a step late otherwise). Between communication
 //! points velocities and accelerations are held; yaw advances with the held yaw rate.
 
-use crate::frame::{add, cross, Quat, Vec3};
+use crate::frame::{Quat, Vec3};
+use agrisim_math::vec3::{add, cross};
 
 /// Chassis ground truth at one instant (inputs of the FMU).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]

@@ -8,7 +8,7 @@
 use agrisim_fmi::{Model, Quiet, Store, Value};
 use agrisim_fmu_lidar::ports::*;
 use agrisim_fmu_lidar::Lidar;
-use agrisim_greenhouse::{generate, GreenhouseConfig};
+use agrisim_scene::{generate, GreenhouseConfig};
 use std::time::Instant;
 
 fn main() {

@@ -7,13 +7,14 @@
 //! With `--out DIR` it writes DIR/scene.glb, DIR/rays.npy, DIR/dist.npy and DIR/rust.json for
 //! python/bench_raycast.py --lidar-pattern to cast the same rays with Open3D.
 
-#[path = "../../greenhouse/examples/common/mod.rs"]
+#[path = "../../lib/raycast/examples/common/mod.rs"]
 mod common;
 
 use agrisim_fmu_lidar::datasheet as ds;
 use agrisim_fmu_lidar::lidar::LIDAR_PACKET;
 use agrisim_fmu_lidar::pattern::ScanPattern;
-use agrisim_greenhouse::{generate, gltf, GreenhouseConfig, RayCaster};
+use agrisim_raycast::RayCaster;
+use agrisim_scene::{generate, GreenhouseConfig};
 
 fn main() {
     let frames: usize = common::arg("--frames").map_or(12, |s| s.parse().expect("--frames N"));
@@ -58,7 +59,7 @@ fn main() {
         let mut hits = [None; LIDAR_PACKET];
         let mut origins = [[0.0; 3]; LIDAR_PACKET];
         let mut dirs = [[0.0; 3]; LIDAR_PACKET];
-        let poses = [agrisim_greenhouse::RigidPose::yawed(0.0, 0.0, 0.0, 0.0); LIDAR_PACKET];
+        let poses = [agrisim_raycast::RigidPose::yawed(0.0, 0.0, 0.0, 0.0); LIDAR_PACKET];
         for chunk in rays.chunks(LIDAR_PACKET) {
             // Packets as the FMU casts them. A chunk may straddle two spots (a frame's 20,000
             // rays are not a multiple of the packet): it just gets a wider origin interval;
@@ -84,7 +85,7 @@ fn main() {
     if let Some(dir) = common::arg("--out") {
         let dir = std::path::PathBuf::from(dir);
         std::fs::create_dir_all(&dir).expect("out dir");
-        gltf::write_glb(&gh.objects, &dir.join("scene.glb")).expect("glb");
+        agrisim_gltf::write_glb(&gh.objects, &dir.join("scene.glb")).expect("glb");
         let rb: Vec<u8> = rays.iter().flat_map(|r| r.iter().flat_map(|&v| (v as f32).to_le_bytes())).collect();
         common::write_npy(&dir.join("rays.npy"), "<f4", &[n, 6], &rb).expect("npy");
         let db: Vec<u8> = dist.iter().flat_map(|v| v.to_le_bytes()).collect();

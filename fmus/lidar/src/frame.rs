@@ -1,6 +1,7 @@
 //! The sensor's mount: a rigid pose on base_link (roll-pitch-yaw about fixed axes, as URDF).
 
-pub type Vec3 = [f64; 3];
+use agrisim_math::vec3::mat_vec;
+pub use agrisim_math::vec3::Vec3;
 
 /// Rotation as a row-major 3x3 matrix plus translation.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -33,12 +34,7 @@ impl Mount {
 
     /// A sensor-frame direction in base_link.
     pub fn rotate(&self, v: Vec3) -> Vec3 {
-        let m = &self.rotation;
-        [
-            m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2],
-            m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2],
-            m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2],
-        ]
+        mat_vec(&self.rotation, v)
     }
 }
 

@@ -12,7 +12,7 @@
 //!
 //! Frames are due at multiples of 1/frame_rate on simulation time, whatever the importer's
 //! step; each holds point_rate / frame_rate rays (20,000 at the defaults), cast one by one
-//! with `agrisim_greenhouse::RayCaster`. Range noise is Gaussian (2 cm, seeded). With the
+//! with `agrisim_raycast::RayCaster`. Range noise is Gaussian (2 cm, seeded). With the
 //! `environment` parameter (the scenario's `[environment]`), fog, rain and haze drop returns
 //! whose two-way-attenuated echo falls below the detection threshold ([`lidar::detected`]).
 

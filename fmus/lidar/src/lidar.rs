@@ -18,13 +18,13 @@ use crate::reflectivity;
 use crate::scene::{RobotInBaseLink, Scene};
 use crate::trajectory::Trajectory;
 use agrisim_fmi::{Log, Model, OutPort, Store, Var};
-use agrisim_fmu_util::{on_threads, to_ns, Schedule};
-use agrisim_greenhouse::environment::Environment;
-use agrisim_greenhouse::weather::Conditions;
-use agrisim_greenhouse::RigidPose;
 use agrisim_math::{Pose2, Rng};
 use agrisim_msgs::sensor_msgs::PointCloud2;
 use agrisim_msgs::Message;
+use agrisim_raycast::RigidPose;
+use agrisim_schedule::{on_threads, to_ns, Schedule};
+use agrisim_sky::environment::Environment;
+use agrisim_sky::weather::Conditions;
 use std::sync::Arc;
 
 /// Most rays in one frame (memory and time guard; the port table bounds the cloud by it).
@@ -166,7 +166,7 @@ struct Batch {
     origins: [[f64; 3]; LIDAR_PACKET],
     dirs: [[f64; 3]; LIDAR_PACKET],
     poses: [RigidPose; LIDAR_PACKET],
-    hits: [Option<agrisim_greenhouse::Hit>; LIDAR_PACKET],
+    hits: [Option<agrisim_raycast::Hit>; LIDAR_PACKET],
 }
 
 impl Default for Batch {

@@ -10,7 +10,7 @@
 //! stems somewhat less; concrete about 0.25; galvanised steel and aluminium 0.3-0.4 diffuse;
 //! white paint 0.6-0.8; glass and clear polycarbonate send little back diffusely.
 
-use agrisim_greenhouse::Kind;
+use agrisim_scene::Kind;
 
 pub fn of_kind(kind: Kind) -> f64 {
     match kind {

@@ -4,10 +4,10 @@
 //! each pose of the scan instead of the robot being re-placed, and the body is rebuilt only
 //! when the lift, arm or finger inputs change.
 
-use agrisim_greenhouse::RayCaster;
+use agrisim_raycast::RayCaster;
 use agrisim_sensor_ports::robot::{Coords, RobotBody};
 
-pub use agrisim_greenhouse::cast_scene::{load_cached as load, CastScene as Scene};
+pub use agrisim_raycast::cast_scene::{load_cached as load, CastScene as Scene};
 
 /// The robot in base_link for the configuration it was last built for.
 #[derive(Clone, Debug)]

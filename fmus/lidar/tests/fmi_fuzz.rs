@@ -1,13 +1,13 @@
 //! Random FMI call sequences (illegal orders, NULLs, bad value references, wrong sizes, NaN,
 //! odd step sizes) into the Lidar FMU's C API layer: no panic escapes, statuses stay valid.
 
-agrisim_fmi::fmu_conformance_tests!(agrisim_fmu_lidar::Lidar, seeds = 4, cases = 300);
+agrisim_fmi_testing::fmu_conformance_tests!(agrisim_fmu_lidar::Lidar, seeds = 4, cases = 300);
 
 /// Weather (the generic dependency check cannot vary the environment text on its own).
 #[test]
 fn initial_dependencies_hold_in_fog() {
     let fog = agrisim_fmi::Value::String("weather = \"fog\"\nvisibility = 30.0".into());
-    agrisim_fmi::testing::assert_initial_dependencies::<agrisim_fmu_lidar::Lidar>(&[(
+    agrisim_fmi_testing::assert_initial_dependencies::<agrisim_fmu_lidar::Lidar>(&[(
         agrisim_fmu_lidar::ports::ENVIRONMENT,
         fog,
     )]);

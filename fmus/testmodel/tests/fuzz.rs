@@ -16,7 +16,7 @@ fn quiet_injected_panics() {
 fn fuzz_fmi3() {
     quiet_injected_panics();
     for seed in 0..4 {
-        agrisim_fmi::testing::fuzz_fmi3::<TestModel>(seed, 300);
+        agrisim_fmi_testing::fuzz_fmi3::<TestModel>(seed, 300);
     }
 }
 
@@ -24,15 +24,15 @@ fn fuzz_fmi3() {
 fn fuzz_fmi2() {
     quiet_injected_panics();
     for seed in 0..4 {
-        agrisim_fmi::testing::fuzz_fmi2::<TestModel>(seed, 300);
+        agrisim_fmi_testing::fuzz_fmi2::<TestModel>(seed, 300);
     }
 }
 
 #[test]
 fn model_structure_dependencies_hold() {
-    agrisim_fmi::testing::assert_valid_table::<TestModel>();
-    agrisim_fmi::testing::assert_initial_dependencies::<TestModel>(&[]);
-    agrisim_fmi::testing::assert_no_direct_feedthrough::<TestModel>();
+    agrisim_fmi_testing::assert_valid_table::<TestModel>();
+    agrisim_fmi_testing::assert_initial_dependencies::<TestModel>(&[]);
+    agrisim_fmi_testing::assert_no_direct_feedthrough::<TestModel>();
 }
 
 #[test]
@@ -40,7 +40,7 @@ fn serialized_states_restore_exactly() {
     use agrisim_fmi::Value;
     use agrisim_fmu_testmodel::*;
     let params = [(X0, Value::Float64(2.5)), (LABEL, Value::String("saved".into()))];
-    let n = agrisim_fmi::testing::assert_state_round_trip::<TestModel>(&params, 0.02, 7, 9, &|io, k| {
+    let n = agrisim_fmi_testing::assert_state_round_trip::<TestModel>(&params, 0.02, 7, 9, &|io, k| {
         io.set_f64(U, (k as f64 * 0.3).sin());
         io.set_binary(MSG_IN, &[k as u8; 3]);
     });

@@ -8,14 +8,14 @@
 //! (`CANDIDATES="yaw,tilt;yaw,tilt;..."` tries other approach directions than
 //! `geometry::APPROACHES`; `VERBOSE=1` prints every failure.)
 
-use agrisim_bench::harvest_targets::eligible;
-use agrisim_greenhouse::{generate, GreenhouseConfig, Kind, Shape};
+use agrisim_bench::harvest::targets::eligible;
 use agrisim_harvest::geometry as geo;
 use agrisim_harvest::motion::{Arm, Motion, HOME};
 use agrisim_math::{Pose2, Rng};
 use agrisim_msgs::agrisim::{CollisionObject, PlanningScene};
 use agrisim_msgs::geometry_msgs::{Point, Pose, Quaternion};
 use agrisim_msgs::shape_msgs::SolidPrimitive;
+use agrisim_scene::{generate, GreenhouseConfig, Kind, Shape};
 use std::collections::BTreeMap;
 
 fn arg(name: &str, default: u64) -> u64 {
@@ -35,7 +35,7 @@ fn kind_label(k: Kind) -> &'static str {
 }
 
 /// The scene objects within `radius` (horizontally, centre distance plus size) of `c`.
-fn scene_near(g: &agrisim_greenhouse::Greenhouse, c: [f64; 2], radius: f64) -> PlanningScene {
+fn scene_near(g: &agrisim_scene::Greenhouse, c: [f64; 2], radius: f64) -> PlanningScene {
     let objects = g
         .objects
         .iter()

@@ -1,11 +1,11 @@
 //! The prior map a trial's robot is given, as a real robot could have it: rasterized from
 //! the building plan, never from a sensor.
 
-use agrisim_greenhouse::occupancy::OccupancyMap;
 use agrisim_msgs::builtin_interfaces::Time;
 use agrisim_msgs::geometry_msgs::{Point, Pose, Quaternion};
 use agrisim_msgs::nav_msgs::{MapMetaData, OccupancyGrid};
 use agrisim_msgs::std_msgs::Header;
+use agrisim_scene::occupancy::OccupancyMap;
 
 /// Map resolution of the static map [m] (the issue asks for about 5 cm).
 pub const MAP_RESOLUTION: f64 = 0.05;
@@ -19,7 +19,7 @@ pub const MAP_BAND: (f64, f64) = (0.05, 1.6);
 /// scan's points may sink into a solid envelope), which biased the building plan's matches
 /// 0.07-0.1 m toward the rows from the true pose (0.25-0.4 m iterated). A whole wall's
 /// thickness would let scan points sink into it the same way (0.04-0.08 m toward it).
-pub fn map_bounds(layout: &agrisim_greenhouse::Layout) -> [f64; 4] {
+pub fn map_bounds(layout: &agrisim_scene::Layout) -> [f64; 4] {
     let [x0, y0, x1, y1] = layout.bounds;
     [x0 - MAP_RESOLUTION, y0 - MAP_RESOLUTION, x1 + MAP_RESOLUTION, y1 + MAP_RESOLUTION]
 }
@@ -31,8 +31,8 @@ pub fn map_bounds(layout: &agrisim_greenhouse::Layout) -> [f64; 4] {
 /// where the rows are but not where this week's leaves hang. Not in it: the trial's own
 /// stems, leaves, trusses and fruit (a scan matcher would otherwise match the LiDAR against
 /// the very plants it sees), and obstacles (the robot must find them with its LiDAR).
-pub fn building_plan(g: &agrisim_greenhouse::Greenhouse) -> OccupancyMap {
-    use agrisim_greenhouse::Kind;
+pub fn building_plan(g: &agrisim_scene::Greenhouse) -> OccupancyMap {
+    use agrisim_scene::Kind;
     let structure: Vec<_> = g
         .objects
         .iter()
@@ -48,16 +48,13 @@ pub fn building_plan(g: &agrisim_greenhouse::Greenhouse) -> OccupancyMap {
 
 /// The map of a mapping run: everything it saw but obstacles (moved since), from
 /// [`mapping_run_scene`](agrisim_session::scene::mapping_run_scene).
-pub fn mapping_run(seen: &agrisim_greenhouse::Greenhouse) -> OccupancyMap {
-    let kept: Vec<_> = seen.objects.iter().filter(|o| o.kind != agrisim_greenhouse::Kind::Obstacle).cloned().collect();
+pub fn mapping_run(seen: &agrisim_scene::Greenhouse) -> OccupancyMap {
+    let kept: Vec<_> = seen.objects.iter().filter(|o| o.kind != agrisim_scene::Kind::Obstacle).cloned().collect();
     OccupancyMap::from_objects(&kept, MAP_RESOLUTION, MAP_BAND, map_bounds(&seen.layout))
 }
 
 /// The scenario's prior map (`[nav] prior_map`) for a trial in scene `g`.
-pub fn prior_map(
-    s: &agrisim_session::Scenario,
-    g: &agrisim_greenhouse::Greenhouse,
-) -> agrisim_error::Result<OccupancyMap> {
+pub fn prior_map(s: &agrisim_session::Scenario, g: &agrisim_scene::Greenhouse) -> agrisim_error::Result<OccupancyMap> {
     Ok(match s.nav.prior_map {
         agrisim_session::PriorMap::Plan => building_plan(g),
         agrisim_session::PriorMap::MappingRun => mapping_run(&agrisim_session::scene::mapping_run_scene(s)?),
@@ -85,7 +82,7 @@ pub fn grid_message(map: &OccupancyMap, t_ns: i64) -> OccupancyGrid {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use agrisim_greenhouse::{config::GreenhouseConfig, generate, Kind};
+    use agrisim_scene::{config::GreenhouseConfig, generate, Kind};
 
     fn small() -> GreenhouseConfig {
         GreenhouseConfig::from_toml_str("rows = 4\nactive_rows = 3\nrow_length = 12.0\nlength = 20.0\nwidth = 14.0")
@@ -97,7 +94,7 @@ mod tests {
     fn the_plan_does_not_depend_on_the_plants() {
         let cfg = small();
         let (a, b) = (generate(&cfg, 1), generate(&cfg, 2));
-        let leaves = |g: &agrisim_greenhouse::Greenhouse| {
+        let leaves = |g: &agrisim_scene::Greenhouse| {
             g.objects.iter().filter(|o| o.kind == Kind::Leaf).map(|o| o.placement.translation).collect::<Vec<_>>()
         };
         assert_ne!(leaves(&a), leaves(&b), "the two seeds must grow different plants");
@@ -155,8 +152,8 @@ mod tests {
     /// A horizontal LiDAR slice of the true scene (plants included) from `pose`: rays at three
     /// heights in the localizer's band, every 0.5 deg, base-frame points, one per 0.1 m voxel
     /// (as the localizer downsamples).
-    fn slice(g: &agrisim_greenhouse::Greenhouse, pose: [f64; 3]) -> Vec<(f64, f64)> {
-        let caster = agrisim_greenhouse::RayCaster::new(&g.objects);
+    fn slice(g: &agrisim_scene::Greenhouse, pose: [f64; 3]) -> Vec<(f64, f64)> {
+        let caster = agrisim_raycast::RayCaster::new(&g.objects);
         let mut pts = std::collections::BTreeMap::new();
         for (k, z) in [0.4, 0.8, 1.2].into_iter().enumerate() {
             for i in 0..720 {

@@ -4,8 +4,9 @@
 //!
 //! Needs the packed FMUs (target/fmu, written by `agrisim fmu pack`, which scripts/setup runs).
 
-use agrisim_bench::harvest::{builtin_node, run_trial_with, HarvestSetup, HarvestTrial, TRIAL_TIMEOUT};
-use agrisim_bench::nav::trial_seed;
+use agrisim_bench::framework::{OptionValues, Trial};
+use agrisim_bench::harvest::{builtin_node, run_with, HarvestSetup, HarvestTrial, TRIAL_TIMEOUT};
+use agrisim_bench::trial_seed;
 use agrisim_bus::{Bus, Node};
 use agrisim_error::Result;
 use agrisim_harvest::topics;
@@ -83,9 +84,17 @@ impl Bench {
     }
 
     fn trial(&self, name: &str, node: &dyn Fn(usize, u64) -> Box<dyn Node>, timeout: f64) -> HarvestTrial {
-        let seed = trial_seed(1, 0);
-        let mcap = self.dir.path().join(format!("{name}.mcap"));
-        run_trial_with(&self.scenario, &self.options, &self.setup, 0, seed, &mcap, node, timeout).unwrap()
+        let options = OptionValues::default();
+        let t = Trial {
+            scenario: &self.scenario,
+            run: &self.options,
+            setup: &self.setup,
+            options: &options,
+            index: 0,
+            scene: 0,
+            seed: trial_seed(1, 0),
+        };
+        run_with(&t, &self.dir.path().join(format!("{name}.mcap")), node, timeout).unwrap()
     }
 }
 

@@ -6,9 +6,10 @@ mod pack;
 mod png;
 mod snapshot;
 
+use agrisim_bench::{Job, Registry};
 use agrisim_error::Result;
 use agrisim_session::{interrupt, Profile, RunOptions, Scenario};
-use clap::{Parser, Subcommand};
+use clap::{Args, CommandFactory, FromArgMatches, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -47,8 +48,9 @@ enum Command {
         log: FmuLog,
         #[command(flatten)]
         record: Record,
+        // Boxed: the largest flags by far, and the one variant that has them.
         #[command(flatten)]
-        live: live::LiveArgs,
+        live: Box<live::LiveArgs>,
         /// Print how the master orders the system (step order, delayed connections,
         /// initialization, exchange periods) and exit without running.
         #[arg(long)]
@@ -56,11 +58,6 @@ enum Command {
         /// Output directory.
         #[arg(long, required_unless_present = "explain")]
         out: Option<PathBuf>,
-    },
-    /// Benchmarks.
-    Bench {
-        #[command(subcommand)]
-        command: BenchCommand,
     },
     /// Pictures of the default view: DIR/rgb.png, DIR/depth.png, DIR/lidar_top.png, DIR/lidar_near.png.
     Snapshot {
@@ -88,7 +85,8 @@ enum FmuCommand {
     /// Write target/fmu/<Name>.fmu (FMI 3.0), target/fmu/fmi2/<Name>.fmu (FMI 2.0) and a
     /// self-contained target/ssp/<system>.ssp for every system file.
     Pack {
-        /// Directory with the built FMU libraries (default: this executable's directory).
+        /// Directory with the built libraries of the FMU crates, those marked
+        /// `[package.metadata.agrisim] fmu` in their Cargo.toml (default: this executable's directory).
         #[arg(long)]
         lib_dir: Option<PathBuf>,
         /// Output directory (default: target/fmu next to the build directory).
@@ -103,86 +101,21 @@ enum FmuCommand {
     },
 }
 
-#[derive(Subcommand)]
-enum BenchCommand {
-    /// The navigation experiment: N trials to seeded targets; DIR/summary.json, trials.jsonl,
-    /// trials/<NNNN>.mcap, report.html (default scenario: models/scenarios/default.toml).
-    Nav(TrialArgs),
-    /// The dual-arm harvesting experiment: N trials on seeded ripe fruit; DIR/summary.json,
-    /// trials.jsonl, trials/<NNNN>.mcap, report.html (default scenario:
-    /// models/scenarios/harvest.toml).
-    Harvest(TrialArgs),
-    /// The whole-row harvest: N aisle segments (both sides), every reachable ripe fruit in
-    /// them harvested in turn; DIR/summary.json, trials.jsonl, trials/<NNNN>.mcap, report.html
-    /// (default scenario: models/scenarios/harvest.toml; --trials is the number of segments).
-    Row {
-        #[command(flatten)]
-        trials: TrialArgs,
-        /// Segment length along the aisle [m].
-        #[arg(long, default_value_t = 10.0)]
-        length: f64,
-    },
-    /// Orchestrator cost per FMU and step, beside the bare fmi3DoStep cost (JSON on stdout).
-    Overhead {
-        #[arg(long, default_value = "models/scenarios/default.toml")]
-        scenario: PathBuf,
-        #[arg(long, default_value_t = 5000)]
-        steps: u64,
-        #[command(flatten)]
-        dirs: Dirs,
-        #[command(flatten)]
-        log: FmuLog,
-        #[command(flatten)]
-        record: Record,
-        #[arg(long)]
-        out: PathBuf,
-    },
-}
-
-/// What a many-trial benchmark takes.
+// `bench overhead`: not a many-trial benchmark, so not in the benchmark registry.
 #[derive(clap::Args)]
-struct TrialArgs {
-    /// Scenario file (default: the benchmark's own).
-    #[arg(long)]
-    scenario: Option<PathBuf>,
-    #[arg(long, default_value_t = 50)]
-    trials: u64,
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
-    /// Scenes the trials are spread over (round robin): scene k is the scenario's greenhouse
-    /// grown from its seed + k. The summary gives per-scene results and a cluster-bootstrap
-    /// interval beside Wilson's.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=10_000))]
-    scenes: u64,
+struct OverheadArgs {
+    #[arg(long, default_value = "models/scenarios/default.toml")]
+    scenario: PathBuf,
+    #[arg(long, default_value_t = 5000)]
+    steps: u64,
     #[command(flatten)]
     dirs: Dirs,
     #[command(flatten)]
     log: FmuLog,
     #[command(flatten)]
     record: Record,
-    #[command(flatten)]
-    live: live::LiveArgs,
-    /// Keep the trials already complete in DIR (an interrupted run) and run the others.
-    #[arg(long)]
-    resume: bool,
-    /// Trials run at once, each in its own worker process (a trial whose process dies, e.g.
-    /// a foreign FMU that segfaults, is recorded as an error and the benchmark goes on).
-    #[arg(long, default_value_t = 1)]
-    jobs: usize,
-    /// Run the trials one after the other inside this process (no worker processes).
-    #[arg(long, conflicts_with = "jobs")]
-    in_process: bool,
-    /// Internal: run trial N only, as a worker process of a benchmark.
-    #[arg(long, hide = true)]
-    worker_trial: Option<u64>,
     #[arg(long)]
     out: PathBuf,
-}
-
-impl TrialArgs {
-    fn plan(&self) -> agrisim_bench::trials::TrialPlan {
-        agrisim_bench::trials::TrialPlan { trials: self.trials, seed: self.seed, scenes: self.scenes }
-    }
 }
 
 #[derive(Subcommand)]
@@ -332,50 +265,89 @@ fn worker_command(i: u64) -> std::process::Command {
     c
 }
 
-/// How a benchmark runs its trials.
-fn exec<'a>(a: &TrialArgs, command: &'a dyn Fn(u64) -> std::process::Command) -> agrisim_bench::trials::Exec<'a> {
-    if a.in_process {
-        agrisim_bench::trials::Exec::InProcess
-    } else {
-        agrisim_bench::trials::Exec::Workers { jobs: a.jobs, command }
-    }
-}
-
-/// The scenario (or the benchmark's default) and run options of a many-trial benchmark.
-fn trial_setup(
-    a: &TrialArgs,
-    default_scenario: &str,
-    target: &Path,
-    bridges: &Bridges,
-) -> Result<(Scenario, RunOptions)> {
-    let s = Scenario::load(a.scenario.as_deref().unwrap_or(Path::new(default_scenario)))?;
-    let mut o = run_options(a.dirs.clone(), target, None, None, BTreeMap::new(), a.log.categories());
-    o.record = a.record.profile;
-    if (a.live.ros2 || a.live.foxglove.is_some()) && a.jobs > 1 {
-        return Err(agrisim_error::err!("--ros2 and --foxglove run one trial at a time (trials would share the DDS topics and the port): use --jobs 1"));
-    }
-    o.nodes = a.live.plan(bridges)?;
-    Ok((s, o))
-}
-
 /// The ROS 2 bridges' statistics of this process's runs.
 type Bridges = std::sync::Arc<std::sync::Mutex<Vec<std::sync::Arc<std::sync::Mutex<agrisim_ros2::Stats>>>>>;
 
-fn real_main() -> Result<()> {
-    let cli = Cli::parse();
-    let bridges = Bridges::default();
-    let stats_file = match &cli.command {
-        Command::Run { live, .. } => live.ros2_stats.clone(),
-        Command::Bench {
-            command: BenchCommand::Nav(a) | BenchCommand::Harvest(a) | BenchCommand::Row { trials: a, .. },
-        } => a.live.ros2_stats.clone(),
-        _ => None,
+/// The whole command line: the derived commands, and `bench` built from the benchmark
+/// registry (every benchmark with the trial flags, its own options and this CLI's run flags).
+fn command(registry: &Registry) -> clap::Command {
+    let shared = |c: clap::Command| {
+        live::LiveArgs::augment_args(Record::augment_args(FmuLog::augment_args(Dirs::augment_args(c))))
     };
-    let result = dispatch(cli, &bridges);
+    let overhead = OverheadArgs::augment_args(clap::Command::new("overhead"))
+        .about("Orchestrator cost per FMU and step, beside the bare fmi3DoStep cost (JSON on stdout)");
+    Cli::command().subcommand(agrisim_bench::cli::command(registry, &shared).subcommand(overhead))
+}
+
+/// `T` from matches of a command it was added to (clap's own error and exit otherwise).
+fn args<T: FromArgMatches>(m: &clap::ArgMatches) -> T {
+    T::from_arg_matches(m).unwrap_or_else(|e| e.exit())
+}
+
+fn real_main() -> Result<()> {
+    let registry = agrisim_bench::registry();
+    let matches = command(&registry).get_matches();
+    let bridges = Bridges::default();
+    let (stats_file, result) = match matches.subcommand() {
+        Some(("bench", m)) => {
+            let stats = match m.subcommand() {
+                Some((name, sub)) if name != "overhead" => args::<live::LiveArgs>(sub).ros2_stats,
+                _ => None,
+            };
+            (stats, bench(&registry, m, &bridges))
+        }
+        _ => {
+            let cli: Cli = args(&matches);
+            let stats = match &cli.command {
+                Command::Run { live, .. } => live.ros2_stats.clone(),
+                _ => None,
+            };
+            (stats, dispatch(cli, &bridges))
+        }
+    };
     if let Some(line) = live::report(&bridges, stats_file.as_deref())? {
         eprintln!("{line}");
     }
     result
+}
+
+/// `agrisim bench ...` (`m`: the matches of `bench`): a registered benchmark, a worker
+/// process's trial of one, or `overhead`.
+fn bench(registry: &Registry, m: &clap::ArgMatches, bridges: &Bridges) -> Result<()> {
+    let (_, target) = build_dirs();
+    if let Some(("overhead", sub)) = m.subcommand() {
+        let OverheadArgs { scenario, steps, dirs, log, record, out } = args(sub);
+        let s = Scenario::load(&scenario)?;
+        let mut opts = run_options(dirs, &target, None, None, BTreeMap::new(), log.categories());
+        opts.record = record.profile;
+        let report = agrisim_bench::overhead(&s, &opts, steps, &out)?;
+        println!("{}", serde_json::to_string_pretty(&report).expect("plain struct serializes"));
+        return Ok(());
+    }
+    let (b, a, options) = agrisim_bench::cli::parse(registry, m)?;
+    let sub = m.subcommand().expect("a benchmark was named").1;
+    let (dirs, log, record, live): (Dirs, FmuLog, Record, live::LiveArgs) =
+        (args(sub), args(sub), args(sub), args(sub));
+    let s = Scenario::load(&a.scenario_path(b))?;
+    let mut o = run_options(dirs, &target, None, None, BTreeMap::new(), log.categories());
+    o.record = record.profile;
+    // The live links run one trial at a time: trials would share the DDS topics and the port.
+    let linked = live.ros2 || live.foxglove.is_some();
+    if linked && a.jobs.is_some_and(|j| j > 1) {
+        return Err(agrisim_error::err!(
+            "--ros2 and --foxglove run one trial at a time (trials would share the DDS topics and the port): use --jobs 1"
+        ));
+    }
+    o.nodes = live.plan(bridges)?;
+    let job = Job { scenario: s, run: o, plan: a.plan(), options, out: a.out.clone() };
+    if let Some(i) = a.worker_trial {
+        return registry.run_one(b.name(), &job, i);
+    }
+    let command = worker_command;
+    let jobs = if linked { 1 } else { agrisim_bench::cli::default_jobs() };
+    let summary = registry.run(b.name(), &job, a.resume, a.exec(jobs, &command), &mut progress_printer())?;
+    println!("{summary}");
+    Ok(())
 }
 
 fn dispatch(cli: Cli, bridges: &Bridges) -> Result<()> {
@@ -394,65 +366,6 @@ fn dispatch(cli: Cli, bridges: &Bridges) -> Result<()> {
             let summary = agrisim_session::run::run(&s, &opts, &out, progress_printer())?;
             println!("{} steps ({} s simulated) -> {}", summary.steps, summary.simulated, summary.mcap.display());
         }
-        Command::Bench { command: BenchCommand::Nav(a) } => {
-            let (s, opts) = trial_setup(&a, "models/scenarios/default.toml", &target, bridges)?;
-            if let Some(i) = a.worker_trial {
-                return agrisim_bench::nav::nav_worker(&s, &opts, a.plan(), &a.out, i);
-            }
-            let command = worker_command;
-            let summary = agrisim_bench::nav::bench_nav(
-                &s,
-                &opts,
-                a.plan(),
-                &a.out,
-                a.resume,
-                exec(&a, &command),
-                progress_printer(),
-            )?;
-            println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
-        }
-        Command::Bench { command: BenchCommand::Harvest(a) } => {
-            let (s, opts) = trial_setup(&a, "models/scenarios/harvest.toml", &target, bridges)?;
-            if let Some(i) = a.worker_trial {
-                return agrisim_bench::harvest::harvest_worker(&s, &opts, a.plan(), &a.out, i);
-            }
-            let command = worker_command;
-            let summary = agrisim_bench::harvest::bench_harvest(
-                &s,
-                &opts,
-                a.plan(),
-                &a.out,
-                a.resume,
-                exec(&a, &command),
-                progress_printer(),
-            )?;
-            println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
-        }
-        Command::Bench { command: BenchCommand::Row { trials: a, length } } => {
-            let (s, opts) = trial_setup(&a, "models/scenarios/harvest.toml", &target, bridges)?;
-            if let Some(i) = a.worker_trial {
-                return agrisim_bench::row::row_worker(&s, &opts, a.plan(), length, &a.out, i);
-            }
-            let command = worker_command;
-            let summary = agrisim_bench::row::bench_row(
-                &s,
-                &opts,
-                a.plan(),
-                length,
-                &a.out,
-                a.resume,
-                exec(&a, &command),
-                progress_printer(),
-            )?;
-            println!("{}", serde_json::to_string_pretty(&summary).expect("plain struct serializes"));
-        }
-        Command::Bench { command: BenchCommand::Overhead { scenario, steps, dirs, log, record, out } } => {
-            let s = Scenario::load(&scenario)?;
-            let mut opts = run_options(dirs, &target, None, None, BTreeMap::new(), log.categories());
-            opts.record = record.profile;
-            let report = agrisim_bench::overhead(&s, &opts, steps, &out)?;
-            println!("{}", serde_json::to_string_pretty(&report).expect("plain struct serializes"));
-        }
         Command::Snapshot { scenario, dirs, out } => {
             let s = Scenario::load(&scenario)?;
             let opts = run_options(dirs, &target, None, None, BTreeMap::new(), None);
@@ -463,7 +376,7 @@ fn dispatch(cli: Cli, bridges: &Bridges) -> Result<()> {
         Command::Scene { command: SceneCommand::Export { scenario, out } } => {
             let s = Scenario::load(&scenario)?;
             let g = agrisim_session::scene::generate_scene(&s)?;
-            agrisim_greenhouse::gltf::write_glb(&g.objects, &out)
+            agrisim_gltf::write_glb(&g.objects, &out)
                 .map_err(|e| agrisim_error::err!("cannot write {}: {e}", out.display()))?;
             println!("{} objects -> {}", g.objects.len(), out.display());
         }

@@ -1,5 +1,10 @@
 //! `agrisim fmu pack`: turns every built FMU library into .fmu archives.
 //!
+//! Which libraries are FMUs comes from the crates' Cargo.toml (`[package.metadata.agrisim]
+//! fmu = "<Id>"`), embedded at compile time by build.rs ([`FMU_CRATES`]), never from file
+//! names: a stale or unrelated library in the directory is not packed, and a marked crate
+//! whose library is missing, or whose library names another model, is an error.
+//!
 //! The modelDescription.xml is not a file in the source tree: each FMU library generates it
 //! from its own variable table (symbols `agrisim_model_description_fmi3/2`), so packing
 //! dlopens the library, asks it, and zips XML + binary. Archives are deterministic (sorted
@@ -34,17 +39,42 @@ fn description(lib: &libloading::Library, symbol: &[u8]) -> Option<String> {
     }
 }
 
-/// FMU libraries among the shared libraries in `dir` (those exporting the agrisim symbol).
-pub fn find_fmu_libraries(dir: &Path) -> Result<Vec<PathBuf>> {
-    let mut libs = vec![];
-    for entry in std::fs::read_dir(dir).context(|| format!("cannot list {}", dir.display()))? {
-        let path = entry.context(|| format!("cannot list {}", dir.display()))?.path();
-        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
-        if name.starts_with("libagrisim_fmu_") && name.ends_with(".so") {
-            libs.push(path);
-        }
+/// A workspace crate marked as an FMU in its Cargo.toml.
+#[derive(Debug, Clone, Copy)]
+pub struct FmuCrate {
+    /// Package name, for messages.
+    pub package: &'static str,
+    /// The cdylib's name (file `lib<library>.so`).
+    pub library: &'static str,
+    /// The marker: the modelIdentifier its modelDescription must name.
+    pub fmu: &'static str,
+}
+
+include!(concat!(env!("OUT_DIR"), "/fmu_crates.rs"));
+
+impl FmuCrate {
+    /// The shared library's file name on this platform.
+    pub fn file_name(&self) -> String {
+        format!("{}{}{}", std::env::consts::DLL_PREFIX, self.library, std::env::consts::DLL_SUFFIX)
     }
-    libs.sort();
+}
+
+/// The library of every FMU crate in `dir`, with the crate; a missing one is an error that
+/// names the crate.
+pub fn find_fmu_libraries(dir: &Path) -> Result<Vec<(PathBuf, FmuCrate)>> {
+    let mut libs = vec![];
+    for c in FMU_CRATES {
+        let path = dir.join(c.file_name());
+        if !path.is_file() {
+            return Err(agrisim_error::err!(
+                "{} missing: crate {} (FMU {}) is not built; run `cargo build --release`",
+                path.display(),
+                c.package,
+                c.fmu
+            ));
+        }
+        libs.push((path, *c));
+    }
     Ok(libs)
 }
 
@@ -77,8 +107,8 @@ fn write_zip(out: &Path, entries: &[(String, &[u8])]) -> Result<()> {
 }
 
 /// Packs one library into `out_dir/<Id>.fmu` and, if it has an FMI 2 description,
-/// `out_dir/fmi2/<Id>.fmu`.
-pub fn pack_library(library: &Path, out_dir: &Path) -> Result<Packed> {
+/// `out_dir/fmi2/<Id>.fmu`. The modelIdentifier its description names must be `expected.fmu`.
+pub fn pack_library(library: &Path, expected: &FmuCrate, out_dir: &Path) -> Result<Packed> {
     // SAFETY: loading our own FMU library; its initializers are Rust statics only.
     let lib = unsafe { libloading::Library::new(library) }.context(|| format!("cannot load {}", library.display()))?;
     let xml3 = description(&lib, b"agrisim_model_description_fmi3\0").ok_or_else(|| {
@@ -89,6 +119,15 @@ pub fn pack_library(library: &Path, out_dir: &Path) -> Result<Packed> {
     })?;
     let md = ModelDescription::parse(&xml3, &library.display().to_string())?;
     let id = md.model_identifier.clone();
+    if id != expected.fmu {
+        return Err(agrisim_error::err!(
+            "{}: its modelDescription names modelIdentifier '{id}', but crate {} is marked fmu = \"{}\" \
+             ([package.metadata.agrisim] in its Cargo.toml); make the two agree",
+            library.display(),
+            expected.package,
+            expected.fmu
+        ));
+    }
     let bytes = std::fs::read(library).context(|| format!("cannot read {}", library.display()))?;
     std::fs::create_dir_all(out_dir).context(|| format!("cannot create {}", out_dir.display()))?;
     let fmi3 = out_dir.join(format!("{id}.fmu"));
@@ -106,16 +145,9 @@ pub fn pack_library(library: &Path, out_dir: &Path) -> Result<Packed> {
     Ok(Packed { model_identifier: id, fmi3, fmi2 })
 }
 
-/// Packs every FMU library found in `lib_dir`.
+/// Packs the library of every FMU crate, found in `lib_dir`.
 pub fn pack_all(lib_dir: &Path, out_dir: &Path) -> Result<Vec<Packed>> {
-    let libs = find_fmu_libraries(lib_dir)?;
-    if libs.is_empty() {
-        return Err(agrisim_error::err!(
-            "no FMU libraries (libagrisim_fmu_*.so) in {}: run `cargo build --release` first",
-            lib_dir.display()
-        ));
-    }
-    libs.iter().map(|l| pack_library(l, out_dir)).collect()
+    find_fmu_libraries(lib_dir)?.iter().map(|(l, c)| pack_library(l, c, out_dir)).collect()
 }
 
 /// Writes `out_dir/<system>.ssp` for every `.ssd` in `systems_dir`: a self-contained SSP
@@ -166,4 +198,54 @@ pub fn pack_ssps(systems_dir: &Path, fmu_dir: &Path, out_dir: &Path) -> Result<V
         written.push(out);
     }
     Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn marked(package: &str) -> FmuCrate {
+        *FMU_CRATES.iter().find(|c| c.package == package).unwrap_or_else(|| panic!("{package} is not in FMU_CRATES"))
+    }
+
+    #[test]
+    fn build_script_embeds_the_marked_crates() {
+        for (package, library, fmu) in [
+            ("agrisim-fmu-chassis-kinematic", "agrisim_fmu_chassis_kinematic", "ChassisKinematic"),
+            ("agrisim-fmu-greenhouse", "agrisim_fmu_greenhouse", "Greenhouse"),
+            ("agrisim-fmu-testmodel", "agrisim_fmu_testmodel", "TestModel"),
+        ] {
+            let c = marked(package);
+            assert_eq!((c.library, c.fmu), (library, fmu));
+        }
+        // Libraries are not FMUs, whatever their names.
+        assert!(FMU_CRATES.iter().all(|c| !["agrisim-fmi", "agrisim-chassis", "agrisim-msgs"].contains(&c.package)));
+        assert_eq!(marked("agrisim-fmu-lift").file_name(), "libagrisim_fmu_lift.so");
+    }
+
+    #[test]
+    fn a_missing_library_names_its_crate() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+        let e = find_fmu_libraries(&dir).expect_err("no library is in src/").to_string();
+        let first = FMU_CRATES[0];
+        assert!(e.contains(&first.file_name()) && e.contains(first.package) && e.contains("cargo build"), "{e}");
+    }
+
+    #[test]
+    fn a_library_naming_another_model_is_refused() {
+        // target/release/deps/<this test> -> target/release, where the FMU libraries are built.
+        let exe = std::env::current_exe().expect("test executable path");
+        let dir = exe.parent().and_then(Path::parent).expect("target/<profile>/deps");
+        let lift = marked("agrisim-fmu-lift");
+        let library = dir.join(lift.file_name());
+        assert!(library.is_file(), "{} missing: run `cargo build --release -p agrisim-fmu-lift`", library.display());
+        let out = std::env::temp_dir().join(format!("agrisim-pack-test-{}", std::process::id()));
+        let wrong = FmuCrate { fmu: "Arm", ..lift };
+        let e = pack_library(&library, &wrong, &out).expect_err("Lift packed as Arm").to_string();
+        assert!(e.contains("modelIdentifier 'Lift'") && e.contains("fmu = \"Arm\""), "{e}");
+        assert!(!out.exists(), "nothing is written for a refused library");
+        let packed = pack_library(&library, &lift, &out).expect("Lift packs as Lift");
+        assert_eq!(packed.fmi3, out.join("Lift.fmu"));
+        std::fs::remove_dir_all(&out).expect("remove the test's output");
+    }
 }

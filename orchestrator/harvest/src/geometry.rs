@@ -2,24 +2,19 @@
 //! forward, y left, z up). Figures are the robot's (models/robot/generate_urdf.py); the test
 //! below checks them against the URDF so the two cannot drift apart.
 
+use agrisim_math::vec3::{cross, dot, normalize};
 use agrisim_robot::Pose;
 
-/// Arm base (link0) x on base_link [m] (lift carriage centre).
-pub const SHOULDER_X: f64 = 0.2;
-/// Arm bases left/right of the carriage centre [m].
-pub const ARM_Y: f64 = 0.25;
+/// Where the base stands to reach a fruit (shared with the benchmarks that lay out its task).
+pub use agrisim_robot::reach::{standoff, standoff_facing, ARM_Y, REACH_AHEAD, REACH_LATERAL, SHOULDER_X};
 /// Arm base height at lift 0 [m].
 pub const ARM_Z0: f64 = 0.475;
 /// Panda shoulder (joint 2) above the arm base [m] (DH d1).
 pub const SHOULDER_UP: f64 = 0.333;
 /// Lift range [m].
 pub const LIFT_MAX: f64 = 0.8;
-/// Where the fruit is relative to the grasping arm's base when the base is in place [m]:
-/// sideways (a horizontal approach still works 0.1 m closer, at the pre-grasp), ahead of the
-/// arm (straight sideways at shoulder height the Panda's wrist meets its own shoulder and IK
-/// fails), and below the shoulder.
-pub const REACH_LATERAL: f64 = 0.6;
-pub const REACH_AHEAD: f64 = 0.2;
+/// Where the fruit is below the grasping arm's shoulder when the lift is in place [m] (its
+/// place sideways and ahead: [`agrisim_robot::reach`]).
 pub const REACH_BELOW_SHOULDER: f64 = 0.1;
 /// Pre-grasp stand-off along the approach axis [m].
 pub const PRE_GRASP: f64 = 0.1;
@@ -43,21 +38,6 @@ pub const BOX_TOP: [f64; 3] = [-0.35, 0.0, 0.97];
 pub const DROP_ABOVE: f64 = 0.13;
 /// Gripper opening for approach [m] (Franka Hand maximum).
 pub const OPEN_WIDTH: f64 = 0.08;
-
-/// Base pose (x, y, yaw) in the map frame that puts a fruit at `fruit` (map) within reach
-/// of the arm on `side` (+1 left, -1 right): facing +x along the aisle.
-pub fn standoff(fruit: [f64; 3], side: f64) -> [f64; 3] {
-    standoff_facing(fruit, side, 0.0)
-}
-
-/// The base pose (x, y, yaw = `heading`) from which the arm on `side` (of the base: +1 left)
-/// reaches `fruit`: the fruit sits at the same place in base_link whichever way the base
-/// faces, so a base that starts facing down the aisle harvests without turning round.
-pub fn standoff_facing(fruit: [f64; 3], side: f64, heading: f64) -> [f64; 3] {
-    let (ax, ay) = (SHOULDER_X + REACH_AHEAD, side * (ARM_Y + REACH_LATERAL));
-    let (s, c) = heading.sin_cos();
-    [fruit[0] - (c * ax - s * ay), fruit[1] - (s * ax + c * ay), heading]
-}
 
 /// Lift height that brings the shoulder level with a fruit at height `z` [m].
 pub fn lift_for(z: f64) -> f64 {
@@ -206,19 +186,6 @@ pub fn in_box(p: [f64; 3]) -> bool {
         && p[2] > BOX_TOP[2] - 0.26
 }
 
-pub fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
-
-pub fn normalize(a: [f64; 3]) -> [f64; 3] {
-    let n = dot(a, a).sqrt();
-    [a[0] / n, a[1] / n, a[2] / n]
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -274,28 +241,5 @@ mod tests {
         assert!(dot(yg, yt).abs() < 1e-12);
         assert!((dot(g.approach, t.approach) + 1.0).abs() < 1e-12);
         assert!((yg[2] - 1.0).abs() < 1e-12, "giver fingers close vertically");
-    }
-}
-
-#[cfg(test)]
-mod standoff_tests {
-    use super::*;
-
-    /// Facing +x or -x, the fruit is at the same place in base_link: ahead of the shoulder,
-    /// on the grasping arm's side.
-    #[test]
-    fn the_fruit_sits_alike_in_base_link_for_either_heading() {
-        let fruit = [5.0, 2.0, 1.2];
-        for (heading, side) in [(0.0, 1.0), (0.0, -1.0), (std::f64::consts::PI, 1.0), (std::f64::consts::PI, -1.0)] {
-            let [x, y, yaw] = standoff_facing(fruit, side, heading);
-            let (s, c) = yaw.sin_cos();
-            let (dx, dy) = (fruit[0] - x, fruit[1] - y);
-            let (bx, by) = (c * dx + s * dy, -s * dx + c * dy);
-            assert!(
-                (bx - (SHOULDER_X + REACH_AHEAD)).abs() < 1e-12 && (by - side * (ARM_Y + REACH_LATERAL)).abs() < 1e-12,
-                "{heading} {side}: ({bx}, {by})"
-            );
-        }
-        assert_eq!(standoff(fruit, 1.0), standoff_facing(fruit, 1.0, 0.0));
     }
 }

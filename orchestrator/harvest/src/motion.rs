@@ -15,6 +15,7 @@ use agrisim_manip::{
     exact_check, ArmModel, Checker, Context, Ik, Meter, Obstacle, ObstacleKind, Planner, Rng, Scene, Shape, Side,
     Target, Work, DOF,
 };
+use agrisim_math::vec3::{cross, normalize};
 use agrisim_math::Pose2;
 use agrisim_msgs::agrisim::PlanningScene;
 use agrisim_msgs::builtin_interfaces::Duration;
@@ -324,10 +325,10 @@ impl Motion {
             let ctx = self.context(arm, lift, other);
             let checker = Checker::new(ctx);
             let ik = self.ik(arm, lift);
-            let z = super::geometry::normalize(grasp.approach);
+            let z = normalize(grasp.approach);
             let up = if z[2].abs() < 0.9 { [0.0, 0.0, 1.0] } else { [1.0, 0.0, 0.0] };
-            let x0 = super::geometry::normalize(super::geometry::cross(super::geometry::cross(z, up), z));
-            let y0 = super::geometry::cross(z, x0);
+            let x0 = normalize(cross(cross(z, up), z));
+            let y0 = cross(z, x0);
             // Rolls to try: every 30 degrees when free; a given roll and its opposite (the
             // same finger line) otherwise.
             let rolls: Vec<(u32, [f64; 3])> = match grasp.x_axis {

@@ -5,18 +5,18 @@
 //! pulls the path to the middle of an aisle; cells at or above the inscribed cost are not
 //! entered, and diagonal moves may not cut an obstacle's corner. The heuristic is the octile
 //! distance (admissible: no move is cheaper than its length), and ties are broken by
-//! (f, h, cell index), so the same costmap always gives the same path.
+//! (f, h, cell index), so the same costmap always gives the same path. [`AStar`] is the
+//! [`GlobalPlanner`] the executor runs by default.
 
-use super::costmap::{GlobalCostmap, INSCRIBED, LETHAL, MAX_NON_OBSTACLE};
+use super::costmap::{GlobalCostmap, LETHAL, MAX_NON_OBSTACLE};
+use super::global_planner::{densify, traversable, GlobalPlanner, PlanError};
 use super::map::GridGeom;
 use agrisim_math::pose2::Pose2;
-use agrisim_msgs::geometry_msgs::PoseStamped;
-use agrisim_msgs::nav_msgs::Path;
-use agrisim_msgs::std_msgs::Header;
 use serde::{Deserialize, Serialize};
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
+/// The global planner's parameters (the last two serve every planner here).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct PlannerConfig {
@@ -43,23 +43,6 @@ impl Default for PlannerConfig {
             start_escape_radius: 0.6,
         }
     }
-}
-
-/// Why no path came out.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PlanError {
-    StartOutside,
-    GoalOutside,
-    /// The goal cell is an obstacle or within the inscribed radius of one.
-    GoalBlocked,
-    /// The start is boxed in beyond the escape radius.
-    StartBlocked,
-    /// Search exhausted.
-    Unreachable,
-}
-
-pub fn traversable(c: u8) -> bool {
-    c < INSCRIBED
 }
 
 /// Cost of moving `len` metres into a cell of cost `c`.
@@ -227,6 +210,18 @@ pub fn plan(
     Ok(densify(&pts, cfg.path_spacing))
 }
 
+/// A* behind the [`GlobalPlanner`] seam.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AStar {
+    pub cfg: PlannerConfig,
+}
+
+impl GlobalPlanner for AStar {
+    fn plan(&mut self, costmap: &GlobalCostmap, start: &Pose2, goal: &Pose2) -> Result<Vec<(f64, f64)>, PlanError> {
+        plan(costmap, start, goal, &self.cfg)
+    }
+}
+
 /// Shortest way (Dijkstra on lengths, through non-lethal cells, within `radius`) from an
 /// inscribed-zone cell to a traversable one.
 fn escape(geom: &GridGeom, cost: &[u8], start: usize, radius: f64) -> Option<Vec<usize>> {
@@ -323,42 +318,6 @@ fn shortcut(costmap: &GlobalCostmap, pts: &[(f64, f64)], cfg: &PlannerConfig) ->
         i = best;
     }
     out
-}
-
-/// Points along the polyline at most `spacing` apart, the vertices kept.
-fn densify(pts: &[(f64, f64)], spacing: f64) -> Vec<(f64, f64)> {
-    let mut out = vec![pts[0]];
-    for k in 1..pts.len() {
-        let (a, b) = (pts[k - 1], pts[k]);
-        let n = (((b.0 - a.0).hypot(b.1 - a.1)) / spacing).ceil().max(1.0) as usize;
-        for i in 1..=n {
-            let t = i as f64 / n as f64;
-            out.push((a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1)));
-        }
-    }
-    out
-}
-
-/// The plan as nav_msgs/Path: each pose faces along the path; the last takes `goal_yaw` if given.
-pub fn to_path_msg(pts: &[(f64, f64)], goal_yaw: Option<f64>, header: &Header) -> Path {
-    let mut poses = Vec::with_capacity(pts.len());
-    for i in 0..pts.len() {
-        let (a, b) = if i + 1 < pts.len() {
-            (pts[i], pts[i + 1])
-        } else if i > 0 {
-            (pts[i - 1], pts[i])
-        } else {
-            (pts[i], pts[i])
-        };
-        let mut yaw = (b.1 - a.1).atan2(b.0 - a.0);
-        if i + 1 == pts.len() {
-            if let Some(gy) = goal_yaw {
-                yaw = gy;
-            }
-        }
-        poses.push(PoseStamped { header: header.clone(), pose: Pose2::new(pts[i].0, pts[i].1, yaw).to_msg() });
-    }
-    Path { header: header.clone(), poses }
 }
 
 #[cfg(test)]

@@ -8,6 +8,7 @@ use super::dwa::ControllerConfig;
 use super::footprint::Footprint;
 use super::lidar_odometry::LidarOdometryConfig;
 use super::local_costmap::LocalCostmapConfig;
+use super::plugins::Plugins;
 use super::scan_match::ScanMatchConfig;
 use serde::{Deserialize, Serialize};
 
@@ -229,6 +230,8 @@ pub struct NavConfig {
     /// before its own step. Set false to run localization as a separate node (or replace it,
     /// e.g. by AMCL through a bridge): the navigator then only reads `/localization/pose`.
     pub embedded_localizer: bool,
+    /// The global planner and the controller by name (`[plugins]`: A* and DWA by default).
+    pub plugins: Plugins,
     pub robot: RobotConfig,
     pub costmap: CostmapConfig,
     pub planner: PlannerConfig,
@@ -241,6 +244,7 @@ impl Default for NavConfig {
     fn default() -> Self {
         NavConfig {
             embedded_localizer: true,
+            plugins: Plugins::default(),
             robot: RobotConfig::default(),
             costmap: CostmapConfig::default(),
             planner: PlannerConfig::default(),
@@ -291,5 +295,8 @@ mod tests {
         assert_eq!(c.controller.max_vx, 0.4);
         assert_eq!(c.controller.max_vy, 0.8);
         assert_eq!(c.executor.xy_goal_tolerance, 0.25);
+        assert_eq!(c.plugins, Plugins::default());
+        let c: NavConfig = toml::from_str("[plugins]\nplanner = \"straight_line\"\n").unwrap();
+        assert_eq!(c.plugins.planner, crate::plugins::PlannerKind::StraightLine);
     }
 }

@@ -8,10 +8,12 @@
 //! (progress), to the plan itself (path following), heading error, an obstacle term that
 //! grows as footprint clearance shrinks, and a little spin. The window is taken from the last
 //! command, not measured odometry (open-loop, like a velocity smoother), so limits hold exactly.
-//! Also here: the rotate-in-place law of the goal's rotate phase.
+//! Also here: the rotate-in-place law of the goal's rotate phase, and [`Dwa`], the
+//! [`Controller`] the executor runs by default.
 
+use super::controller::{integrate, Controller, Decision, Obstacles, Request, Velocity};
 use super::footprint::Footprint;
-use agrisim_math::pose2::{wrap_angle, Pose2};
+use agrisim_math::pose2::wrap_angle;
 use serde::{Deserialize, Serialize};
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -78,39 +80,6 @@ impl Default for ControllerConfig {
     }
 }
 
-/// A base-frame velocity command (REP 103: x forward, y left, z up).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Velocity {
-    pub vx: f64,
-    pub vy: f64,
-    pub wz: f64,
-}
-
-impl Velocity {
-    pub const ZERO: Velocity = Velocity { vx: 0.0, vy: 0.0, wz: 0.0 };
-}
-
-/// What the controller is asked to do this period.
-#[derive(Debug, Clone, Copy)]
-pub struct Request<'a> {
-    pub pose: Pose2,
-    /// The last command sent.
-    pub current: Velocity,
-    /// The plan from the robot's projection onward (map frame).
-    pub path: &'a [(f64, f64)],
-    pub carrot: (f64, f64),
-    pub desired_yaw: f64,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Decision {
-    pub cmd: Velocity,
-    /// False when every roll-out collides; `cmd` then brakes as hard as allowed.
-    pub valid: bool,
-    /// Footprint clearance along the chosen roll-out [m].
-    pub clearance: f64,
-}
-
 /// Per-axis reachable interval [lo, hi] within one period, inside the limits.
 fn window(current: f64, limit: f64, acc: f64, period: f64) -> (f64, f64) {
     let (lo, hi) = ((current - acc * period).max(-limit), (current + acc * period).min(limit));
@@ -153,17 +122,6 @@ pub fn brake(cfg: &ControllerConfig, current: Velocity) -> Velocity {
         v.vy *= cfg.max_speed_xy / s;
     }
     v
-}
-
-/// Pose after driving `v` for `dt` from `p` (midpoint heading).
-pub fn integrate(p: &Pose2, v: &Velocity, dt: f64) -> Pose2 {
-    let yaw_mid = p.yaw + 0.5 * v.wz * dt;
-    let (s, c) = yaw_mid.sin_cos();
-    Pose2 {
-        x: p.x + (v.vx * c - v.vy * s) * dt,
-        y: p.y + (v.vx * s + v.vy * c) * dt,
-        yaw: wrap_angle(p.yaw + v.wz * dt),
-    }
 }
 
 /// How much closer than it is now a robot inside the collision margin may come [m].
@@ -238,9 +196,30 @@ pub fn rotate_in_place(cfg: &ControllerConfig, current: Velocity, yaw_error: f64
     Velocity { vx: b.vx, vy: b.vy, wz: approach(current.wz, target, cfg.max_wz, cfg.acc_wz, cfg.period) }
 }
 
+/// The DWA behind the [`Controller`] seam.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Dwa {
+    pub cfg: ControllerConfig,
+}
+
+impl Controller for Dwa {
+    fn compute_velocity(&mut self, req: &Request, outline: &[(f64, f64)], obstacles: &Obstacles) -> Decision {
+        dwa(&self.cfg, req, outline, |x, y| obstacles.distance_at(x, y))
+    }
+
+    fn rotate_in_place(&mut self, current: Velocity, yaw_error: f64) -> Velocity {
+        rotate_in_place(&self.cfg, current, yaw_error)
+    }
+
+    fn brake(&self, current: Velocity) -> Velocity {
+        brake(&self.cfg, current)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use agrisim_math::pose2::Pose2;
 
     #[test]
     fn drives_towards_the_carrot_in_free_space() {

@@ -9,11 +9,16 @@
 //!            |  +-> failed (no_path)  +-> following (pushed out of the xy tolerance)
 //!            +-- recovering <- (no progress; after max_recoveries: failed "stuck")
 //! ```
+//!
+//! It plans through a [`GlobalPlanner`] and drives through a [`Controller`] (A* and DWA
+//! unless the configuration's `plugins` name others), as a Nav2 BT navigator calls its
+//! planner and controller servers.
 
-use super::astar::{self, PlanError};
 use super::config::NavConfig;
-use super::costmap::{ClearanceGrid, GlobalCostmap};
-use super::dwa::{self, Velocity};
+use super::controller::{integrate, Controller, Obstacles, Request, Velocity};
+use super::costmap::GlobalCostmap;
+use super::dwa::ControllerConfig;
+use super::global_planner::{GlobalPlanner, PlanError};
 use super::local_costmap::LocalCostmap;
 use super::tracking::TrackedPath;
 use agrisim_math::pose2::{wrap_angle, Pose2};
@@ -116,6 +121,8 @@ const REVERSE_HYSTERESIS: f64 = 0.3;
 
 pub struct Executor {
     cfg: NavConfig,
+    planner: Box<dyn GlobalPlanner>,
+    controller: Box<dyn Controller>,
     outline: Vec<(f64, f64)>,
     state: State,
     detail: String,
@@ -139,9 +146,18 @@ pub struct Executor {
 }
 
 impl Executor {
+    /// With the planner and controller `cfg.plugins` names.
     pub fn new(cfg: &NavConfig) -> Executor {
+        let planner = cfg.plugins.planner.build(&cfg.planner);
+        Executor::with(cfg, planner, cfg.plugins.controller.build(&cfg.controller))
+    }
+
+    /// With a planner and a controller of the caller's (`cfg.plugins` is not read).
+    pub fn with(cfg: &NavConfig, planner: Box<dyn GlobalPlanner>, controller: Box<dyn Controller>) -> Executor {
         Executor {
             cfg: *cfg,
+            planner,
+            controller,
             outline: cfg.robot.footprint.outline(0.05),
             state: State::Idle,
             detail: String::new(),
@@ -257,9 +273,9 @@ impl Executor {
                     let target = Velocity { vx: b.dir.0 * ec.backup_speed, vy: b.dir.1 * ec.backup_speed, wz: 0.0 };
                     let cmd = step_towards(c, self.last_cmd, target);
                     // Stop backing into something.
-                    let next = dwa::integrate(&pose, &cmd, 0.5);
+                    let next = integrate(&pose, &cmd, 0.5);
                     let clear = footprint_clearance(&self.outline, &next, &world);
-                    let cmd = if clear < c.collision_margin { dwa::brake(c, self.last_cmd) } else { cmd };
+                    let cmd = if clear < c.collision_margin { self.controller.brake(self.last_cmd) } else { cmd };
                     self.last_cmd = cmd;
                     out.cmd = Some(cmd);
                     return out;
@@ -336,19 +352,14 @@ impl Executor {
         } else {
             self.travel_heading(self.path.tangent(ia), pose.yaw)
         };
-        let c = &self.cfg.controller;
-        let req = dwa::Request {
+        let req = Request {
             pose,
             current: self.last_cmd,
-            path: self.path.ahead(c.lookahead + 0.5),
+            path: self.path.ahead(self.cfg.controller.lookahead + 0.5),
             carrot,
             desired_yaw,
         };
-        let (global, local) = (&*world.global, &*world.local);
-        let grid = ClearanceGrid::from_costmaps(global, local);
-        let d = dwa::dwa(c, &req, &self.outline, |x, y| {
-            grid.get(x, y).unwrap_or_else(|| global.distance_at(x, y).min(local.distance_at(x, y)))
-        });
+        let d = self.controller.compute_velocity(&req, &self.outline, &Obstacles::new(world.global, world.local));
         if !d.valid {
             self.stats.controller_failures += 1;
         }
@@ -402,7 +413,7 @@ impl Executor {
         let margin = self.cfg.controller.collision_margin;
         let clearance = |p: &Pose2| footprint_clearance(&self.outline, p, world);
         if super::turn_spot::turn_clear(pose.x, pose.y, pose.yaw, pose.yaw + err, margin, &clearance) {
-            return dwa::rotate_in_place(&self.cfg.controller, self.last_cmd, err);
+            return self.controller.rotate_in_place(self.last_cmd, err);
         }
         if let Some((spot, back)) = super::turn_spot::find(pose, &goal.pose, margin, clearance) {
             let turn = Turn { spot, back, out_yaw: pose.yaw, phase: TurnPhase::Out };
@@ -410,21 +421,15 @@ impl Executor {
             self.rotate_start_ns = t_ns;
             return self.turn_elsewhere(turn, pose, goal, world, t_ns);
         }
-        let c = &self.cfg.controller;
         let path = [(pose.x, pose.y), (goal.pose.x, goal.pose.y)];
-        let req = dwa::Request {
+        let req = Request {
             pose: *pose,
             current: self.last_cmd,
             path: &path,
             carrot: (goal.pose.x, goal.pose.y),
             desired_yaw: goal.pose.yaw,
         };
-        let grid = ClearanceGrid::from_costmaps(world.global, world.local);
-        let (global, local) = (&*world.global, &*world.local);
-        dwa::dwa(c, &req, &self.outline, |x, y| {
-            grid.get(x, y).unwrap_or_else(|| global.distance_at(x, y).min(local.distance_at(x, y)))
-        })
-        .cmd
+        self.controller.compute_velocity(&req, &self.outline, &Obstacles::new(world.global, world.local)).cmd
     }
 
     /// The command of a turn made at a spot beside the goal; fails "stuck" when it takes
@@ -450,7 +455,7 @@ impl Executor {
         self.turn = Some(turn);
         let cmd = match turn.phase {
             TurnPhase::Out => self.shift(pose, turn.spot, turn.out_yaw),
-            TurnPhase::Turn => dwa::rotate_in_place(&self.cfg.controller, self.last_cmd, err),
+            TurnPhase::Turn => self.controller.rotate_in_place(self.last_cmd, err),
             TurnPhase::Back => self.shift(pose, turn.back, goal.pose.yaw),
         };
         self.last_cmd = cmd;
@@ -485,7 +490,7 @@ impl Executor {
         sync_blocked(global, local);
         self.last_plan_ns = Some(t_ns);
         self.stats.plans += 1;
-        match astar::plan(global, pose, &goal.pose, &self.cfg.planner) {
+        match self.planner.plan(global, pose, &goal.pose) {
             Ok(pts) => {
                 self.path = TrackedPath::new(pts.clone());
                 out.plan = Some(pts);
@@ -544,7 +549,7 @@ impl Executor {
         self.backup = Some(Backup { until_ns: t_ns + (ec.backup_time * 1e9) as i64, dir });
         self.anchor = (*pose, t_ns);
         self.set(State::Recovering, "");
-        self.last_cmd = dwa::brake(&self.cfg.controller, self.last_cmd);
+        self.last_cmd = self.controller.brake(self.last_cmd);
         out.cmd = Some(self.last_cmd);
         out
     }
@@ -573,7 +578,7 @@ fn footprint_clearance(outline: &[(f64, f64)], p: &Pose2, world: &World) -> f64 
 }
 
 /// One acceleration-limited step from `current` towards `target`.
-fn step_towards(c: &dwa::ControllerConfig, current: Velocity, target: Velocity) -> Velocity {
+fn step_towards(c: &ControllerConfig, current: Velocity, target: Velocity) -> Velocity {
     let lim =
         |cur: f64, tgt: f64, max: f64, acc: f64| tgt.clamp(-max, max).clamp(cur - acc * c.period, cur + acc * c.period);
     Velocity {

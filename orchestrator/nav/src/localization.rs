@@ -308,10 +308,10 @@ impl Localizer {
 
     fn publish(&self, t_ns: i64, odom: &Pose2, bus: &mut Bus) {
         let stamp = Time::from_nanos(t_ns);
-        let pose = PoseStamped { header: Header::new(stamp, "map"), pose: self.mean.to_msg() };
+        let pose = PoseStamped { header: Header::new(stamp, "map"), pose: self.mean.into() };
         bus.publish(topics::POSE, t_ns, &pose);
         let map_odom = self.mean.compose(&odom.inverse());
-        let q = map_odom.to_msg().orientation;
+        let q = geometry_msgs::Pose::from(map_odom).orientation;
         let tf = TransformStamped {
             header: Header::new(stamp, "map"),
             child_frame_id: "odom".into(),
@@ -340,7 +340,7 @@ impl Node for Localizer {
         for o in self.odom.take::<Odometry>(bus)? {
             let stamp = o.header.stamp.to_nanos();
             let stamp = if stamp > 0 { stamp } else { t_ns };
-            let cur = Pose2::from_msg(&o.pose.pose);
+            let cur = Pose2::from(&o.pose.pose);
             let tw = &o.twist.twist;
             if let Some((t_prev, prev)) = self.last_odom {
                 let mut d = prev.inverse().compose(&cur);

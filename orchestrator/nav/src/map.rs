@@ -71,7 +71,7 @@ impl StaticMap {
         if msg.data.len() != w * h {
             return Err(err!("/map: {} cells for a {w} x {h} grid", msg.data.len()));
         }
-        let yaw = agrisim_math::pose2::yaw_of(&info.origin.orientation);
+        let yaw = info.origin.orientation.yaw();
         if yaw.abs() > 1e-6 {
             return Err(err!("/map: rotated map origins (yaw {yaw:.3} rad) are not supported"));
         }

@@ -18,7 +18,7 @@ use agrisim_msgs::sensor_msgs::Imu;
 use agrisim_msgs::std_msgs::Header;
 use agrisim_msgs::Message;
 use agrisim_nav::cloud::encode_xyzi;
-use agrisim_nav::dwa::{integrate, Velocity};
+use agrisim_nav::controller::{integrate, Velocity};
 use agrisim_nav::map::{occupancy_grid, GridGeom};
 use agrisim_nav::{topics, Localizer, NavConfig, Navigator, Pose2, State};
 
@@ -193,7 +193,7 @@ impl Sim {
         let stamp = Time::from_nanos(self.t_ns);
         let mut o =
             Odometry { header: Header::new(stamp, "odom"), child_frame_id: "base_link".into(), ..Default::default() };
-        o.pose.pose = self.odom.to_msg();
+        o.pose.pose = self.odom.into();
         o.twist.twist.linear.x = self.odom_vel.vx;
         o.twist.twist.linear.y = self.odom_vel.vy;
         o.twist.twist.angular.z = self.odom_vel.wz;
@@ -247,7 +247,7 @@ impl Sim {
 fn goal_msg(t_ns: i64, x: f64, y: f64, yaw: Option<f64>) -> PoseStamped {
     let mut g = PoseStamped {
         header: Header::new(Time::from_nanos(t_ns), "map"),
-        pose: Pose2::new(x, y, yaw.unwrap_or(0.0)).to_msg(),
+        pose: Pose2::new(x, y, yaw.unwrap_or(0.0)).into(),
     };
     if yaw.is_none() {
         g.pose.orientation = Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 0.0 };
@@ -496,7 +496,7 @@ fn goal_on_a_row_fails_with_no_path() {
     let row_y = WALL + AISLE + 0.5 * ROW;
     let (state, detail, _) = h.navigate(8.0, row_y, None, 10.0);
     assert_eq!((state.as_str(), detail.as_str()), ("failed", "no_path"));
-    assert_eq!(h.nav.last_plan_error(), Some(agrisim_nav::astar::PlanError::GoalBlocked));
+    assert_eq!(h.nav.last_plan_error(), Some(agrisim_nav::PlanError::GoalBlocked));
     // The navigator stops the base: zero twists follow.
     assert_eq!(h.sim.cmd, Velocity::ZERO);
 }
@@ -713,4 +713,119 @@ fn turns_to_the_goal_heading_beside_a_box_by_shifting_away() {
     assert!((p.x - 8.3).hypot(p.y - yc) <= 0.25, "{p:?}");
     assert!(agrisim_nav::pose2::wrap_angle(p.yaw - goal_yaw).abs() < 0.15, "{p:?}");
     assert_eq!(h.sim.collisions, 0);
+}
+
+/// An open field: a walled 20 x 12 m hall with nothing inside.
+fn open_field() -> (GridGeom, Vec<bool>) {
+    let (length, width) = (20.0, 12.0);
+    let geom = GridGeom {
+        origin_x: 0.0,
+        origin_y: 0.0,
+        resolution: RES,
+        width: (length / RES).round() as usize,
+        height: (width / RES).round() as usize,
+    };
+    let occ = (0..geom.len())
+        .map(|i| {
+            let (x, y) = geom.center(i % geom.width, i / geom.width);
+            x < WALL || y < WALL || x > length - WALL || y > width - WALL
+        })
+        .collect();
+    (geom, occ)
+}
+
+/// The largest distance of a plan's points from the line through its first and last.
+fn off_line(plan: &Path) -> f64 {
+    let p: Vec<(f64, f64)> = plan.poses.iter().map(|q| (q.pose.position.x, q.pose.position.y)).collect();
+    let (a, b) = (p[0], p[p.len() - 1]);
+    let len = (b.0 - a.0).hypot(b.1 - a.1);
+    p.iter().map(|q| ((q.0 - a.0) * (b.1 - a.1) - (q.1 - a.1) * (b.0 - a.0)).abs() / len).fold(0.0, f64::max)
+}
+
+/// The planner named `planner` in the `[plugins]` table of the navigation configuration.
+fn with_planner(planner: &str) -> impl Fn(&mut NavConfig) + '_ {
+    move |c| c.plugins = toml::from_str(&format!("planner = \"{planner}\"")).unwrap()
+}
+
+#[test]
+fn the_straight_line_planner_crosses_an_open_field_on_a_straight_plan_as_astar_reaches_it() {
+    let (geom, occ) = open_field();
+    let start = Pose2::new(2.0, 2.0, 0.0);
+    let (gx, gy) = (17.0, 9.5);
+    let mut lengths = vec![];
+    for planner in ["straight_line", "astar"] {
+        let mut h = Harness::with_config(&occ, occ.clone(), geom, start, 13, true, with_planner(planner));
+        let (state, detail, t) = h.navigate(gx, gy, Some(1.0), 120.0);
+        let err = h.sim.truth.dist(&Pose2::new(gx, gy, 0.0));
+        let path: f64 = h.truth_track.windows(2).map(|w| w[0].dist(&w[1])).sum();
+        let worst = h.plans.iter().filter(|p| p.poses.len() >= 2).map(off_line).fold(0.0, f64::max);
+        println!(
+            "open field, {planner}: {state} {detail} in {t:.1} s, final error {err:.3} m, driven {path:.2} m, {} plans (furthest point off its plan's line {worst:.2e} m), collisions {}",
+            h.plans.len(),
+            h.sim.collisions
+        );
+        assert_eq!((state.as_str(), detail.as_str()), ("succeeded", ""), "{planner}");
+        assert!(err <= 0.25 && h.sim.collisions == 0, "{planner}");
+        assert!(!h.plans.is_empty() && h.plans.iter().all(|p| p.poses.len() >= 2), "{planner}");
+        let first = &h.plans[0].poses;
+        let (p0, pn) = (&first[0].pose.position, &first[first.len() - 1].pose.position);
+        assert!((p0.x - 2.0).hypot(p0.y - 2.0) < 0.1 && (pn.x - gx).hypot(pn.y - gy) < 1e-9, "{planner}");
+        if planner == "straight_line" {
+            assert!(worst < 1e-9, "a straight-line plan bends by {worst} m");
+        }
+        lengths.push(path);
+    }
+    // The straight line is the shortest way; A*'s plan, which keeps out of the walls'
+    // inflation, is no shorter (0.5 m longer here).
+    assert!(lengths[0] <= lengths[1] + 0.05, "{lengths:?}");
+}
+
+#[test]
+fn the_straight_line_planner_refuses_a_goal_behind_a_row_that_astar_reaches() {
+    let (geom, occ) = greenhouse();
+    let start = Pose2::new(1.8, aisle_centre(1), 0.0);
+    let (gx, gy) = (9.0, aisle_centre(3));
+    let mut h = Harness::with_config(&occ, occ.clone(), geom, start, 17, true, with_planner("straight_line"));
+    let (state, detail, _) = h.navigate(gx, gy, None, 30.0);
+    assert_eq!((state.as_str(), detail.as_str()), ("failed", "no_path"));
+    assert_eq!(h.nav.last_plan_error(), Some(agrisim_nav::PlanError::LineBlocked));
+    assert_eq!(h.sim.cmd, Velocity::ZERO);
+    let mut h = Harness::with_config(&occ, occ.clone(), geom, start, 17, true, with_planner("astar"));
+    let (state, detail, _) = h.navigate(gx, gy, None, 120.0);
+    assert_eq!((state.as_str(), detail.as_str()), ("succeeded", ""));
+}
+
+/// A planner of the test's own: two straight legs, from the start through `via` to the goal.
+struct ViaPoint {
+    via: (f64, f64),
+}
+
+impl agrisim_nav::GlobalPlanner for ViaPoint {
+    fn plan(
+        &mut self,
+        _: &agrisim_nav::costmap::GlobalCostmap,
+        start: &Pose2,
+        goal: &Pose2,
+    ) -> Result<Vec<(f64, f64)>, agrisim_nav::PlanError> {
+        Ok(agrisim_nav::global_planner::densify(&[(start.x, start.y), self.via, (goal.x, goal.y)], 0.05))
+    }
+}
+
+#[test]
+fn a_planner_of_ones_own_drives_the_navigator_through_the_seam() {
+    let (geom, occ) = open_field();
+    let start = Pose2::new(2.0, 2.0, 0.0);
+    let mut h = Harness::with_nodes(&occ, occ.clone(), geom, start, 19, true);
+    let cfg = NavConfig::for_start([start.x, start.y, start.yaw]);
+    let controller = agrisim_nav::ControllerKind::Dwa.build(&cfg.controller);
+    h.nav = Navigator::with(cfg, Box::new(ViaPoint { via: (10.0, 9.0) }), controller);
+    let (state, detail, t) = h.navigate(17.0, 2.0, None, 120.0);
+    let near_via = h.truth_track.iter().map(|p| (p.x - 10.0).hypot(p.y - 9.0)).fold(f64::INFINITY, f64::min);
+    println!("via (10, 9): {state} {detail} in {t:.1} s, passed {near_via:.2} m from the via point");
+    assert_eq!((state.as_str(), detail.as_str()), ("succeeded", ""));
+    // The navigator published the planner's plan and drove it (a straight line would have
+    // stayed at y = 2).
+    let plan = &h.plans[0].poses;
+    assert!(plan.iter().any(|p| (p.pose.position.x - 10.0).hypot(p.pose.position.y - 9.0) < 1e-9));
+    assert!(near_via < 1.0, "{near_via}");
 }

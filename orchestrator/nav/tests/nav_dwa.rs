@@ -1,7 +1,8 @@
 //! The local planner's commands respect the velocity and acceleration limits from any state
 //! (property test over random poses, velocities, plans and obstacle fields).
 
-use agrisim_nav::dwa::{dwa, rotate_in_place, ControllerConfig, Request, Velocity, ESCAPE_SLACK};
+use agrisim_nav::controller::{Request, Velocity};
+use agrisim_nav::dwa::{dwa, rotate_in_place, ControllerConfig, ESCAPE_SLACK};
 use agrisim_nav::footprint::Footprint;
 use agrisim_nav::Pose2;
 use proptest::prelude::*;

@@ -7,6 +7,7 @@ mod goal_publisher;
 mod map_server;
 mod odom_tf;
 mod robot_state;
+mod task_publisher;
 
 pub use command_script::{BaseCommand, CommandScript, LiftCommand};
 pub use fault_injector::{FaultInjector, Injection};
@@ -14,5 +15,6 @@ pub use goal_publisher::GoalPublisher;
 pub use map_server::MapServer;
 pub use odom_tf::OdomTf;
 pub use robot_state::RobotStatePublisher;
+pub use task_publisher::TaskPublisher;
 
 pub use agrisim_bus::Node;

@@ -25,12 +25,12 @@ pub struct Scenario {
     #[serde(default)]
     pub timing: Timing,
     pub system: SystemRef,
-    /// The greenhouse (agrisim_greenhouse::GreenhouseConfig keys). Passed verbatim, as TOML
+    /// The greenhouse (agrisim_scene::GreenhouseConfig keys). Passed verbatim, as TOML
     /// text, to every component with a String parameter `scene`, so all of them build the
     /// same scene. Its `seed` (the scene's layout seed) defaults to the scenario's seed.
     #[serde(default)]
     pub greenhouse: toml::Table,
-    /// Sun, weather and render quality (agrisim_greenhouse::environment keys). Passed as TOML
+    /// Sun, weather and render quality (agrisim_sky::environment keys). Passed as TOML
     /// text to every component with a String parameter `environment` (the camera and the
     /// LiDAR); changes images and ranges, never the scene's geometry. Absent = the sensors'
     /// fixed defaults.
@@ -100,6 +100,11 @@ pub struct NavSettings {
     pub initial_pose_std: [f64; 3],
     /// The robot's prior map (never the trial scene's own plant parts).
     pub prior_map: PriorMap,
+    /// The navigator's global planner by name: `astar` (the default) or `straight_line` (for
+    /// open ground); the names are agrisim_nav's plugins, checked when a benchmark starts.
+    pub planner: String,
+    /// The navigator's controller by name: `dwa`.
+    pub controller: String,
 }
 
 /// `[harvest]`: how harvest trials draw their targets.
@@ -138,6 +143,8 @@ impl Default for NavSettings {
             aisle_margin: 1.0,
             initial_pose_std: [0.1, 0.1, 3f64.to_radians()],
             prior_map: PriorMap::Plan,
+            planner: "astar".into(),
+            controller: "dwa".into(),
         }
     }
 }
@@ -266,7 +273,7 @@ impl Scenario {
             }
         }
         if self.environment.is_some() {
-            agrisim_greenhouse::environment::Environment::from_toml_str(&self.environment_toml())
+            agrisim_sky::environment::Environment::from_toml_str(&self.environment_toml())
                 .map_err(|e| agrisim_error::err!("scenario {file}: [environment]: {e}"))?;
         }
         for inj in &self.inject {
@@ -324,6 +331,16 @@ mod tests {
         }
         let e = parse("[logging]\nfmus = true\n").unwrap_err();
         assert!(e.0.contains("x.toml") && e.0.contains("fmus"), "{e}");
+    }
+
+    #[test]
+    fn nav_planner_and_controller_are_named_with_astar_and_dwa_by_default() {
+        let s = Scenario::parse("[system]\nfile = \"a.ssd\"\n", Path::new("x.toml")).unwrap();
+        assert_eq!((s.nav.planner.as_str(), s.nav.controller.as_str()), ("astar", "dwa"));
+        let s =
+            Scenario::parse("[system]\nfile = \"a.ssd\"\n[nav]\nplanner = \"straight_line\"\n", Path::new("x.toml"))
+                .unwrap();
+        assert_eq!((s.nav.planner.as_str(), s.nav.controller.as_str()), ("straight_line", "dwa"));
     }
 
     #[test]

@@ -4,7 +4,7 @@
 
 use crate::scenario::Scenario;
 use agrisim_error::Result;
-use agrisim_greenhouse::{generate, Greenhouse, GreenhouseConfig, Layout};
+use agrisim_scene::{generate, Greenhouse, GreenhouseConfig, Layout};
 
 fn config(s: &Scenario) -> Result<GreenhouseConfig> {
     GreenhouseConfig::from_toml_str(&s.scene_toml())

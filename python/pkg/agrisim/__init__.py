@@ -13,6 +13,7 @@ Importing the package registers the environments ``agrisim/Navigate-v0`` and
 
 from . import _agrisim
 from ._agrisim import *  # noqa: F401,F403  (Simulation, Snapshot, Node, NavTask, ArmModel, ...)
+from ._agrisim import __version__  # noqa: F401  (the crates' version)
 from . import bench, msg  # noqa: F401
 from .msg import image_to_array, pointcloud_to_array  # noqa: F401
 

@@ -1,9 +1,10 @@
-"""The many-trial benchmarks from Python: ``nav`` and ``harvest`` run exactly what
-``agrisim bench nav|harvest`` runs and write the same files (summary.json, trials.jsonl,
-trials/NNNN.mcap and .json, report.html). Trials run in this process (``jobs=0``), in N local
-worker processes (``jobs=N``), or as Ray tasks on a Ray cluster (``backend="ray"``, after
-``ray.init(...)``). Trial i depends only on (seed, i), so trials.jsonl and every trial MCAP
-are the same whatever the backend; only wall-clock figures (wall_time, rtf) differ."""
+"""The many-trial benchmarks from Python: every benchmark ``agrisim bench <name>`` offers
+(:func:`names`), run by :func:`run` through the same registry and dispatch as the CLI, writing
+the same files (summary.json, trials.jsonl, trials/NNNN.mcap and .json, report.html). Trials
+run in this process (``jobs=0``), in N local worker processes (``jobs=N``), or as Ray tasks on
+a Ray cluster (``backend="ray"``, after ``ray.init(...)``). Trial i depends only on (seed, i),
+so trials.jsonl and every trial MCAP are the same whatever the backend; only wall-clock
+figures (wall_time, rtf) differ."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ import os
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from . import _agrisim
 
@@ -30,38 +32,59 @@ def _result(out: Path, summary_text: str) -> Result:
     return Result(summary=json.loads(summary_text), trials=[json.loads(x) for x in lines if x.strip()], out=out)
 
 
-def _run(kind: str, out, scenario, trials: int, seed: int, scenes: int, record, jobs: int, backend: str, resume: bool) -> Result:
+@dataclass(frozen=True)
+class Benchmark:
+    """A registered benchmark: its name, what it is, its default scenario and its own
+    options (name -> default; a keyword of :func:`run`)."""
+
+    name: str
+    about: str
+    default_scenario: str
+    options: dict
+
+
+def benchmarks() -> list[Benchmark]:
+    """Every registered benchmark, in the order ``agrisim bench --help`` lists them."""
+    return [Benchmark(n, a, s, dict(o)) for n, a, s, o in _agrisim.benchmarks()]
+
+
+def names() -> list[str]:
+    """The names :func:`run` takes: the subcommands of ``agrisim bench`` (``overhead`` aside)."""
+    return [b.name for b in benchmarks()]
+
+
+def run(benchmark: str, out, scenario=None, trials: int = 50, seed: int = 1, scenes: int = 1, record: str | None = None, jobs: int = 0, backend: str = "local", resume: bool = False, **options) -> Result:
+    """Benchmark ``benchmark`` (one of :func:`names`), as ``agrisim bench <benchmark>`` runs it.
+
+    ``record``: full, standard (default), judge or none. ``jobs``: 0 = in this process,
+    N = N worker processes. ``backend="ray"``: one Ray task per trial on the cluster
+    ``ray.init`` joined. ``options``: the benchmark's own (e.g. ``length=2.0`` for row)."""
     out = Path(out)
-    plan = dict(scenario=None if scenario is None else str(scenario), trials=trials, seed=seed, scenes=scenes, record=record)
-    run = _agrisim.bench_nav if kind == "nav" else _agrisim.bench_harvest
+    plan: dict[str, Any] = dict(scenario=None if scenario is None else str(scenario), trials=trials, seed=seed, scenes=scenes, record=record, options=options)
     if backend == "local":
-        return _result(out, run(str(out), jobs=jobs, resume=resume, **plan))
+        return _result(out, _agrisim.bench_run(benchmark, str(out), jobs=jobs, resume=resume, **plan))
     if backend == "ray":
-        _ray_trials(kind, out, plan, resume)
+        _ray_trials(benchmark, out, plan, resume)
         # Every trial's files are in place: the benchmark sums them up as a resumed run does.
-        return _result(out, run(str(out), jobs=0, resume=True, **plan))
+        return _result(out, _agrisim.bench_run(benchmark, str(out), jobs=0, resume=True, **plan))
     raise ValueError(f"unknown backend {backend!r} (local or ray)")
 
 
 def nav(out, scenario=None, trials: int = 50, seed: int = 1, scenes: int = 1, record: str | None = None, jobs: int = 0, backend: str = "local", resume: bool = False) -> Result:
-    """The navigation benchmark (default scenario: models/scenarios/default.toml).
-
-    ``record``: full, standard (default), judge or none. ``jobs``: 0 = in this process,
-    N = N worker processes. ``backend="ray"``: one Ray task per trial on the cluster
-    ``ray.init`` joined."""
-    return _run("nav", out, scenario, trials, seed, scenes, record, jobs, backend, resume)
+    """``run("nav", ...)``: the navigation benchmark (default scenario: models/scenarios/default.toml)."""
+    return run("nav", out, scenario, trials, seed, scenes, record, jobs, backend, resume)
 
 
 def harvest(out, scenario=None, trials: int = 50, seed: int = 1, scenes: int = 1, record: str | None = None, jobs: int = 0, backend: str = "local", resume: bool = False) -> Result:
-    """The dual-arm harvest benchmark (default scenario: models/scenarios/harvest.toml); as
-    :func:`nav`."""
-    return _run("harvest", out, scenario, trials, seed, scenes, record, jobs, backend, resume)
+    """``run("harvest", ...)``: the dual-arm harvest benchmark (default scenario:
+    models/scenarios/harvest.toml)."""
+    return run("harvest", out, scenario, trials, seed, scenes, record, jobs, backend, resume)
 
 
-def run_trial(benchmark: str, out, index: int, scenario=None, trials: int = 50, seed: int = 1, scenes: int = 1, record: str | None = None) -> None:
+def run_trial(benchmark: str, out, index: int, scenario=None, trials: int = 50, seed: int = 1, scenes: int = 1, record: str | None = None, **options) -> None:
     """Trial ``index`` alone, into ``out/trials/NNNN.mcap`` and ``.json`` (as the benchmark
-    writes them); a later ``nav(..., resume=True)`` sums the trials up."""
-    _agrisim.run_trial(benchmark, str(out), index, scenario=None if scenario is None else str(scenario), trials=trials, seed=seed, scenes=scenes, record=record)
+    writes them); a later ``run(..., resume=True)`` sums the trials up."""
+    _agrisim.run_trial(benchmark, str(out), index, scenario=None if scenario is None else str(scenario), trials=trials, seed=seed, scenes=scenes, record=record, options=options)
 
 
 def _trial_files(kind: str, index: int, plan: dict) -> tuple[bytes, bytes]:

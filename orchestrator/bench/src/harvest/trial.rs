@@ -1,0 +1,270 @@
+//! One harvest trial and its judge: the harvest system started afresh with the robot in an
+//! aisle short of a seeded ripe target fruit (see [`super::targets`]); the harvest node
+//! positions the base and the lift, plans and executes grasp, handover and placement.
+//! Success is judged on ground truth from the world FMU: the target fruit was placed in the
+//! box, no collision (robot against structure, arm against arm, base against anything),
+//! within the time limit. Planning success means every motion the trial asked for was
+//! planned.
+
+use super::judge::{base_contact, Reports, Touches, COLLISION_COUNTERS, SOFT_COUNTERS};
+use super::session::harvest_session;
+use super::setup::HarvestSetup;
+use super::targets::{draw, HarvestTarget};
+use crate::framework::report::decimate;
+use crate::framework::Trial;
+use agrisim_bus::{Node, Reader};
+use agrisim_error::Result;
+use agrisim_harvest::HarvestNode;
+use agrisim_math::Rng;
+use agrisim_msgs::agrisim::CollisionState;
+use agrisim_nodes::TaskPublisher;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::time::Instant;
+
+/// Simulated-time limit of one harvest [s].
+pub const TRIAL_TIMEOUT: f64 = 120.0;
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct HarvestTrial {
+    pub trial: u64,
+    /// Scene index (`--scenes`): the greenhouse grown from the scenario's seed + scene.
+    #[serde(default)]
+    pub scene: u64,
+    pub seed: u64,
+    pub fruit_index: usize,
+    pub fruit_id: u32,
+    pub fruit_name: String,
+    pub fruit: [f64; 3],
+    /// What lies between the fruit and its aisle: free, partly_occluded, behind_stem.
+    #[serde(default)]
+    pub visibility: String,
+    pub start: [f64; 3],
+    pub outcome: String,
+    /// Failure category: planning, grasp, handover, placement, timeout, collision, error.
+    pub failure: Option<String>,
+    pub failed_stage: Option<String>,
+    pub detail: String,
+    /// The planning verdict: "ok" (the harvest got to placing the fruit, so every plan it
+    /// needed was made),
+    /// "failed" (a plan without a fallback failed) or "not_reached" (no plan failed, but the
+    /// trial ended for another reason before every plan was asked for: unknown).
+    pub planning: String,
+    /// `planning == "ok"`.
+    pub planning_ok: bool,
+    pub plans: usize,
+    /// Wall time of each plan [s]: the harvest node's step that asked for it (IK + RRT-Connect
+    /// + shortcut + time parameterization), shared among the plans of that step.
+    pub planning_times: Vec<f64>,
+    /// Simulated planning time the node charged, summed over its plans (`planning_time` of
+    /// /harvest/plans) [s]: part of the time to harvest.
+    #[serde(default)]
+    pub thinking_time: f64,
+    pub time_to_harvest: Option<f64>,
+    pub placed_count: i64,
+    pub contacts: BTreeMap<String, i64>,
+    /// Scene objects the robot began to touch, by kind (stem, leaf, truss, fruit: fruit other
+    /// than the target; post, gutter...), from every /collision message: what a grower would
+    /// call damage risk. Counted, not failures (only base and structure contacts fail).
+    #[serde(default)]
+    pub touches: BTreeMap<String, u64>,
+    /// RMS joint tracking error of the last trajectory of each arm [rad].
+    pub tracking_rms: [f64; 2],
+    pub sim_time: f64,
+    pub wall_time: f64,
+    pub mcap: String,
+    /// Ground-truth base path (chassis x, y: every 10th exchange and the last); in
+    /// trials/NNNN.json, not in trials.jsonl.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub path: Vec<[f64; 2]>,
+}
+
+/// The harvest node under test: `fruit_index` is the task (the target the paper hands over),
+/// `seed` the trial's seed. Any node that speaks the harvest topics can take its place.
+pub type HarvestNodeFactory<'a> = &'a dyn Fn(usize, u64) -> Box<dyn Node>;
+
+/// The built-in harvest node.
+pub fn builtin_node(fruit_index: usize, seed: u64) -> Box<dyn Node> {
+    Box::new(HarvestNode::new(fruit_index, seed))
+}
+
+/// Runs trial `t` into `mcap` with the built-in harvest node.
+pub fn run(t: &Trial<HarvestSetup>, mcap: &Path) -> Result<HarvestTrial> {
+    run_with(t, mcap, &builtin_node, TRIAL_TIMEOUT)
+}
+
+/// Runs trial `t` into `mcap` with the harvest node `node` makes, within `timeout` [s] of
+/// simulated time. The judge reads the node's messages (/harvest/status, /harvest/plans),
+/// the bus and the world FMU's ground truth; nothing else of the node.
+pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, timeout: f64) -> Result<HarvestTrial> {
+    let (s, setup, index, seed) = (t.scenario, t.setup, t.index, t.seed);
+    let wall = Instant::now();
+    let mut rng = Rng::new(seed);
+    let target = draw(&setup.candidates, &setup.layout, &mut rng).expect("candidates checked non-empty");
+    let harvest = node(target.fruit_index, seed);
+    let node_name = harvest.name().to_string();
+    // An external node takes the harvest node's place: it is told the task the same way.
+    let task = t.run.nodes.external.contains(&node_name).then(|| TaskPublisher::new(target.fruit_index));
+    let mut m = harvest_session(t, target.start, mcap, harvest, task)?;
+    let (world, arm_l, arm_r) = (
+        m.component("world", "harvest benchmark")?,
+        m.component("arm_left", "harvest benchmark")?,
+        m.component("arm_right", "harvest benchmark")?,
+    );
+    let chassis = m.component("chassis", "harvest benchmark")?;
+    let max_ticks = (timeout / s.timing.step).round() as u64;
+    let mut path = vec![[m.number(chassis, "x")?, m.number(chassis, "y")?]];
+    let mut reports = Reports::subscribe(&mut m.bus);
+    let mut collisions = Reader::subscribe(&mut m.bus, "/collision");
+    let mut judged: Option<(Option<String>, String)> = None;
+    let mut time_to_harvest = None;
+    let mut touches = Touches::default();
+    let result: Result<()> = (|| {
+        for k in 1..=max_ticks {
+            m.advance()?;
+            path.push([m.number(chassis, "x")?, m.number(chassis, "y")?]);
+            reports.read(&mut m, &node_name)?;
+            // The base must touch nothing; the arms may brush plants (counted, not failures).
+            // Every collision state counts, however short the contact.
+            for cs in collisions.take::<CollisionState>(&mut m.bus)? {
+                touches.update(&cs, |id| id == target.object_id);
+                if let Some(why) = base_contact(&cs) {
+                    judged = Some((Some("collision".into()), why));
+                    return Ok(());
+                }
+            }
+            for c in COLLISION_COUNTERS {
+                if m.number(world, c)? > 0.0 {
+                    judged = Some((Some("collision".into()), c.to_string()));
+                    return Ok(());
+                }
+            }
+            if let Some(st) = &reports.outcome {
+                let success = st.outcome == "success";
+                if success {
+                    time_to_harvest = Some(k as f64 * s.timing.step);
+                }
+                judged = Some((
+                    (!success).then(|| st.failure_category.clone()),
+                    if success { String::new() } else { st.detail.clone() },
+                ));
+                return Ok(());
+            }
+        }
+        judged = Some((Some("timeout".into()), format!("no outcome within {timeout} s")));
+        Ok(())
+    })();
+    let sim_time = m.time();
+    let failed_stage = reports.outcome.as_ref().filter(|o| o.outcome != "success").map(|o| o.stage.clone());
+    let mut contacts = BTreeMap::new();
+    let mut placed = 0;
+    let mut tracking = [0.0; 2];
+    let mut probe = || -> Result<()> {
+        for c in COLLISION_COUNTERS.iter().chain(SOFT_COUNTERS.iter()) {
+            contacts.insert(c.to_string(), m.number(world, c)? as i64);
+        }
+        placed = m.number(world, "placed_count")? as i64;
+        let placed_id = m.number(world, "last_placed_id")? as i64;
+        if placed > 0 && placed_id != target.object_id as i64 {
+            placed = 0;
+        }
+        tracking = [m.number(arm_l, "tracking_error_rms")?, m.number(arm_r, "tracking_error_rms")?];
+        Ok(())
+    };
+    let probed = probe();
+    let (mut failure, mut detail) = match (result, probed) {
+        (Ok(()), Ok(())) => {
+            m.finish_point()?;
+            judged.expect("set on every exit")
+        }
+        (Err(e), _) | (Ok(()), Err(e)) => {
+            m.record_failure(&e);
+            (Some("error".to_string()), e.to_string())
+        }
+    };
+    m.recorder_finish()?;
+    // Ground truth has the last word: the node believing in success is not enough.
+    if failure.is_none() && placed == 0 {
+        failure = Some("placement".into());
+        detail = "the node reported success but the world has not placed the target fruit".into();
+    }
+    let planning = if failure.as_deref() == Some("planning") || reports.plans.iter().any(|p| !p.ok && !p.optional) {
+        "failed"
+    } else if failure.is_none() || failure.as_deref() == Some("placement") {
+        // Placement is judged after the node's last motion: every plan was made.
+        "ok"
+    } else {
+        "not_reached"
+    };
+    Ok(HarvestTrial {
+        outcome: if failure.is_none() { "success" } else { "failure" }.to_string(),
+        failed_stage: failure.as_ref().and(failed_stage),
+        failure,
+        detail,
+        planning: planning.into(),
+        planning_ok: planning == "ok",
+        plans: reports.plans.len(),
+        planning_times: reports.planning_times,
+        thinking_time: reports.plans.iter().map(|p| p.planning_time).sum(),
+        time_to_harvest,
+        placed_count: placed,
+        contacts,
+        touches: touches.by_kind,
+        tracking_rms: tracking,
+        sim_time,
+        wall_time: wall.elapsed().as_secs_f64(),
+        mcap: mcap.file_name().map(|f| format!("trials/{}", f.to_string_lossy())).unwrap_or_default(),
+        path: decimate(&path, 10),
+        scene: t.scene,
+        ..HarvestTrial::of_target(index, seed, &target)
+    })
+}
+
+/// The record of a trial whose process died: an error, with its target (drawn as the trial
+/// draws it) and the reason.
+pub fn failed(t: &Trial<HarvestSetup>, reason: String) -> HarvestTrial {
+    let target =
+        draw(&t.setup.candidates, &t.setup.layout, &mut Rng::new(t.seed)).expect("candidates checked non-empty");
+    HarvestTrial {
+        scene: t.scene,
+        failure: Some("error".into()),
+        detail: reason,
+        ..HarvestTrial::of_target(t.index, t.seed, &target)
+    }
+}
+
+impl HarvestTrial {
+    /// Trial `index` on `target`, a failure until said otherwise, nothing measured yet.
+    pub(crate) fn of_target(index: u64, seed: u64, target: &HarvestTarget) -> HarvestTrial {
+        HarvestTrial {
+            trial: index,
+            scene: 0,
+            seed,
+            fruit_index: target.fruit_index,
+            fruit_id: target.object_id,
+            fruit_name: target.name.clone(),
+            fruit: target.center,
+            visibility: target.visibility.name().into(),
+            start: target.start,
+            outcome: "failure".into(),
+            failure: None,
+            failed_stage: None,
+            detail: String::new(),
+            planning: "not_reached".into(),
+            planning_ok: false,
+            plans: 0,
+            planning_times: vec![],
+            thinking_time: 0.0,
+            time_to_harvest: None,
+            placed_count: 0,
+            contacts: BTreeMap::new(),
+            touches: BTreeMap::new(),
+            tracking_rms: [0.0; 2],
+            sim_time: 0.0,
+            wall_time: 0.0,
+            mcap: format!("trials/{index:04}.mcap"),
+            path: vec![],
+        }
+    }
+}

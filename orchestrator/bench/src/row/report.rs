@@ -1,0 +1,65 @@
+//! report.html of the row benchmark.
+
+use super::summary::RowSummary;
+use super::trial::RowTrial;
+use crate::framework::report::{bar_chart, count_table, interval, opt, per_kind, rate_table, render_with, TrialTrace};
+
+/// report.html: summary, per-class table, failure taxonomy, cycle-time histogram, and the
+/// map of scene 0 with every segment's base path and fruit (green harvested, red not).
+/// `g` is scene 0's greenhouse.
+pub fn report_html(g: &agrisim_scene::Greenhouse, sum: &RowSummary, results: &[RowTrial]) -> String {
+    let rows = vec![
+        ("scenario".to_string(), sum.scenario.clone()),
+        ("segments x length".to_string(), format!("{} x {} m", sum.segments, sum.segment_length)),
+        ("ripe fruit reachable / harvested".to_string(), format!("{} / {}", sum.targets, sum.harvested)),
+        (
+            "harvested fraction".to_string(),
+            format!("{:.3} (cluster bootstrap 95 % {})", sum.harvested_fraction, interval(sum.cluster_bootstrap95)),
+        ),
+        ("fruit per hour".to_string(), format!("{:.1}", sum.fruit_per_hour)),
+        (
+            "cycle time mean / p50 / p95 [s]".to_string(),
+            format!("{} / {} / {}", opt(sum.cycle_time_mean), opt(sum.cycle_time_p50), opt(sum.cycle_time_p95)),
+        ),
+        ("plant touches per fruit".to_string(), per_kind(&sum.touches_per_fruit)),
+        ("dropped fruit".to_string(), sum.dropped.to_string()),
+        ("segments ended".to_string(), format!("{:?}", sum.segments_ended)),
+        ("real-time factor".to_string(), format!("{:.2}", sum.rtf)),
+    ];
+    let classes = sum.per_class.iter().map(|(k, c)| (k.clone(), c.targets, c.harvested, c.wilson95));
+    let cycles: Vec<f64> = results.iter().flat_map(|t| t.cycle_times.iter().copied()).collect();
+    let sections = vec![
+        ("Harvested by visibility class".to_string(), rate_table(["class", "fruit", "harvested"], classes)),
+        ("Failure taxonomy (fruit not harvested)".to_string(), count_table(["category", "fruit"], &sum.failures)),
+        ("Cycle times (placement to placement)".to_string(), bar_chart(&cycles, 5.0, "cycle time [s]")),
+    ];
+    let traces: Vec<TrialTrace> = results
+        .iter()
+        .filter(|t| t.scene == 0)
+        .flat_map(|t| {
+            let path = TrialTrace {
+                index: t.trial,
+                success: t.harvested == t.targets,
+                reason: format!("segment {}: {}/{} harvested, ended {}", t.trial, t.harvested, t.targets, t.ended),
+                target: t.start,
+                path: t.path.clone(),
+            };
+            std::iter::once(path).chain(t.fruit.iter().map(move |f| TrialTrace {
+                index: t.trial,
+                success: f.harvested,
+                reason: f.failure.clone().unwrap_or_default(),
+                target: f.fruit,
+                path: vec![],
+            }))
+        })
+        .collect();
+    let [x0, y0, x1, y1] = g.layout.bounds;
+    render_with(
+        &format!("agrisim row harvest benchmark: {}", sum.scenario),
+        &rows,
+        &g.objects,
+        [x0, y0, x1, y1],
+        &traces,
+        &sections,
+    )
+}

@@ -1,0 +1,253 @@
+//! One row trial and its judge: a segment harvested by the built-in row node
+//! ([`agrisim_harvest::RowNode`]), judged from ground truth and messages only. A fruit is
+//! harvested when the world has placed it in the box (`placed_count`, `last_placed_id` after
+//! every exchange); the node's `/harvest/status` gives each fruit's failure category;
+//! contacts come from the world's counters (structure, arm-arm, carried fruit: they end the
+//! segment) and `/collision` (plant touches, counted).
+
+use super::segment::draw_segment;
+use crate::framework::Trial;
+use crate::harvest::judge::{base_contact, Touches, COLLISION_COUNTERS};
+use crate::harvest::session::harvest_session;
+use crate::harvest::HarvestSetup;
+use agrisim_bus::Reader;
+use agrisim_error::{err, Result};
+use agrisim_harvest::{topics, RowNode};
+use agrisim_math::Rng;
+use agrisim_msgs::agrisim::{CollisionState, HarvestStatus, PlanResult};
+use serde::{Deserialize, Serialize};
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+use std::time::Instant;
+
+/// Simulated time a segment may take per fruit, and on top [s].
+pub const TIME_PER_FRUIT: f64 = 90.0;
+pub const TIME_EXTRA: f64 = 60.0;
+/// How long the judge waits after the last outcome for released fruit to come to rest [s]
+/// (the world settles a fruit still moving after 10 s).
+const SETTLE_LIMIT: f64 = 11.0;
+
+/// One fruit of a segment and what became of it.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct RowFruit {
+    pub fruit_index: usize,
+    pub fruit_id: u32,
+    pub fruit: [f64; 3],
+    pub visibility: String,
+    pub harvested: bool,
+    /// Failure category from the node's status (or "not_reached" when the segment ended first).
+    pub failure: Option<String>,
+    pub failed_stage: Option<String>,
+    pub detail: String,
+    /// When the world placed it in the box [s].
+    pub placed_at: Option<f64>,
+}
+
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct RowTrial {
+    pub trial: u64,
+    pub scene: u64,
+    pub seed: u64,
+    /// The aisle's centre line and the segment's extent along it [m].
+    pub aisle_y: f64,
+    pub x_range: [f64; 2],
+    pub start: [f64; 3],
+    pub targets: u64,
+    pub harvested: u64,
+    /// (targets, harvested) by visibility class.
+    pub per_class: BTreeMap<String, [u64; 2]>,
+    pub failures: BTreeMap<String, u64>,
+    /// Why the segment ended: "done" (every fruit has its outcome), "timeout", "collision: ...",
+    /// "error: ...".
+    pub ended: String,
+    /// Time between successive placements (the first from the start) [s].
+    pub cycle_times: Vec<f64>,
+    /// Harvested fruit per hour of the segment's simulated time.
+    pub fruit_per_hour: f64,
+    /// Plant objects the robot began to touch, by kind.
+    pub touches: BTreeMap<String, u64>,
+    pub dropped: i64,
+    /// Simulated planning time the node charged [s].
+    pub thinking_time: f64,
+    pub fruit: Vec<RowFruit>,
+    /// Ground-truth base path (every 10th exchange); in trials/NNNN.json, not in
+    /// trials.jsonl.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub path: Vec<[f64; 2]>,
+    pub sim_time: f64,
+    pub wall_time: f64,
+    pub mcap: String,
+}
+
+/// The segment length option [m].
+pub const LENGTH: &str = "length";
+
+/// Runs trial `t`'s segment into `mcap` with the built-in row node.
+pub fn run(t: &Trial<HarvestSetup>, mcap: &Path) -> Result<RowTrial> {
+    let (s, setup, index, seed, length) = (t.scenario, t.setup, t.index, t.seed, t.options.f64(LENGTH));
+    let wall = Instant::now();
+    let seg = draw_segment(setup, length, &mut Rng::new(seed))
+        .ok_or_else(|| err!("scenario {}: no aisle with reachable ripe fruit", s.path.display()))?;
+    let node = RowNode::new(seg.targets.iter().map(|t| t.fruit_index).collect(), seed);
+    let mut m = harvest_session(t, seg.start, mcap, Box::new(node), None)?;
+    let (world, chassis) = (m.component("world", "row benchmark")?, m.component("chassis", "row benchmark")?);
+    let step = s.timing.step;
+    let timeout = TIME_PER_FRUIT * seg.targets.len() as f64 + TIME_EXTRA;
+    let max_ticks = (timeout / step).round() as u64;
+    let mut statuses = Reader::subscribe(&mut m.bus, topics::STATUS);
+    let mut plans = Reader::subscribe(&mut m.bus, topics::PLANS);
+    let mut collisions = Reader::subscribe(&mut m.bus, "/collision");
+    let ids: BTreeSet<u32> = seg.targets.iter().map(|t| t.object_id).collect();
+    let mut outcomes: BTreeMap<i32, HarvestStatus> = BTreeMap::new();
+    let mut placed: BTreeMap<u32, f64> = BTreeMap::new();
+    let mut placed_count = 0.0;
+    let mut touches = Touches::default();
+    let mut thinking = 0.0;
+    let mut path = vec![];
+    let mut ended = String::from("timeout");
+    let mut all_done: Option<u64> = None;
+    let result: Result<()> = (|| {
+        for k in 1..=max_ticks {
+            m.advance()?;
+            if k % 10 == 1 {
+                path.push([m.number(chassis, "x")?, m.number(chassis, "y")?]);
+            }
+            for st in statuses.take::<HarvestStatus>(&mut m.bus)? {
+                if st.outcome == "success" || st.outcome == "failure" {
+                    outcomes.entry(st.target_id).or_insert(st);
+                }
+            }
+            thinking += plans.take::<PlanResult>(&mut m.bus)?.iter().map(|p| p.planning_time).sum::<f64>();
+            // Plant touches (onsets, the segment's own fruit left out); the base touches nothing.
+            for cs in collisions.take::<CollisionState>(&mut m.bus)? {
+                touches.update(&cs, |id| ids.contains(&id));
+                if let Some(why) = base_contact(&cs) {
+                    ended = format!("collision: {why}");
+                    return Ok(());
+                }
+            }
+            for c in COLLISION_COUNTERS {
+                if m.number(world, c)? > 0.0 {
+                    ended = format!("collision: {c}");
+                    return Ok(());
+                }
+            }
+            let n = m.number(world, "placed_count")?;
+            if n > placed_count {
+                placed_count = n;
+                let id = m.number(world, "last_placed_id")?;
+                if id >= 0.0 {
+                    placed.entry(id as u32).or_insert(k as f64 * step);
+                }
+            }
+            // Done when every fruit has its outcome and every picked fruit has come to rest
+            // (placed or dropped), or SETTLE_LIMIT after the last outcome.
+            if seg.targets.iter().all(|t| outcomes.contains_key(&(t.fruit_index as i32))) {
+                let done_at = *all_done.get_or_insert(k);
+                let resting = m.number(world, "picked_count")? <= n + m.number(world, "dropped_count")?;
+                if resting || (k - done_at) as f64 * step >= SETTLE_LIMIT {
+                    ended = "done".into();
+                    return Ok(());
+                }
+            }
+        }
+        Ok(())
+    })();
+    let sim_time = m.time();
+    let dropped = m.number(world, "dropped_count").map(|v| v as i64);
+    match (&result, &dropped) {
+        (Ok(()), Ok(_)) => m.finish_point()?,
+        (Err(e), _) | (Ok(()), Err(e)) => {
+            m.record_failure(e);
+            ended = format!("error: {e}");
+        }
+    }
+    m.recorder_finish()?;
+    let fruit: Vec<RowFruit> = seg
+        .targets
+        .iter()
+        .map(|t| {
+            let placed_at = placed.get(&t.object_id).copied();
+            let st = outcomes.get(&(t.fruit_index as i32));
+            let failure = match (placed_at, st) {
+                (Some(_), _) => None,
+                (None, Some(st)) if st.outcome == "failure" => Some(st.failure_category.clone()),
+                // The node believed in success, but the world has not placed it.
+                (None, Some(_)) => Some("placement".into()),
+                (None, None) => Some("not_reached".into()),
+            };
+            RowFruit {
+                fruit_index: t.fruit_index,
+                fruit_id: t.object_id,
+                fruit: t.center,
+                visibility: t.visibility.name().into(),
+                harvested: placed_at.is_some(),
+                failed_stage: failure.as_ref().and(st.map(|s| s.stage.clone())),
+                detail: if failure.is_some() {
+                    st.map(|s| s.detail.clone()).unwrap_or_default()
+                } else {
+                    String::new()
+                },
+                failure,
+                placed_at,
+            }
+        })
+        .collect();
+    let mut per_class: BTreeMap<String, [u64; 2]> = BTreeMap::new();
+    let mut failures: BTreeMap<String, u64> = BTreeMap::new();
+    for f in &fruit {
+        let c = per_class.entry(f.visibility.clone()).or_default();
+        c[0] += 1;
+        c[1] += f.harvested as u64;
+        if let Some(why) = &f.failure {
+            *failures.entry(why.clone()).or_insert(0) += 1;
+        }
+    }
+    let mut times: Vec<f64> = fruit.iter().filter_map(|f| f.placed_at).collect();
+    times.sort_by(f64::total_cmp);
+    let cycle_times: Vec<f64> = times.iter().scan(0.0, |prev, &t| Some(t - std::mem::replace(prev, t))).collect();
+    let harvested = times.len() as u64;
+    Ok(RowTrial {
+        trial: index,
+        scene: t.scene,
+        seed,
+        aisle_y: seg.aisle_y,
+        x_range: seg.x_range,
+        start: seg.start,
+        targets: seg.targets.len() as u64,
+        harvested,
+        per_class,
+        failures,
+        ended,
+        cycle_times,
+        fruit_per_hour: if sim_time > 0.0 { harvested as f64 * 3600.0 / sim_time } else { 0.0 },
+        touches: touches.by_kind,
+        dropped: dropped.unwrap_or(0),
+        thinking_time: thinking,
+        fruit,
+        path,
+        sim_time,
+        wall_time: wall.elapsed().as_secs_f64(),
+        mcap: format!("trials/{index:04}.mcap"),
+    })
+}
+
+/// The record of a segment whose process died.
+pub fn failed(t: &Trial<HarvestSetup>, reason: String) -> RowTrial {
+    let (index, seed) = (t.index, t.seed);
+    let seg = draw_segment(t.setup, t.options.f64(LENGTH), &mut Rng::new(seed));
+    let targets = seg.as_ref().map_or(0, |s| s.targets.len() as u64);
+    RowTrial {
+        trial: index,
+        scene: t.scene,
+        seed,
+        aisle_y: seg.as_ref().map_or(0.0, |s| s.aisle_y),
+        x_range: seg.as_ref().map_or([0.0; 2], |s| s.x_range),
+        start: seg.as_ref().map_or([0.0; 3], |s| s.start),
+        targets,
+        failures: BTreeMap::from([("error".to_string(), targets)]),
+        ended: format!("error: {reason}"),
+        mcap: format!("trials/{index:04}.mcap"),
+        ..RowTrial::default()
+    }
+}

@@ -1,0 +1,435 @@
+//! The harvest node's stages, one function each; [`HarvestNode::run_stage`] dispatches to
+//! them, and each moves on by [`HarvestNode::enter`]ing the next stage or ends the harvest.
+
+use super::{topics, HarvestNode};
+use crate::geometry::{self as geo, TcpGoal};
+use crate::motion::Arm;
+use crate::stage::{Failure, Stage};
+use agrisim_bus::Bus;
+use agrisim_msgs::geometry_msgs::{Twist, Vector3};
+
+/// Gripper force for tomatoes [N] (well below bruising; the Franka Hand holds 70 N).
+const GRASP_FORCE: f64 = 20.0;
+/// Time the released fruit gets to fall and settle before the box is checked [s].
+const SETTLE: f64 = 1.5;
+/// Where the later grasp attempts aim, from the first: (across the finger pads, deeper along
+/// the approach) [m]. A miss means the fruit is not where the localized base put it: the
+/// pads tolerate least across them, and a base that stands off a little too far (lateral
+/// localization error) leaves the fruit beyond the pads' tips.
+const REGRASP_SHIFTS: [(f64, f64); 3] = [(0.012, 0.0), (-0.012, 0.0), (0.0, 0.015)];
+/// Taker TCP positions along its approach for the second and third handover attempt [m].
+const HANDOVER_OFFSETS: [f64; 2] = [0.015, -0.015];
+/// Sphere-check margin of the taker's final approach [m]: the hands meet by design there.
+const HANDOVER_PADDING: f64 = 0.002;
+/// How far the giver backs off along its approach after letting go [m].
+const GIVER_BACKOFF: f64 = 0.1;
+/// Motions the recovery may send before it gives up (two per arm: back-off and home).
+const RECOVERY_MOTIONS: u32 = 4;
+
+impl HarvestNode {
+    /// Between two fruit: open both grippers and stop the base, then send home each arm that
+    /// is not, the one that reached furthest first. -> select_target once both are home.
+    pub(super) fn run_recover(&mut self, t_ns: i64, bus: &mut Bus) {
+        match self.phase_now() {
+            0 => {
+                for arm in [Arm::Left, Arm::Right] {
+                    self.gripper(arm, geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
+                }
+                self.stop_base(t_ns, bus);
+                self.phase = 1;
+            }
+            // The grippers open (half a second), then each arm that is not home goes
+            // home, the one that reached furthest first (it may stand in the other's way).
+            1 if self.step_in_stage > 5 => {
+                let far = |a: Arm| agrisim_manip::ik::dist(&self.q(a), &crate::motion::HOME);
+                let arm = if far(Arm::Left) >= far(Arm::Right) { Arm::Left } else { Arm::Right };
+                if far(arm) < 1e-3 {
+                    self.attempts = 0;
+                    self.enter(Stage::SelectTarget, t_ns, bus, "both arms home");
+                } else if self.attempts >= RECOVERY_MOTIONS {
+                    self.fail(
+                        Failure::Planning,
+                        t_ns,
+                        bus,
+                        format!("recover: the arms are not home after {RECOVERY_MOTIONS} motions"),
+                    );
+                } else if self.go_home(arm, t_ns, bus) {
+                    self.attempts += 1;
+                    self.phase = 2;
+                }
+            }
+            2 if [Arm::Left, Arm::Right].iter().all(|&a| self.arm_done(a, t_ns, bus) == Some(true)) => self.phase = 1,
+            _ => {}
+        }
+    }
+
+    /// Waits for the target, the localized pose and both arms' joints, then chooses the side
+    /// of the row, the grasp, the base's stand-off and the lift height. -> position_base.
+    pub(super) fn run_select_target(&mut self, t_ns: i64, bus: &mut Bus) {
+        bus.set_scalar(topics::TARGET_ID, self.fruit_index as f64);
+        if self.target_map.is_some() && self.pose.is_some() && self.arms.iter().all(|a| a.q.is_some()) {
+            let t = self.target_map.expect("checked");
+            // The base harvests facing along the aisle the way it already faces (+x or
+            // -x: no turning round in the aisle); the row is on the side of that
+            // heading where the fruit is.
+            let pose = self.pose.expect("checked");
+            let heading = if pose.yaw.cos() >= 0.0 { 0.0 } else { std::f64::consts::PI };
+            let (s, c) = f64::sin_cos(heading);
+            self.side = if -s * (t[0] - pose.x) + c * (t[1] - pose.y) >= 0.0 { 1.0 } else { -1.0 };
+            self.grasp = geo::grasp([0.0; 3], self.side);
+            self.base_goal = geo::standoff_facing(t, self.side, heading);
+            self.lift_target = geo::lift_for(t[2]);
+            self.enter(
+                Stage::PositionBase,
+                t_ns,
+                bus,
+                &format!("fruit {} at ({:.3}, {:.3}, {:.3})", self.fruit_index, t[0], t[1], t[2]),
+            );
+        }
+    }
+
+    /// Drives the base to its stand-off and the lift to the fruit's height.
+    /// -> pre_grasp once both are in place.
+    pub(super) fn run_position_base(&mut self, first: bool, t_ns: i64, bus: &mut Bus) {
+        bus.set_scalar(topics::LIFT_SETPOINT, self.lift_target);
+        let pose = self.pose.expect("known since SelectTarget");
+        if first {
+            self.base_ctl = crate::base::BaseController::default();
+        }
+        let ctl = &mut self.base_ctl;
+        if ctl.in_place(pose, self.base_goal) {
+            self.in_place_ticks += 1;
+            self.stop_base(t_ns, bus);
+        } else {
+            self.in_place_ticks = 0;
+            let [vx, vy, wz] = ctl.command(pose, self.base_goal);
+            bus.publish(
+                topics::CMD_VEL,
+                t_ns,
+                &Twist { linear: Vector3 { x: vx, y: vy, z: 0.0 }, angular: Vector3 { x: 0.0, y: 0.0, z: wz } },
+            );
+        }
+        if self.in_place_ticks >= 5 && self.lift_at(self.lift_target) {
+            self.enter(Stage::PreGrasp, t_ns, bus, "base and lift in place");
+        }
+    }
+
+    /// Opens the giver's gripper and plans it to the stand-off of the first reachable grasp,
+    /// on a planning scene sent after the base stopped. -> approach once it is there.
+    pub(super) fn run_pre_grasp(&mut self, first: bool, t_ns: i64, bus: &mut Bus) {
+        let giver = self.giver();
+        if first {
+            self.gripper(giver, geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
+        }
+        if !self.planned {
+            // Plan on a scene sent after the base stopped, the target through TF.
+            if !self.fresh_scene(self.stage_start_ns) {
+                return;
+            }
+            self.motion.set_target(self.target_map.expect("known since SelectTarget"));
+            self.update_scene();
+            let Some(c) = self.target_base() else { return };
+            self.motion.ignore_target(false);
+            self.planned = true;
+            let candidates = geo::grasp_candidates(c, self.side);
+            if let Some(i) = self.move_pregrasp(giver, &candidates, t_ns, bus) {
+                self.grasp = candidates[i];
+            }
+        } else if self.arm_done(giver, t_ns, bus) == Some(true) {
+            self.enter(Stage::Approach, t_ns, bus, "");
+        }
+    }
+
+    /// Straight in to the grasp (a later attempt: to the next aim of [`REGRASP_SHIFTS`]).
+    /// -> grasp.
+    pub(super) fn run_approach(&mut self, first: bool, t_ns: i64, bus: &mut Bus) {
+        let giver = self.giver();
+        if first {
+            let Some(c) = self.target_base() else { return };
+            // A later attempt whose aim cannot be reached goes on to the next aim.
+            let [x, z] = self.regrasp_axes;
+            let shifts =
+                if self.attempts == 0 { &[(0.0, 0.0)][..] } else { &REGRASP_SHIFTS[self.attempts as usize - 1..] };
+            let mut goals: Vec<TcpGoal> = shifts
+                .iter()
+                .map(|&(a, d)| {
+                    TcpGoal { position: std::array::from_fn(|i| c[i] + a * x[i] + d * z[i]), ..self.grasp }
+                        .along(geo::GRASP_DEPTH)
+                })
+                .collect();
+            // The target as the localized base sees it now may have moved a few
+            // millimetres since the pre-grasp plan; where the straight line to it is
+            // blocked, the line the pre-grasp plan checked.
+            if self.attempts == 0 && (0..3).any(|i| (goals[0].position[i] - self.grasp.position[i]).abs() > 1e-3) {
+                goals.push(self.grasp);
+            }
+            if let Some(i) = self.plan_and_send(giver, "linear", t_ns, bus, |m, lift, start, other| {
+                m.plan_linear_any(giver, lift, start, &goals, other)
+            }) {
+                if self.attempts > 0 {
+                    self.attempts += i as u32;
+                }
+                self.grasp_point = goals[i].position;
+            }
+        } else if self.arm_done(giver, t_ns, bus) == Some(true) {
+            self.enter(Stage::Grasp, t_ns, bus, "");
+        }
+    }
+
+    /// Closes the giver's gripper. -> retreat holding the fruit; -> regrasp when it closed on
+    /// nothing (failed after the last aim).
+    pub(super) fn run_grasp(&mut self, first: bool, t_ns: i64, bus: &mut Bus) {
+        let giver = self.giver();
+        if first {
+            self.gripper(giver, 0.0, GRASP_FORCE, t_ns, bus);
+        } else if self.holding(giver) && self.step_in_stage > 3 {
+            let r = self
+                .motion
+                .target_radius()
+                .unwrap_or(0.5 * self.view(giver).gripper.as_ref().map_or(0.06, |g| g.position));
+            self.motion.set_held(giver, Some(r));
+            self.enter(Stage::Retreat, t_ns, bus, "fruit held");
+        } else if self.view(giver).gripper.as_ref().is_some_and(|g| g.reached_goal && g.position < 0.005) {
+            if self.attempts as usize >= REGRASP_SHIFTS.len() {
+                self.fail(
+                    Failure::Grasp,
+                    t_ns,
+                    bus,
+                    format!("the gripper closed on nothing ({} attempts)", self.attempts + 1),
+                );
+            } else {
+                self.enter(Stage::Regrasp, t_ns, bus, "the gripper closed on nothing");
+            }
+        }
+    }
+
+    /// The fruit is not where the TCP went (localization error): open, back off to the
+    /// pre-grasp and come in again at the next aim of [`REGRASP_SHIFTS`]. -> approach.
+    pub(super) fn run_regrasp(&mut self, t_ns: i64, bus: &mut Bus) {
+        let giver = self.giver();
+        match self.phase_now() {
+            0 => {
+                self.gripper(giver, geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
+                self.phase = 1;
+            }
+            1 if self.view(giver).gripper.as_ref().is_some_and(|g| g.position > geo::OPEN_WIDTH - 0.005) => {
+                let goal = TcpGoal { position: self.grasp_point, ..self.grasp }.along(-geo::PRE_GRASP);
+                if self.move_arm(giver, &goal, true, t_ns, bus) {
+                    self.phase = 2;
+                }
+            }
+            2 if self.arm_done(giver, t_ns, bus) == Some(true) => {
+                if self.attempts == 0 {
+                    let tcp = self.motion.model(giver).fk(self.lift, &self.q(giver));
+                    self.regrasp_axes = [0, 2].map(|k| [tcp.rot[0][k], tcp.rot[1][k], tcp.rot[2][k]]);
+                }
+                self.attempts += 1;
+                self.enter(Stage::Approach, t_ns, bus, &format!("attempt {}", self.attempts + 1));
+            }
+            _ => {}
+        }
+    }
+
+    /// Backs the held fruit out of the plant. -> handover_pose (failed if it slipped out).
+    pub(super) fn run_retreat(&mut self, first: bool, t_ns: i64, bus: &mut Bus) {
+        let giver = self.giver();
+        if first {
+            // The fruit now belongs to the hand: it is no obstacle. Back out along the
+            // approach and a little up; where the held fruit would catch on a
+            // neighbour that way, straight back, then a shorter way.
+            self.motion.ignore_target(true);
+            let grasp = TcpGoal { position: self.grasp_point, ..self.grasp };
+            let goals = geo::RETREATS.map(|[back, up]| {
+                let g = grasp.along(-back);
+                TcpGoal { position: [g.position[0], g.position[1], g.position[2] + up], ..g }
+            });
+            self.plan_and_send(giver, "linear", t_ns, bus, |m, lift, start, other| {
+                m.plan_linear_any(giver, lift, start, &goals, other)
+            });
+        } else if self.arm_done(giver, t_ns, bus) == Some(true) {
+            if !self.holding(giver) {
+                self.fail(Failure::Grasp, t_ns, bus, "the fruit slipped out during the retreat".into());
+                return;
+            }
+            self.enter(Stage::HandoverPose, t_ns, bus, "");
+        }
+    }
+
+    /// Lifts to the transfer height, the giver presents the fruit, then the taker comes to
+    /// its pre-handover pose: one arm moves at a time, so each plans against the other's actual
+    /// configuration. -> handover.
+    pub(super) fn run_handover_pose(&mut self, t_ns: i64, bus: &mut Bus) {
+        let (giver, taker) = (self.giver(), self.taker());
+        match self.phase_now() {
+            0 => {
+                // Lift to the transfer height unless an arm would meet the robot on the way.
+                let q = [self.q(Arm::Left), self.q(Arm::Right)];
+                if self.motion.lift_sweep_clear(q, self.lift, geo::LIFT_TRANSFER) {
+                    self.lift_target = geo::LIFT_TRANSFER;
+                }
+                bus.set_scalar(topics::LIFT_SETPOINT, self.lift_target);
+                self.gripper(taker, geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
+                self.phase = 1;
+            }
+            1 if self.lift_at(self.lift_target) => {
+                let (g, _) = geo::handover_goals(geo::handover_point(self.lift), self.side);
+                if self.move_arm(giver, &g, false, t_ns, bus) {
+                    self.phase = 2;
+                }
+            }
+            2 if self.arm_done(giver, t_ns, bus) == Some(true) => {
+                // The taker's stand-off is chosen so its straight approach to the
+                // fruit is valid too; the hands meet by design, the exact check decides.
+                let (_, t) = geo::handover_goals(geo::handover_point(self.lift), self.side);
+                self.motion.set_padding(HANDOVER_PADDING);
+                let ok = self.move_pregrasp(taker, &[t], t_ns, bus).is_some();
+                self.motion.set_padding(agrisim_manip::checker::DEFAULT_PADDING);
+                if ok {
+                    self.phase = 3;
+                }
+            }
+            3 if self.arm_done(taker, t_ns, bus) == Some(true) => self.enter(Stage::Handover, t_ns, bus, ""),
+            _ => {}
+        }
+    }
+
+    /// The taker closes on the fruit in the giver's hand and the giver lets go and backs
+    /// off; where the taker closed on nothing, it tries again deeper, then shallower
+    /// ([`HANDOVER_OFFSETS`]). -> transfer.
+    pub(super) fn run_handover(&mut self, t_ns: i64, bus: &mut Bus) {
+        let (giver, taker) = (self.giver(), self.taker());
+        let (_, t) = geo::handover_goals(geo::handover_point(self.lift), self.side);
+        match self.phase_now() {
+            0 => {
+                self.motion.set_padding(HANDOVER_PADDING);
+                let ok =
+                    self.move_arm(taker, &TcpGoal { x_axis: None, ..t.along(self.handover_offset) }, true, t_ns, bus);
+                self.motion.set_padding(agrisim_manip::checker::DEFAULT_PADDING);
+                if ok {
+                    self.phase = 1;
+                }
+            }
+            1 if self.arm_done(taker, t_ns, bus) == Some(true) => {
+                self.gripper(taker, 0.0, GRASP_FORCE, t_ns, bus);
+                self.phase = 2;
+            }
+            2 if self.holding(taker) => {
+                let r = self.motion.target_radius();
+                self.motion.set_held(taker, r);
+                self.motion.set_held(giver, None);
+                self.gripper(giver, geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
+                self.release_ns = t_ns;
+                self.phase = 3;
+            }
+            2 if self.view(taker).gripper.as_ref().is_some_and(|g| g.reached_goal && g.position < 0.005) => {
+                // Where the fruit sits between the giver's pads (along the approach)
+                // is not known: open, back off and try deeper / shallower.
+                if self.handover_attempts as usize >= HANDOVER_OFFSETS.len() {
+                    self.fail(
+                        Failure::Handover,
+                        t_ns,
+                        bus,
+                        format!("the taking gripper closed on nothing ({} attempts)", self.handover_attempts + 1),
+                    );
+                } else {
+                    self.gripper(taker, geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
+                    self.phase = 4;
+                }
+            }
+            3 => {
+                let opened = self.view(giver).gripper.as_ref().is_some_and(|g| g.position > geo::OPEN_WIDTH - 0.005);
+                if opened && t_ns - self.release_ns > 500_000_000 {
+                    if !self.holding(taker) {
+                        self.fail(Failure::Handover, t_ns, bus, "the fruit fell during the exchange".into());
+                        return;
+                    }
+                    // The giver backs off if a straight line allows it; otherwise
+                    // its plan home (next stage) starts right here.
+                    let (g, _) = geo::handover_goals(geo::handover_point(self.lift), self.side);
+                    let goal = TcpGoal { x_axis: None, ..g.along(-GIVER_BACKOFF) };
+                    let (start, other) = (self.q(giver), self.q(taker));
+                    let r = self.motion.plan_linear(giver, self.lift, start, &goal, other);
+                    self.record(giver, "linear", &r, true, t_ns, bus);
+                    if let Ok(p) = r {
+                        self.send(giver, p, t_ns, bus);
+                    }
+                    self.enter(Stage::Transfer, t_ns, bus, "fruit handed over");
+                }
+            }
+            4 if self.view(taker).gripper.as_ref().is_some_and(|g| g.position > geo::OPEN_WIDTH - 0.005) => {
+                if self.move_arm(taker, &TcpGoal { x_axis: None, ..t.along(-0.04) }, true, t_ns, bus) {
+                    self.phase = 5;
+                }
+            }
+            5 if self.arm_done(taker, t_ns, bus) == Some(true) => {
+                self.handover_offset = HANDOVER_OFFSETS[self.handover_attempts as usize];
+                self.handover_attempts += 1;
+                self.publish_status(
+                    t_ns,
+                    bus,
+                    "running",
+                    "",
+                    &format!("handover attempt {}", self.handover_attempts + 1),
+                );
+                self.phase = 0;
+            }
+            _ => {}
+        }
+    }
+
+    /// The giver, whose back-off was sent on entering, goes home, then the taker carries the
+    /// fruit over the box. -> release.
+    pub(super) fn run_transfer(&mut self, t_ns: i64, bus: &mut Bus) {
+        let (giver, taker) = (self.giver(), self.taker());
+        match self.phase_now() {
+            0 if self.arm_done(giver, t_ns, bus) == Some(true) => {
+                if self.move_home(giver, t_ns, bus) {
+                    self.phase = 1;
+                }
+            }
+            1 if self.arm_done(giver, t_ns, bus) == Some(true) => {
+                // Successive fruit of a row go to successive spots over the box, so they
+                // spread instead of heaping up under one.
+                let mut goals = geo::drop_goals();
+                goals.rotate_left(self.boxed as usize % geo::DROP_SPOTS);
+                if self.move_any(taker, &goals, t_ns, bus) {
+                    self.phase = 2;
+                }
+            }
+            2 if self.arm_done(taker, t_ns, bus) == Some(true) => {
+                if !self.holding(taker) {
+                    self.fail(Failure::Handover, t_ns, bus, "the fruit was lost on the way to the box".into());
+                    return;
+                }
+                self.enter(Stage::Release, t_ns, bus, "");
+            }
+            _ => {}
+        }
+    }
+
+    /// Opens the taker over the box and judges where the fruit settled, on a target message
+    /// sent after it did. -> done, or failed (placement).
+    pub(super) fn run_release(&mut self, first: bool, t_ns: i64, bus: &mut Bus) {
+        let taker = self.taker();
+        if first {
+            self.gripper(taker, geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
+            self.motion.set_held(taker, None);
+            self.release_ns = t_ns;
+            return;
+        }
+        // Judge on a target message sent after the fruit settled.
+        let settled_ns = self.release_ns + (SETTLE * 1e9) as i64;
+        if t_ns >= settled_ns && self.target_stamp_ns >= settled_ns {
+            match self.target_base() {
+                Some(p) if geo::in_box(p) => self.succeed(t_ns, bus),
+                Some(p) => self.fail(
+                    Failure::Placement,
+                    t_ns,
+                    bus,
+                    format!("fruit at ({:.3}, {:.3}, {:.3}) in base_link, not in the box", p[0], p[1], p[2]),
+                ),
+                None => {}
+            }
+        }
+    }
+}
