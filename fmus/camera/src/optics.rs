@@ -114,6 +114,13 @@ impl CameraPose {
     }
 }
 
+/// The unit ray through (x, y, 1): [`Intrinsics::ray`] from a pixel's plane coordinates.
+#[inline]
+pub fn ray_through(x: f64, y: f64) -> Vec3 {
+    let n = (x * x + y * y + 1.0).sqrt();
+    [x / n, y / n, 1.0 / n]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -133,11 +140,4 @@ mod tests {
         assert!(near(pose.to_map([1.0, 0.0, 0.0]), [1.6, 1.0, 1.2])); // x right = map -y
         assert!(near(pose.to_map([0.0, 1.0, 0.0]), [1.6, 2.0, 0.2])); // y down = map -z
     }
-}
-
-/// The unit ray through (x, y, 1): [`Intrinsics::ray`] from a pixel's plane coordinates.
-#[inline]
-pub fn ray_through(x: f64, y: f64) -> Vec3 {
-    let n = (x * x + y * y + 1.0).sqrt();
-    [x / n, y / n, 1.0 / n]
 }

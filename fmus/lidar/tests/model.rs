@@ -35,7 +35,7 @@ fn run(m: &mut Lidar, io: &mut Store, from: usize, steps: usize) -> Vec<PointClo
         let seq = io.i64(POINTS_SEQ);
         m.do_step(io, k as f64 * H, H, &mut Quiet).unwrap();
         if io.i64(POINTS_SEQ) != seq {
-            out.push(PointCloud2::from_cdr(agrisim_fmi::port::latest(&io, POINTS)).unwrap());
+            out.push(PointCloud2::from_cdr(agrisim_fmi::port::latest(io, POINTS)).unwrap());
         }
     }
     out

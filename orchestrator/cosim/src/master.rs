@@ -275,7 +275,7 @@ impl Master {
 
     /// True when the next communication point is a message instant (nodes run there).
     pub fn at_message_instant(&self) -> bool {
-        self.tick % self.message_ticks == 0
+        self.tick.is_multiple_of(self.message_ticks)
     }
 
     /// Final point: outputs of the last step reach the hooks, and the point is closed.
@@ -289,7 +289,7 @@ impl Master {
         let k = self.tick;
         let t_ns = self.time_ns();
         self.collect_outputs(k, hooks)?;
-        hooks.exchange(t_ns, k % self.message_ticks == 0)?;
+        hooks.exchange(t_ns, k.is_multiple_of(self.message_ticks))?;
         self.deliver_bus_inputs(k, hooks)?;
         hooks.point(&mut self.system, t_ns)
     }
@@ -299,7 +299,7 @@ impl Master {
         let t_ns = k as i64 * self.step_ns;
         for r in 0..self.system.routes.len() {
             let route = &self.system.routes[r];
-            if k % route.period_ticks != 0 || !matches!(route.to, Port::Bus { .. }) {
+            if !k.is_multiple_of(route.period_ticks) || !matches!(route.to, Port::Bus { .. }) {
                 continue;
             }
             match &route.from {
@@ -324,7 +324,7 @@ impl Master {
     fn deliver_bus_inputs(&mut self, k: u64, hooks: &mut dyn Hooks) -> Result<()> {
         for r in 0..self.system.routes.len() {
             let route = &self.system.routes[r];
-            if k % route.period_ticks != 0 {
+            if !k.is_multiple_of(route.period_ticks) {
                 continue;
             }
             let (Port::Bus { topic }, Port::Fmu { var, seq, .. }) = (&route.from, &route.to) else { continue };
@@ -414,7 +414,7 @@ impl Master {
         };
         let mut cursor = route.cursor;
         if route.framed_from {
-            let frames = cursor.take(&bytes, n).map_err(|e| lost(&self.system, e));
+            let frames = cursor.take(bytes, n).map_err(|e| lost(&self.system, e));
             self.system.routes[r].cursor = cursor;
             for f in frames? {
                 each(&self.system, f)?;
@@ -427,7 +427,7 @@ impl Master {
             if skipped {
                 return Err(lost(&self.system, agrisim_frames::Error::Gap { first, last: n - 1 }));
             }
-            each(&self.system, Frame { seq: n, stamp_ns: t_ns, payload: &bytes })?;
+            each(&self.system, Frame { seq: n, stamp_ns: t_ns, payload: bytes })?;
         }
         Ok(())
     }

@@ -396,7 +396,7 @@ mod tests {
         let mut occ = vec![false; geom.len()];
         for y in 0..60 {
             for x in 0..800 {
-                occ[y * 800 + x] = y < 10 || y >= 50;
+                occ[y * 800 + x] = !(10..50).contains(&y);
             }
         }
         let map = StaticMap::from_cells(geom, occ, "map".into());

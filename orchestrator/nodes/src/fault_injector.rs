@@ -22,7 +22,7 @@ pub struct Injection {
 impl Injection {
     pub fn bytes(&self) -> Result<Vec<u8>> {
         let h = self.hex.trim();
-        if h.len() % 2 != 0 || !h.bytes().all(|b| b.is_ascii_hexdigit()) {
+        if !h.len().is_multiple_of(2) || !h.bytes().all(|b| b.is_ascii_hexdigit()) {
             return Err(agrisim_error::err!(
                 "inject on {} at t={}: hex {:?} is not an even number of hex digits",
                 self.topic,

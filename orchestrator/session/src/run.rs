@@ -222,9 +222,8 @@ pub fn run(s: &Scenario, o: &RunOptions, out_dir: &Path, progress: impl FnMut(u6
     std::fs::create_dir_all(out_dir).context(|| format!("cannot create {}", out_dir.display()))?;
     let mcap = out_dir.join("run.mcap");
     let duration = o.duration.unwrap_or(s.duration);
-    let steps = ticks_of(duration, s.timing.step, "duration").or_else(|_| -> Result<u64> {
-        Err(err!("duration {duration} s is not a whole number of {} s steps", s.timing.step))
-    })?;
+    let steps = ticks_of(duration, s.timing.step, "duration")
+        .map_err(|_| err!("duration {duration} s is not a whole number of {} s steps", s.timing.step))?;
     let mut session = prepare(s, o, &mcap, default_nodes(s))?;
     let mut progress = progress;
     let result = session.run(steps, |k| progress(k, steps));

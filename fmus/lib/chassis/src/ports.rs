@@ -14,7 +14,7 @@ agrisim_fmi::variables! { pub VARIABLES {
     TRACK = Var::param("track", Start::Float64(0.8)).unit("m").range(0.1, 10.0)
         .desc("Distance between left and right wheels"),
     WHEEL_RADIUS = Var::param("wheel_radius", Start::Float64(0.1)).unit("m").range(0.01, 2.0),
-    STEER_MAX = Var::param("steer_max", Start::Float64(1.5707963267948966)).unit("rad").range(0.0, 3.2)
+    STEER_MAX = Var::param("steer_max", Start::Float64(std::f64::consts::FRAC_PI_2)).unit("rad").range(0.0, 3.2)
         .desc("Steering angle limit (symmetric)"),
     STEER_RATE_MAX = Var::param("steer_rate_max", Start::Float64(3.0)).unit("rad/s").range(0.0, 1e9),
     WHEEL_SPEED_MAX = Var::param("wheel_speed_max", Start::Float64(15.0)).unit("rad/s").range(0.0, 1e9)

@@ -114,7 +114,7 @@ fn watchdog_stops_the_base_without_fresh_commands() {
 
 #[test]
 fn twist_message_is_followed_and_latest_wins() {
-    let (mut m, mut io) = start::<ChassisKinematic>(|io| ideal(io));
+    let (mut m, mut io) = start::<ChassisKinematic>(ideal);
     let msg = Twist { linear: Vector3 { x: 0.0, y: 0.4, z: 0.0 }, angular: Vector3::default() };
     io.set_binary(CMD_VEL, &msg.to_cdr());
     io.set_i64(CMD_VEL_SEQ, 1);

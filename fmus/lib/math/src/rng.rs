@@ -238,7 +238,7 @@ mod tests {
         let mut beyond_r = 0;
         for _ in 0..n {
             let x = r.normal_ziggurat();
-            beyond_r += (x.abs() > 3.6541528853610088) as u64;
+            beyond_r += (x.abs() > 3.654_152_885_361_009) as u64;
             count[edges.partition_point(|&e| e <= x)] += 1;
         }
         let chi2: f64 = count.iter().zip(&p).map(|(&c, &q)| (c as f64 - n as f64 * q).powi(2) / (n as f64 * q)).sum();

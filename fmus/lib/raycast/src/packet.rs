@@ -16,7 +16,7 @@ use std::mem::MaybeUninit;
 
 /// Most rays in a packet (at most 64: the visitors keep one bit per ray in a `u64`).
 pub const MAX_PACKET: usize = 64;
-const _: () = assert!(MAX_PACKET <= 64 && MAX_PACKET % 8 == 0);
+const _: () = assert!(MAX_PACKET <= 64 && MAX_PACKET.is_multiple_of(8));
 
 /// The rays of a packet, lane-wise (structure of arrays) for the leaf tests.
 pub(crate) struct Packet {

@@ -399,8 +399,8 @@ fn packets_equal_single_rays() {
             for i in 0..n {
                 let single = rc.cast_among_posed(origins[i], dirs[i], tmin, tmax, &local, &poses[i]);
                 assert_eq!(out[i], single, "posed packet {k} ray {i}");
-                posed_hits += single.map_or(false, |h| h.object == 1_000_001) as usize;
-                coherent_posed_hits += (k % 2 == 1 && single.map_or(false, |h| h.object == 1_000_001)) as usize;
+                posed_hits += single.is_some_and(|h| h.object == 1_000_001) as usize;
+                coherent_posed_hits += (k % 2 == 1 && single.is_some_and(|h| h.object == 1_000_001)) as usize;
             }
         }
     }
