@@ -26,3 +26,25 @@ pub use overhead::{overhead, OverheadReport};
 pub fn registry() -> Registry {
     Registry::default().with(&nav::Nav).with(&harvest::Harvest).with(&row::Row)
 }
+
+#[cfg(test)]
+mod tests {
+    // Here, not in framework/registry.rs: the framework knows no benchmark, the crate root all.
+    use super::{harvest::Harvest, nav::Nav, registry, row::Row, Registry};
+
+    #[test]
+    #[should_panic(expected = "benchmark nav is registered twice")]
+    fn a_name_is_registered_once() {
+        let _ = registry().with(&Nav);
+    }
+
+    #[test]
+    fn benchmarks_are_found_by_name_in_order() {
+        let r = Registry::default().with(&Row).with(&Nav);
+        assert_eq!(r.names(), ["row", "nav"]);
+        assert_eq!(r.get("nav").unwrap().name(), "nav");
+        let e = r.get("harvest").err().expect("not registered").to_string();
+        assert!(e.contains("unknown benchmark 'harvest' (known: row, nav)"), "{e}");
+        assert_eq!(r.with(&Harvest).names(), ["row", "nav", "harvest"]);
+    }
+}

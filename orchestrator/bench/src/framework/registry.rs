@@ -58,24 +58,3 @@ impl Registry {
         self.get(name)?.run_one(job, i)
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use crate::{harvest::Harvest, nav::Nav, registry, row::Row};
-
-    #[test]
-    #[should_panic(expected = "benchmark nav is registered twice")]
-    fn a_name_is_registered_once() {
-        let _ = registry().with(&Nav);
-    }
-
-    #[test]
-    fn benchmarks_are_found_by_name_in_order() {
-        let r = super::Registry::default().with(&Row).with(&Nav);
-        assert_eq!(r.names(), ["row", "nav"]);
-        assert_eq!(r.get("nav").unwrap().name(), "nav");
-        let e = r.get("harvest").err().expect("not registered").to_string();
-        assert!(e.contains("unknown benchmark 'harvest' (known: row, nav)"), "{e}");
-        assert_eq!(r.with(&Harvest).names(), ["row", "nav", "harvest"]);
-    }
-}
