@@ -247,3 +247,19 @@ pub fn render_with(
         extra = sections.iter().map(|(h, body)| format!("<h2>{}</h2>{body}", escape(h))).collect::<String>()
     )
 }
+
+/// The per-scene section of a report (only when trials span more than one scene): each
+/// scene's `outcome` count with its Wilson interval; the page's map is scene 0's.
+pub fn per_scene_section(per_scene: &[super::scenes::SceneResult], outcome: &str) -> Option<(String, String)> {
+    if per_scene.len() <= 1 {
+        return None;
+    }
+    let scenes = per_scene.iter().map(|r| {
+        let label = format!("{} (greenhouse seed {})", r.scene, r.scene_seed);
+        (label, r.trials, r.successes, super::stats::wilson(r.successes, r.trials, super::stats::Z95))
+    });
+    let note = "<p>The map above is scene 0's; the trials of the other scenes are drawn on it.</p>";
+    let mut title = format!("{outcome} per scene");
+    title[..1].make_ascii_uppercase();
+    Some((title, rate_table(["scene", "trials", outcome], scenes) + note))
+}

@@ -3,9 +3,9 @@
 use super::summary::HarvestSummary;
 use super::trial::HarvestTrial;
 use crate::framework::report::{
-    bar_chart, count_table, interval, opt, per_kind, rate_table, render_with, view_bounds, TrialTrace,
+    bar_chart, count_table, interval, opt, per_kind, per_scene_section, rate_table, render_with, view_bounds,
+    TrialTrace,
 };
-use crate::framework::stats::{wilson, Z95};
 
 /// report.html: the rates (harvest, planning, conditional) with their intervals, results per
 /// scene and per visibility class, the failure taxonomy, a histogram of the time to harvest,
@@ -47,18 +47,7 @@ pub fn report_html(g: &agrisim_scene::Greenhouse, sum: &HarvestSummary, results:
     let classes = sum.per_visibility.iter().map(|(k, c)| (k.clone(), c.trials, c.successes, c.wilson95));
     let times: Vec<f64> = results.iter().filter_map(|t| t.time_to_harvest).collect();
     let mut sections = vec![];
-    if sum.scenes > 1 {
-        let scenes = sum.per_scene.iter().map(|r| {
-            (
-                format!("{} (greenhouse seed {})", r.scene, r.scene_seed),
-                r.trials,
-                r.successes,
-                wilson(r.successes, r.trials, Z95),
-            )
-        });
-        let note = "<p>The map above is scene 0's; the trials of the other scenes are drawn on it.</p>";
-        sections.push(("Harvested per scene".to_string(), rate_table(["scene", "trials", "harvested"], scenes) + note));
-    }
+    sections.extend(per_scene_section(&sum.per_scene, "harvested"));
     sections.extend([
         ("Harvested by visibility class".to_string(), rate_table(["class", "trials", "harvested"], classes)),
         ("Failure taxonomy (trials not harvested)".to_string(), count_table(["category", "trials"], &sum.failures)),

@@ -5,9 +5,8 @@ use super::setup::NavSetup;
 use super::summary::NavSummary;
 use super::trial::NavRecord;
 use crate::framework::report::{
-    bar_chart, count_table, interval, opt, rate_table, render_with, view_bounds, TrialTrace,
+    bar_chart, count_table, interval, opt, per_scene_section, render_with, view_bounds, TrialTrace,
 };
-use crate::framework::stats::{wilson, Z95};
 
 /// The report page: figures the seed determines only (the wall-clock ones are in
 /// summary.json), so the same seed gives the same page. Drawn on `setup`'s map (scene 0).
@@ -35,18 +34,7 @@ pub fn report_html(setup: &NavSetup, sum: &NavSummary, records: &[NavRecord]) ->
         ("wall-clock figures".to_string(), "in summary.json (rtf, wall_time)".to_string()),
     ];
     let mut sections = vec![];
-    if sum.scenes > 1 {
-        let scenes = sum.per_scene.iter().map(|r| {
-            (
-                format!("{} (greenhouse seed {})", r.scene, r.scene_seed),
-                r.trials,
-                r.successes,
-                wilson(r.successes, r.trials, Z95),
-            )
-        });
-        let note = "<p>The map above is scene 0's; the trials of the other scenes are drawn on it.</p>";
-        sections.push(("Reached per scene".to_string(), rate_table(["scene", "trials", "reached"], scenes) + note));
-    }
+    sections.extend(per_scene_section(&sum.per_scene, "reached"));
     let times: Vec<f64> = records.iter().filter_map(|r| r.trial.time_to_goal).collect();
     sections.extend([
         ("Failure taxonomy (trials not reached)".to_string(), count_table(["reason", "trials"], &sum.failures)),
