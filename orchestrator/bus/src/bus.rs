@@ -16,7 +16,7 @@ pub struct Sample {
     pub type_name: String,
     /// Counts messages on this topic (1 for the first).
     pub seq: u64,
-    /// Simulation time of publication [ns].
+    /// Simulation time of publication \[ns\].
     pub time_ns: i64,
     /// Shared by the topic's latest sample, its readers' queue and the outbox: a camera
     /// image is copied once onto the bus, not once per holder.

@@ -74,7 +74,7 @@ pub struct RecordPolicy {
     /// Topics dropped whatever the profile says (a trailing `*` matches a prefix).
     #[serde(default)]
     pub exclude: Vec<String>,
-    /// Topic -> the shortest period between two kept messages [s], overriding the profile.
+    /// Topic -> the shortest period between two kept messages \[s\], overriding the profile.
     #[serde(default)]
     pub decimate: BTreeMap<String, f64>,
 }
@@ -86,9 +86,9 @@ fn matches(pattern: &str, topic: &str) -> bool {
     }
 }
 
-/// Period of point clouds and images in the `standard` profile [s].
+/// Period of point clouds and images in the `standard` profile \[s\].
 pub const HEAVY_PERIOD: f64 = 5.0;
-/// Period of IMU samples in the `standard` profile [s] (50 Hz: noise compresses badly).
+/// Period of IMU samples in the `standard` profile \[s\] (50 Hz: noise compresses badly).
 pub const IMU_PERIOD: f64 = 0.02;
 const HEAVY_TYPES: [&str; 2] = ["sensor_msgs/msg/PointCloud2", "sensor_msgs/msg/Image"];
 const JUDGE_TOPICS: [&str; 5] =

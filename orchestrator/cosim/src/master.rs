@@ -42,7 +42,7 @@ pub trait Hooks {
         Ok(())
     }
     /// Every message on system connector `connector` that route `route` has not delivered
-    /// yet, oldest first, as (stamp [ns], CDR bytes), appended to `out`.
+    /// yet, oldest first, as (stamp \[ns\], CDR bytes), appended to `out`.
     fn message_input(&mut self, _route: usize, _connector: &str, _out: &mut Vec<(i64, Vec<u8>)>) -> Result<()> {
         Ok(())
     }
@@ -142,7 +142,7 @@ impl Master {
         order::explain(&self.system, &self.order)
     }
 
-    /// Simulation time of the next communication point [s].
+    /// Simulation time of the next communication point \[s\].
     pub fn time(&self) -> f64 {
         time_of(self.tick, self.step_ns)
     }
@@ -152,7 +152,7 @@ impl Master {
         self.tick
     }
 
-    /// Simulation time of the next communication point [ns].
+    /// Simulation time of the next communication point \[ns\].
     pub fn time_ns(&self) -> i64 {
         self.tick as i64 * self.step_ns
     }

@@ -1,7 +1,7 @@
 //! A [`Snapshot`] as bytes: the whole system's state, to be written to a file and restored
 //! later in this process or another (a fresh master of the same system, initialized).
 //!
-//! Layout: `b"AGSYS\x01"`, then postcard of [`Saved`]: the tick, each component's name, the
+//! Layout: `b"AGSYS\x01"`, then postcard of `Saved`: the tick, each component's name, the
 //! importer's state-machine state and the FMU's own serialized state
 //! (`fmi3SerializeFMUState`), and each route's position (last sequence number taken, last
 //! value written).

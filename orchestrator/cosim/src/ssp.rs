@@ -164,7 +164,7 @@ impl fmt::Display for Endpoint {
 pub struct Connection {
     pub start: Endpoint,
     pub end: Endpoint,
-    /// Exchange period [s] from the `org.agrisim.exchange` annotation; `None` = every step.
+    /// Exchange period \[s\] from the `org.agrisim.exchange` annotation; `None` = every step.
     pub period: Option<f64>,
 }
 

@@ -27,7 +27,7 @@ pub struct LoadOptions {
     /// Component -> FMU file, replacing the system file's `source`.
     pub fmu_overrides: BTreeMap<String, String>,
     pub step: f64,
-    /// Period of message connections without their own [s].
+    /// Period of message connections without their own \[s\].
     pub message_period: f64,
     /// FMU debug logging (FMI `loggingOn`, then `fmi3SetDebugLogging`): `None` off, the
     /// default (the FMUs report only warnings and errors, which always reach the user: in a

@@ -19,7 +19,7 @@ pub struct Scenario {
     /// Master seed: every component's `seed` parameter is derived from it.
     #[serde(default = "default_seed")]
     pub seed: u64,
-    /// Simulated duration of `agrisim run` [s].
+    /// Simulated duration of `agrisim run` \[s\].
     #[serde(default = "default_duration")]
     pub duration: f64,
     #[serde(default)]
@@ -69,10 +69,10 @@ pub struct Scenario {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Timing {
-    /// Master communication step [s].
+    /// Master communication step \[s\].
     #[serde(default = "default_step")]
     pub step: f64,
-    /// Rate of message connections [Hz] (those without their own period in the system file).
+    /// Rate of message connections \[Hz\] (those without their own period in the system file).
     #[serde(default = "default_message_rate")]
     pub message_rate: f64,
 }
@@ -87,13 +87,13 @@ impl Default for Timing {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct NavSettings {
-    /// Simulated time limit of a trial [s].
+    /// Simulated time limit of a trial \[s\].
     pub trial_timeout: f64,
-    /// Success radius around the target for the ground-truth base centre [m] (Nav2's default).
+    /// Success radius around the target for the ground-truth base centre \[m\] (Nav2's default).
     pub goal_tolerance: f64,
     /// Where targets are drawn: aisles and the headland.
     pub targets_in_headland: bool,
-    /// Keep targets at least this far from the aisle ends [m].
+    /// Keep targets at least this far from the aisle ends \[m\].
     pub aisle_margin: f64,
     /// Standard deviations [m, m, rad] of the error of the localizer's initial pose estimate
     /// (an operator's estimate of the start pose; the robot must converge from it).

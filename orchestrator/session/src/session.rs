@@ -27,7 +27,7 @@ pub struct Session {
     pub recorder: Recorder,
     /// The ROS 2 type of each route's messages (None: a scalar route).
     types: Vec<Option<String>>,
-    /// Wall time of each node's last step [s]: a speed statistic for reports, never an input.
+    /// Wall time of each node's last step \[s\]: a speed statistic for reports, never an input.
     node_wall: Vec<f64>,
     /// What is recorded every point, built once: per FMU its signals topic and message (the
     /// values and stamp change), and the scalar system inputs' message.
@@ -94,7 +94,7 @@ impl Session {
         self.master.system.number(comp, name)
     }
 
-    /// Wall time of the last step of node `name` [s] (for speed statistics only).
+    /// Wall time of the last step of node `name` \[s\] (for speed statistics only).
     pub fn node_wall(&self, name: &str) -> Option<f64> {
         self.nodes.iter().position(|n| n.name() == name).map(|i| self.node_wall[i])
     }
