@@ -187,7 +187,9 @@ def test_sigkill_then_resume_gives_the_uninterrupted_outputs(tmp_path):
     """A benchmark killed outright (SIGKILL to its process group: the machine dies) leaves
     every completed trial's files whole; --resume finishes with trials.jsonl, summary and
     every MCAP identical to an uninterrupted run's."""
-    args = ["bench", "nav", "--trials", "3", "--seed", "6", "--record", "judge"]
+    # One trial at a time (--jobs defaults to the core count), so trial 1 under way means
+    # trial 0 is complete.
+    args = ["bench", "nav", "--trials", "3", "--seed", "6", "--record", "judge", "--jobs", "1"]
     run_agrisim(*args, "--out", str(tmp_path / "whole"))
     cut = tmp_path / "cut"
     p = subprocess.Popen([str(agrisim_bin()), *args, "--out", str(cut)], cwd=REPO, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
