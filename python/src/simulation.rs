@@ -280,7 +280,7 @@ impl Simulation {
     /// An FMU variable's current value (float, int, bool, str or bytes).
     fn get<'py>(&mut self, py: Python<'py>, component: &str, name: &str) -> PyResult<Bound<'py, PyAny>> {
         let (comp, v) = self.variable(component, name)?;
-        let inst = &mut self.session()?.master.system.components[comp].instance;
+        let inst = self.session()?.master.system.components[comp].instance.as_mut();
         let x = value::get(inst, &v).map_err(|e| py_err(format!("FMU '{component}', variable '{name}': {e}")))?;
         Ok(match x {
             value::Value::F64(f) => f.into_pyobject(py)?.into_any(),
@@ -300,7 +300,7 @@ impl Simulation {
             Err(_) => value::from_toml(&v, &toml_of(value, &format!("{component}.{name}"))?)
                 .map_err(|e| py_err(format!("FMU '{component}': {e}")))?,
         };
-        let inst = &mut self.session()?.master.system.components[comp].instance;
+        let inst = self.session()?.master.system.components[comp].instance.as_mut();
         value::set(inst, &v, &x).map_err(|e| py_err(format!("FMU '{component}', variable '{name}': {e}")))
     }
 

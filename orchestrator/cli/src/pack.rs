@@ -150,6 +150,22 @@ pub fn pack_all(lib_dir: &Path, out_dir: &Path) -> Result<Vec<Packed>> {
     find_fmu_libraries(lib_dir)?.iter().map(|(l, c)| pack_library(l, c, out_dir)).collect()
 }
 
+/// The subdirectory of the systems directory, of the packed-FMU directory and of the SSP
+/// output directory that holds FMI 2.0 systems, FMUs and archives.
+pub const FMI2_DIR: &str = "fmi2";
+
+/// Packs every system: `systems_dir/*.ssd` with the FMI 3.0 archives of `fmu_dir` into
+/// `out_dir/*.ssp`, and `systems_dir/fmi2/*.ssd` (when that directory exists) with the FMI 2.0
+/// archives of `fmu_dir/fmi2` into `out_dir/fmi2/*.ssp`, for masters that import FMI 2.0 only.
+pub fn pack_systems(systems_dir: &Path, fmu_dir: &Path, out_dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut written = pack_ssps(systems_dir, fmu_dir, out_dir)?;
+    let fmi2 = systems_dir.join(FMI2_DIR);
+    if fmi2.is_dir() {
+        written.extend(pack_ssps(&fmi2, &fmu_dir.join(FMI2_DIR), &out_dir.join(FMI2_DIR))?);
+    }
+    Ok(written)
+}
+
 /// Writes `out_dir/<system>.ssp` for every `.ssd` in `systems_dir`: a self-contained SSP
 /// archive (SystemStructure.ssd at the root, every component's FMU under resources/, sources
 /// rewritten to point there) that other SSP tools and `agrisim run` load as they are.
@@ -246,6 +262,32 @@ mod tests {
         assert!(!out.exists(), "nothing is written for a refused library");
         let packed = pack_library(&library, &lift, &out).expect("Lift packs as Lift");
         assert_eq!(packed.fmi3, out.join("Lift.fmu"));
+        std::fs::remove_dir_all(&out).expect("remove the test's output");
+    }
+
+    #[test]
+    fn a_model_exchange_only_library_packs_for_both_versions() {
+        // The modelIdentifier comes from <ModelExchange> when there is no <CoSimulation>.
+        let exe = std::env::current_exe().expect("test executable path");
+        let dir = exe.parent().and_then(Path::parent).expect("target/<profile>/deps");
+        let osc = marked("agrisim-fmu-oscillator");
+        let library = dir.join(osc.file_name());
+        assert!(
+            library.is_file(),
+            "{} missing: run `cargo build --release -p agrisim-fmu-oscillator`",
+            library.display()
+        );
+        let out = std::env::temp_dir().join(format!("agrisim-pack-me-test-{}", std::process::id()));
+        let packed = pack_library(&library, &osc, &out).expect("Oscillator packs");
+        assert_eq!(packed.model_identifier, "Oscillator");
+        for path in [Some(packed.fmi3), packed.fmi2].into_iter().flatten() {
+            let file = std::fs::File::open(&path).expect("archive written");
+            let mut zip = zip::ZipArchive::new(file).expect("a zip archive");
+            let mut xml = String::new();
+            std::io::Read::read_to_string(&mut zip.by_name("modelDescription.xml").expect("its XML"), &mut xml)
+                .expect("UTF-8 XML");
+            assert!(xml.contains("<ModelExchange modelIdentifier=\"Oscillator\"") && !xml.contains("<CoSimulation"));
+        }
         std::fs::remove_dir_all(&out).expect("remove the test's output");
     }
 }

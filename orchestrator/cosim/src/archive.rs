@@ -25,6 +25,17 @@ pub const PLATFORM: &str = if cfg!(all(target_arch = "x86_64", target_os = "linu
     "x86_64-windows"
 };
 
+/// The FMI 2.0 name of the same platform (`binaries/linux64`, ...).
+pub const PLATFORM_FMI2: &str = if cfg!(all(target_arch = "x86_64", target_os = "linux")) {
+    "linux64"
+} else if cfg!(target_os = "linux") {
+    "linux32"
+} else if cfg!(target_os = "macos") {
+    "darwin64"
+} else {
+    "win64"
+};
+
 /// Shared-library file extension on this platform.
 const LIB_EXT: &str = if cfg!(target_os = "macos") {
     "dylib"
@@ -74,8 +85,8 @@ pub struct FmuArchive {
 
 impl FmuArchive {
     /// Unpacks `fmu_path` under `cache_root` (or reuses a complete earlier unpacking of the same
-    /// bytes) and checks it has a valid FMI 3.0 co-simulation description and a binary for
-    /// this platform.
+    /// bytes) and checks it has a valid FMI 3.0 or 2.0 description and a binary for this
+    /// platform.
     pub fn open(fmu_path: &Path, cache_root: &Path) -> Result<FmuArchive, ImportError> {
         let bytes = std::fs::read(fmu_path).map_err(|e| ImportError::new(fmu_path, format!("cannot read: {e}")))?;
         let mut zip = zip::ZipArchive::new(Cursor::new(&bytes[..]))
@@ -102,7 +113,11 @@ impl FmuArchive {
             extract(&mut zip, fmu_path, cache_root, &dir)?;
         }
 
-        let rel_lib = format!("binaries/{PLATFORM}/{}.{LIB_EXT}", md.model_identifier);
+        let platform = match md.version {
+            crate::model_description::FmiVersion::V3 => PLATFORM,
+            crate::model_description::FmiVersion::V2 => PLATFORM_FMI2,
+        };
+        let rel_lib = format!("binaries/{platform}/{}.{LIB_EXT}", md.model_identifier);
         let library_path = dir.join(&rel_lib);
         if !library_path.is_file() {
             let platforms = list_dir(&dir.join("binaries"));

@@ -1,4 +1,5 @@
-//! agrisim-cosim: the co-simulation engine. It imports FMI 3.0 co-simulation FMUs, composes
+//! agrisim-cosim: the co-simulation engine. It imports FMI 3.0 and FMI 2.0 FMUs (co-simulation,
+//! and model exchange integrated by the master with fixed-step RK4: [`me`]), composes
 //! them from an SSP system structure, and steps them on integer ticks with per-connection
 //! exchange rates (physics every step, message connections at their own period).
 //!
@@ -22,10 +23,14 @@
 //! ```
 
 pub mod archive;
+pub mod fmi2;
 pub mod fmi3;
+pub mod fmu;
 pub mod master;
+pub mod me;
 pub mod model_description;
 pub mod order;
+mod python;
 pub mod saved;
 pub mod seed;
 pub mod ssp;
@@ -33,6 +38,7 @@ pub mod system;
 pub mod value;
 
 pub use agrisim_error::{err, Context, Error, Result};
+pub use fmu::FmuInstance;
 pub use master::{Hooks, Master, NoHooks, Snapshot};
 pub use order::Order;
 pub use system::{LoadOptions, Port, Route, System};
@@ -45,4 +51,4 @@ pub(crate) mod error {
 macro_rules! from_display {
     ($($t:ty),*) => { $( impl From<$t> for Error { fn from(e: $t) -> Self { Error(e.to_string()) } } )* };
 }
-from_display!(fmi3::FmiError, archive::ImportError, model_description::ModelDescriptionError, ssp::SspError);
+from_display!(fmu::FmiError, archive::ImportError, model_description::ModelDescriptionError, ssp::SspError);

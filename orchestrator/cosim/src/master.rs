@@ -66,7 +66,7 @@ impl Hooks for NoHooks {}
 /// it and stepping gives exactly what stepping on from the snapshot gave. The program around
 /// the engine (its hooks: bus, nodes, recorder) keeps its own state.
 pub struct Snapshot {
-    pub(crate) fmus: Vec<crate::fmi3::FmuState>,
+    pub(crate) fmus: Vec<crate::fmu::FmuState>,
     pub(crate) tick: u64,
     pub(crate) routes: Vec<(agrisim_frames::Cursor, i64)>,
 }
@@ -217,11 +217,12 @@ impl Master {
             return Ok(false);
         };
         let (src, dst) = (*src, *dst);
-        let v = value::get(&mut self.system.components[src].instance, sv)?;
+        let v = value::get(self.system.components[src].instance.as_mut(), sv)?;
         if last[r].as_ref().is_some_and(|l| l.identical(&v)) {
             return Ok(false);
         }
-        value::set(&mut self.system.components[dst].instance, dv, &v)?;
+        let out = route.transfer_value(v.clone())?;
+        value::set(self.system.components[dst].instance.as_mut(), dv, &out)?;
         last[r] = Some(v);
         Ok(true)
     }
@@ -310,7 +311,8 @@ impl Master {
                 }
                 Port::Fmu { comp, var, seq: None } => {
                     let Port::Bus { topic } = &route.to else { unreachable!("checked above") };
-                    if let Some(x) = value::get(&mut self.system.components[*comp].instance, var)?.as_f64() {
+                    let v = value::get(self.system.components[*comp].instance.as_mut(), var)?;
+                    if let Some(x) = route.transfer_value(v)?.as_f64() {
                         hooks.scalar(topic, x);
                     }
                 }
@@ -337,8 +339,9 @@ impl Master {
                 res?;
             } else if let Some(x) = hooks.scalar_input(topic) {
                 let v = value::scalar_from_f64(var, x).map_err(|e| crate::err!("{}: {e}", route.label))?;
+                let v = route.transfer_value(v)?;
                 let Port::Fmu { comp, var, .. } = &self.system.routes[r].to else { unreachable!("matched above") };
-                value::set(&mut self.system.components[*comp].instance, var, &v)?;
+                value::set(self.system.components[*comp].instance.as_mut(), var, &v)?;
             }
         }
         Ok(())
@@ -356,7 +359,7 @@ impl Master {
         let Port::Fmu { comp, var, seq: Some(seq) } = &route.to else {
             return Err(crate::err!("{}: not a message input", route.label));
         };
-        let inst = &mut components[*comp].instance;
+        let inst = components[*comp].instance.as_mut();
         let first = route.written as u64 + 1;
         let n = messages.len() as u64;
         if route.framed_to {
@@ -383,7 +386,7 @@ impl Master {
         let route = &self.system.routes[r];
         let Port::Fmu { comp, var, seq: Some(seq) } = &route.from else { return Ok(()) };
         let comp = *comp;
-        let inst = &mut self.system.components[comp].instance;
+        let inst = self.system.components[comp].instance.as_mut();
         let Value::I64(n) = value::get(inst, seq)? else { unreachable!("counter is Int64") };
         let n = n.max(0) as u64;
         if n == route.cursor.last {
@@ -470,10 +473,11 @@ impl Master {
                 self.write_messages(r, taken.iter().map(|(t, b)| (*t, b.as_slice())))
             }
             (Port::Fmu { comp: src, var: sv, seq: None }, Port::Fmu { .. }) => {
-                let v = value::get(&mut self.system.components[*src].instance, sv)?;
+                let v = value::get(self.system.components[*src].instance.as_mut(), sv)?;
                 let System { routes, components, .. } = &mut self.system;
+                let v = routes[r].transfer_value(v)?;
                 let Port::Fmu { comp: dst, var: dv, .. } = &routes[r].to else { unreachable!("matched above") };
-                value::set(&mut components[*dst].instance, dv, &v)
+                value::set(components[*dst].instance.as_mut(), dv, &v)
             }
             _ => Ok(()),
         }

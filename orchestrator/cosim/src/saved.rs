@@ -6,7 +6,7 @@
 //! (`fmi3SerializeFMUState`), and each route's position (last sequence number taken, last
 //! value written).
 
-use crate::fmi3::InstanceState;
+use crate::fmu::InstanceState;
 use crate::{err, Master, Result, Snapshot};
 use agrisim_frames::Cursor;
 use serde::{Deserialize, Serialize};

@@ -9,8 +9,8 @@
 
 use crate::archive::FmuArchive;
 use crate::error::{Context, Result};
-use crate::fmi3::Instance;
-use crate::model_description::{Causality, ModelDescription, ModelVariable, VarType};
+use crate::fmu::FmuInstance;
+use crate::model_description::{Causality, FmiVersion, Interface, ModelDescription, ModelVariable, VarType};
 use crate::seed::component_seed;
 use crate::ssp::{self, SystemStructure};
 use crate::value::{self, Value};
@@ -58,7 +58,8 @@ impl LoadOptions {
 pub struct Component {
     pub name: String,
     pub archive: FmuArchive,
-    pub instance: Instance,
+    /// FMI 3 or FMI 2; co-simulation, or model exchange under the master's integrator.
+    pub instance: Box<dyn FmuInstance>,
     /// Scalar inputs and outputs, recorded every step.
     pub signals: Vec<ModelVariable>,
     /// [`Component::signals`] grouped by type: (type, their indices, their value references),
@@ -67,7 +68,7 @@ pub struct Component {
 }
 
 impl Component {
-    pub fn new(name: String, archive: FmuArchive, instance: Instance) -> Component {
+    pub fn new(name: String, archive: FmuArchive, instance: Box<dyn FmuInstance>) -> Component {
         let signals: Vec<ModelVariable> = archive
             .md
             .variables
@@ -151,6 +152,19 @@ pub struct Route {
     pub framed_to: bool,
     /// Messages written to a message input (its counter).
     pub written: i64,
+    /// What the route does to a scalar value on its way (SSP unit conversion and
+    /// transformation); `None` passes it unchanged.
+    pub transfer: Option<ssp::Transfer>,
+}
+
+impl Route {
+    /// The value this route delivers for source value `v`.
+    pub fn transfer_value(&self, v: Value) -> Result<Value> {
+        match &self.transfer {
+            None => Ok(v),
+            Some(t) => t.apply(v).map_err(|e| crate::err!("connection {}: {e}", self.label)),
+        }
+    }
 }
 
 pub struct System {
@@ -197,13 +211,38 @@ fn check_log_categories(categories: &[String], mds: &BTreeMap<String, ModelDescr
     Ok(())
 }
 
+/// Instantiates an archive as its description says: FMI 3 or FMI 2, co-simulation when
+/// the FMU offers it, else model exchange under the master's RK4 ([`crate::me`]).
+pub fn instantiate_archive(archive: &FmuArchive, name: &str, logging_on: bool) -> Result<Box<dyn FmuInstance>> {
+    let md = &archive.md;
+    let me_info = || {
+        md.model_exchange.as_ref().ok_or_else(|| crate::err!("FMU '{name}': model exchange without its description"))
+    };
+    Ok(match (md.version, md.interface) {
+        (FmiVersion::V3, Interface::CoSimulation) => {
+            Box::new(crate::fmi3::Instance::instantiate(archive, name, logging_on)?)
+        }
+        (FmiVersion::V2, Interface::CoSimulation) => {
+            Box::new(crate::fmi2::Instance::instantiate(archive, name, Interface::CoSimulation, logging_on)?)
+        }
+        (FmiVersion::V2, Interface::ModelExchange) => {
+            let inner = crate::fmi2::Instance::instantiate(archive, name, Interface::ModelExchange, logging_on)?;
+            Box::new(crate::me::Integrated::new(inner, me_info()?))
+        }
+        (FmiVersion::V3, Interface::ModelExchange) => {
+            let inner = crate::fmi3::Instance::instantiate_model_exchange(archive, name, logging_on)?;
+            Box::new(crate::me::Integrated::new(inner, me_info()?))
+        }
+    })
+}
+
 /// Instantiates component `name` with debug logging as `fmu_log` asks (see
 /// [`LoadOptions::fmu_log`]): of a category list, the FMU gets those it declares (all of them
 /// when it declares none); with none of them, debug logging stays off.
-fn instantiate(archive: &FmuArchive, name: &str, fmu_log: Option<&[String]>) -> Result<Instance> {
-    let Some(categories) = fmu_log else { return Ok(Instance::instantiate(archive, name, false)?) };
+fn instantiate(archive: &FmuArchive, name: &str, fmu_log: Option<&[String]>) -> Result<Box<dyn FmuInstance>> {
+    let Some(categories) = fmu_log else { return instantiate_archive(archive, name, false) };
     if categories.is_empty() {
-        return Ok(Instance::instantiate(archive, name, true)?);
+        return instantiate_archive(archive, name, true);
     }
     let declared = &archive.md.log_categories;
     let mine: Vec<&str> = categories
@@ -211,11 +250,19 @@ fn instantiate(archive: &FmuArchive, name: &str, fmu_log: Option<&[String]>) -> 
         .map(String::as_str)
         .filter(|c| declared.is_empty() || declared.iter().any(|d| d == c))
         .collect();
-    let mut instance = Instance::instantiate(archive, name, false)?;
+    let mut instance = instantiate_archive(archive, name, false)?;
     if !mine.is_empty() {
         instance.set_debug_logging(true, &mine)?;
     }
     Ok(instance)
+}
+
+/// The units of an opened FMU's variables, from its unpacked modelDescription.xml (FMI 2 or 3).
+fn read_fmu_units(a: &FmuArchive) -> Result<BTreeMap<String, ssp::Unit>> {
+    let path = a.dir.join("modelDescription.xml");
+    let xml = std::fs::read_to_string(&path).map_err(|e| crate::err!("cannot read {}: {e}", path.display()))?;
+    let origin = format!("{}!modelDescription.xml", a.path.display());
+    ssp::units::fmu_variable_units(&xml, &origin).map_err(|e| crate::err!("{e}"))
 }
 
 impl System {
@@ -244,14 +291,17 @@ impl System {
         }
         let mut archives = BTreeMap::new();
         let mut mds = BTreeMap::new();
+        let mut fmu_units = ssp::FmuUnits::new();
         for c in &structure.components {
             let path = ssp::resolve_source(ssd, &c.source, &opts.fmu_dir);
             let a = FmuArchive::open(&path, &opts.cache_dir)
                 .context(|| format!("component '{}' of {}", c.name, ssd.display()))?;
             mds.insert(c.name.clone(), a.md.clone());
+            fmu_units.insert(c.name.clone(), read_fmu_units(&a)?);
             archives.insert(c.name.clone(), a);
         }
-        ssp::validate(&structure, &mds)?;
+        let transfers = ssp::plan_transfers(&structure, &mds, &fmu_units)?;
+        ssp::convert_parameter_units(&mut structure, &fmu_units)?;
         if let Some(categories) = &opts.fmu_log {
             check_log_categories(categories, &mds, ssd)?;
         }
@@ -263,6 +313,10 @@ impl System {
         }
         let mut sys = System { structure, components, routes: vec![] };
         sys.routes = sys.build_routes(opts)?;
+        // build_routes makes one route per connection, in order.
+        for (route, t) in sys.routes.iter_mut().zip(transfers) {
+            route.transfer = t;
+        }
         Ok(sys)
     }
 
@@ -335,6 +389,7 @@ impl System {
                 framed_from,
                 framed_to,
                 written: 0,
+                transfer: None,
             });
         }
         Ok(routes)
@@ -380,7 +435,7 @@ impl System {
             }
             for (name, v) in &comp.parameters {
                 let var = param(name)?;
-                let val = value::from_ssp(&var, v).ok_or_else(|| {
+                let val = v.to_value(&var).ok_or_else(|| {
                     crate::err!(
                         "{}: parameter {}.{name}: value {v:?} does not fit type {}",
                         self.structure.path.display(),
@@ -400,7 +455,7 @@ impl System {
             let name_of_comp = comp.name.clone();
             for (name, val) in &set {
                 let var = param(name)?;
-                value::set(&mut self.components[i].instance, &var, val)?;
+                value::set(self.components[i].instance.as_mut(), &var, val)?;
                 texts.insert(name.clone(), val.to_text());
             }
             applied.insert(name_of_comp, texts);
@@ -418,7 +473,7 @@ impl System {
             .variable(name)
             .cloned()
             .ok_or_else(|| crate::err!("FMU '{}' has no variable '{name}'", c.name))?;
-        match value::get(&mut c.instance, &v)? {
+        match value::get(c.instance.as_mut(), &v)? {
             Value::F64(x) => Ok(x),
             Value::Bool(b) => Ok(b as u8 as f64),
             Value::I32(i) => Ok(i as f64),

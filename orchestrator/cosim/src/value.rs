@@ -2,7 +2,7 @@
 //! any supported type without a match in every loop.
 
 use crate::error::Result;
-use crate::fmi3::Instance;
+use crate::fmu::FmuInstance;
 use crate::model_description::{ModelVariable, VarType};
 
 /// A scalar or binary value read from or written to an FMU.
@@ -58,7 +58,7 @@ pub fn supported(ty: VarType) -> bool {
     )
 }
 
-pub fn get(inst: &mut Instance, v: &ModelVariable) -> Result<Value> {
+pub fn get(inst: &mut dyn FmuInstance, v: &ModelVariable) -> Result<Value> {
     let vr = [v.value_reference];
     Ok(match v.ty {
         VarType::Float64 => {
@@ -94,7 +94,7 @@ pub fn get(inst: &mut Instance, v: &ModelVariable) -> Result<Value> {
     })
 }
 
-pub fn set(inst: &mut Instance, v: &ModelVariable, value: &Value) -> Result<()> {
+pub fn set(inst: &mut dyn FmuInstance, v: &ModelVariable, value: &Value) -> Result<()> {
     let vr = [v.value_reference];
     match (v.ty, value) {
         (VarType::Float64, Value::F64(x)) => inst.set_f64(&vr, &[*x])?,
@@ -174,20 +174,6 @@ pub fn scalar_from_f64(v: &ModelVariable, x: f64) -> Result<Value> {
     }
 }
 
-/// Converts an SSP parameter value to the variable's type.
-pub fn from_ssp(v: &ModelVariable, x: &crate::ssp::ParamValue) -> Option<Value> {
-    use crate::ssp::ParamValue as P;
-    Some(match (v.ty, x) {
-        (VarType::Float64, P::Real(f)) => Value::F64(*f),
-        (VarType::Int32, P::Integer(i)) => Value::I32(i32::try_from(*i).ok()?),
-        (VarType::Int64, P::Integer(i)) => Value::I64(*i),
-        (VarType::Boolean, P::Boolean(b)) => Value::Bool(*b),
-        (VarType::String, P::String(s)) => Value::Str(s.clone()),
-        (VarType::Binary, P::Binary(b)) => Value::Bin(b.clone()),
-        _ => return None,
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -203,6 +189,7 @@ mod tests {
             start: None,
             mime_type: None,
             description: None,
+            unit: None,
         }
     }
 

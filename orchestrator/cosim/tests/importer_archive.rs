@@ -221,13 +221,13 @@ fn missing_model_description_is_rejected() {
 #[test]
 fn invalid_model_description_names_the_entry() {
     let tmp = tempfile::tempdir().unwrap();
-    let fmu = tmp.path().join("Fmi2.fmu");
-    let md = MD.replace(r#"fmiVersion="3.0""#, r#"fmiVersion="2.0""#);
+    let fmu = tmp.path().join("Fmi1.fmu");
+    let md = MD.replace(r#"fmiVersion="3.0""#, r#"fmiVersion="1.0""#);
     write_zip(&fmu, &[("modelDescription.xml", md.as_bytes()), (&lib_entry(), b"x")]);
     assert_import_err(
         &fmu,
         &tmp.path().join("cache"),
-        &format!("{}!modelDescription.xml: fmiVersion is \"2.0\"", fmu.display()),
+        &format!("{}!modelDescription.xml: fmiVersion is \"1.0\", only FMI 2.0 and 3.0", fmu.display()),
     );
 }
 

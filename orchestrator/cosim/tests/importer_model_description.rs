@@ -1,6 +1,6 @@
 //! modelDescription.xml parsing: a full fixture, and each malformed case named in the error.
 
-use agrisim_cosim::model_description::{Causality, ModelDescription, VarType, Variability};
+use agrisim_cosim::model_description::{Causality, FmiVersion, Interface, ModelDescription, VarType, Variability};
 
 const GOOD: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
 <fmiModelDescription fmiVersion="3.0" modelName="ChassisKinematic" instantiationToken="{1234-abcd}"
@@ -110,8 +110,8 @@ fn assert_err(xml: &str, expected: &str) {
 }
 
 #[test]
-fn fmi2_is_rejected() {
-    assert_err(&replace(r#"fmiVersion="3.0""#, r#"fmiVersion="2.0""#), r#"fmiVersion is "2.0", only FMI 3.0"#);
+fn fmi1_is_rejected() {
+    assert_err(&replace(r#"fmiVersion="3.0""#, r#"fmiVersion="1.0""#), r#"fmiVersion is "1.0", only FMI 2.0 and 3.0"#);
 }
 
 #[test]
@@ -126,13 +126,77 @@ fn missing_model_name_and_token_are_rejected() {
 }
 
 #[test]
-fn no_co_simulation_is_rejected() {
+fn model_exchange_alone_is_imported_as_model_exchange() {
     let xml = replace(
         r#"<CoSimulation modelIdentifier="agrisim_chassis_kinematic" canGetAndSetFMUState="true"
       canSerializeFMUState="false"/>"#,
         "",
     );
-    assert_err(&xml, "no <CoSimulation> element");
+    let md = ModelDescription::parse(&xml, "x").unwrap();
+    assert_eq!(md.interface, Interface::ModelExchange);
+    assert_eq!(md.model_identifier, "ignored_me");
+    let none = xml.replace(r#"<ModelExchange modelIdentifier="ignored_me"/>"#, "");
+    assert_err(&none, "neither <CoSimulation> nor <ModelExchange>");
+}
+
+/// An FMI 2.0 description in the same shape: types mapped, aliases allowed, ModelStructure
+/// indices turned into value references, the ME state/derivative pairs found.
+const FMI2: &str = r#"<?xml version="1.0" encoding="UTF-8"?>
+<fmiModelDescription fmiVersion="2.0" modelName="Osc" guid="{g-1}" numberOfEventIndicators="1">
+  <ModelExchange modelIdentifier="osc" completedIntegratorStepNotNeeded="true"/>
+  <CoSimulation modelIdentifier="osc" canGetAndSetFMUstate="true" canSerializeFMUstate="true"/>
+  <LogCategories><Category name="logAll"/></LogCategories>
+  <DefaultExperiment stepSize="0.01"/>
+  <ModelVariables>
+    <ScalarVariable name="x" valueReference="0" causality="output" initial="exact"><Real start="1" unit="m"/></ScalarVariable>
+    <ScalarVariable name="der(x)" valueReference="1"><Real derivative="1"/></ScalarVariable>
+    <ScalarVariable name="x_alias" valueReference="0" causality="local"><Real/></ScalarVariable>
+    <ScalarVariable name="n" valueReference="0" causality="parameter" variability="fixed"><Integer start="3"/></ScalarVariable>
+    <ScalarVariable name="on" valueReference="0" causality="input"><Boolean start="true"/></ScalarVariable>
+    <ScalarVariable name="label" valueReference="0" causality="parameter" variability="fixed"><String start="a"/></ScalarVariable>
+    <ScalarVariable name="u" valueReference="2" causality="input"><Real start="0"/></ScalarVariable>
+  </ModelVariables>
+  <ModelStructure>
+    <Outputs><Unknown index="1" dependencies=""/></Outputs>
+    <Derivatives><Unknown index="2" dependencies="1 7"/></Derivatives>
+    <InitialUnknowns><Unknown index="1" dependencies="4"/></InitialUnknowns>
+  </ModelStructure>
+</fmiModelDescription>"#;
+
+#[test]
+fn fmi2_parses_into_the_same_shape() {
+    let md = ModelDescription::parse(FMI2, "osc.fmu!modelDescription.xml").unwrap();
+    assert_eq!(md.version, FmiVersion::V2);
+    assert_eq!(md.interface, Interface::CoSimulation);
+    assert_eq!(md.instantiation_token, "{g-1}");
+    assert!(md.can_get_and_set_fmu_state && md.can_serialize_fmu_state);
+    assert_eq!(md.variable("x").unwrap().ty, VarType::Float64);
+    assert_eq!(md.variable("x").unwrap().unit.as_deref(), Some("m"));
+    assert_eq!(md.variable("x").unwrap().variability, Variability::Continuous);
+    assert_eq!(md.variable("n").unwrap().ty, VarType::Int32);
+    assert_eq!(md.variable("on").unwrap().variability, Variability::Discrete);
+    assert_eq!(md.variable("label").unwrap().start.as_deref(), Some("a"));
+    assert_eq!(md.output_dependencies.get(&0), Some(&Some(vec![])));
+    assert_eq!(md.initial_dependencies.get(&0), Some(&Some(vec![0])));
+    let me = md.model_exchange.as_ref().unwrap();
+    assert_eq!(me.states, vec![(0, 1)]);
+    assert_eq!(me.number_of_event_indicators, 1);
+    assert!(!me.needs_completed_integrator_step);
+}
+
+#[test]
+fn fmi2_mistakes_are_named() {
+    let bad = |from: &str, to: &str, expected: &str| {
+        assert!(FMI2.contains(from), "fixture lacks {from:?}");
+        let e = ModelDescription::parse(&FMI2.replacen(from, to, 1), "o.xml").unwrap_err().to_string();
+        assert!(e.contains(expected), "error {e:?} does not contain {expected:?}");
+    };
+    bad(r#" guid="{g-1}""#, "", "has no attribute 'guid'");
+    bad(r#"<Unknown index="1" dependencies=""/></Outputs>"#, r#"<Unknown index="9"/></Outputs>"#, "index 9 is not a variable");
+    bad(r#"<Real derivative="1"/>"#, r#"<Real derivative="x"/>"#, r#"derivative="x" is not a variable index"#);
+    bad(r#"<Integer start="3"/>"#, r#"<Int64 start="3"/>"#, "unknown FMI 2.0 type element <Int64>");
+    bad(r#"causality="input"><Boolean"#, r#"causality="input" variability="continuous"><Boolean"#, "only allowed for Real");
+    bad(r#"<Derivatives><Unknown index="2""#, r#"<Derivatives><Unknown index="1""#, "has no 'derivative' attribute");
 }
 
 #[test]

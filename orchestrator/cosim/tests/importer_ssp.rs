@@ -345,7 +345,7 @@ fn malformed_files_are_rejected_by_parse() {
     parse_err(
         r#"<ssd:ParameterBinding>"#,
         r#"<ssd:ParameterBinding source="chassis.ssv">"#,
-        "external parameter source \"chassis.ssv\" is not supported",
+        "component 'chassis': ssd:ParameterBinding has both source \"chassis.ssv\" and inline values",
     );
     parse_err(r#"<ssd:System name="robot">"#, r#"<ssd:System>"#, "ssd:System has no attribute 'name'");
     parse_err(r#"startConnector="h""#, "", "an ssd:Connection has no attribute 'startConnector'");

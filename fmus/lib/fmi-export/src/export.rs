@@ -7,7 +7,9 @@
 //!
 //! Generated from the FMI 3.0 / 2.0 headers' function list (argument names follow them).
 
-/// Exports the FMI 3.0 and FMI 2.0 co-simulation C API for a [`Model`](crate::Model) type,
+/// Exports the FMI 3.0 and FMI 2.0 C API for a [`Model`](crate::Model) type (co-simulation,
+/// or model exchange for a model with continuous states; the other interface's functions
+/// fail and log why),
 /// plus `agrisim_model_description_fmi3()` / `agrisim_model_description_fmi2()` returning
 /// the NUL-terminated modelDescription.xml texts (used by `agrisim fmu pack`).
 ///
@@ -165,7 +167,7 @@ macro_rules! export_fmu {
 
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi3EnterEventMode(instance: *mut ::std::ffi::c_void) -> $crate::Status {
-                $crate::fmi3::unsupported::<$M>(instance, "fmi3EnterEventMode")
+                $crate::fmi3::enter_event_mode::<$M>(instance)
             }
 
             #[unsafe(no_mangle)]
@@ -695,95 +697,108 @@ macro_rules! export_fmu {
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi3UpdateDiscreteStates(
                 instance: *mut ::std::ffi::c_void,
-                _discrete_states_need_update: *mut u8,
-                _terminate_simulation: *mut u8,
-                _nominals_of_continuous_states_changed: *mut u8,
-                _values_of_continuous_states_changed: *mut u8,
-                _next_event_time_defined: *mut u8,
-                _next_event_time: *mut f64,
+                discrete_states_need_update: *mut u8,
+                terminate_simulation: *mut u8,
+                nominals_of_continuous_states_changed: *mut u8,
+                values_of_continuous_states_changed: *mut u8,
+                next_event_time_defined: *mut u8,
+                next_event_time: *mut f64,
             ) -> $crate::Status {
-                $crate::fmi3::unsupported::<$M>(instance, "fmi3UpdateDiscreteStates")
+                $crate::fmi3::update_discrete_states::<$M>(
+                    instance,
+                    discrete_states_need_update,
+                    terminate_simulation,
+                    nominals_of_continuous_states_changed,
+                    values_of_continuous_states_changed,
+                    next_event_time_defined,
+                    next_event_time,
+                )
             }
 
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi3EnterContinuousTimeMode(instance: *mut ::std::ffi::c_void) -> $crate::Status {
-                $crate::fmi3::unsupported::<$M>(instance, "fmi3EnterContinuousTimeMode")
+                $crate::fmi3::enter_continuous_time_mode::<$M>(instance)
             }
 
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi3CompletedIntegratorStep(
                 instance: *mut ::std::ffi::c_void,
-                _no_set_fmu_state_prior_to_current_point: u8,
-                _enter_event_mode: *mut u8,
-                _terminate_simulation: *mut u8,
+                no_set_fmu_state_prior_to_current_point: u8,
+                enter_event_mode: *mut u8,
+                terminate_simulation: *mut u8,
             ) -> $crate::Status {
-                $crate::fmi3::unsupported::<$M>(instance, "fmi3CompletedIntegratorStep")
+                $crate::fmi3::completed_integrator_step::<$M>(
+                    instance,
+                    no_set_fmu_state_prior_to_current_point,
+                    enter_event_mode,
+                    terminate_simulation,
+                )
             }
 
             #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi3SetTime(instance: *mut ::std::ffi::c_void, _time: f64) -> $crate::Status {
-                $crate::fmi3::unsupported::<$M>(instance, "fmi3SetTime")
+            pub unsafe extern "C" fn fmi3SetTime(instance: *mut ::std::ffi::c_void, time: f64) -> $crate::Status {
+                $crate::fmi3::set_time::<$M>(instance, time)
             }
 
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi3SetContinuousStates(
                 instance: *mut ::std::ffi::c_void,
-                _continuous_states: *const f64,
-                _n_continuous_states: usize,
+                continuous_states: *const f64,
+                n_continuous_states: usize,
             ) -> $crate::Status {
-                $crate::fmi3::unsupported::<$M>(instance, "fmi3SetContinuousStates")
+                $crate::fmi3::set_continuous_states::<$M>(instance, continuous_states, n_continuous_states)
             }
 
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi3GetContinuousStateDerivatives(
                 instance: *mut ::std::ffi::c_void,
-                _derivatives: *mut f64,
-                _n_continuous_states: usize,
+                derivatives: *mut f64,
+                n_continuous_states: usize,
             ) -> $crate::Status {
-                $crate::fmi3::unsupported::<$M>(instance, "fmi3GetContinuousStateDerivatives")
+                $crate::fmi3::get_continuous_state_derivatives::<$M>(instance, derivatives, n_continuous_states)
             }
 
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi3GetEventIndicators(
                 instance: *mut ::std::ffi::c_void,
-                _event_indicators: *mut f64,
-                _n_event_indicators: usize,
+                event_indicators: *mut f64,
+                n_event_indicators: usize,
             ) -> $crate::Status {
-                $crate::fmi3::unsupported::<$M>(instance, "fmi3GetEventIndicators")
+                $crate::fmi3::get_event_indicators::<$M>(instance, event_indicators, n_event_indicators)
             }
 
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi3GetContinuousStates(
                 instance: *mut ::std::ffi::c_void,
-                _continuous_states: *mut f64,
-                _n_continuous_states: usize,
+                continuous_states: *mut f64,
+                n_continuous_states: usize,
             ) -> $crate::Status {
-                $crate::fmi3::unsupported::<$M>(instance, "fmi3GetContinuousStates")
+                $crate::fmi3::get_continuous_states::<$M>(instance, continuous_states, n_continuous_states)
             }
 
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi3GetNominalsOfContinuousStates(
                 instance: *mut ::std::ffi::c_void,
-                _nominals: *mut f64,
-                _n_continuous_states: usize,
+                nominals: *mut f64,
+                n_continuous_states: usize,
             ) -> $crate::Status {
-                $crate::fmi3::unsupported::<$M>(instance, "fmi3GetNominalsOfContinuousStates")
+                $crate::fmi3::get_nominals_of_continuous_states::<$M>(instance, nominals, n_continuous_states)
             }
 
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi3GetNumberOfEventIndicators(
                 instance: *mut ::std::ffi::c_void,
-                _n_event_indicators: *mut usize,
+                n_event_indicators: *mut usize,
             ) -> $crate::Status {
-                $crate::fmi3::unsupported::<$M>(instance, "fmi3GetNumberOfEventIndicators")
+                $crate::fmi3::get_number_of_event_indicators::<$M>(instance, n_event_indicators)
             }
 
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi3GetNumberOfContinuousStates(
                 instance: *mut ::std::ffi::c_void,
-                _n_continuous_states: *mut usize,
+                n_continuous_states: *mut usize,
             ) -> $crate::Status {
-                $crate::fmi3::unsupported::<$M>(instance, "fmi3GetNumberOfContinuousStates")
+                $crate::fmi3::get_number_of_continuous_states::<$M>(instance, n_continuous_states)
             }
 
             #[unsafe(no_mangle)]
@@ -1068,80 +1083,85 @@ macro_rules! export_fmu {
 
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi2EnterEventMode(c: *mut ::std::ffi::c_void) -> $crate::Status {
-                $crate::fmi2::unsupported::<$M>(c, "fmi2EnterEventMode")
+                $crate::fmi2::enter_event_mode::<$M>(c)
             }
 
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi2NewDiscreteStates(
                 c: *mut ::std::ffi::c_void,
-                _event_info: *mut ::std::ffi::c_void,
+                event_info: *mut $crate::fmi2::EventInfo,
             ) -> $crate::Status {
-                $crate::fmi2::unsupported::<$M>(c, "fmi2NewDiscreteStates")
+                $crate::fmi2::new_discrete_states::<$M>(c, event_info)
             }
 
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi2EnterContinuousTimeMode(c: *mut ::std::ffi::c_void) -> $crate::Status {
-                $crate::fmi2::unsupported::<$M>(c, "fmi2EnterContinuousTimeMode")
+                $crate::fmi2::enter_continuous_time_mode::<$M>(c)
             }
 
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi2CompletedIntegratorStep(
                 c: *mut ::std::ffi::c_void,
-                _no_set_fmu_state_prior_to_current_point: ::std::ffi::c_int,
-                _enter_event_mode: *mut ::std::ffi::c_int,
-                _terminate_simulation: *mut ::std::ffi::c_int,
+                no_set_fmu_state_prior_to_current_point: ::std::ffi::c_int,
+                enter_event_mode: *mut ::std::ffi::c_int,
+                terminate_simulation: *mut ::std::ffi::c_int,
             ) -> $crate::Status {
-                $crate::fmi2::unsupported::<$M>(c, "fmi2CompletedIntegratorStep")
+                $crate::fmi2::completed_integrator_step::<$M>(
+                    c,
+                    no_set_fmu_state_prior_to_current_point,
+                    enter_event_mode,
+                    terminate_simulation,
+                )
             }
 
             #[unsafe(no_mangle)]
-            pub unsafe extern "C" fn fmi2SetTime(c: *mut ::std::ffi::c_void, _time: f64) -> $crate::Status {
-                $crate::fmi2::unsupported::<$M>(c, "fmi2SetTime")
+            pub unsafe extern "C" fn fmi2SetTime(c: *mut ::std::ffi::c_void, time: f64) -> $crate::Status {
+                $crate::fmi2::set_time::<$M>(c, time)
             }
 
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi2SetContinuousStates(
                 c: *mut ::std::ffi::c_void,
-                _x: *const f64,
-                _nx: usize,
+                x: *const f64,
+                nx: usize,
             ) -> $crate::Status {
-                $crate::fmi2::unsupported::<$M>(c, "fmi2SetContinuousStates")
+                $crate::fmi2::set_continuous_states::<$M>(c, x, nx)
             }
 
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi2GetDerivatives(
                 c: *mut ::std::ffi::c_void,
-                _derivatives: *mut f64,
-                _nx: usize,
+                derivatives: *mut f64,
+                nx: usize,
             ) -> $crate::Status {
-                $crate::fmi2::unsupported::<$M>(c, "fmi2GetDerivatives")
+                $crate::fmi2::get_derivatives::<$M>(c, derivatives, nx)
             }
 
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi2GetEventIndicators(
                 c: *mut ::std::ffi::c_void,
-                _event_indicators: *mut f64,
-                _ni: usize,
+                event_indicators: *mut f64,
+                ni: usize,
             ) -> $crate::Status {
-                $crate::fmi2::unsupported::<$M>(c, "fmi2GetEventIndicators")
+                $crate::fmi2::get_event_indicators::<$M>(c, event_indicators, ni)
             }
 
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi2GetContinuousStates(
                 c: *mut ::std::ffi::c_void,
-                _x: *mut f64,
-                _nx: usize,
+                x: *mut f64,
+                nx: usize,
             ) -> $crate::Status {
-                $crate::fmi2::unsupported::<$M>(c, "fmi2GetContinuousStates")
+                $crate::fmi2::get_continuous_states::<$M>(c, x, nx)
             }
 
             #[unsafe(no_mangle)]
             pub unsafe extern "C" fn fmi2GetNominalsOfContinuousStates(
                 c: *mut ::std::ffi::c_void,
-                _x_nominal: *mut f64,
-                _nx: usize,
+                x_nominal: *mut f64,
+                nx: usize,
             ) -> $crate::Status {
-                $crate::fmi2::unsupported::<$M>(c, "fmi2GetNominalsOfContinuousStates")
+                $crate::fmi2::get_nominals_of_continuous_states::<$M>(c, x_nominal, nx)
             }
 
             #[unsafe(no_mangle)]

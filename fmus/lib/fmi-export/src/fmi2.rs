@@ -12,7 +12,7 @@ use crate::fmi3::set_debug_logging_impl;
 use crate::guard::{self, out, slice, slice_mut, with_instance, Failure};
 use crate::instance::Instance;
 use crate::logger::{Fmi2Logger, Logger};
-use crate::model::Model;
+use crate::model::{is_model_exchange, Model};
 use crate::registry::Api;
 use crate::state::{fmi2 as mask, Status};
 
@@ -28,6 +28,20 @@ pub struct CallbackFunctions {
     pub component_environment: *mut c_void,
 }
 
+/// `fmi2EventInfo` (every fmi2Boolean is a C `int`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EventInfo {
+    pub new_discrete_states_needed: c_int,
+    pub terminate_simulation: c_int,
+    pub nominals_of_continuous_states_changed: c_int,
+    pub values_of_continuous_states_changed: c_int,
+    pub next_event_time_defined: c_int,
+    pub next_event_time: f64,
+}
+
+/// `fmi2Type` value for model exchange.
+pub const FMI2_MODEL_EXCHANGE: c_int = 0;
 /// `fmi2Type` value for co-simulation.
 pub const FMI2_CO_SIMULATION: c_int = 1;
 /// `fmi2StatusKind` values.
@@ -46,8 +60,9 @@ pub fn get_version() -> *const c_char {
     c"2.0".as_ptr()
 }
 
-/// `fmi2Instantiate`: NULL (logged when a logger exists) unless `fmuType` is
-/// fmi2CoSimulation and `fmuGUID` equals the model's token.
+/// `fmi2Instantiate`: NULL (logged when a logger exists) unless `fmuType` is the model's
+/// one interface (fmi2ModelExchange for models with continuous states, else
+/// fmi2CoSimulation) and `fmuGUID` equals the model's token.
 ///
 /// # Safety
 /// Strings must be NULL or NUL-terminated; `functions` NULL or a valid callback struct.
@@ -74,7 +89,15 @@ pub unsafe fn instantiate<M: Model>(
         if name.is_empty() {
             return fail("instanceName must be a non-empty UTF-8 string");
         }
-        if fmu_type != FMI2_CO_SIMULATION {
+        if is_model_exchange::<M>() {
+            if fmu_type != FMI2_MODEL_EXCHANGE {
+                return fail(&format!("fmuType {fmu_type} requested, but this FMU supports Model Exchange (0) only"));
+            }
+            let problems = crate::xml::check_continuous_states(M::VARIABLES, M::CONTINUOUS_STATES);
+            if !problems.is_empty() {
+                return fail(&format!("the model's continuous states are declared wrongly: {}", problems.join("; ")));
+            }
+        } else if fmu_type != FMI2_CO_SIMULATION {
             return fail(&format!("fmuType {fmu_type} requested, but this FMU supports Co-Simulation (1) only"));
         }
         let guid = if fmu_guid.is_null() { None } else { CStr::from_ptr(fmu_guid).to_str().ok() };
@@ -414,6 +437,150 @@ pub unsafe fn get_string_status<M: Model>(c: *mut c_void, kind: c_int, value: *m
     with_instance::<M>(API, c, "fmi2GetStringStatus", mask::GET_STATUS, |_| {
         let _ = out(value, "value")?;
         Err(no_status(kind))
+    })
+}
+
+/// A model-exchange function: runs `f` for a model-exchange model, else is unsupported
+/// (exactly as before model exchange existed).
+unsafe fn me<M: Model>(
+    c: *mut c_void,
+    function: &str,
+    mask: crate::state::Mask,
+    f: impl FnOnce(&mut Instance<M>) -> Result<Status, Failure>,
+) -> Status {
+    if !is_model_exchange::<M>() {
+        return unsupported::<M>(c, function);
+    }
+    with_instance::<M>(API, c, function, mask, f)
+}
+
+/// `fmi2EnterEventMode`.
+///
+/// # Safety
+/// `c` may be anything (checked against the registry).
+pub unsafe fn enter_event_mode<M: Model>(c: *mut c_void) -> Status {
+    me::<M>(c, "fmi2EnterEventMode", mask::ENTER_EVENT_MODE, |inst| {
+        inst.enter_event_mode();
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi2NewDiscreteStates`: one pass handles every event due (newDiscreteStatesNeeded is
+/// always false); the model never requests termination; nominals are constant.
+///
+/// # Safety
+/// `event_info` must be NULL (an error) or writable.
+pub unsafe fn new_discrete_states<M: Model>(c: *mut c_void, event_info: *mut EventInfo) -> Status {
+    me::<M>(c, "fmi2NewDiscreteStates", mask::NEW_DISCRETE_STATES, |inst| {
+        let ei = out(event_info, "fmi2EventInfo")?;
+        let info = inst.update_discrete_states()?;
+        *ei = EventInfo {
+            new_discrete_states_needed: 0,
+            terminate_simulation: 0,
+            nominals_of_continuous_states_changed: 0,
+            values_of_continuous_states_changed: info.values_of_continuous_states_changed as c_int,
+            next_event_time_defined: info.next_event_time.is_some() as c_int,
+            next_event_time: info.next_event_time.unwrap_or(0.0),
+        };
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi2EnterContinuousTimeMode`.
+///
+/// # Safety
+/// `c` may be anything (checked against the registry).
+pub unsafe fn enter_continuous_time_mode<M: Model>(c: *mut c_void) -> Status {
+    me::<M>(c, "fmi2EnterContinuousTimeMode", mask::ENTER_CONTINUOUS_TIME_MODE, |inst| {
+        inst.enter_continuous_time_mode();
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi2CompletedIntegratorStep`: no step events, never terminates
+/// (completedIntegratorStepNotNeeded=true, so importers may skip it).
+///
+/// # Safety
+/// The two output pointers must be writable (NULL is an error).
+pub unsafe fn completed_integrator_step<M: Model>(
+    c: *mut c_void,
+    _no_set_fmu_state_prior_to_current_point: c_int,
+    enter_event_mode: *mut c_int,
+    terminate_simulation: *mut c_int,
+) -> Status {
+    me::<M>(c, "fmi2CompletedIntegratorStep", mask::COMPLETED_INTEGRATOR_STEP, |_| {
+        let enter = out(enter_event_mode, "enterEventMode")?;
+        let term = out(terminate_simulation, "terminateSimulation")?;
+        *enter = 0;
+        *term = 0;
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi2SetTime`.
+///
+/// # Safety
+/// `c` may be anything (checked against the registry).
+pub unsafe fn set_time<M: Model>(c: *mut c_void, time: f64) -> Status {
+    me::<M>(c, "fmi2SetTime", mask::SET_TIME, |inst| {
+        inst.set_time(time)?;
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi2SetContinuousStates`: all-or-nothing (every value finite).
+///
+/// # Safety
+/// `x` must hold `nx` values (or be NULL when 0).
+pub unsafe fn set_continuous_states<M: Model>(c: *mut c_void, x: *const f64, nx: usize) -> Status {
+    me::<M>(c, "fmi2SetContinuousStates", mask::SET_CONTINUOUS_STATES, |inst| {
+        inst.set_continuous_states(slice(x, nx, "x")?)?;
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi2GetDerivatives`.
+///
+/// # Safety
+/// `dx` must have room for `nx` values (or be NULL when 0).
+pub unsafe fn get_derivatives<M: Model>(c: *mut c_void, dx: *mut f64, nx: usize) -> Status {
+    me::<M>(c, "fmi2GetDerivatives", mask::GET_CONTINUOUS, |inst| {
+        inst.derivatives(slice_mut(dx, nx, "derivatives")?)?;
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi2GetEventIndicators`: there are none, so only `ni = 0` succeeds.
+///
+/// # Safety
+/// `z` must have room for `ni` values (or be NULL when 0).
+pub unsafe fn get_event_indicators<M: Model>(c: *mut c_void, z: *mut f64, ni: usize) -> Status {
+    me::<M>(c, "fmi2GetEventIndicators", mask::GET_CONTINUOUS, |inst| {
+        let _ = slice_mut(z, ni, "eventIndicators")?;
+        inst.event_indicators(ni)?;
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi2GetContinuousStates`.
+///
+/// # Safety
+/// `x` must have room for `nx` values (or be NULL when 0).
+pub unsafe fn get_continuous_states<M: Model>(c: *mut c_void, x: *mut f64, nx: usize) -> Status {
+    me::<M>(c, "fmi2GetContinuousStates", mask::GET_CONTINUOUS, |inst| {
+        inst.continuous_states(slice_mut(x, nx, "x")?)?;
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi2GetNominalsOfContinuousStates`.
+///
+/// # Safety
+/// `nominals` must have room for `nx` values (or be NULL when 0).
+pub unsafe fn get_nominals_of_continuous_states<M: Model>(c: *mut c_void, nominals: *mut f64, nx: usize) -> Status {
+    me::<M>(c, "fmi2GetNominalsOfContinuousStates", mask::GET_NOMINALS, |inst| {
+        inst.nominals(slice_mut(nominals, nx, "x_nominal")?)?;
+        Ok(Status::Ok)
     })
 }
 

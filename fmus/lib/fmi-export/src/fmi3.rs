@@ -10,7 +10,7 @@ use crate::ctype::{self, CType};
 use crate::guard::{self, out, slice, slice_mut, with_instance, Failure};
 use crate::instance::Instance;
 use crate::logger::{Fmi3LogMessage, Logger};
-use crate::model::Model;
+use crate::model::{is_model_exchange, Model};
 use crate::registry::Api;
 use crate::state::{fmi3 as mask, Status};
 
@@ -81,6 +81,9 @@ pub unsafe fn instantiate_co_simulation<M: Model>(
         if name.is_empty() {
             return fail("instanceName must be a non-empty UTF-8 string");
         }
+        if is_model_exchange::<M>() {
+            return fail("this FMU supports Model Exchange only (it has no <CoSimulation> interface)");
+        }
         match opt_str(instantiation_token) {
             Some(t) if t == M::TOKEN => {}
             Some(t) => {
@@ -106,20 +109,24 @@ pub unsafe fn instantiate_co_simulation<M: Model>(
     result.unwrap_or(std::ptr::null_mut())
 }
 
-/// `fmi3InstantiateModelExchange`: not supported (NULL, logged).
+/// `fmi3InstantiateModelExchange`: a model-exchange instance of a model with continuous
+/// states; NULL (logged) for a co-simulation model, a missing instance name or a wrong token.
 ///
 /// # Safety
-/// `instance_name` must be NULL or NUL-terminated.
+/// String arguments must be NULL or NUL-terminated.
 #[allow(clippy::too_many_arguments)]
 pub unsafe fn instantiate_model_exchange<M: Model>(
     instance_name: *const c_char,
-    _instantiation_token: *const c_char,
+    instantiation_token: *const c_char,
     _resource_path: *const c_char,
     _visible: u8,
-    _logging_on: u8,
+    logging_on: u8,
     instance_environment: *mut c_void,
     log_message: Option<Fmi3LogMessage>,
 ) -> *mut c_void {
+    if is_model_exchange::<M>() {
+        return instantiate_me::<M>(instance_name, instantiation_token, logging_on, instance_environment, log_message);
+    }
     let _ = std::panic::catch_unwind(|| {
         let name = opt_str(instance_name).unwrap_or("");
         log_instantiate_error(
@@ -131,6 +138,46 @@ pub unsafe fn instantiate_model_exchange<M: Model>(
         );
     });
     std::ptr::null_mut()
+}
+
+unsafe fn instantiate_me<M: Model>(
+    instance_name: *const c_char,
+    instantiation_token: *const c_char,
+    logging_on: u8,
+    instance_environment: *mut c_void,
+    log_message: Option<Fmi3LogMessage>,
+) -> *mut c_void {
+    const F: &str = "fmi3InstantiateModelExchange";
+    let result = std::panic::catch_unwind(|| {
+        let name = opt_str(instance_name).unwrap_or("");
+        let fail = |msg: &str| {
+            log_instantiate_error(name, instance_environment, log_message, F, msg);
+            std::ptr::null_mut()
+        };
+        if name.is_empty() {
+            return fail("instanceName must be a non-empty UTF-8 string");
+        }
+        match opt_str(instantiation_token) {
+            Some(t) if t == M::TOKEN => {}
+            Some(t) => {
+                return fail(&format!(
+                    "instantiationToken '{t}' does not match this FMU's '{}' (modelDescription.xml and binary differ)",
+                    M::TOKEN
+                ))
+            }
+            None => return fail("instantiationToken is NULL or not UTF-8"),
+        }
+        let problems = crate::xml::check_continuous_states(M::VARIABLES, M::CONTINUOUS_STATES);
+        if !problems.is_empty() {
+            return fail(&format!("the model's continuous states are declared wrongly: {}", problems.join("; ")));
+        }
+        let logger = Logger::fmi3(name, instance_environment, log_message, logging_on != 0);
+        match Instance::<M>::new(API, logger) {
+            Ok(inst) => guard::publish(inst),
+            Err(e) => fail(&e),
+        }
+    });
+    result.unwrap_or(std::ptr::null_mut())
 }
 
 /// `fmi3InstantiateScheduledExecution`: not supported (NULL, logged).
@@ -157,7 +204,11 @@ pub unsafe fn instantiate_scheduled_execution<M: Model>(
             instance_environment,
             log_message,
             "fmi3InstantiateScheduledExecution",
-            "this FMU supports Co-Simulation only",
+            if is_model_exchange::<M>() {
+                "this FMU supports Model Exchange only"
+            } else {
+                "this FMU supports Co-Simulation only"
+            },
         );
     });
     std::ptr::null_mut()
@@ -583,6 +634,192 @@ pub unsafe fn do_step<M: Model>(
     })
 }
 
+/// A model-exchange function: runs `f` for a model-exchange model, else is unsupported
+/// (exactly as before model exchange existed).
+unsafe fn me<M: Model>(
+    instance: *mut c_void,
+    function: &str,
+    mask: crate::state::Mask,
+    f: impl FnOnce(&mut Instance<M>) -> Result<Status, Failure>,
+) -> Status {
+    if !is_model_exchange::<M>() {
+        return unsupported::<M>(instance, function);
+    }
+    with_instance::<M>(API, instance, function, mask, f)
+}
+
+/// `fmi3EnterEventMode`.
+///
+/// # Safety
+/// `instance` may be anything (checked against the registry).
+pub unsafe fn enter_event_mode<M: Model>(instance: *mut c_void) -> Status {
+    me::<M>(instance, "fmi3EnterEventMode", mask::ENTER_EVENT_MODE, |inst| {
+        inst.enter_event_mode();
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi3UpdateDiscreteStates`: one pass handles every event due (discreteStatesNeedUpdate
+/// is always false); the model never requests termination; nominals are constant.
+///
+/// # Safety
+/// The six output pointers must be writable (NULL is an error).
+#[allow(clippy::too_many_arguments)]
+pub unsafe fn update_discrete_states<M: Model>(
+    instance: *mut c_void,
+    discrete_states_need_update: *mut u8,
+    terminate_simulation: *mut u8,
+    nominals_of_continuous_states_changed: *mut u8,
+    values_of_continuous_states_changed: *mut u8,
+    next_event_time_defined: *mut u8,
+    next_event_time: *mut f64,
+) -> Status {
+    me::<M>(instance, "fmi3UpdateDiscreteStates", mask::UPDATE_DISCRETE_STATES, |inst| {
+        let need = out(discrete_states_need_update, "discreteStatesNeedUpdate")?;
+        let term = out(terminate_simulation, "terminateSimulation")?;
+        let nominals = out(nominals_of_continuous_states_changed, "nominalsOfContinuousStatesChanged")?;
+        let values = out(values_of_continuous_states_changed, "valuesOfContinuousStatesChanged")?;
+        let defined = out(next_event_time_defined, "nextEventTimeDefined")?;
+        let next = out(next_event_time, "nextEventTime")?;
+        let info = inst.update_discrete_states()?;
+        *need = 0;
+        *term = 0;
+        *nominals = 0;
+        *values = info.values_of_continuous_states_changed as u8;
+        *defined = info.next_event_time.is_some() as u8;
+        *next = info.next_event_time.unwrap_or(0.0);
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi3EnterContinuousTimeMode`.
+///
+/// # Safety
+/// `instance` may be anything (checked against the registry).
+pub unsafe fn enter_continuous_time_mode<M: Model>(instance: *mut c_void) -> Status {
+    me::<M>(instance, "fmi3EnterContinuousTimeMode", mask::ENTER_CONTINUOUS_TIME_MODE, |inst| {
+        inst.enter_continuous_time_mode();
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi3CompletedIntegratorStep`: no step events, never terminates
+/// (needsCompletedIntegratorStep=false, so importers may skip it).
+///
+/// # Safety
+/// The two output pointers must be writable (NULL is an error).
+pub unsafe fn completed_integrator_step<M: Model>(
+    instance: *mut c_void,
+    _no_set_fmu_state_prior_to_current_point: u8,
+    enter_event_mode: *mut u8,
+    terminate_simulation: *mut u8,
+) -> Status {
+    me::<M>(instance, "fmi3CompletedIntegratorStep", mask::COMPLETED_INTEGRATOR_STEP, |_| {
+        let enter = out(enter_event_mode, "enterEventMode")?;
+        let term = out(terminate_simulation, "terminateSimulation")?;
+        *enter = 0;
+        *term = 0;
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi3SetTime`.
+///
+/// # Safety
+/// `instance` may be anything (checked against the registry).
+pub unsafe fn set_time<M: Model>(instance: *mut c_void, time: f64) -> Status {
+    me::<M>(instance, "fmi3SetTime", mask::SET_TIME, |inst| {
+        inst.set_time(time)?;
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi3SetContinuousStates`: all-or-nothing (every value finite).
+///
+/// # Safety
+/// `x` must hold `nx` values (or be NULL when 0).
+pub unsafe fn set_continuous_states<M: Model>(instance: *mut c_void, x: *const f64, nx: usize) -> Status {
+    me::<M>(instance, "fmi3SetContinuousStates", mask::SET_CONTINUOUS_STATES, |inst| {
+        let x = slice(x, nx, "continuousStates")?;
+        inst.set_continuous_states(x)?;
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi3GetContinuousStateDerivatives`.
+///
+/// # Safety
+/// `dx` must have room for `nx` values (or be NULL when 0).
+pub unsafe fn get_continuous_state_derivatives<M: Model>(instance: *mut c_void, dx: *mut f64, nx: usize) -> Status {
+    me::<M>(instance, "fmi3GetContinuousStateDerivatives", mask::GET_CONTINUOUS, |inst| {
+        let dx = slice_mut(dx, nx, "derivatives")?;
+        inst.derivatives(dx)?;
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi3GetEventIndicators`: there are none, so only `ni = 0` succeeds.
+///
+/// # Safety
+/// `z` must have room for `ni` values (or be NULL when 0).
+pub unsafe fn get_event_indicators<M: Model>(instance: *mut c_void, z: *mut f64, ni: usize) -> Status {
+    me::<M>(instance, "fmi3GetEventIndicators", mask::GET_CONTINUOUS, |inst| {
+        let _ = slice_mut(z, ni, "eventIndicators")?;
+        inst.event_indicators(ni)?;
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi3GetContinuousStates`.
+///
+/// # Safety
+/// `x` must have room for `nx` values (or be NULL when 0).
+pub unsafe fn get_continuous_states<M: Model>(instance: *mut c_void, x: *mut f64, nx: usize) -> Status {
+    me::<M>(instance, "fmi3GetContinuousStates", mask::GET_CONTINUOUS, |inst| {
+        let x = slice_mut(x, nx, "continuousStates")?;
+        inst.continuous_states(x)?;
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi3GetNominalsOfContinuousStates`.
+///
+/// # Safety
+/// `nominals` must have room for `nx` values (or be NULL when 0).
+pub unsafe fn get_nominals_of_continuous_states<M: Model>(
+    instance: *mut c_void,
+    nominals: *mut f64,
+    nx: usize,
+) -> Status {
+    me::<M>(instance, "fmi3GetNominalsOfContinuousStates", mask::GET_NOMINALS, |inst| {
+        let nominals = slice_mut(nominals, nx, "nominals")?;
+        inst.nominals(nominals)?;
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi3GetNumberOfEventIndicators`: 0.
+///
+/// # Safety
+/// `n` must be writable (NULL is an error).
+pub unsafe fn get_number_of_event_indicators<M: Model>(instance: *mut c_void, n: *mut usize) -> Status {
+    me::<M>(instance, "fmi3GetNumberOfEventIndicators", mask::GET_NUMBER_OF, |_| {
+        *out(n, "nEventIndicators")? = 0;
+        Ok(Status::Ok)
+    })
+}
+
+/// `fmi3GetNumberOfContinuousStates`.
+///
+/// # Safety
+/// `n` must be writable (NULL is an error).
+pub unsafe fn get_number_of_continuous_states<M: Model>(instance: *mut c_void, n: *mut usize) -> Status {
+    me::<M>(instance, "fmi3GetNumberOfContinuousStates", mask::GET_NUMBER_OF, |_| {
+        *out(n, "nContinuousStates")? = M::CONTINUOUS_STATES.len();
+        Ok(Status::Ok)
+    })
+}
+
 /// Why each unsupported function is unsupported (logged with the error).
 pub fn unsupported_reason(function: &str) -> &'static str {
     match function {
@@ -612,10 +849,20 @@ pub fn unsupported_reason(function: &str) -> &'static str {
     }
 }
 
+/// Why a function a model-exchange FMU does not support is unsupported.
+fn unsupported_reason_me(function: &str) -> &'static str {
+    match function {
+        "fmi3EnterStepMode" => "this is a Model Exchange FMU (Step Mode belongs to Co-Simulation)",
+        "fmi3EvaluateDiscreteStates" => "providesEvaluateDiscreteStates=false",
+        other => unsupported_reason(other),
+    }
+}
+
 /// Any function of [`unsupported_reason`]: Error, logged.
 ///
 /// # Safety
 /// `instance` may be anything (checked against the registry).
 pub unsafe fn unsupported<M: Model>(instance: *mut c_void, function: &str) -> Status {
-    guard::unsupported::<M>(API, instance, function, unsupported_reason(function))
+    let why = if is_model_exchange::<M>() { unsupported_reason_me(function) } else { unsupported_reason(function) };
+    guard::unsupported::<M>(API, instance, function, why)
 }

@@ -6,9 +6,9 @@ use std::ffi::c_void;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use crate::instance::{panic_message, Instance};
-use crate::model::Model;
+use crate::model::{is_model_exchange, Model};
 use crate::registry::{self, Api};
-use crate::state::{mask_names, Mask, Mode, Status};
+use crate::state::{mask_names, Mask, Mode, Status, CONTINUOUS_TIME, EVENT, STEP};
 
 /// Why a call failed: the status to return and the message to log.
 #[derive(Debug)]
@@ -61,10 +61,12 @@ pub unsafe fn with_instance<M: Model>(
             return Err(Failure::fatal("the instance is in the Fatal state; only FreeInstance may be called"));
         }
         if mask & inst.mode.bit() == 0 {
+            // Name only the modes of this FMU's interface (step vs event/continuous time).
+            let other = if is_model_exchange::<M>() { STEP } else { EVENT | CONTINUOUS_TIME };
             return Err(Failure::from(format!(
                 "must not be called in mode {} (allowed in: {})",
                 inst.mode.name(),
-                mask_names(mask)
+                mask_names(mask & !other)
             )));
         }
         f(inst)

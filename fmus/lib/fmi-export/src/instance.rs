@@ -9,7 +9,7 @@ use std::panic::catch_unwind;
 
 use crate::ctype::CType;
 use crate::logger::Logger;
-use crate::model::Model;
+use crate::model::{is_model_exchange, Model};
 use crate::registry::Api;
 use crate::serial;
 use crate::state::{settable, Mode};
@@ -56,6 +56,16 @@ pub struct Instance<M: Model> {
     strings: Vec<CString>,
     /// FMU states handed out and not yet freed (only these pointers are ever dereferenced).
     states: Vec<*mut Snapshot<M>>,
+    /// Model exchange: time, states or inputs changed since the last `Model::evaluate`, so
+    /// derivatives and outputs in the store are out of date.
+    stale: bool,
+}
+
+/// What Event Mode's discrete-state update reports (fmi2EventInfo / fmi3UpdateDiscreteStates).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EventInfo {
+    pub values_of_continuous_states_changed: bool,
+    pub next_event_time: Option<f64>,
 }
 
 impl<M: Model> Drop for Instance<M> {
@@ -69,7 +79,7 @@ impl<M: Model> Drop for Instance<M> {
 
 /// Whether the model has run `initialize` in this mode (its state is worth saving).
 fn initialized(mode: Mode) -> bool {
-    matches!(mode, Mode::StepMode | Mode::Terminated)
+    matches!(mode, Mode::StepMode | Mode::Terminated | Mode::EventMode | Mode::ContinuousTimeMode)
 }
 
 /// Parameters (and everything else fixed before the run) bit for bit equal.
@@ -119,6 +129,7 @@ impl<M: Model> Instance<M> {
             preview: None,
             strings: Vec::new(),
             states: Vec::new(),
+            stale: false,
         })
     }
 
@@ -134,6 +145,7 @@ impl<M: Model> Instance<M> {
         self.start_time = 0.0;
         self.stop_time = None;
         self.mode = Mode::Instantiated;
+        self.stale = false;
         Ok(())
     }
 
@@ -180,8 +192,26 @@ impl<M: Model> Instance<M> {
             model
                 .initialize(&mut store, self.start_time, &mut self.logger)
                 .map_err(|e| format!("the model failed to initialize (while computing initial values): {e}"))?;
+            if is_model_exchange::<M>() {
+                model
+                    .evaluate(&mut store, self.start_time)
+                    .map_err(|e| format!("the model failed to evaluate its initial derivatives: {e}"))?;
+            }
             check_output_sizes::<M>(&store)?;
             self.preview = Some((model, store));
+        }
+        self.refresh()
+    }
+
+    /// Model exchange: brings derivatives and outputs up to date with time, states and
+    /// inputs (lazily: an integrator sets states far more often than it reads outputs).
+    fn refresh(&mut self) -> Result<(), String> {
+        if self.stale {
+            self.model
+                .evaluate(&mut self.store, self.time)
+                .map_err(|e| format!("the model failed to evaluate at t={:?}: {e}", self.time))?;
+            check_output_sizes::<M>(&self.store)?;
+            self.stale = false;
         }
         Ok(())
     }
@@ -256,6 +286,7 @@ impl<M: Model> Instance<M> {
             if !self.store.value(i).identical(&value) {
                 *self.store.value_mut(i) = value;
                 self.preview = None;
+                self.stale = is_model_exchange::<M>() && initialized(self.mode);
             }
         }
         Ok(())
@@ -297,9 +328,16 @@ impl<M: Model> Instance<M> {
                     .initialize(&mut self.store, self.start_time, &mut self.logger)
                     .map_err(|e| format!("the model failed to initialize: {e}"))?;
                 check_output_sizes::<M>(&self.store)?;
+                if is_model_exchange::<M>() {
+                    self.model
+                        .evaluate(&mut self.store, self.start_time)
+                        .map_err(|e| format!("the model failed to evaluate its initial derivatives: {e}"))?;
+                }
             }
         }
-        self.mode = Mode::StepMode;
+        // Model exchange starts with the initial event iteration (FMI 2.0 3.2.3, FMI 3.0 3.2).
+        self.mode = if is_model_exchange::<M>() { Mode::EventMode } else { Mode::StepMode };
+        self.stale = false;
         Ok(())
     }
 
@@ -383,6 +421,8 @@ impl<M: Model> Instance<M> {
         self.start_time = s.start_time;
         self.stop_time = s.stop_time;
         self.preview = None;
+        // Derived values were saved with the store; evaluating again only costs time.
+        self.stale = false;
         Ok(())
     }
 
@@ -481,6 +521,117 @@ impl<M: Model> Instance<M> {
             serialized: Some(bytes.to_vec()),
         };
         self.store_state(snap, existing)
+    }
+
+    // ---- Model exchange ------------------------------------------------------------------
+
+    /// SetTime: any finite time (an integrator may go back within a rejected step).
+    pub fn set_time(&mut self, t: f64) -> Result<(), String> {
+        if !t.is_finite() {
+            return Err(format!("time must be finite, got {t}"));
+        }
+        if t.to_bits() != self.time.to_bits() {
+            self.time = t;
+            self.stale = true;
+        }
+        Ok(())
+    }
+
+    fn check_nx(n: usize, what: &str) -> Result<(), String> {
+        let nx = M::CONTINUOUS_STATES.len();
+        if n != nx {
+            return Err(format!("{what} is {n}, but this FMU has {nx} continuous states"));
+        }
+        Ok(())
+    }
+
+    /// SetContinuousStates: every value finite, else nothing is set.
+    pub fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
+        Self::check_nx(x.len(), "nx (nContinuousStates)")?;
+        if let Some((k, v)) = x.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(format!("state {k} ({}) is {v}, not finite", M::VARIABLES[M::CONTINUOUS_STATES[k].state].name));
+        }
+        for (s, &v) in M::CONTINUOUS_STATES.iter().zip(x) {
+            self.store.set_f64(s.state, v);
+        }
+        self.stale = true;
+        Ok(())
+    }
+
+    /// The store to read continuous values from (the preview in Initialization Mode), up to date.
+    fn continuous_view(&mut self) -> Result<&Store, String> {
+        self.ensure_view()?;
+        Ok(match (&self.preview, self.mode) {
+            (Some((_, s)), Mode::InitializationMode) => s,
+            _ => &self.store,
+        })
+    }
+
+    /// GetContinuousStates.
+    pub fn continuous_states(&mut self, out: &mut [f64]) -> Result<(), String> {
+        Self::check_nx(out.len(), "nx (nContinuousStates)")?;
+        let store = self.continuous_view()?;
+        for (o, s) in out.iter_mut().zip(M::CONTINUOUS_STATES) {
+            *o = store.f64(s.state);
+        }
+        Ok(())
+    }
+
+    /// GetDerivatives / GetContinuousStateDerivatives.
+    pub fn derivatives(&mut self, out: &mut [f64]) -> Result<(), String> {
+        Self::check_nx(out.len(), "nx (nContinuousStates)")?;
+        let store = self.continuous_view()?;
+        for (o, s) in out.iter_mut().zip(M::CONTINUOUS_STATES) {
+            *o = store.f64(s.derivative);
+        }
+        if let Some((k, v)) = out.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+            return Err(format!("the derivative of state {k} is {v} at t={:?}", self.time));
+        }
+        Ok(())
+    }
+
+    /// GetNominalsOfContinuousStates (fixed by the model's declaration).
+    pub fn nominals(&self, out: &mut [f64]) -> Result<(), String> {
+        Self::check_nx(out.len(), "nx (nContinuousStates)")?;
+        for (o, s) in out.iter_mut().zip(M::CONTINUOUS_STATES) {
+            *o = s.nominal;
+        }
+        Ok(())
+    }
+
+    /// GetEventIndicators: this layer supports none (numberOfEventIndicators = 0).
+    pub fn event_indicators(&self, n: usize) -> Result<(), String> {
+        if n != 0 {
+            return Err(format!("ni (nEventIndicators) is {n}, but this FMU has no event indicators"));
+        }
+        Ok(())
+    }
+
+    pub fn enter_event_mode(&mut self) {
+        self.mode = Mode::EventMode;
+    }
+
+    /// NewDiscreteStates / UpdateDiscreteStates: the model handles the events due now.
+    pub fn update_discrete_states(&mut self) -> Result<EventInfo, String> {
+        self.refresh()?;
+        let t = self.time;
+        let changed = self
+            .model
+            .update_discrete_states(&mut self.store, t, &mut self.logger)
+            .map_err(|e| format!("the model failed to handle the event at t={t:?}: {e}"))?;
+        self.stale = true;
+        self.refresh()?;
+        let next = self.model.next_event_time(&self.store, t);
+        if let Some(te) = next {
+            if !(te.is_finite() && te > t) {
+                return Err(format!("the model announced its next time event at {te:?}, not after t={t:?}"));
+            }
+        }
+        Ok(EventInfo { values_of_continuous_states_changed: changed, next_event_time: next })
+    }
+
+    pub fn enter_continuous_time_mode(&mut self) {
+        self.mode = Mode::ContinuousTimeMode;
     }
 
     /// Number of FMU states not yet freed (for tests).

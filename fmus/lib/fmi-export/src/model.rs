@@ -29,7 +29,21 @@ impl Log for Quiet {
     fn warning(&mut self, _: std::fmt::Arguments<'_>) {}
 }
 
-/// A co-simulation model. Implementors are plain Rust; see `export_fmu!` for the C API.
+/// A continuous state of a model-exchange model: which variables hold it and its derivative.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContinuousState {
+    /// Index in the variable table of the state (a continuous Float64 output or local).
+    pub state: usize,
+    /// Index of its time derivative (a continuous Float64 local or output, computed by
+    /// [`Model::evaluate`]).
+    pub derivative: usize,
+    /// Its typical magnitude (GetNominalsOfContinuousStates), for the importer's error control.
+    pub nominal: f64,
+}
+
+/// A model, exported as a co-simulation FMU or, when it declares
+/// [`CONTINUOUS_STATES`](Model::CONTINUOUS_STATES), as a model-exchange FMU. Implementors are
+/// plain Rust; see `export_fmu!` for the C API.
 pub trait Model: Clone + Send + 'static {
     /// modelIdentifier: the FMU's shared-library name and its model name.
     const NAME: &'static str;
@@ -65,4 +79,47 @@ pub trait Model: Clone + Send + 'static {
     /// Overwrites what [`save_state`](Model::save_state) wrote. Called on a model initialized
     /// with the same parameter values, so derived parts are already in place.
     fn load_state(&mut self, bytes: &[u8]) -> Result<(), ModelError>;
+
+    // ---- Model exchange (optional) ------------------------------------------------------
+    //
+    // A model opts in by listing its continuous states. It is then exported as a
+    // model-exchange FMU *only*: no <CoSimulation> element, fmi*InstantiateCoSimulation /
+    // fmi2Instantiate(fmi2CoSimulation) refuse. Why not both, with a built-in fixed-step
+    // integrator for co-simulation: importers (agrisim's engine among them) pick
+    // co-simulation whenever an FMU offers it, so the model-exchange path would go
+    // unexercised, and a fixed-step integrator inside the FMU would only duplicate, without
+    // error control, what the importer's solver does.
+    //
+    // The state vector lives in the variable store (the state variables' values), so FMU
+    // states, serialization and getters need nothing extra. The layer writes the states on
+    // SetContinuousStates and calls `evaluate` before anything reads derived values.
+    // Event indicators (state events) are not supported: numberOfEventIndicators is 0. Time
+    // events are: see `next_event_time`.
+
+    /// The continuous states, in state-vector order; empty (the default): co-simulation.
+    const CONTINUOUS_STATES: &'static [ContinuousState] = &[];
+
+    /// Model exchange: computes every derivative variable and every output from the time
+    /// `t`, the states and the inputs in `io`. Called after `initialize` and whenever time,
+    /// states or inputs changed before a value is read; it must not change the states.
+    fn evaluate(&mut self, _io: &mut Store, _t: f64) -> Result<(), ModelError> {
+        Err("this model has no continuous states (it is not a model-exchange model)".into())
+    }
+
+    /// Model exchange: handles the events due at time `t` in Event Mode (one pass; the
+    /// layer never asks for another). Returns whether it changed continuous state values.
+    fn update_discrete_states(&mut self, _io: &mut Store, _t: f64, _log: &mut dyn Log) -> Result<bool, ModelError> {
+        Ok(false)
+    }
+
+    /// Model exchange: the next time event strictly after the events handled at `t`
+    /// (announced as nextEventTime when Event Mode ends); `None`: no time event ahead.
+    fn next_event_time(&self, _io: &Store, _t: f64) -> Option<f64> {
+        None
+    }
+}
+
+/// Whether `M` is exported as a model-exchange FMU (it declares continuous states).
+pub const fn is_model_exchange<M: Model>() -> bool {
+    !M::CONTINUOUS_STATES.is_empty()
 }

@@ -104,6 +104,10 @@ impl Var {
     pub const fn output_discrete(name: &'static str, start: Start) -> Self {
         Self::new(name, Causality::Output, Variability::Discrete, start)
     }
+    /// Continuous Float64 local (e.g. a state derivative of a model-exchange model).
+    pub const fn local(name: &'static str) -> Self {
+        Self::new(name, Causality::Local, Variability::Continuous, Start::Float64(0.0))
+    }
     /// Fixed parameter (settable before initialization ends).
     pub const fn param(name: &'static str, start: Start) -> Self {
         Self::new(name, Causality::Parameter, Variability::Fixed, start)

@@ -11,6 +11,13 @@
 //! - InitialUnknowns carry the dependencies the table declares ([`Var::init_depends_on`]:
 //!   parameters, inputs, the start time); undeclared ones omit the attribute (= all knowns);
 //! - Binary variables carry `maxSize` (FMI 3).
+//! - Model exchange (a model with [`Model::CONTINUOUS_STATES`]): a `<ModelExchange>` element
+//!   instead of `<CoSimulation>`; each derivative variable names its state (`derivative=`,
+//!   FMI 3 a value reference, FMI 2 a 1-based position); ModelStructure lists the
+//!   derivatives (`ContinuousStateDerivative` / `Derivatives`) and adds calculated states
+//!   and derivatives to the initial unknowns. Outputs and derivatives there omit
+//!   `dependencies` (= every known): the layer cannot know which states and inputs the
+//!   model's `evaluate` reads, and omitting is the one declaration that is always true.
 //!
 //! Output is deterministic (no timestamps); floats are written in round-trip form.
 
@@ -18,7 +25,7 @@ use std::collections::BTreeSet;
 use std::fmt::Write;
 
 use crate::logger::LOG_CATEGORIES;
-use crate::model::Model;
+use crate::model::{is_model_exchange, ContinuousState, Model};
 use crate::units::{base_unit, EXPONENT_NAMES};
 use crate::var::{Causality, Start, Var, Variability};
 
@@ -232,6 +239,51 @@ pub fn check_table(vars: &[Var]) -> Vec<String> {
     problems
 }
 
+/// Everything in a model's continuous-state declaration that would make an invalid
+/// model-exchange FMU; empty = fine. States and derivatives must be distinct continuous
+/// Float64 outputs or locals (computed by the model, never set from outside), nominals
+/// positive and finite.
+pub fn check_continuous_states(vars: &[Var], states: &[ContinuousState]) -> Vec<String> {
+    let mut problems = Vec::new();
+    let mut used = BTreeSet::new();
+    for (k, s) in states.iter().enumerate() {
+        for (what, i) in [("state", s.state), ("derivative", s.derivative)] {
+            let Some(v) = vars.get(i) else {
+                problems.push(format!("continuous state {k}: {what} index {i} is not in the table"));
+                continue;
+            };
+            if !used.insert(i) {
+                problems.push(format!("continuous state {k}: '{}' is used twice", v.name));
+            }
+            let ok = matches!(v.start, Start::Float64(_))
+                && v.variability == Variability::Continuous
+                && matches!(v.causality, Causality::Output | Causality::Local);
+            if !ok {
+                problems.push(format!(
+                    "continuous state {k}: {what} '{}' must be a continuous Float64 output or local",
+                    v.name
+                ));
+            }
+        }
+        if !(s.nominal.is_finite() && s.nominal > 0.0) {
+            problems.push(format!("continuous state {k}: nominal {} must be positive and finite", s.nominal));
+        }
+    }
+    problems
+}
+
+/// The index of the state whose derivative is variable `i`, for model-exchange models.
+fn state_of_derivative<M: Model>(i: usize) -> Option<usize> {
+    M::CONTINUOUS_STATES.iter().find(|s| s.derivative == i).map(|s| s.state)
+}
+
+/// Initial unknowns of `M`: [`is_initial_unknown`] plus, for model exchange, the calculated
+/// continuous states and derivatives (FMI 3.0 section 2.4.8, FMI 2.0 section 2.2.8).
+fn is_initial_unknown_of<M: Model>(i: usize, v: &Var) -> bool {
+    is_initial_unknown(v)
+        || (is_calculated(v) && M::CONTINUOUS_STATES.iter().any(|s| s.state == i || s.derivative == i))
+}
+
 /// Units used by the table (sorted, unique), plus "s" for time.
 fn used_units(vars: &[&Var]) -> BTreeSet<&'static str> {
     let mut units: BTreeSet<&'static str> = vars.iter().map(|v| v.unit).filter(|u| !u.is_empty()).collect();
@@ -306,11 +358,20 @@ pub fn fmi3<M: Model>() -> String {
         escape(M::DESCRIPTION),
         env!("CARGO_PKG_VERSION")
     );
-    let _ = writeln!(
-        o,
-        "  <CoSimulation modelIdentifier=\"{}\" needsExecutionTool=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" canGetAndSetFMUState=\"true\" canSerializeFMUState=\"true\" providesDirectionalDerivatives=\"false\" providesAdjointDerivatives=\"false\" providesPerElementDependencies=\"false\" canHandleVariableCommunicationStepSize=\"true\" maxOutputDerivativeOrder=\"0\" providesIntermediateUpdate=\"false\" mightReturnEarlyFromDoStep=\"false\" canReturnEarlyAfterIntermediateUpdate=\"false\" hasEventMode=\"false\" providesEvaluateDiscreteStates=\"false\"/>",
-        escape(M::NAME)
-    );
+    let me = is_model_exchange::<M>();
+    if me {
+        let _ = writeln!(
+            o,
+            "  <ModelExchange modelIdentifier=\"{}\" needsExecutionTool=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" canGetAndSetFMUState=\"true\" canSerializeFMUState=\"true\" providesDirectionalDerivatives=\"false\" providesAdjointDerivatives=\"false\" providesPerElementDependencies=\"false\" needsCompletedIntegratorStep=\"false\" providesEvaluateDiscreteStates=\"false\"/>",
+            escape(M::NAME)
+        );
+    } else {
+        let _ = writeln!(
+            o,
+            "  <CoSimulation modelIdentifier=\"{}\" needsExecutionTool=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" canGetAndSetFMUState=\"true\" canSerializeFMUState=\"true\" providesDirectionalDerivatives=\"false\" providesAdjointDerivatives=\"false\" providesPerElementDependencies=\"false\" canHandleVariableCommunicationStepSize=\"true\" maxOutputDerivativeOrder=\"0\" providesIntermediateUpdate=\"false\" mightReturnEarlyFromDoStep=\"false\" canReturnEarlyAfterIntermediateUpdate=\"false\" hasEventMode=\"false\" providesEvaluateDiscreteStates=\"false\"/>",
+            escape(M::NAME)
+        );
+    }
     let units = used_units(&vars);
     unit_definitions(&mut o, &units);
     // Units through one Float64Type per unit (declaredType) rather than a unit attribute on
@@ -336,6 +397,9 @@ pub fn fmi3<M: Model>() -> String {
                     let _ = write!(o, " declaredType=\"{}\"", escape(v.unit));
                 }
                 min_max(&mut o, v, false);
+                if let Some(state) = state_of_derivative::<M>(i) {
+                    let _ = write!(o, " derivative=\"{}\"", state + 1);
+                }
                 if with_start {
                     let _ = write!(o, " start=\"{}\"", fmt_f64(x));
                 }
@@ -384,11 +448,18 @@ pub fn fmi3<M: Model>() -> String {
     o.push_str("  </ModelVariables>\n  <ModelStructure>\n");
     for (i, v) in vars.iter().enumerate() {
         if v.causality == Causality::Output {
-            let _ = writeln!(o, "    <Output valueReference=\"{}\" dependencies=\"\"/>", i + 1);
+            if me {
+                let _ = writeln!(o, "    <Output valueReference=\"{}\"/>", i + 1);
+            } else {
+                let _ = writeln!(o, "    <Output valueReference=\"{}\" dependencies=\"\"/>", i + 1);
+            }
         }
     }
+    for s in M::CONTINUOUS_STATES {
+        let _ = writeln!(o, "    <ContinuousStateDerivative valueReference=\"{}\"/>", s.derivative + 1);
+    }
     for (i, v) in vars.iter().enumerate() {
-        if is_initial_unknown(v) {
+        if is_initial_unknown_of::<M>(i, v) {
             let _ = write!(o, "    <InitialUnknown valueReference=\"{}\"", i + 1);
             if let Some(deps) = initial_dependency_vrs(v) {
                 let _ = write!(o, " dependencies=\"{}\"", join(deps));
@@ -407,6 +478,10 @@ pub fn fmi2<M: Model>() -> String {
     // (time is position 1).
     let visible: Vec<(usize, &Var)> =
         M::VARIABLES.iter().enumerate().filter(|(_, v)| v.fmi2_representable()).map(|(i, v)| (i + 1, v)).collect();
+    // Position of a visible variable by value reference (time = vr 0 is position 1); knowns
+    // FMI 2 cannot see are frozen at their start values there and drop out.
+    let position =
+        |vr: usize| if vr == 0 { Some(1) } else { visible.iter().position(|&(r, _)| r == vr).map(|k| k + 2) };
     let vars: Vec<&Var> = visible.iter().map(|(_, v)| *v).collect();
     let mut o = String::new();
     o.push_str("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
@@ -418,11 +493,20 @@ pub fn fmi2<M: Model>() -> String {
         escape(M::DESCRIPTION),
         env!("CARGO_PKG_VERSION")
     );
-    let _ = writeln!(
-        o,
-        "  <CoSimulation modelIdentifier=\"{}\" needsExecutionTool=\"false\" canHandleVariableCommunicationStepSize=\"true\" canInterpolateInputs=\"false\" maxOutputDerivativeOrder=\"0\" canRunAsynchronuously=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"/>",
-        escape(M::NAME)
-    );
+    let me = is_model_exchange::<M>();
+    if me {
+        let _ = writeln!(
+            o,
+            "  <ModelExchange modelIdentifier=\"{}\" needsExecutionTool=\"false\" completedIntegratorStepNotNeeded=\"true\" canBeInstantiatedOnlyOncePerProcess=\"false\" canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"/>",
+            escape(M::NAME)
+        );
+    } else {
+        let _ = writeln!(
+            o,
+            "  <CoSimulation modelIdentifier=\"{}\" needsExecutionTool=\"false\" canHandleVariableCommunicationStepSize=\"true\" canInterpolateInputs=\"false\" maxOutputDerivativeOrder=\"0\" canRunAsynchronuously=\"false\" canBeInstantiatedOnlyOncePerProcess=\"false\" canNotUseMemoryManagementFunctions=\"true\" canGetAndSetFMUstate=\"true\" canSerializeFMUstate=\"true\" providesDirectionalDerivative=\"false\"/>",
+            escape(M::NAME)
+        );
+    }
     unit_definitions(&mut o, &used_units(&vars));
     log_categories(&mut o);
     let _ = writeln!(o, "  <DefaultExperiment startTime=\"0.0\" stepSize=\"{}\"/>", fmt_f64(M::STEP_SIZE));
@@ -440,6 +524,9 @@ pub fn fmi2<M: Model>() -> String {
                     let _ = write!(o, " unit=\"{}\"", escape(v.unit));
                 }
                 min_max(&mut o, v, false);
+                if let Some(p) = state_of_derivative::<M>(vr - 1).and_then(|s| position(s + 1)) {
+                    let _ = write!(o, " derivative=\"{p}\"");
+                }
                 if with_start {
                     let _ = write!(o, " start=\"{}\"", fmt_f64(x));
                 }
@@ -468,21 +555,33 @@ pub fn fmi2<M: Model>() -> String {
         o.push_str("/>\n    </ScalarVariable>\n");
     }
     o.push_str("  </ModelVariables>\n  <ModelStructure>\n");
-    // Position of a visible variable by value reference (time = vr 0 is position 1); knowns
-    // FMI 2 cannot see are frozen at their start values there and drop out.
-    let position =
-        |vr: usize| if vr == 0 { Some(1) } else { visible.iter().position(|&(r, _)| r == vr).map(|k| k + 2) };
     let outputs: Vec<usize> =
         visible.iter().filter(|(_, v)| v.causality == Causality::Output).filter_map(|&(vr, _)| position(vr)).collect();
     if !outputs.is_empty() {
         o.push_str("    <Outputs>\n");
         for i in &outputs {
-            let _ = writeln!(o, "      <Unknown index=\"{i}\" dependencies=\"\"/>");
+            if me {
+                let _ = writeln!(o, "      <Unknown index=\"{i}\"/>");
+            } else {
+                let _ = writeln!(o, "      <Unknown index=\"{i}\" dependencies=\"\"/>");
+            }
         }
         o.push_str("    </Outputs>\n");
     }
-    let initial: Vec<(usize, &Var)> =
-        visible.iter().filter(|(_, v)| is_initial_unknown(v)).filter_map(|&(vr, v)| Some((position(vr)?, v))).collect();
+    if me {
+        o.push_str("    <Derivatives>\n");
+        for s in M::CONTINUOUS_STATES {
+            if let Some(i) = position(s.derivative + 1) {
+                let _ = writeln!(o, "      <Unknown index=\"{i}\"/>");
+            }
+        }
+        o.push_str("    </Derivatives>\n");
+    }
+    let initial: Vec<(usize, &Var)> = visible
+        .iter()
+        .filter(|&&(vr, v)| is_initial_unknown_of::<M>(vr - 1, v))
+        .filter_map(|&(vr, v)| Some((position(vr)?, v)))
+        .collect();
     if !initial.is_empty() {
         o.push_str("    <InitialUnknowns>\n");
         for (i, v) in initial {

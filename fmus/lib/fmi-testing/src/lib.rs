@@ -18,6 +18,7 @@
 mod args;
 mod fuzz2;
 mod fuzz3;
+mod fuzz_me;
 mod logs;
 mod restore;
 mod rng;
@@ -28,12 +29,48 @@ mod structure;
 
 pub use fuzz2::fuzz_fmi2;
 pub use fuzz3::fuzz_fmi3;
+pub use fuzz_me::{fuzz_me2, fuzz_me3};
 pub use restore::{assert_state_round_trip, wiggle_inputs};
 pub use structure::{assert_initial_dependencies, assert_no_direct_feedthrough, assert_valid_table};
 
 /// For [`fmu_conformance_tests!`], so its users need not name `agrisim_fmi` themselves.
 #[doc(hidden)]
 pub use agrisim_fmi::Model;
+
+/// The conformance tests of a model-exchange FMU crate (a model with continuous states):
+/// its variable table and continuous states make a valid FMU, its initial dependencies hold,
+/// and `seeds` x `cases` random FMI 3 and FMI 2 model-exchange call sequences never let a
+/// panic escape nor break the state machine. (The co-simulation checks of
+/// [`fmu_conformance_tests!`] do not apply: such an FMU cannot be instantiated for
+/// co-simulation.)
+#[macro_export]
+macro_rules! fmu_me_conformance_tests {
+    ($model:ty, seeds = $seeds:expr, cases = $cases:expr) => {
+        #[test]
+        fn variable_table_makes_a_valid_fmu() {
+            $crate::assert_valid_table::<$model>();
+        }
+
+        #[test]
+        fn initial_dependencies_are_complete() {
+            $crate::assert_initial_dependencies::<$model>(&[]);
+        }
+
+        #[test]
+        fn random_fmi3_model_exchange_call_sequences() {
+            for seed in 0..$seeds {
+                $crate::fuzz_me3::<$model>(seed, $cases);
+            }
+        }
+
+        #[test]
+        fn random_fmi2_model_exchange_call_sequences() {
+            for seed in 0..$seeds {
+                $crate::fuzz_me2::<$model>(seed, $cases);
+            }
+        }
+    };
+}
 
 /// The conformance tests every FMU crate runs, in one line of its `tests/fmi_fuzz.rs`:
 /// its variable table makes a valid FMU, its ModelStructure dependencies hold (initial

@@ -121,8 +121,9 @@ pub(crate) unsafe fn check<M: Model>(o: &Outcome, sh: &mut Shadow, inst: *mut c_
     let actual = &*inst.cast::<Instance<M>>();
     assert_eq!(actual.mode, sh.mode, "mode differs from the shadow; {}", ctx());
     assert_eq!(actual.live_states(), sh.states.len(), "live FMU states differ; {}", ctx());
-    if matches!(sh.mode, Mode::StepMode | Mode::Terminated) && o.status <= Status::Warning {
-        assert_eq!(actual.time, sh.time, "time differs from tc + h; {}", ctx());
+    let running = matches!(sh.mode, Mode::StepMode | Mode::Terminated | Mode::EventMode | Mode::ContinuousTimeMode);
+    if running && o.status <= Status::Warning {
+        assert_eq!(actual.time, sh.time, "time differs from tc + h (or the time set); {}", ctx());
     }
     logs.0.clear();
 }

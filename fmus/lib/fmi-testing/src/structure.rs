@@ -14,6 +14,7 @@ use crate::args::zeroed;
 /// that every initial unknown declares its dependencies and that the tokens are the derived ones.
 pub fn assert_valid_table<M: Model>() {
     let mut problems = agrisim_fmi::xml::check_table(M::VARIABLES);
+    problems.extend(agrisim_fmi::xml::check_continuous_states(M::VARIABLES, M::CONTINUOUS_STATES));
     for v in M::VARIABLES.iter().filter(|v| is_initial_unknown(v) && v.initial_dependencies.is_none()) {
         problems.push(format!("'{}': no init_depends_on declaration (what its initial value depends on)", v.name));
     }

@@ -129,3 +129,32 @@ pub type DeserializeFmuState = unsafe extern "C" fn(
     size: usize,
     state: *mut Fmi3FmuState,
 ) -> Fmi3Status;
+
+// Model exchange.
+pub type InstantiateModelExchange = unsafe extern "C" fn(
+    instance_name: *const c_char,
+    instantiation_token: *const c_char,
+    resource_path: *const c_char,
+    visible: bool,
+    logging_on: bool,
+    instance_environment: Fmi3InstanceEnvironment,
+    log_message: Option<LogMessageCallback>,
+) -> Fmi3Instance;
+pub type UpdateDiscreteStates = unsafe extern "C" fn(
+    instance: Fmi3Instance,
+    discrete_states_need_update: *mut bool,
+    terminate_simulation: *mut bool,
+    nominals_of_continuous_states_changed: *mut bool,
+    values_of_continuous_states_changed: *mut bool,
+    next_event_time_defined: *mut bool,
+    next_event_time: *mut f64,
+) -> Fmi3Status;
+pub type CompletedIntegratorStep = unsafe extern "C" fn(
+    instance: Fmi3Instance,
+    no_set_fmu_state_prior_to_current_point: bool,
+    enter_event_mode: *mut bool,
+    terminate_simulation: *mut bool,
+) -> Fmi3Status;
+pub type SetTime = unsafe extern "C" fn(instance: Fmi3Instance, time: f64) -> Fmi3Status;
+pub type SetVector = unsafe extern "C" fn(instance: Fmi3Instance, x: *const f64, n: usize) -> Fmi3Status;
+pub type GetVector = unsafe extern "C" fn(instance: Fmi3Instance, x: *mut f64, n: usize) -> Fmi3Status;

@@ -21,34 +21,16 @@ use std::ptr;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
-use super::error::{write_call, FmiError, FmiErrorInfo};
+use crate::fmu::error::write_call;
+use crate::fmu::{FmiError, FmiErrorInfo, InstanceState};
 use super::ffi::{self, Fmi3FmuState, Fmi3Instance, Vr};
 use super::library::{Fmi3Library, Functions};
-use super::log::{log_callback, LogMessage, LogSink};
-use super::status::{Status, StepResult};
+use crate::fmu::log::{log_callback, LogMessage, LogSink};
+use crate::fmu::{Status, StepResult};
 use crate::archive::FmuArchive;
+pub use crate::fmu::FmuState;
+use crate::model_description::{FmiVersion, Interface};
 
-/// Where the instance is in the FMI co-simulation state machine, as far as the wrapper knows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum InstanceState {
-    Instantiated,
-    InitializationMode,
-    StepMode,
-    Terminated,
-    /// The last call returned fmi3Error: only `reset`, restoring an FMU state (or dropping)
-    /// makes sense now. (fmi3Discard does not lead here.)
-    Error,
-    /// The FMU returned fmi3Fatal: every further call is refused, and it is never freed.
-    Fatal,
-}
-
-/// A saved FMU state (`fmi3FMUState`). Owned by the instance that made it, which frees any
-/// states still held when it is dropped; only valid with that instance.
-#[derive(Debug)]
-pub struct FmuState {
-    slot: usize,
-    owner: u64,
-}
 
 /// Call context for messages, formatted only when a message needs it (never on the
 /// per-step success path).
@@ -91,6 +73,7 @@ pub struct Instance {
     id: u64,
     /// Read by the logger callback via `instanceEnvironment`; boxed so its address is stable.
     sink: Box<LogSink>,
+    interface: Interface,
     /// Kept alive as long as the instance; declared last so it is released last.
     lib: Arc<Fmi3Library>,
 }
@@ -109,7 +92,30 @@ impl Instance {
     /// `resourcePath` is passed as the FMI 3.0 standard defines it: the absolute native path
     /// of `resources/` with a trailing separator (not the FMI 2.0 `file://` URI).
     pub fn instantiate(archive: &FmuArchive, instance_name: &str, logging_on: bool) -> Result<Instance, FmiError> {
+        Self::instantiate_as(archive, instance_name, logging_on, Interface::CoSimulation)
+    }
+
+    /// Instantiates for model exchange (`fmi3InstantiateModelExchange`), for the master's
+    /// integrator ([`crate::me::Integrated`]).
+    pub fn instantiate_model_exchange(
+        archive: &FmuArchive,
+        instance_name: &str,
+        logging_on: bool,
+    ) -> Result<Instance, FmiError> {
+        Self::instantiate_as(archive, instance_name, logging_on, Interface::ModelExchange)
+    }
+
+    fn instantiate_as(
+        archive: &FmuArchive,
+        instance_name: &str,
+        logging_on: bool,
+        interface: Interface,
+    ) -> Result<Instance, FmiError> {
         let md = &archive.md;
+        let f_name = match interface {
+            Interface::CoSimulation => "fmi3InstantiateCoSimulation",
+            Interface::ModelExchange => "fmi3InstantiateModelExchange",
+        };
         let fail = |function: &str, detail: String, messages: Vec<LogMessage>| -> FmiError {
             FmiErrorInfo {
                 instance: instance_name.to_string(),
@@ -124,7 +130,7 @@ impl Instance {
             }
             .into()
         };
-        let lib = Fmi3Library::load(&archive.library_path).map_err(|e| fail("loading", e, Vec::new()))?;
+        let lib = Fmi3Library::load(&archive.library_path, interface).map_err(|e| fail("loading", e, Vec::new()))?;
         let version = lib.version();
         if !version.starts_with("3.") {
             return Err(fail("fmi3GetVersion", format!("reports FMI version \"{version}\", expected 3.0"), Vec::new()));
@@ -133,39 +139,47 @@ impl Instance {
         let names: BTreeMap<Vr, String> = md.variables.iter().map(|v| (v.value_reference, v.name.clone())).collect();
 
         let c_name = CString::new(instance_name)
-            .map_err(|_| fail("fmi3InstantiateCoSimulation", "instance name contains a NUL byte".into(), Vec::new()))?;
-        let c_token = CString::new(md.instantiation_token.as_str()).map_err(|_| {
-            fail("fmi3InstantiateCoSimulation", "instantiationToken contains a NUL byte".into(), Vec::new())
-        })?;
-        let c_resources = CString::new(resource_path(&archive.resources_dir)).map_err(|_| {
-            fail("fmi3InstantiateCoSimulation", "resources path contains a NUL byte".into(), Vec::new())
-        })?;
+            .map_err(|_| fail(f_name, "instance name contains a NUL byte".into(), Vec::new()))?;
+        let c_token = CString::new(md.instantiation_token.as_str())
+            .map_err(|_| fail(f_name, "instantiationToken contains a NUL byte".into(), Vec::new()))?;
+        let c_resources = CString::new(resource_path(&archive.resources_dir))
+            .map_err(|_| fail(f_name, "resources path contains a NUL byte".into(), Vec::new()))?;
+        let missing = || fail(f_name, "the shared library does not export this interface".into(), Vec::new());
 
         let sink = Box::new(LogSink::default());
         let env = &*sink as *const LogSink as *mut c_void;
         // SAFETY: all strings outlive the call; `env` outlives the instance (see Drop).
-        let handle = unsafe {
-            (lib.f.instantiate_co_simulation)(
-                c_name.as_ptr(),
-                c_token.as_ptr(),
-                c_resources.as_ptr(),
-                false,
-                logging_on,
-                false,
-                false,
-                ptr::null(),
-                0,
-                env,
-                Some(log_callback),
-                None,
-            )
+        let handle = match interface {
+            Interface::CoSimulation => unsafe {
+                (lib.f.instantiate_co_simulation.ok_or_else(missing)?)(
+                    c_name.as_ptr(),
+                    c_token.as_ptr(),
+                    c_resources.as_ptr(),
+                    false,
+                    logging_on,
+                    false,
+                    false,
+                    ptr::null(),
+                    0,
+                    env,
+                    Some(log_callback),
+                    None,
+                )
+            },
+            Interface::ModelExchange => unsafe {
+                (lib.f.me.as_ref().ok_or_else(missing)?.instantiate)(
+                    c_name.as_ptr(),
+                    c_token.as_ptr(),
+                    c_resources.as_ptr(),
+                    false,
+                    logging_on,
+                    env,
+                    Some(log_callback),
+                )
+            },
         };
         if handle.is_null() {
-            return Err(fail(
-                "fmi3InstantiateCoSimulation",
-                "returned NULL (instantiation failed)".into(),
-                sink.take(),
-            ));
+            return Err(fail(f_name, "returned NULL (instantiation failed)".into(), sink.take()));
         }
         let inst = Instance {
             handle,
@@ -180,9 +194,10 @@ impl Instance {
             fmu_states: Vec::new(),
             id: NEXT_INSTANCE_ID.fetch_add(1, Ordering::Relaxed),
             sink,
+            interface,
             lib,
         };
-        inst.report("fmi3InstantiateCoSimulation", &[], Ctx::None, 0, Status::Ok);
+        inst.report(f_name, &[], Ctx::None, 0, Status::Ok);
         Ok(inst)
     }
 
@@ -234,6 +249,14 @@ impl Instance {
         &self.name
     }
 
+    pub fn fmi_version(&self) -> FmiVersion {
+        FmiVersion::V3
+    }
+
+    pub fn interface(&self) -> Interface {
+        self.interface
+    }
+
     pub fn model_name(&self) -> &str {
         &self.model
     }
@@ -274,8 +297,11 @@ impl Instance {
             early_return: false,
             last_successful_time: t,
         };
-        let res = self.call("fmi3DoStep", &[], Ctx::Step(t, h), |f, inst| unsafe {
-            (f.do_step)(
+        let Some(step) = self.lib.f.do_step else {
+            return Err(self.refuse("fmi3DoStep", &[], "refused: this instance is model exchange (not called)"));
+        };
+        let res = self.call("fmi3DoStep", &[], Ctx::Step(t, h), |_, inst| unsafe {
+            step(
                 inst,
                 t,
                 h,
@@ -679,4 +705,90 @@ fn resource_path(dir: &Path) -> String {
         s.push(std::path::MAIN_SEPARATOR);
     }
     s
+}
+
+crate::fmu::delegate_fmu_instance!(Instance);
+
+impl Instance {
+    fn me_call(
+        &mut self,
+        function: &'static str,
+        context: Ctx,
+        f: impl FnOnce(&super::library::MeFunctions, Fmi3Instance) -> ffi::Fmi3Status,
+    ) -> Result<Status, FmiError> {
+        if self.lib.f.me.is_none() {
+            return Err(self.refuse(function, &[], "refused: the binary has no model-exchange interface (not called)"));
+        }
+        let lib = self.lib.clone();
+        self.call(function, &[], context, move |_, h| f(lib.f.me.as_ref().expect("checked above"), h))
+    }
+}
+
+impl crate::me::ModelExchange for Instance {
+    fn enter_event_mode(&mut self) -> Result<(), FmiError> {
+        self.me_call("fmi3EnterEventMode", Ctx::None, |f, h| unsafe { (f.enter_event_mode)(h) }).map(drop)
+    }
+
+    fn update_discrete_states(&mut self) -> Result<crate::me::EventUpdate, FmiError> {
+        let (mut again, mut term, mut nominals, mut values, mut defined, mut next) =
+            (false, false, false, false, false, 0.0);
+        self.me_call("fmi3UpdateDiscreteStates", Ctx::None, |f, h| unsafe {
+            (f.update_discrete_states)(h, &mut again, &mut term, &mut nominals, &mut values, &mut defined, &mut next)
+        })?;
+        Ok(crate::me::EventUpdate {
+            again,
+            terminate: term,
+            states_changed: values,
+            next_event_time: defined.then_some(next),
+        })
+    }
+
+    fn enter_continuous_time_mode(&mut self) -> Result<(), FmiError> {
+        self.me_call("fmi3EnterContinuousTimeMode", Ctx::None, |f, h| unsafe { (f.enter_continuous_time_mode)(h) })
+            .map(drop)
+    }
+
+    fn completed_integrator_step(&mut self) -> Result<(bool, bool), FmiError> {
+        let (mut event, mut term) = (false, false);
+        self.me_call("fmi3CompletedIntegratorStep", Ctx::None, |f, h| unsafe {
+            (f.completed_integrator_step)(h, true, &mut event, &mut term)
+        })?;
+        Ok((event, term))
+    }
+
+    fn set_time(&mut self, t: f64) -> Result<(), FmiError> {
+        self.me_call("fmi3SetTime", Ctx::At(t), |f, h| unsafe { (f.set_time)(h, t) }).map(drop)
+    }
+
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), FmiError> {
+        self.me_call("fmi3SetContinuousStates", Ctx::None, |f, h| unsafe {
+            (f.set_continuous_states)(h, x.as_ptr(), x.len())
+        })
+        .map(drop)
+    }
+
+    fn get_continuous_states(&mut self, x: &mut [f64]) -> Result<(), FmiError> {
+        self.me_call("fmi3GetContinuousStates", Ctx::None, |f, h| unsafe {
+            (f.get_continuous_states)(h, x.as_mut_ptr(), x.len())
+        })
+        .map(drop)
+    }
+
+    fn get_derivatives(&mut self, dx: &mut [f64]) -> Result<(), FmiError> {
+        self.me_call("fmi3GetContinuousStateDerivatives", Ctx::None, |f, h| unsafe {
+            (f.get_derivatives)(h, dx.as_mut_ptr(), dx.len())
+        })
+        .map(drop)
+    }
+
+    fn get_event_indicators(&mut self, z: &mut [f64]) -> Result<(), FmiError> {
+        self.me_call("fmi3GetEventIndicators", Ctx::None, |f, h| unsafe {
+            (f.get_event_indicators)(h, z.as_mut_ptr(), z.len())
+        })
+        .map(drop)
+    }
+
+    fn set_wrapper_state(&mut self, s: InstanceState) {
+        self.state = s;
+    }
 }

@@ -13,13 +13,14 @@ use super::ffi;
 /// Resolved FMI 3.0 co-simulation functions.
 pub(crate) struct Functions {
     pub get_version: ffi::GetVersion,
-    pub instantiate_co_simulation: ffi::InstantiateCoSimulation,
+    /// Co-simulation (absent from a model-exchange-only binary).
+    pub instantiate_co_simulation: Option<ffi::InstantiateCoSimulation>,
     pub free_instance: ffi::FreeInstance,
     pub enter_initialization_mode: ffi::EnterInitializationMode,
     pub exit_initialization_mode: ffi::InstanceOnly,
     pub terminate: ffi::InstanceOnly,
     pub reset: ffi::InstanceOnly,
-    pub do_step: ffi::DoStep,
+    pub do_step: Option<ffi::DoStep>,
     pub get_float64: ffi::Getter<f64>,
     pub set_float64: ffi::Setter<f64>,
     pub get_int32: ffi::Getter<i32>,
@@ -43,6 +44,21 @@ pub(crate) struct Functions {
     pub serialized_fmu_state_size: Option<ffi::SerializedFmuStateSize>,
     pub serialize_fmu_state: Option<ffi::SerializeFmuState>,
     pub deserialize_fmu_state: Option<ffi::DeserializeFmuState>,
+    /// Model exchange, when the binary exports all of it.
+    pub me: Option<MeFunctions>,
+}
+
+pub(crate) struct MeFunctions {
+    pub instantiate: ffi::InstantiateModelExchange,
+    pub enter_event_mode: ffi::InstanceOnly,
+    pub update_discrete_states: ffi::UpdateDiscreteStates,
+    pub enter_continuous_time_mode: ffi::InstanceOnly,
+    pub completed_integrator_step: ffi::CompletedIntegratorStep,
+    pub set_time: ffi::SetTime,
+    pub set_continuous_states: ffi::SetVector,
+    pub get_derivatives: ffi::GetVector,
+    pub get_event_indicators: ffi::GetVector,
+    pub get_continuous_states: ffi::GetVector,
 }
 
 /// A loaded FMU binary.
@@ -56,22 +72,9 @@ pub struct Fmi3Library {
 impl Fmi3Library {
     /// Loads `path` and resolves the functions. Errors are plain text (the caller adds the
     /// FMU and instance names): the dlopen failure, or the first missing symbol.
-    pub fn load(path: &Path) -> Result<Fmi3Library, String> {
-        // SAFETY: loading runs the library's initialisers; FMU binaries are trusted code by
-        // the nature of co-simulation. RTLD_LOCAL keeps two FMUs' identical fmi3* symbols apart.
-        let lib: libloading::Library = unsafe {
-            #[cfg(unix)]
-            {
-                use libloading::os::unix::{Library, RTLD_LOCAL, RTLD_NOW};
-                Library::open(Some(path), RTLD_NOW | RTLD_LOCAL).map(Into::into)
-            }
-            #[cfg(not(unix))]
-            {
-                libloading::Library::new(path)
-            }
-        }
-        .map_err(|e| format!("cannot load shared library '{}': {e}", path.display()))?;
-
+    /// The functions of `interface` are required; the other interface's are optional.
+    pub fn load(path: &Path, interface: crate::model_description::Interface) -> Result<Fmi3Library, String> {
+        let lib = crate::fmu::library::open(path)?;
         macro_rules! sym {
             ($name:literal) => {
                 // SAFETY: the type is the FMI 3.0 signature of this symbol.
@@ -89,13 +92,13 @@ impl Fmi3Library {
         }
         let f = Functions {
             get_version: sym!("fmi3GetVersion"),
-            instantiate_co_simulation: sym!("fmi3InstantiateCoSimulation"),
+            instantiate_co_simulation: opt_sym!("fmi3InstantiateCoSimulation"),
             free_instance: sym!("fmi3FreeInstance"),
             enter_initialization_mode: sym!("fmi3EnterInitializationMode"),
             exit_initialization_mode: sym!("fmi3ExitInitializationMode"),
             terminate: sym!("fmi3Terminate"),
             reset: sym!("fmi3Reset"),
-            do_step: sym!("fmi3DoStep"),
+            do_step: opt_sym!("fmi3DoStep"),
             get_float64: sym!("fmi3GetFloat64"),
             set_float64: sym!("fmi3SetFloat64"),
             get_int32: sym!("fmi3GetInt32"),
@@ -115,7 +118,42 @@ impl Fmi3Library {
             serialized_fmu_state_size: opt_sym!("fmi3SerializedFMUStateSize"),
             serialize_fmu_state: opt_sym!("fmi3SerializeFMUState"),
             deserialize_fmu_state: opt_sym!("fmi3DeserializeFMUState"),
+            me: (|| {
+                Some(MeFunctions {
+                    instantiate: opt_sym!("fmi3InstantiateModelExchange")?,
+                    enter_event_mode: opt_sym!("fmi3EnterEventMode")?,
+                    update_discrete_states: opt_sym!("fmi3UpdateDiscreteStates")?,
+                    enter_continuous_time_mode: opt_sym!("fmi3EnterContinuousTimeMode")?,
+                    completed_integrator_step: opt_sym!("fmi3CompletedIntegratorStep")?,
+                    set_time: opt_sym!("fmi3SetTime")?,
+                    set_continuous_states: opt_sym!("fmi3SetContinuousStates")?,
+                    get_derivatives: opt_sym!("fmi3GetContinuousStateDerivatives")?,
+                    get_event_indicators: opt_sym!("fmi3GetEventIndicators")?,
+                    get_continuous_states: opt_sym!("fmi3GetContinuousStates")?,
+                })
+            })(),
         };
+        let required: &[&str] = match interface {
+            crate::model_description::Interface::CoSimulation => &["fmi3InstantiateCoSimulation", "fmi3DoStep"],
+            crate::model_description::Interface::ModelExchange => &[
+                "fmi3InstantiateModelExchange",
+                "fmi3EnterEventMode",
+                "fmi3UpdateDiscreteStates",
+                "fmi3EnterContinuousTimeMode",
+                "fmi3CompletedIntegratorStep",
+                "fmi3SetTime",
+                "fmi3SetContinuousStates",
+                "fmi3GetContinuousStateDerivatives",
+                "fmi3GetEventIndicators",
+                "fmi3GetContinuousStates",
+            ],
+        };
+        for name in required {
+            // SAFETY: only checks that the symbol exists.
+            if unsafe { lib.get::<*const ()>(name.as_bytes()) }.is_err() {
+                return Err(format!("shared library '{}' does not export {name}", path.display()));
+            }
+        }
         Ok(Fmi3Library { f, path: path.to_path_buf(), _lib: lib })
     }
 

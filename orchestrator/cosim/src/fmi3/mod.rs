@@ -4,15 +4,11 @@
 //! [`Instance`] is the only safe entry point and turns every non-OK status into an
 //! [`FmiError`] that names the instance, model, function, variables and the FMU's own log.
 
-mod error;
 pub mod ffi;
 mod instance;
 mod library;
-mod log;
-mod status;
 
-pub use error::{FmiError, FmiErrorInfo};
-pub use instance::{FmuState, Instance, InstanceState};
+pub use crate::fmu::{FmiError, FmiErrorInfo, LogMessage, Status, StepResult};
+pub use crate::fmu::{FmuState, InstanceState};
+pub use instance::Instance;
 pub use library::Fmi3Library;
-pub use log::LogMessage;
-pub use status::{Status, StepResult};

@@ -12,7 +12,6 @@ use std::ffi::{c_char, c_void, CStr};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 
-use super::ffi::Fmi3Status;
 use super::status::Status;
 
 /// One message an FMU sent through the logger callback.
@@ -85,7 +84,7 @@ unsafe fn lossy(p: *const c_char) -> String {
 /// `fmi3LogMessageCallback`. `env` is the `LogSink` of the calling instance.
 pub(crate) unsafe extern "C" fn log_callback(
     env: *mut c_void,
-    status: Fmi3Status,
+    status: std::ffi::c_int,
     category: *const c_char,
     message: *const c_char,
 ) {

@@ -1,0 +1,36 @@
+//! Opening an FMU's shared library, the same way for every FMI version.
+
+use std::path::Path;
+
+/// Opens an FMU binary: now (every symbol resolved up front) and locally, so two FMUs'
+/// identical `fmi*` symbols stay apart. A binary that leaves Python's C API unresolved
+/// (pythonfmu's) gets an embedded Python first ([`crate::python`]).
+pub(crate) fn open(path: &Path) -> Result<libloading::Library, String> {
+    let fail = |e: libloading::Error| format!("cannot load shared library '{}': {e}", path.display());
+    match dlopen(path) {
+        Ok(lib) => Ok(lib),
+        Err(e) if crate::python::needs_python(&e.to_string()) => {
+            crate::python::ensure()
+                .map_err(|why| format!("{}; it needs an embedded Python, which failed: {why}", fail(e)))?;
+            dlopen(path).map_err(fail)
+        }
+        Err(e) => Err(fail(e)),
+    }
+}
+
+fn dlopen(path: &Path) -> Result<libloading::Library, libloading::Error> {
+    // SAFETY: loading runs the library's initialisers; FMU binaries are trusted code by the
+    // nature of co-simulation.
+    unsafe {
+        #[cfg(unix)]
+        {
+            use libloading::os::unix::{Library, RTLD_LOCAL, RTLD_NOW};
+            Library::open(Some(path), RTLD_NOW | RTLD_LOCAL).map(Into::into)
+        }
+        #[cfg(not(unix))]
+        {
+            libloading::Library::new(path)
+        }
+    }
+}
+
