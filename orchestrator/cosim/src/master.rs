@@ -12,6 +12,9 @@
 //!   5. the components step from t_k to t_k+1 in order; before each steps, its FMU-to-FMU
 //!      inputs are read from their sources: at t_k+1 from a source that has already stepped,
 //!      at t_k from one that has not (a delayed connection).
+//!      With [`Algorithm::Jacobi`], every FMU-to-FMU input is read first, all from the
+//!      sources' values at t_k, and then every component steps (what libcosim's fixed-step
+//!      algorithm and other parallel masters compute).
 //!
 //! Message ports lose nothing: a framed port ([`agrisim_frames`]) holds every message of its
 //! FMU's `port_window`, and a route takes each one once, in order; a jump in the sequence
@@ -78,6 +81,22 @@ impl Snapshot {
     }
 }
 
+/// How the components step within one communication step.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Algorithm {
+    /// In the order of [`crate::order`]: a component reads its FMU-to-FMU inputs just before it
+    /// steps, at t_k+1 from the sources that have stepped already (only the connections that
+    /// close a loop are read one step late). The default: the world sees the base where it is.
+    #[default]
+    GaussSeidel,
+    /// Every FMU-to-FMU input is read from its source's value at t_k, before any component
+    /// steps; then all step (each connection one step late). This is what libcosim's
+    /// `fixed_step_algorithm` computes (it steps all simulators, then transfers every output
+    /// to the inputs used by the next step), so the same FMI 2 system gives the same values
+    /// in both masters. Initialization is the same as with [`Algorithm::GaussSeidel`].
+    Jacobi,
+}
+
 /// Most fixed-point passes initialization makes through a loop before giving up.
 const INIT_PASSES: usize = 50;
 
@@ -90,6 +109,7 @@ pub struct Master {
     delayed: Vec<bool>,
     step_ns: i64,
     message_ticks: u64,
+    algorithm: Algorithm,
     /// The next communication point.
     tick: u64,
     /// Reused buffers.
@@ -126,10 +146,23 @@ impl Master {
             delayed,
             step_ns,
             message_ticks,
+            algorithm: Algorithm::default(),
             tick: 0,
             inbound: vec![],
             framed: vec![],
         })
+    }
+
+    /// The master with `algorithm` (Gauss-Seidel unless chosen otherwise); set before the first
+    /// step.
+    pub fn with_algorithm(mut self, algorithm: Algorithm) -> Master {
+        self.algorithm = algorithm;
+        self
+    }
+
+    /// How the components step within one communication step.
+    pub fn algorithm(&self) -> Algorithm {
+        self.algorithm
     }
 
     /// The stepping order and the delayed connections.
@@ -139,7 +172,15 @@ impl Master {
 
     /// The order in words (`agrisim run --explain`).
     pub fn explain(&self) -> String {
-        order::explain(&self.system, &self.order)
+        let text = order::explain(&self.system, &self.order);
+        match self.algorithm {
+            Algorithm::GaussSeidel => text,
+            Algorithm::Jacobi => format!(
+                "Algorithm: Jacobi (every component reads its FMU inputs from the values at the start of the \
+                 step, then all step: every connection is one step late; the order below is only the order of \
+                 the calls and of initialization)\n{text}"
+            ),
+        }
     }
 
     /// Simulation time of the next communication point \[s\].
@@ -435,13 +476,28 @@ impl Master {
         Ok(())
     }
 
-    /// Step 5: every component steps in order, its FMU-to-FMU inputs read just before.
+    /// Step 5: every component steps in order, its FMU-to-FMU inputs read just before
+    /// (Gauss-Seidel); or every input is read at t_k first and then every component steps
+    /// (Jacobi).
     fn step_all(&mut self, hooks: &mut dyn Hooks) -> Result<()> {
         let k = self.tick;
         let (t, h) = (self.time(), self.step_ns as f64 / 1e9);
+        let jacobi = self.algorithm == Algorithm::Jacobi;
+        if jacobi {
+            // Every source at t_k, before any component steps.
+            for i in 0..self.order.step.len() {
+                let c = self.order.step[i];
+                for j in 0..self.inputs_of[c].len() {
+                    let r = self.inputs_of[c][j];
+                    if k.is_multiple_of(self.system.routes[r].period_ticks) {
+                        self.propagate(r, k, hooks)?;
+                    }
+                }
+            }
+        }
         for i in 0..self.order.step.len() {
             let c = self.order.step[i];
-            for j in 0..self.inputs_of[c].len() {
+            for j in 0..if jacobi { 0 } else { self.inputs_of[c].len() } {
                 let r = self.inputs_of[c][j];
                 // A source that has stepped already is at t_k+1.
                 let at = if self.delayed[r] { k } else { k + 1 };

@@ -6,10 +6,10 @@ use std::path::Path;
 /// identical `fmi*` symbols stay apart. A binary that leaves Python's C API unresolved
 /// (pythonfmu's) gets an embedded Python first ([`crate::python`]).
 pub(crate) fn open(path: &Path) -> Result<libloading::Library, String> {
-    let fail = |e: libloading::Error| format!("cannot load shared library '{}': {e}", path.display());
+    let fail = |e: libloading::Error| format!("cannot load shared library '{}': {}", path.display(), describe(&e));
     match dlopen(path) {
         Ok(lib) => Ok(lib),
-        Err(e) if crate::python::needs_python(&e.to_string()) => {
+        Err(e) if crate::python::needs_python(&describe(&e)) => {
             crate::python::ensure()
                 .map_err(|why| format!("{}; it needs an embedded Python, which failed: {why}", fail(e)))?;
             dlopen(path).map_err(fail)
@@ -34,3 +34,11 @@ fn dlopen(path: &Path) -> Result<libloading::Library, libloading::Error> {
     }
 }
 
+
+/// The loader's own words (libloading's Display alone says only "dlopen failed").
+fn describe(e: &libloading::Error) -> String {
+    match std::error::Error::source(e) {
+        Some(why) => format!("{e}: {why}"),
+        None => e.to_string(),
+    }
+}
