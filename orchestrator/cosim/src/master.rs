@@ -497,9 +497,10 @@ impl Master {
         }
         for i in 0..self.order.step.len() {
             let c = self.order.step[i];
-            for j in 0..if jacobi { 0 } else { self.inputs_of[c].len() } {
+            // Gauss-Seidel: read just before stepping; a source that has stepped is at t_k+1.
+            let gauss_seidel_inputs = if jacobi { 0 } else { self.inputs_of[c].len() };
+            for j in 0..gauss_seidel_inputs {
                 let r = self.inputs_of[c][j];
-                // A source that has stepped already is at t_k+1.
                 let at = if self.delayed[r] { k } else { k + 1 };
                 if at % self.system.routes[r].period_ticks == 0 {
                     self.propagate(r, at, hooks)?;

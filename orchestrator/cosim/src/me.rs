@@ -57,8 +57,10 @@ pub struct Integrated<I: ModelExchange> {
     z: Vec<f64>,
     z_new: Vec<f64>,
     next_event: Option<f64>,
+    /// Where the FMU's time stands (the next step must start here).
+    time: f64,
     /// The integrator's own state per saved FMU state slot.
-    saved: BTreeMap<usize, (Option<f64>, Vec<f64>)>,
+    saved: BTreeMap<usize, (Option<f64>, Vec<f64>, f64)>,
 }
 
 impl<I: ModelExchange> Integrated<I> {
@@ -73,6 +75,7 @@ impl<I: ModelExchange> Integrated<I> {
             z: vec![0.0; info.number_of_event_indicators],
             z_new: vec![0.0; info.number_of_event_indicators],
             next_event: None,
+            time: 0.0,
             saved: BTreeMap::new(),
         }
     }
@@ -212,7 +215,9 @@ impl<I: ModelExchange> FmuInstance for Integrated<I> {
         self.inner.set_debug_logging(on, categories)
     }
     fn enter_initialization_mode(&mut self, start_time: f64, stop_time: Option<f64>) -> Result<(), FmiError> {
-        self.inner.enter_initialization_mode(start_time, stop_time)
+        self.inner.enter_initialization_mode(start_time, stop_time)?;
+        self.time = start_time;
+        Ok(())
     }
 
     /// Leaves Initialization Mode into Event Mode, runs the initial event iteration and
@@ -235,6 +240,14 @@ impl<I: ModelExchange> FmuInstance for Integrated<I> {
         let end = t + h;
         // Events closer than this to a step end coincide with it (steps are whole ns).
         let eps = 1e-12 * end.abs().max(1.0);
+        // As a co-simulation FMU would: a step starts where the last one ended, and is
+        // positive and finite.
+        if !(t.is_finite() && h.is_finite() && h > 0.0 && (t - self.time).abs() <= eps) {
+            return Err(self.error(
+                "do_step (model exchange)",
+                format!("refused: a step from t={t} with h={h}; the FMU is at t={} (not called)", self.time),
+            ));
+        }
         let mut now = t;
         let mut result =
             StepResult { event_handling_needed: false, terminate_simulation: false, early_return: false, last_successful_time: end };
@@ -259,6 +272,7 @@ impl<I: ModelExchange> FmuInstance for Integrated<I> {
                 break;
             }
         }
+        self.time = result.last_successful_time;
         Ok(result)
     }
 
@@ -267,6 +281,7 @@ impl<I: ModelExchange> FmuInstance for Integrated<I> {
     }
     fn reset(&mut self) -> Result<(), FmiError> {
         self.next_event = None;
+        self.time = 0.0;
         self.inner.reset()
     }
     fn set_f64(&mut self, vrs: &[Vr], values: &[f64]) -> Result<(), FmiError> {
@@ -308,14 +323,15 @@ impl<I: ModelExchange> FmuInstance for Integrated<I> {
     /// The FMU's state and the integrator's (next time event, indicator signs) with it.
     fn get_state(&mut self) -> Result<FmuState, FmiError> {
         let s = self.inner.get_state()?;
-        self.saved.insert(s.slot, (self.next_event, self.z.clone()));
+        self.saved.insert(s.slot, (self.next_event, self.z.clone(), self.time));
         Ok(s)
     }
     fn set_state(&mut self, state: &FmuState) -> Result<(), FmiError> {
         self.inner.set_state(state)?;
-        if let Some((next, z)) = self.saved.get(&state.slot) {
+        if let Some((next, z, time)) = self.saved.get(&state.slot) {
             self.next_event = *next;
             self.z.clone_from(z);
+            self.time = *time;
         }
         if !self.x.is_empty() {
             self.inner.get_continuous_states(&mut self.x)?;

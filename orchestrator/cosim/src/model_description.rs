@@ -318,6 +318,10 @@ impl ModelDescription {
     }
 }
 
+/// More event indicators than any model has: a bound so a damaged description cannot make
+/// the importer allocate without limit.
+const MAX_EVENT_INDICATORS: usize = 1 << 20;
+
 /// The parts both FMI versions share, and one function per version.
 struct Parser<'o> {
     origin: &'o str,
@@ -670,9 +674,13 @@ impl Parser<'_> {
                 let n = root.attribute("numberOfEventIndicators").unwrap_or("0");
                 Some(ModelExchangeInfo {
                     states,
-                    number_of_event_indicators: n.trim().parse().map_err(|_| {
-                        self.err(format!("numberOfEventIndicators=\"{n}\" is not a non-negative integer"))
-                    })?,
+                    number_of_event_indicators: n.trim().parse().ok().filter(|&k: &usize| k <= MAX_EVENT_INDICATORS).ok_or_else(
+                        || {
+                            self.err(format!(
+                                "numberOfEventIndicators=\"{n}\" is not an integer in 0..={MAX_EVENT_INDICATORS}"
+                            ))
+                        },
+                    )?,
                     needs_completed_integrator_step: !self.flag(me, "completedIntegratorStepNotNeeded", false)?,
                 })
             }

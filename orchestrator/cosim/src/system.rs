@@ -124,6 +124,7 @@ impl Component {
 
 /// One end of a route.
 #[derive(Clone, Debug)]
+#[allow(clippy::large_enum_variant, reason = "built once per connection, never on a hot path")]
 pub enum Port {
     /// A variable of component `comp`; `seq` is the counter of a message port.
     Fmu { comp: usize, var: ModelVariable, seq: Option<ModelVariable> },

@@ -128,7 +128,10 @@ impl agrisim_cosim::Hooks for Record {
     }
 }
 
-fn run_harvest(overrides: BTreeMap<String, String>) -> (Vec<(usize, i64, Vec<u8>)>, Vec<Vec<u64>>) {
+/// Every message (route, stamp, bytes) and every step's signals, as bits.
+type Trace = (Vec<(usize, i64, Vec<u8>)>, Vec<Vec<u64>>);
+
+fn run_harvest(overrides: BTreeMap<String, String>) -> Trace {
     let cache = tempfile::tempdir().unwrap();
     let mut opts = LoadOptions::new(fmu_dir(), cache.path(), 0.02, 0.1);
     opts.fmu_overrides = overrides;

@@ -349,6 +349,9 @@ impl Instance {
         const F: &str = "fmi2DeSerializeFMUstate";
         let needs = [(self.core.can_serialize_state, "canSerializeFMUstate"), self.state_flags()[0]];
         let de = self.core.optional(F, &needs, self.lib.f.deserialize_fmu_state)?;
+        if matches!(saved_in, InstanceState::Fatal | InstanceState::Error) {
+            return Err(self.core.refuse(F, &[], &format!("refused: no state is saved in {saved_in:?} (not called)")));
+        }
         let mut s: ffi::Fmi2FmuState = ptr::null_mut();
         self.call(F, &[], Ctx::None, |_, h| unsafe { de(h, bytes.as_ptr() as *const c_char, bytes.len(), &mut s) })?;
         if s.is_null() {

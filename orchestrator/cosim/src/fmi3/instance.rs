@@ -496,6 +496,10 @@ impl Instance {
     /// this FMU, possibly from another instance or process); `saved_in` is restored with it.
     pub fn deserialize_state(&mut self, bytes: &[u8], saved_in: InstanceState) -> Result<FmuState, FmiError> {
         let de = self.serial_fns("fmi3DeserializeFMUState", |f| f.deserialize_fmu_state)?;
+        if matches!(saved_in, InstanceState::Fatal | InstanceState::Error) {
+            let detail = format!("refused: no state is saved in {saved_in:?} (not called)");
+            return Err(self.refuse("fmi3DeserializeFMUState", &[], &detail));
+        }
         let mut s: Fmi3FmuState = ptr::null_mut();
         self.call("fmi3DeserializeFMUState", &[], Ctx::None, |_, h| unsafe {
             de(h, bytes.as_ptr(), bytes.len(), &mut s)

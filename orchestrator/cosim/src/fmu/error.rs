@@ -121,6 +121,10 @@ impl fmt::Display for FmiErrorInfo {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write_call(f, &self.instance, &self.model, &self.function, &self.variables, self.context.as_deref())?;
         match self.status {
+            // Statuses carry the version's prefix of the function that returned them.
+            Some(s) if self.function.starts_with("fmi2") => {
+                write!(f, " returned {}: {}", s.name().replacen("fmi3", "fmi2", 1), self.reason())?
+            }
             Some(s) => write!(f, " returned {s}: {}", self.reason())?,
             None => write!(f, " failed: {}", self.reason())?,
         }
