@@ -1,6 +1,6 @@
 """A chassis built with another tool, swapped in: PyChassis (models/thirdparty/PyChassis.py)
 is a plain Python class exported by pythonfmu as an FMI 2.0 co-simulation FMU with Real
-ports and no ROS types. models/systems/swap_chassis.ssd puts it where the built-in chassis
+ports and no ROS types. models/systems/thirdparty/swap_chassis.ssd puts it where the built-in chassis
 was, behind the TwistToScalars and ScalarsToOdometry adapter FMUs, and the navigation
 benchmark is judged on it exactly as on the built-in chassis.
 

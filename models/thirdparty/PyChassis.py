@@ -4,7 +4,7 @@ co-simulation): the kind of third-party component agrisim lets users swap in.
 It knows nothing of ROS: Real velocity commands in (base frame, REP 103: x forward, y left,
 yaw counter-clockwise), Real pose and velocities out. agrisim's adapter FMUs turn
 /cmd_vel (geometry_msgs/Twist) into its inputs and its outputs into nav_msgs/Odometry
-(models/systems/swap_chassis.ssd; docs/guides/swap-component.md).
+(models/systems/thirdparty/swap_chassis.ssd; docs/guides/swap-component.md).
 
 The model: an omnidirectional base whose body velocities follow the command with
 acceleration and speed limits (the built-in chassis's wheel limits, 10 rad/s^2 and 15 rad/s

@@ -92,7 +92,8 @@ enum FmuCommand {
         /// Output directory (default: target/fmu next to the build directory).
         #[arg(long)]
         out: Option<PathBuf>,
-        /// System files to pack as .ssp archives (default: models/systems of the checkout).
+        /// System files to pack as .ssp archives (default: models/systems of the checkout);
+        /// those in its fmi2/ subdirectory are packed with the FMI 2.0 archives into fmi2/.
         #[arg(long)]
         systems: Option<PathBuf>,
         /// Where the .ssp archives go (default: target/ssp).
@@ -139,6 +140,15 @@ struct Dirs {
     cache_dir: Option<PathBuf>,
 }
 
+/// `--fmu` of `agrisim bench`: the same component swaps as `agrisim run`.
+#[derive(clap::Args, Clone)]
+struct Swaps {
+    /// Replace a component's FMU: COMPONENT=FILE.fmu (e.g. chassis=target/fmu/thirdparty/PyChassis.fmu);
+    /// on top of the scenario's [system] fmus.
+    #[arg(long = "fmu", value_parser = parse_override)]
+    fmus: Vec<(String, String)>,
+}
+
 #[derive(clap::Args, Clone)]
 struct FmuLog {
     /// FMU debug logging to stderr (off by default; warnings and errors are always shown):
@@ -164,10 +174,15 @@ impl FmuLog {
     }
 }
 
+/// `COMPONENT=FILE.fmu`. A FILE that exists from the working directory is made absolute (a
+/// user's own FMU); a bare name is looked up beside the system file, then among the packed FMUs.
 fn parse_override(s: &str) -> std::result::Result<(String, String), String> {
-    s.split_once('=')
-        .map(|(a, b)| (a.to_string(), b.to_string()))
-        .ok_or_else(|| format!("expected COMPONENT=FILE.fmu, got '{s}'"))
+    let (component, file) = s.split_once('=').ok_or_else(|| format!("expected COMPONENT=FILE.fmu, got '{s}'"))?;
+    let file = match std::fs::canonicalize(file) {
+        Ok(p) if p.is_file() => p.display().to_string(),
+        _ => file.to_string(),
+    };
+    Ok((component.to_string(), file))
 }
 
 /// target/<profile>/ of this executable, and target/.
@@ -272,7 +287,9 @@ type Bridges = std::sync::Arc<std::sync::Mutex<Vec<std::sync::Arc<std::sync::Mut
 /// registry (every benchmark with the trial flags, its own options and this CLI's run flags).
 fn command(registry: &Registry) -> clap::Command {
     let shared = |c: clap::Command| {
-        live::LiveArgs::augment_args(Record::augment_args(FmuLog::augment_args(Dirs::augment_args(c))))
+        live::LiveArgs::augment_args(Record::augment_args(FmuLog::augment_args(Swaps::augment_args(
+            Dirs::augment_args(c),
+        ))))
     };
     let overhead = OverheadArgs::augment_args(clap::Command::new("overhead"))
         .about("Orchestrator cost per FMU and step, beside the bare fmi3DoStep cost (JSON on stdout)");
@@ -326,10 +343,10 @@ fn bench(registry: &Registry, m: &clap::ArgMatches, bridges: &Bridges) -> Result
     }
     let (b, a, options) = agrisim_bench::cli::parse(registry, m)?;
     let sub = m.subcommand().expect("a benchmark was named").1;
-    let (dirs, log, record, live): (Dirs, FmuLog, Record, live::LiveArgs) =
-        (args(sub), args(sub), args(sub), args(sub));
+    let (dirs, swaps, log, record, live): (Dirs, Swaps, FmuLog, Record, live::LiveArgs) =
+        (args(sub), args(sub), args(sub), args(sub), args(sub));
     let s = Scenario::load(&a.scenario_path(b))?;
-    let mut o = run_options(dirs, &target, None, None, BTreeMap::new(), log.categories());
+    let mut o = run_options(dirs, &target, None, None, swaps.fmus.into_iter().collect(), log.categories());
     o.record = record.profile;
     // The live links run one trial at a time: trials would share the DDS topics and the port.
     let linked = live.ros2 || live.foxglove.is_some();
@@ -390,7 +407,7 @@ fn dispatch(cli: Cli, bridges: &Bridges) -> Result<()> {
                 }
             }
             let systems = systems.unwrap_or_else(|| target.parent().unwrap_or(Path::new(".")).join("models/systems"));
-            for p in pack::pack_ssps(&systems, &out, &ssp_out.unwrap_or_else(|| target.join("ssp")))? {
+            for p in pack::pack_systems(&systems, &out, &ssp_out.unwrap_or_else(|| target.join("ssp")))? {
                 println!("{}", p.display());
             }
         }

@@ -39,7 +39,7 @@ pub mod value;
 
 pub use agrisim_error::{err, Context, Error, Result};
 pub use fmu::FmuInstance;
-pub use master::{Hooks, Master, NoHooks, Snapshot};
+pub use master::{Algorithm, Hooks, Master, NoHooks, Snapshot};
 pub use order::Order;
 pub use system::{LoadOptions, Port, Route, System};
 

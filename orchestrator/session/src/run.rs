@@ -179,6 +179,7 @@ pub fn prepare(s: &Scenario, o: &RunOptions, mcap: &Path, nodes: Vec<Box<dyn Nod
         ("seed".to_string(), seed.to_string()),
         ("step".to_string(), format!("{:?}", s.timing.step)),
         ("message_rate".to_string(), format!("{:?}", s.timing.message_rate)),
+        ("algorithm".to_string(), s.timing.algorithm.name().to_string()),
     ]);
     for c in &system.components {
         run_info.insert(format!("fmu.{}", c.name), c.archive.md.model_name.clone());
@@ -187,7 +188,7 @@ pub fn prepare(s: &Scenario, o: &RunOptions, mcap: &Path, nodes: Vec<Box<dyn Nod
     for (comp, params) in applied {
         recorder.metadata(&format!("agrisim.parameters.{comp}"), params)?;
     }
-    let master = Master::new(system, s.timing.step, lo.message_period)?;
+    let master = Master::new(system, s.timing.step, lo.message_period)?.with_algorithm(s.timing.algorithm.into());
     let (mut messages, mut scalars, mut outputs) = (BTreeSet::new(), BTreeSet::new(), BTreeSet::new());
     for (r, ty) in master.system.routes.iter().zip(&types) {
         match (&r.from, &r.to, ty) {
@@ -213,7 +214,7 @@ pub fn prepare(s: &Scenario, o: &RunOptions, mcap: &Path, nodes: Vec<Box<dyn Nod
 pub fn explain(s: &Scenario, o: &RunOptions) -> Result<String> {
     let lo = load_options(s, o);
     let system = System::load(&s.system_path(), &lo)?;
-    let master = Master::new(system, s.timing.step, lo.message_period)?;
+    let master = Master::new(system, s.timing.step, lo.message_period)?.with_algorithm(s.timing.algorithm.into());
     Ok(format!("System {} ({})\n{}", master.system.structure.name, s.system_path().display(), master.explain()))
 }
 

@@ -75,11 +75,43 @@ pub struct Timing {
     /// Rate of message connections \[Hz\] (those without their own period in the system file).
     #[serde(default = "default_message_rate")]
     pub message_rate: f64,
+    /// How the components step within a step: `gauss-seidel` (the default, in the planned
+    /// order) or `jacobi` (all from the values at the step's start, as libcosim does).
+    #[serde(default)]
+    pub algorithm: MasterAlgorithm,
 }
 
 impl Default for Timing {
     fn default() -> Self {
-        Timing { step: default_step(), message_rate: default_message_rate() }
+        Timing { step: default_step(), message_rate: default_message_rate(), algorithm: MasterAlgorithm::default() }
+    }
+}
+
+/// `[timing] algorithm`: the engine's [`agrisim_cosim::master::Algorithm`], by name.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MasterAlgorithm {
+    #[default]
+    GaussSeidel,
+    Jacobi,
+}
+
+impl MasterAlgorithm {
+    /// The name a scenario gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            MasterAlgorithm::GaussSeidel => "gauss-seidel",
+            MasterAlgorithm::Jacobi => "jacobi",
+        }
+    }
+}
+
+impl From<MasterAlgorithm> for agrisim_cosim::master::Algorithm {
+    fn from(a: MasterAlgorithm) -> Self {
+        match a {
+            MasterAlgorithm::GaussSeidel => agrisim_cosim::master::Algorithm::GaussSeidel,
+            MasterAlgorithm::Jacobi => agrisim_cosim::master::Algorithm::Jacobi,
+        }
     }
 }
 
@@ -314,7 +346,22 @@ mod tests {
     fn defaults_are_the_papers_timing() {
         let s = Scenario::parse("[system]\nfile = \"a.ssd\"\n", Path::new("dir/x.toml")).unwrap();
         assert_eq!((s.timing.step, s.timing.message_rate), (0.02, 10.0));
+        assert_eq!(s.timing.algorithm, MasterAlgorithm::GaussSeidel);
         assert_eq!(s.system_path(), Path::new("dir/a.ssd"));
+    }
+
+    #[test]
+    fn the_master_algorithm_is_chosen_by_name() {
+        let parse = |a: &str| {
+            Scenario::parse(
+                &format!("[system]\nfile = \"a.ssd\"\n[timing]\nalgorithm = \"{a}\"\n"),
+                Path::new("x.toml"),
+            )
+        };
+        assert_eq!(parse("jacobi").unwrap().timing.algorithm, MasterAlgorithm::Jacobi);
+        assert_eq!(parse("gauss-seidel").unwrap().timing.algorithm.name(), "gauss-seidel");
+        let e = parse("parallel").unwrap_err();
+        assert!(e.0.contains("x.toml") && e.0.contains("jacobi"), "{e}");
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //!
 //! `fmi2Boolean` is C `int`, `fmi2Status` and `fmi2Type` are C enums (`c_int`),
 //! `fmi2ValueReference` is `unsigned int`. The logger callback is variadic C, so it lives in
-//! `logger.c` (see [`super::log`]).
+//! `logger.c` (formatted there, then handed to the instance's log sink).
 
 use std::ffi::{c_char, c_int, c_uint, c_void};
 

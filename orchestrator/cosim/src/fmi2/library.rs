@@ -61,7 +61,7 @@ pub struct Fmi2Library {
 }
 
 impl Fmi2Library {
-    /// Loads `path` (see [`crate::fmu::library::open`]) and resolves the functions
+    /// Loads `path` (now, locally; pythonfmu binaries get an embedded Python) and resolves the functions
     /// `interface` needs.
     pub fn load(path: &Path, interface: Interface) -> Result<Fmi2Library, String> {
         let lib = crate::fmu::library::open(path)?;
