@@ -249,8 +249,12 @@ impl<I: ModelExchange> FmuInstance for Integrated<I> {
             ));
         }
         let mut now = t;
-        let mut result =
-            StepResult { event_handling_needed: false, terminate_simulation: false, early_return: false, last_successful_time: end };
+        let mut result = StepResult {
+            event_handling_needed: false,
+            terminate_simulation: false,
+            early_return: false,
+            last_successful_time: end,
+        };
         while now < end - eps {
             let stop = match self.next_event {
                 Some(te) if te > now + eps && te < end - eps => te,

@@ -340,7 +340,10 @@ impl Parser<'_> {
 
     /// The interface element to use (CoSimulation when present, else ModelExchange) and
     /// its model identifier.
-    fn interface<'a, 'i>(&self, root: Node<'a, 'i>) -> Result<(Interface, Node<'a, 'i>, String), ModelDescriptionError> {
+    fn interface<'a, 'i>(
+        &self,
+        root: Node<'a, 'i>,
+    ) -> Result<(Interface, Node<'a, 'i>, String), ModelDescriptionError> {
         let (interface, el) = match (child(root, "CoSimulation"), child(root, "ModelExchange")) {
             (Some(cs), _) => (Interface::CoSimulation, cs),
             (None, Some(me)) => (Interface::ModelExchange, me),
@@ -383,7 +386,8 @@ impl Parser<'_> {
         match child(root, "DefaultExperiment").and_then(|d| d.attribute("stepSize")) {
             None => Ok(None),
             Some(v) => Ok(Some(
-                parse_f64(v).ok_or_else(|| self.err(format!("<DefaultExperiment> stepSize=\"{v}\" is not a number")))?,
+                parse_f64(v)
+                    .ok_or_else(|| self.err(format!("<DefaultExperiment> stepSize=\"{v}\" is not a number")))?,
             )),
         }
     }
@@ -440,8 +444,9 @@ impl Parser<'_> {
                     // FMI 3.0 default: continuous for Float32/64, discrete otherwise.
                     None if matches!(ty, VarType::Float32 | VarType::Float64) => Variability::Continuous,
                     None => Variability::Discrete,
-                    Some(v) => Variability::parse(v)
-                        .ok_or_else(|| self.err(format!("{what}: unknown variability \"{v}\"")))?,
+                    Some(v) => {
+                        Variability::parse(v).ok_or_else(|| self.err(format!("{what}: unknown variability \"{v}\"")))?
+                    }
                 };
                 if variability == Variability::Continuous && !matches!(ty, VarType::Float32 | VarType::Float64) {
                     return Err(self.err(format!(
@@ -449,9 +454,9 @@ impl Parser<'_> {
                     )));
                 }
                 if let Some(other) = vrs.insert(value_reference, name.clone()) {
-                    return Err(self.err(format!(
-                        "duplicate valueReference {value_reference}: used by '{other}' and '{name}'"
-                    )));
+                    return Err(
+                        self.err(format!("duplicate valueReference {value_reference}: used by '{other}' and '{name}'"))
+                    );
                 }
                 if !names.insert(name.clone()) {
                     return Err(self.err(format!("duplicate variable name '{name}'")));
@@ -586,8 +591,9 @@ impl Parser<'_> {
                     // FMI 2.0's default is continuous, which only a Real can be.
                     None if ty == VarType::Float64 => Variability::Continuous,
                     None => Variability::Discrete,
-                    Some(v) => Variability::parse(v)
-                        .ok_or_else(|| self.err(format!("{what}: unknown variability \"{v}\"")))?,
+                    Some(v) => {
+                        Variability::parse(v).ok_or_else(|| self.err(format!("{what}: unknown variability \"{v}\"")))?
+                    }
                 };
                 if variability == Variability::Continuous && ty != VarType::Float64 {
                     return Err(self.err(format!(
@@ -600,13 +606,13 @@ impl Parser<'_> {
                 }
                 derivative_of.push(match typed.attribute("derivative") {
                     None => None,
-                    Some(d) => Some(
-                        d.trim()
-                            .parse::<usize>()
-                            .ok()
-                            .filter(|&i| i >= 1)
-                            .ok_or_else(|| self.err(format!("{what}: derivative=\"{d}\" is not a variable index")))?,
-                    ),
+                    Some(d) => {
+                        Some(
+                            d.trim().parse::<usize>().ok().filter(|&i| i >= 1).ok_or_else(|| {
+                                self.err(format!("{what}: derivative=\"{d}\" is not a variable index"))
+                            })?,
+                        )
+                    }
                 });
                 let unit = if ty == VarType::Float64 { typed.attribute("unit").map(str::to_string) } else { None };
                 variables.push(ModelVariable {
@@ -674,13 +680,16 @@ impl Parser<'_> {
                 let n = root.attribute("numberOfEventIndicators").unwrap_or("0");
                 Some(ModelExchangeInfo {
                     states,
-                    number_of_event_indicators: n.trim().parse().ok().filter(|&k: &usize| k <= MAX_EVENT_INDICATORS).ok_or_else(
-                        || {
+                    number_of_event_indicators: n
+                        .trim()
+                        .parse()
+                        .ok()
+                        .filter(|&k: &usize| k <= MAX_EVENT_INDICATORS)
+                        .ok_or_else(|| {
                             self.err(format!(
                                 "numberOfEventIndicators=\"{n}\" is not an integer in 0..={MAX_EVENT_INDICATORS}"
                             ))
-                        },
-                    )?,
+                        })?,
                     needs_completed_integrator_step: !self.flag(me, "completedIntegratorStepNotNeeded", false)?,
                 })
             }

@@ -62,11 +62,7 @@ fn start() -> Result<(), String> {
         .output()
         .map_err(|e| format!("cannot run Python '{}' (set AGRISIM_PYTHON): {e}", python.display()))?;
     if !out.status.success() {
-        return Err(format!(
-            "Python '{}' failed: {}",
-            python.display(),
-            String::from_utf8_lossy(&out.stderr).trim()
-        ));
+        return Err(format!("Python '{}' failed: {}", python.display(), String::from_utf8_lossy(&out.stderr).trim()));
     }
     let text = String::from_utf8_lossy(&out.stdout).into_owned();
     let mut lines = text.lines();

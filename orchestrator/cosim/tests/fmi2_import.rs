@@ -19,7 +19,11 @@ fn root() -> PathBuf {
 
 fn fmu_dir() -> PathBuf {
     let d = root().join("target/fmu");
-    assert!(d.join("fmi2/Lift.fmu").exists(), "{} has no packed FMUs: run `target/release/agrisim fmu pack`", d.display());
+    assert!(
+        d.join("fmi2/Lift.fmu").exists(),
+        "{} has no packed FMUs: run `target/release/agrisim fmu pack`",
+        d.display()
+    );
     d
 }
 
@@ -77,7 +81,9 @@ fn every_fmi2_build_runs_ten_seconds() {
 fn fmi2_and_fmi3_builds_agree_bit_for_bit() {
     let dir = fmu_dir();
     let cache = tempfile::tempdir().unwrap();
-    for (name, inputs) in [("Lift", vec![("setpoint", 0.6)]), ("ChassisKinematic", vec![("cmd_vx", 0.4), ("cmd_wz", 0.2)])] {
+    for (name, inputs) in
+        [("Lift", vec![("setpoint", 0.6)]), ("ChassisKinematic", vec![("cmd_vx", 0.4), ("cmd_wz", 0.2)])]
+    {
         let mut results = vec![];
         for path in [dir.join(format!("{name}.fmu")), dir.join(format!("fmi2/{name}.fmu"))] {
             let a = FmuArchive::open(&path, cache.path()).unwrap();
@@ -96,7 +102,8 @@ fn fmi2_and_fmi3_builds_agree_bit_for_bit() {
                     }
                 }
                 inst.do_step(k as f64 * 0.02, 0.02).unwrap();
-                for v in a.md.variables.iter().filter(|v| v.causality == Causality::Output && v.ty == VarType::Float64) {
+                for v in a.md.variables.iter().filter(|v| v.causality == Causality::Output && v.ty == VarType::Float64)
+                {
                     let mut x = [0.0];
                     inst.get_f64(&[v.value_reference], &mut x).unwrap();
                     trace.push((v.name.clone(), x[0].to_bits()));

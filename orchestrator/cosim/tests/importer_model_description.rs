@@ -192,10 +192,18 @@ fn fmi2_mistakes_are_named() {
         assert!(e.contains(expected), "error {e:?} does not contain {expected:?}");
     };
     bad(r#" guid="{g-1}""#, "", "has no attribute 'guid'");
-    bad(r#"<Unknown index="1" dependencies=""/></Outputs>"#, r#"<Unknown index="9"/></Outputs>"#, "index 9 is not a variable");
+    bad(
+        r#"<Unknown index="1" dependencies=""/></Outputs>"#,
+        r#"<Unknown index="9"/></Outputs>"#,
+        "index 9 is not a variable",
+    );
     bad(r#"<Real derivative="1"/>"#, r#"<Real derivative="x"/>"#, r#"derivative="x" is not a variable index"#);
     bad(r#"<Integer start="3"/>"#, r#"<Int64 start="3"/>"#, "unknown FMI 2.0 type element <Int64>");
-    bad(r#"causality="input"><Boolean"#, r#"causality="input" variability="continuous"><Boolean"#, "only allowed for Real");
+    bad(
+        r#"causality="input"><Boolean"#,
+        r#"causality="input" variability="continuous"><Boolean"#,
+        "only allowed for Real",
+    );
     bad(r#"<Derivatives><Unknown index="2""#, r#"<Derivatives><Unknown index="1""#, "has no 'derivative' attribute");
 }
 

@@ -55,10 +55,15 @@ impl Instance {
         let lib = Fmi2Library::load(&archive.library_path, interface).map_err(|e| core.refuse("loading", &[], &e))?;
         let version = lib.version();
         if !version.starts_with("2.") {
-            return Err(core.refuse("fmi2GetVersion", &[], &format!("reports FMI version \"{version}\", expected 2.0")));
+            return Err(core.refuse(
+                "fmi2GetVersion",
+                &[],
+                &format!("reports FMI version \"{version}\", expected 2.0"),
+            ));
         }
         let lib = Arc::new(lib);
-        let c_name = CString::new(instance_name).map_err(|_| core.refuse(f_name, &[], "instance name contains a NUL byte"))?;
+        let c_name =
+            CString::new(instance_name).map_err(|_| core.refuse(f_name, &[], "instance name contains a NUL byte"))?;
         let c_guid = CString::new(md.instantiation_token.as_str())
             .map_err(|_| core.refuse(f_name, &[], "guid contains a NUL byte"))?;
         let c_resources = CString::new(resource_uri(&archive.resources_dir))
@@ -181,8 +186,12 @@ impl Instance {
             return Err(self.core.unsupported(F, &[], "this instance is model exchange"));
         };
         let res = self.call(F, &[], Ctx::Step(t, h), |_, c| unsafe { step(c, t, h, 1) });
-        let mut r =
-            StepResult { event_handling_needed: false, terminate_simulation: false, early_return: false, last_successful_time: t + h };
+        let mut r = StepResult {
+            event_handling_needed: false,
+            terminate_simulation: false,
+            early_return: false,
+            last_successful_time: t + h,
+        };
         match res {
             Ok(_) => Ok(r),
             Err(mut e) => {
@@ -231,8 +240,10 @@ impl Instance {
 
     pub fn set_f64(&mut self, vrs: &[Vr], values: &[f64]) -> Result<(), FmiError> {
         self.core.check_len("fmi2SetReal", vrs, values.len())?;
-        self.call("fmi2SetReal", vrs, Ctx::None, |f, h| unsafe { (f.set_real)(h, vrs.as_ptr(), vrs.len(), values.as_ptr()) })
-            .map(drop)
+        self.call("fmi2SetReal", vrs, Ctx::None, |f, h| unsafe {
+            (f.set_real)(h, vrs.as_ptr(), vrs.len(), values.as_ptr())
+        })
+        .map(drop)
     }
 
     pub fn get_f64(&mut self, vrs: &[Vr], values: &mut [f64]) -> Result<(), FmiError> {
@@ -270,8 +281,10 @@ impl Instance {
     pub fn set_bool(&mut self, vrs: &[Vr], values: &[bool]) -> Result<(), FmiError> {
         self.core.check_len("fmi2SetBoolean", vrs, values.len())?;
         let v: Vec<c_int> = values.iter().map(|&x| b(x)).collect();
-        self.call("fmi2SetBoolean", vrs, Ctx::None, |f, h| unsafe { (f.set_boolean)(h, vrs.as_ptr(), vrs.len(), v.as_ptr()) })
-            .map(drop)
+        self.call("fmi2SetBoolean", vrs, Ctx::None, |f, h| unsafe {
+            (f.set_boolean)(h, vrs.as_ptr(), vrs.len(), v.as_ptr())
+        })
+        .map(drop)
     }
 
     pub fn get_bool(&mut self, vrs: &[Vr], values: &mut [bool]) -> Result<(), FmiError> {
@@ -285,7 +298,8 @@ impl Instance {
     }
 
     pub fn set_string(&mut self, vr: Vr, value: &str) -> Result<(), FmiError> {
-        let c = CString::new(value).map_err(|_| self.core.refuse("fmi2SetString", &[vr], "the string contains a NUL byte"))?;
+        let c = CString::new(value)
+            .map_err(|_| self.core.refuse("fmi2SetString", &[vr], "the string contains a NUL byte"))?;
         let p = c.as_ptr();
         self.call("fmi2SetString", &[vr], Ctx::None, |f, h| unsafe { (f.set_string)(h, &vr, 1, &p) }).map(drop)
     }
@@ -426,8 +440,10 @@ impl crate::me::ModelExchange for Instance {
     }
 
     fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), FmiError> {
-        self.me_call("fmi2SetContinuousStates", Ctx::None, |f, h| unsafe { (f.set_continuous_states)(h, x.as_ptr(), x.len()) })
-            .map(drop)
+        self.me_call("fmi2SetContinuousStates", Ctx::None, |f, h| unsafe {
+            (f.set_continuous_states)(h, x.as_ptr(), x.len())
+        })
+        .map(drop)
     }
 
     fn get_continuous_states(&mut self, x: &mut [f64]) -> Result<(), FmiError> {
@@ -438,8 +454,10 @@ impl crate::me::ModelExchange for Instance {
     }
 
     fn get_derivatives(&mut self, dx: &mut [f64]) -> Result<(), FmiError> {
-        self.me_call("fmi2GetDerivatives", Ctx::None, |f, h| unsafe { (f.get_derivatives)(h, dx.as_mut_ptr(), dx.len()) })
-            .map(drop)
+        self.me_call("fmi2GetDerivatives", Ctx::None, |f, h| unsafe {
+            (f.get_derivatives)(h, dx.as_mut_ptr(), dx.len())
+        })
+        .map(drop)
     }
 
     fn get_event_indicators(&mut self, z: &mut [f64]) -> Result<(), FmiError> {

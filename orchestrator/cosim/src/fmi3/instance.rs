@@ -21,16 +21,15 @@ use std::ptr;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
-use crate::fmu::error::write_call;
-use crate::fmu::{FmiError, FmiErrorInfo, InstanceState};
 use super::ffi::{self, Fmi3FmuState, Fmi3Instance, Vr};
 use super::library::{Fmi3Library, Functions};
-use crate::fmu::log::{log_callback, LogMessage, LogSink};
-use crate::fmu::{Status, StepResult};
 use crate::archive::FmuArchive;
+use crate::fmu::error::write_call;
+use crate::fmu::log::{log_callback, LogMessage, LogSink};
 pub use crate::fmu::FmuState;
+use crate::fmu::{FmiError, FmiErrorInfo, InstanceState};
+use crate::fmu::{Status, StepResult};
 use crate::model_description::{FmiVersion, Interface};
-
 
 /// Call context for messages, formatted only when a message needs it (never on the
 /// per-step success path).

@@ -7,9 +7,9 @@ use std::ffi::c_void;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
-use super::{FmiError, FmuState, InstanceState, Status, Vr};
 use super::error::{write_call, FmiErrorInfo};
 use super::log::LogSink;
+use super::{FmiError, FmuState, InstanceState, Status, Vr};
 
 /// Call context for messages, formatted only when a message needs it.
 #[derive(Clone, Copy)]
@@ -68,7 +68,8 @@ impl Core {
     /// Before an FFI call: refused after Fatal; else the log mark to pass to [`Core::after`].
     pub(crate) fn before(&self, function: &str, vrs: &[Vr], context: Ctx) -> Result<u64, FmiError> {
         if self.state == InstanceState::Fatal {
-            let mut e = self.refuse(function, vrs, "refused: this instance returned a fatal status earlier and is unusable");
+            let mut e =
+                self.refuse(function, vrs, "refused: this instance returned a fatal status earlier and is unusable");
             e.status = Some(Status::Fatal);
             e.context = context.text();
             return Err(e);

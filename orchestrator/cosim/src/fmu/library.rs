@@ -34,7 +34,6 @@ fn dlopen(path: &Path) -> Result<libloading::Library, libloading::Error> {
     }
 }
 
-
 /// The loader's own words (libloading's Display alone says only "dlopen failed").
 fn describe(e: &libloading::Error) -> String {
     match std::error::Error::source(e) {

@@ -13,10 +13,10 @@ pub(crate) mod library;
 pub(crate) mod log;
 mod status;
 
+use crate::model_description::{FmiVersion, Interface};
 pub use error::{FmiError, FmiErrorInfo};
 pub use log::LogMessage;
 pub use status::{Status, StepResult};
-use crate::model_description::{FmiVersion, Interface};
 
 /// Where the instance is in the FMI state machine, as far as the wrapper knows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
