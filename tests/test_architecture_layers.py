@@ -2,7 +2,7 @@
 which (normal dependencies, followed transitively through the workspace).
 
   fmus/ (environment, robot, sensors)  <-  orchestrator/cosim (engine)
-  orchestrator/bus (messages)  <-  algorithm nodes (nodes, nav, manip, trajectory, harvest)
+  orchestrator/bus (messages)  <-  algorithm nodes (nodes, nav, manip, trajectory, harvest, perception)
   session (engine + bus)  <-  bench  <-  cli, python (the pyo3 package; siblings on top)
   bus  <-  bridges (ros2: DDS, foxglove: WebSocket): they carry messages, like a node
 
@@ -21,7 +21,10 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 
-ALGORITHMS = {"agrisim-nodes", "agrisim-nav", "agrisim-harvest", "agrisim-manip", "agrisim-trajectory"}
+ALGORITHMS = {"agrisim-nodes", "agrisim-nav", "agrisim-harvest", "agrisim-manip", "agrisim-trajectory", "agrisim-perception"}
+# The perception node sees images, depth, CameraInfo and TF only: besides the algorithm rule,
+# it must reach no FMU crate at all (the world, the camera: their ground truth).
+PERCEPTION = "agrisim-perception"
 ENGINE = "agrisim-cosim"
 # The greenhouse libraries: scene generation, ray casting, sun and weather, glTF export.
 SCENE = {"agrisim-scene", "agrisim-raycast", "agrisim-sky", "agrisim-gltf"}
@@ -32,7 +35,7 @@ MESSAGES = "agrisim-msgs"
 BUS = "agrisim-bus"
 PYTHON = "agrisim-python"
 BRIDGES = {"agrisim-ros2", "agrisim-foxglove"}
-ABOVE = {"agrisim-session", "agrisim-bench", "agrisim", PYTHON}
+ABOVE = {"agrisim-session", "agrisim-bench", "agrisim-dataset", "agrisim", PYTHON}
 
 # crate -> crates it must not reach (directly or through other workspace crates), and why.
 FORBIDDEN = {
@@ -263,3 +266,28 @@ def test_harness_check_can_fail(metadata):
         f"agrisim has {FMI_TESTING} as a build dependency: it is a dev-dependency only",
         f"agrisim-fmu-lift has {FMI_TESTING} as a normal dependency: it is a dev-dependency only",
     ]
+
+
+def perception_violations(graph, fmus):
+    """What the perception node links that could hand it ground truth: the engine, scene
+    generation or any FMU crate (the world FMU above all)."""
+    banned = {ENGINE} | SCENE | set(fmus)
+    return [
+        f"{PERCEPTION} depends on {t} ({' -> '.join(path)}): perception sees only messages"
+        for t, path in sorted(reach(graph, PERCEPTION).items())
+        if t in banned
+    ]
+
+
+def test_perception_links_no_engine_scene_or_world(graph, fmus):
+    assert PERCEPTION in graph
+    assert perception_violations(graph, fmus) == []
+    # The check can fail: a dependency on the world FMU, direct or through another crate.
+    world = next(name for name, ident in fmus.items() if ident == "Greenhouse")
+    broken = {k: set(v) for k, v in graph.items()}
+    broken[PERCEPTION].add(world)
+    assert any(v.startswith(f"{PERCEPTION} depends on {world}") for v in perception_violations(broken, fmus))
+    broken = {k: set(v) for k, v in graph.items()}
+    broken[MESSAGES].add("agrisim-scene")
+    found = perception_violations(broken, fmus)
+    assert any("agrisim-perception -> agrisim-msgs -> agrisim-scene" in v for v in found), found

@@ -343,11 +343,72 @@ EXPECTED.update({
     },
 })
 
+# Perception types (vision_msgs 4.x); mirrors vision_samples() in samples.rs.
+_VCOV = [0.0] * 36
+for _i in range(3):
+    _VCOV[_i * 7] = 2.5e-5 * (_i + 1)
+
+
+def hypothesis(class_id, score, x, y, z):
+    return {"hypothesis": {"class_id": class_id, "score": score},
+            "pose": {"pose": pose(x, y, z, IDENT), "covariance": list(_VCOV)}}
+
+
+def tomato(id_, class_id, score):
+    return {
+        "header": hdr(9, 100_000_000, "camera_color_optical_frame"),
+        "results": [hypothesis(class_id, score, 0.125, -0.25, 0.75)],
+        "bbox": {"center": pose(0.125, -0.25, 0.75, IDENT), "size": v3(0.0625, 0.0625, 0.0625)},
+        "id": id_,
+    }
+
+
+EXPECTED.update({
+    "object_hypothesis": {"class_id": "ripe", "score": 0.875},
+    "object_hypothesis_with_pose": hypothesis("stage_6", 0.5, 1.0, 2.0, 0.5),
+    "bounding_box3d": {"center": pose(1.0, 2.0, 3.0, IDENT), "size": v3(0.5, 0.25, 0.125)},
+    "detection3d": tomato("17", "stage_5", 0.75),
+    "detection3d_array": {
+        "header": hdr(9, 100_000_000, "camera_color_optical_frame"),
+        "detections": [tomato("17", "stage_5", 0.75), tomato("", "stage_1", 0.25)],
+    },
+    "detection3d_array_empty": {"header": hdr(0, 0, ""), "detections": []},
+})
+
 # control_msgs is not in rosbags' stores; its definition (ros-controls/control_msgs,
 # msg/GripperCommand.msg, identical in ROS 1 and ROS 2) is checked here instead.
-NOT_IN_ROSBAGS_STORES = {"control_msgs/msg/GripperCommand": [("position", "float64"), ("max_effort", "float64")]}
+# vision_msgs is not in them either; its field layout (ros-perception/vision_msgs 4.x, the
+# ROS 2 Humble/Jazzy release) is written out here from that package's msg/ files.
+NOT_IN_ROSBAGS_STORES = {
+    "control_msgs/msg/GripperCommand": [("position", "float64"), ("max_effort", "float64")],
+    "vision_msgs/msg/ObjectHypothesis": [("class_id", "string"), ("score", "float64")],
+    "vision_msgs/msg/ObjectHypothesisWithPose": [
+        ("hypothesis", "vision_msgs/msg/ObjectHypothesis"),
+        ("pose", "geometry_msgs/msg/PoseWithCovariance"),
+    ],
+    "vision_msgs/msg/BoundingBox3D": [("center", "geometry_msgs/msg/Pose"), ("size", "geometry_msgs/msg/Vector3")],
+    "vision_msgs/msg/Detection3D": [
+        ("header", "std_msgs/msg/Header"),
+        ("results", "vision_msgs/msg/ObjectHypothesisWithPose[]"),
+        ("bbox", "vision_msgs/msg/BoundingBox3D"),
+        ("id", "string"),
+    ],
+    "vision_msgs/msg/Detection3DArray": [("header", "std_msgs/msg/Header"), ("detections", "vision_msgs/msg/Detection3D[]")],
+}
 
 # ----------------------------------------------------------------------------- helpers
+
+
+def _field_type(d):
+    """A rosbags field definition as .msg spells its type: `float64`, `pkg/msg/Type`, `T[]`."""
+    kind, rest = d
+    if kind == typesys.base.Nodetype.BASE:
+        return rest[0]
+    if kind == typesys.base.Nodetype.NAME:
+        return rest
+    if kind == typesys.base.Nodetype.SEQUENCE:
+        return _field_type(rest[0]) + "[]"
+    raise AssertionError(f"field kind {kind} not expected here")
 
 
 def _samples_cmd(*args: str) -> list[str]:
@@ -425,7 +486,7 @@ SAMPLE_NAMES = sorted(EXPECTED)
 def test_samples_cover_every_msg_file(samples):
     assert set(samples) == set(EXPECTED)
     assert {t for t, _, _ in samples.values()} == set(msg_files())
-    assert len(msg_files()) == 46
+    assert len(msg_files()) == 51
 
 
 @pytest.mark.parametrize("name", SAMPLE_NAMES)
@@ -518,7 +579,7 @@ def test_msg_texts_match_ros2_distro(rosbags_store, store_name):
             continue
         if name in NOT_IN_ROSBAGS_STORES:
             assert name not in ref.fielddefs, name  # if rosbags gains it, compare there
-            got = [(f, d[1][0]) for f, d in rosbags_store.fielddefs[name][1]]
+            got = [(f, _field_type(d)) for f, d in rosbags_store.fielddefs[name][1]]
             assert got == NOT_IN_ROSBAGS_STORES[name], name
             continue
         assert rosbags_store.fielddefs[name] == ref.fielddefs[name], name

@@ -1,28 +1,45 @@
 //! The `Camera` model: at every frame instant (k / frame_rate on simulation time) renders the
-//! scene from the latest base pose input and publishes colour, depth, CameraInfo and labels.
+//! scene from the latest base pose and robot inputs and publishes colour, depth, CameraInfo and
+//! labels; at its first step it publishes its own frames for TF.
 //!
 //! The frame due at T is rendered during the step that reaches T, from the pose at the step's
 //! start (the chassis pose at T is not known yet): up to one communication step of lag
 //! (2 cm at 1 m/s with the 0.02 s step). Global shutter; colour and depth are co-registered
 //! (as the driver's aligned depth), one optical frame.
+//!
+//! Where the camera is: camera_link at the mount pose in the frame of the URDF link
+//! `mount_parent` (base_link, the lift carriage, a wrist...), which the robot's forward
+//! kinematics (`agrisim_robot::model`, the world's and the LiDAR's) place from the lift and arm
+//! inputs; the optical frame is camera_link turned to z forward, x right, y down. The same
+//! chain is what TF gives: robot_state_publisher's base_link -> mount_parent, then this
+//! camera's `tf_static` (mount_parent -> link_frame -> frame_id).
 
 use crate::image;
 use crate::lighting::Lighting;
-use crate::optics::{CameraPose, Intrinsics, Mount};
+use crate::optics::{CameraPose, Intrinsics, Mount, OPTICAL_IN_BODY};
 use crate::ports::*;
 use crate::render::{self, DepthModel, DepthNoise, Frame, Shot};
 use crate::scene::Scene;
 use agrisim_fmi::{Log, Model, OutPort, Store, Var};
 use agrisim_math::Rng;
+use agrisim_msgs::builtin_interfaces::Time;
+use agrisim_msgs::geometry_msgs::{Quaternion, Transform, TransformStamped, Vector3};
+use agrisim_msgs::std_msgs::Header;
+use agrisim_msgs::tf2_msgs::TFMessage;
 use agrisim_msgs::Message;
 use agrisim_raycast::SunColumns;
+use agrisim_robot::model::RobotModel;
+use agrisim_robot::Pose as RPose;
 use agrisim_schedule::{to_ns, Schedule};
-use agrisim_sensor_ports::robot::{Coords, RobotBody};
+use agrisim_sensor_ports::robot::{self as robot_ports, Coords, RobotBody};
 use agrisim_sky::environment::Environment;
 use agrisim_sky::weather::Conditions;
 use std::sync::Arc;
 
 pub use crate::ports::MAX_SIDE;
+
+/// The optical frame in camera_link (a pure rotation).
+const OPTICAL: RPose = RPose { rot: OPTICAL_IN_BODY, trans: [0.0; 3] };
 
 #[derive(Clone, Debug)]
 pub struct Config {
@@ -40,6 +57,14 @@ pub struct Config {
     pub conditions: Option<Conditions>,
     pub threads: usize,
     pub frame_id: String,
+    /// TF name of camera_link (the body frame the mount places).
+    pub link_frame: String,
+    /// The link the camera rides on: its name and index in `model`'s links.
+    pub parent: (String, usize),
+    /// camera_link in the parent link's frame (`mount` as a transform).
+    pub mount_pose: RPose,
+    /// The robot's kinematics (the URDF), which place the parent link.
+    pub model: Arc<RobotModel>,
     /// The robot's own body (base box and, with `robot_links`, its URDF links).
     pub robot: RobotBody,
     pub robot_links: bool,
@@ -52,20 +77,23 @@ pub struct Camera {
     config: Option<Config>,
     schedule: Schedule,
     rng: Rng,
-    /// image, depth, camera_info, labels.
-    ports: Option<[OutPort; 4]>,
+    /// image, depth, camera_info, labels, tf_static.
+    ports: Option<[OutPort; 5]>,
+    /// The camera's frames went out on tf_static (at the first step).
+    tf_sent: bool,
     window_ns: i64,
     /// The last frame's buffers, rendered into again (derived: not serialized).
     #[serde(skip)]
     frame: Frame,
 }
 
-fn new_ports() -> [OutPort; 4] {
+fn new_ports() -> [OutPort; 5] {
     [
         OutPort::new(IMAGE, IMAGE_SEQ),
         OutPort::new(DEPTH, DEPTH_SEQ),
         OutPort::new(CAMERA_INFO, CAMERA_INFO_SEQ),
         OutPort::new(LABELS_IMAGE, LABELS_SEQ),
+        OutPort::new(TF_STATIC, TF_STATIC_SEQ),
     ]
 }
 
@@ -103,6 +131,21 @@ impl Config {
             m => return Err(format!("parameter depth_noise_model must be 0 (none), 1 (fixed) or 2 (stereo), got {m}")),
         };
         let mount = SENSOR_PORTS.mount(io)?;
+        let model = robot_ports::model()?;
+        let parent_name = io.string(MOUNT_PARENT).trim().to_string();
+        let parent = model.link_index(&parent_name).ok_or_else(|| {
+            format!(
+                "parameter mount_parent = {parent_name:?} is not a link of the robot (agrisim_robot.urdf); its links: {}",
+                model.link_names.join(", ")
+            )
+        })?;
+        let link_frame = frame_name(io, LINK_FRAME)?;
+        let frame_id = frame_name(io, FRAME_ID)?;
+        if link_frame == frame_id || link_frame == parent_name || frame_id == parent_name {
+            return Err(format!(
+                "parameters mount_parent, link_frame and frame_id must name three different frames, got {parent_name:?}, {link_frame:?}, {frame_id:?}"
+            ));
+        }
         let conditions = match io.string(ENVIRONMENT).trim() {
             "" => None,
             text => Some(Conditions::of(
@@ -121,9 +164,16 @@ impl Config {
         };
         let scene = SENSOR_PORTS.scene(io)?;
         let columns = Arc::new(render::sun_columns(&scene, &light));
+        // The camera's own housing, if the URDF has it (the default camera's camera_link), is
+        // left out: the rays start inside it. Any other camera sees it.
+        let robot = RobotBody::new(scene.object_count() as u32, SENSOR_PORTS.base_box(io)?, &link_frame)?;
         Ok(Config {
-            robot: SENSOR_PORTS.robot_body(io, scene.object_count() as u32)?,
+            robot,
             robot_links: io.bool(ROBOT_LINKS),
+            mount_pose: RPose::from_xyz_rpy(mount.translation, [mount.roll, mount.pitch, mount.yaw]),
+            parent: (parent_name, parent),
+            model,
+            link_frame,
             scene,
             intrinsics: Intrinsics::from_fov(width, height, fov_h, fov_v),
             period: 1.0 / rate,
@@ -140,40 +190,102 @@ impl Config {
             labels: io.bool(LABELS),
             conditions,
             threads,
-            frame_id: io.string(FRAME_ID).to_string(),
+            frame_id,
         })
+    }
+
+    /// The optical frame in base_link with the robot at `coords` (the URDF's forward
+    /// kinematics to the parent link, then the mount, then the optical axes).
+    pub fn optical_in_base(&self, coords: &Coords) -> RPose {
+        let mut fk = Vec::new();
+        self.model.fk(coords, &mut fk);
+        fk[self.parent.1].mul(&self.mount_pose).mul(&OPTICAL)
+    }
+
+    /// The optical frame in the map with base_link at (x, y, yaw) and the robot at `coords`.
+    pub fn camera_pose(&self, coords: &Coords, x: f64, y: f64, yaw: f64) -> CameraPose {
+        let p = RPose::from_xyz_rpy([x, y, 0.0], [0.0, 0.0, yaw]).mul(&self.optical_in_base(coords));
+        CameraPose { origin: p.trans, rotation: p.rot }
+    }
+
+    /// The camera's fixed frames stamped `stamp_ns`: parent -> link_frame (the mount) and
+    /// link_frame -> frame_id (the optical axes), as a static TF broadcaster sends them.
+    pub fn tf_static(&self, stamp_ns: i64) -> TFMessage {
+        TFMessage {
+            transforms: vec![
+                stamped(stamp_ns, &self.parent.0, &self.link_frame, &self.mount_pose),
+                stamped(stamp_ns, &self.link_frame, &self.frame_id, &OPTICAL),
+            ],
+        }
     }
 }
 
+/// A TF frame name parameter: non-empty, no blanks, no leading '/' (tf2 refuses those).
+fn frame_name(io: &Store, i: usize) -> Result<String, String> {
+    let v = io.string(i);
+    if v.is_empty() || v.starts_with('/') || v.chars().any(char::is_whitespace) {
+        return Err(format!(
+            "parameter {} = {v:?} is not a TF frame name (non-empty, no blanks, no leading '/')",
+            VARIABLES[i].name
+        ));
+    }
+    Ok(v.to_string())
+}
+
+fn stamped(stamp_ns: i64, parent: &str, child: &str, p: &RPose) -> TransformStamped {
+    let [x, y, z, w] = p.quaternion();
+    TransformStamped {
+        header: Header::new(Time::from_nanos(stamp_ns), parent),
+        child_frame_id: child.to_string(),
+        transform: Transform {
+            translation: Vector3 { x: p.trans[0], y: p.trans[1], z: p.trans[2] },
+            rotation: Quaternion { x, y, z, w },
+        },
+    }
+}
+
+/// The lift and arm inputs, which place the camera whether or not it sees the links
+/// (finite, below 1e3, as the shared readers require).
+fn placement(io: &Store) -> Result<Coords, String> {
+    let get = |i: usize| {
+        let v = io.f64(i);
+        if v.is_finite() && v.abs() < 1e3 {
+            Ok(v)
+        } else {
+            Err(format!("input {} = {v} is not finite or beyond 1e3", VARIABLES[i].name))
+        }
+    };
+    let p = &SENSOR_PORTS;
+    let mut c = Coords { lift: get(p.lift)?, ..Coords::default() };
+    for side in 0..2 {
+        for (q, &i) in c.arms[side].iter_mut().zip(&p.arms[side]) {
+            *q = get(i)?;
+        }
+        c.widths[side] = get(p.widths[side])?;
+    }
+    Ok(c)
+}
+
 impl Camera {
-    /// Renders a frame with base_link at (x, y, yaw) (advances the noise generator); the
-    /// arms, if seen, in their default (ready) pose.
+    /// Renders a frame with base_link at (x, y, yaw) (advances the noise generator), the robot
+    /// in its default configuration (lift down, arms in the ready pose).
     pub fn capture(&mut self, x: f64, y: f64, yaw: f64) -> Frame {
-        self.capture_on_lift(x, y, yaw, 0.0)
+        self.capture_at(x, y, yaw, &Coords::default())
     }
 
-    /// As [`Camera::capture`] with the lift (and the camera on it) raised by `lift` metres.
-    pub fn capture_on_lift(&mut self, x: f64, y: f64, yaw: f64, lift: f64) -> Frame {
-        let links = self.config.as_ref().is_some_and(|c| c.robot_links);
-        let coords = links.then(|| Coords { lift, ..Coords::default() });
-        self.capture_posed(x, y, yaw, lift, coords.as_ref())
-    }
-
-    /// A frame with the camera raised by `lift` and the robot's links at `coords` (None: the
-    /// base box only).
-    pub fn capture_posed(&mut self, x: f64, y: f64, yaw: f64, lift: f64, coords: Option<&Coords>) -> Frame {
+    /// A frame with base_link at (x, y, yaw) and the robot at `coords`: they place the camera
+    /// (on its parent link) and, with `robot_links`, the links it sees.
+    pub fn capture_at(&mut self, x: f64, y: f64, yaw: f64, coords: &Coords) -> Frame {
         let mut frame = Frame::default();
-        self.render_posed(&mut frame, x, y, yaw, lift, coords);
+        self.render_posed(&mut frame, x, y, yaw, coords);
         frame
     }
 
-    /// [`Camera::capture_posed`] into `frame`'s buffers.
-    fn render_posed(&mut self, frame: &mut Frame, x: f64, y: f64, yaw: f64, lift: f64, coords: Option<&Coords>) {
+    /// [`Camera::capture_at`] into `frame`'s buffers.
+    fn render_posed(&mut self, frame: &mut Frame, x: f64, y: f64, yaw: f64, coords: &Coords) {
         let c = self.config.as_ref().expect("initialized");
-        let robot = c.robot.objects(coords, x, y, yaw);
-        let mut mount = c.mount;
-        mount.translation[2] += lift;
-        let pose = CameraPose::new(&mount, x, y, yaw);
+        let robot = c.robot.objects(c.robot_links.then_some(coords), x, y, yaw);
+        let pose = c.camera_pose(coords, x, y, yaw);
         let shot = Shot {
             scene: &c.scene,
             dynamic: &robot,
@@ -215,6 +327,7 @@ impl Model for Camera {
         self.rng = Rng::new(io.i32(NOISE_SEED) as u32 as u64);
         self.window_ns = agrisim_fmi::port::window_ns(io, PORT_WINDOW)?;
         self.ports = Some(new_ports());
+        self.tf_sent = false;
         self.sync(io, to_ns(start_time));
         let (zenith, azimuth, visibility) = match &config.conditions {
             Some(c) => (c.sun.zenith, c.sun.azimuth, c.visibility),
@@ -229,13 +342,16 @@ impl Model for Camera {
 
     fn do_step(&mut self, io: &mut Store, t: f64, h: f64, _log: &mut dyn Log) -> Result<(), String> {
         let (x, y, yaw) = SENSOR_PORTS.base_pose(io)?;
-        let lift = io.f64(LIFT_POSITION);
-        if !(lift.is_finite() && lift.abs() < 100.0) {
-            return Err(format!("input lift_position = {lift} is not finite or beyond 100 m"));
+        let coords = placement(io)?;
+        if !self.tf_sent {
+            let c = self.config.as_ref().ok_or("not initialized")?;
+            let stamp = to_ns(t);
+            let tf = c.tf_static(stamp).to_cdr();
+            self.ports.get_or_insert_with(new_ports)[4].publish(stamp, tf);
+            self.tf_sent = true;
         }
         if let Some(stamp) = self.schedule.due(t + h) {
-            let coords = SENSOR_PORTS.coords(io)?;
-            self.capture_and_publish(io, stamp, x, y, yaw, lift, coords.as_ref());
+            self.capture_and_publish(io, stamp, x, y, yaw, &coords);
         }
         self.sync(io, to_ns(t + h));
         Ok(())
@@ -250,19 +366,9 @@ impl Camera {
         }
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn capture_and_publish(
-        &mut self,
-        io: &mut Store,
-        stamp: i64,
-        x: f64,
-        y: f64,
-        yaw: f64,
-        lift: f64,
-        coords: Option<&Coords>,
-    ) {
+    fn capture_and_publish(&mut self, io: &mut Store, stamp: i64, x: f64, y: f64, yaw: f64, coords: &Coords) {
         let mut frame = std::mem::take(&mut self.frame);
-        self.render_posed(&mut frame, x, y, yaw, lift, coords);
+        self.render_posed(&mut frame, x, y, yaw, coords);
         let c = self.config.as_ref().expect("initialized");
         let (w, hh, id) = (c.intrinsics.width, c.intrinsics.height, c.frame_id.as_str());
         let info = c.intrinsics.camera_info(stamp, id).to_cdr();

@@ -7,6 +7,7 @@ use agrisim_fmi::{Start, Var};
 
 pub const IMAGE_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=sensor_msgs/msg/Image";
 pub const CAMERA_INFO_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=sensor_msgs/msg/CameraInfo";
+pub const TF_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=tf2_msgs/msg/TFMessage";
 
 /// Room for a message's header, metadata and frame_id [bytes]: all of CameraInfo, and what
 /// an Image adds to its pixels.
@@ -21,11 +22,18 @@ pub const fn image_max_size(bytes_per_pixel: usize) -> usize {
     side * side * bytes_per_pixel + HEADER_ROOM
 }
 
-// camera_link on base_link (x forward, y left, z up; the optical frame is z forward, x right,
-// y down relative to it).
+// camera_link (x forward, y left, z up; the optical frame is z forward, x right, y down
+// relative to it) on the link `mount_parent`: by default the URDF's camera_joint, on the lift
+// carriage (camera_link at (0.32, 0, 0.60 + lift) on base_link, agrisim_robot.urdf). The
+// shared table's descriptions say "on base_link": the mount is in mount_parent's frame, which
+// is base_link only when mount_parent says so.
 agrisim_sensor_ports::sensor_variables! { pub VARIABLES {
-  mount: "camera_link" (0.6, 0.0, 1.2),
+  mount: "camera_link" (0.12, 0.0, 0.15),
   params: {
+    MOUNT_PARENT = Var::param("mount_parent", Start::String("lift_link"))
+        .desc("URDF link (agrisim_robot.urdf) the camera is mounted on; mount_x..mount_yaw are camera_link's pose in its frame, and the camera moves with it (posed from lift_position and the arm inputs by the robot's forward kinematics): base_link, lift_link (the lift carriage, default), <side>_hand or <side>_link7 (a wrist), or any other link"),
+    LINK_FRAME = Var::param("link_frame", Start::String("camera_link"))
+        .desc("TF name of the camera body frame (REP 103: x forward, y left, z up) that the mount places; a URDF link of that name is the camera's own housing, left out of its view"),
     ENVIRONMENT = Var::param("environment", Start::String(""))
         .desc("The keys of the scenario's [environment] table as TOML (no header): date, time, place, weather, render quality; empty = the fixed sun of sun_azimuth / sun_elevation / ambient. Changes images, never geometry"),
     RENDER_THREADS = Var::param("render_threads", Start::Int32(2))
@@ -65,7 +73,7 @@ agrisim_sensor_ports::sensor_variables! { pub VARIABLES {
     LABELS = Var::param("publish_labels", Start::Boolean(true))
         .desc("Publish the instance-label image (32SC1: scene object id + 1, 0 = nothing)"),
     FRAME_ID = Var::param("frame_id", Start::String("camera_color_optical_frame"))
-        .desc("header.frame_id of images and CameraInfo (optical convention: z forward, x right, y down)"),
+        .desc("header.frame_id of images and CameraInfo, child of link_frame in TF (optical convention: z forward, x right, y down)"),
     PORT_WINDOW = agrisim_fmi::port_window(),
   },
   ports: {
@@ -92,6 +100,10 @@ agrisim_sensor_ports::sensor_variables! { pub VARIABLES {
         .desc("With environment: the sun's compass azimuth, clockwise from north (NREL SPA); else the map angle sun_azimuth"),
     VISIBILITY = Var::output_discrete("visibility", Start::Float64(0.0)).unit("m").init_depends_on(&[ENVIRONMENT])
         .desc("Meteorological visibility of the environment (Koschmieder, 3.912 / extinction); 0 = no environment (clear air)"),
+    TF_STATIC = Var::output_discrete("tf_static", Start::Binary(&[])).mime(TF_MIME).max_size(agrisim_fmi::port::frames_max_size(HEADER_ROOM, 2))
+        .init_depends_on(&[])
+        .desc("The camera's fixed frames, once, at the first step (CDR frames), tf2_msgs/TFMessage: mount_parent -> link_frame (the mount) and link_frame -> frame_id (the optical axes); wired to /tf_static, they hang the camera on the robot's TF tree as robot_state_publisher publishes it"),
+    TF_STATIC_SEQ = Var::output_discrete("tf_static_seq", Start::Int64(0)).init_depends_on(&[]).desc("Sequence counter of tf_static"),
     VALID_DEPTH = Var::output_discrete("valid_depth_pixels", Start::Int32(0)).init_depends_on(&[])
         .desc("Pixels with depth data in the latest frame"),
   },

@@ -3,7 +3,8 @@
 //! sensor's failure modes and noise. Rows are rendered on several threads; every pixel's
 //! result (noise included) depends on the pixel alone, so frames are bit-reproducible.
 
-use crate::lighting::{self, Lighting};
+use crate::crop;
+use crate::lighting::Lighting;
 use crate::optics::{ray_through, CameraPose, Intrinsics, Vec3};
 use crate::scene::Scene;
 use crate::shading::{self, Palette};
@@ -156,9 +157,10 @@ struct Ctx<'a> {
 enum Surface {
     /// Sky (or nothing), final linear RGB.
     Sky([f64; 3]),
-    /// A surface: the shadow ray's start `p` (just off it), the normal's z, cos(incidence) of
-    /// the sun, transmittance of the layers seen through, fog path length, the object.
-    Lit { p: Vec3, n_z: f64, cos_sun: f64, through: f64, fog_path: f64, object: u32 },
+    /// A surface: the shadow ray's start `p` (just off it), the normal `n` (facing the ray),
+    /// the ray's direction `d`, cos(incidence) of the sun, transmittance of the layers seen
+    /// through, fog path length, the object.
+    Lit { p: Vec3, n: Vec3, d: Vec3, cos_sun: f64, through: f64, fog_path: f64, object: u32 },
 }
 
 /// Panes of glass or film a camera ray sees through (beyond: the last one is shown).
@@ -212,6 +214,7 @@ impl Ctx<'_> {
                 dirs[i] = mat_vec(&self.pose.rotation, d_opt[i]);
             }
             self.scene.caster.cast_packet(self.pose.origin, &dirs[..n], 0.0, FAR, self.movers, &mut hits[..n]);
+            crop::resolve_packet(self.scene, self.movers, self.pose.origin, &dirs[..n], FAR, &mut hits[..n]);
             for i in 0..n {
                 let j = (i / cols) * w + u0 + i % cols;
                 (z[j], labels[j]) = match &hits[i] {
@@ -253,6 +256,7 @@ impl Ctx<'_> {
         for (du, dv) in SUB {
             let ds = mat_vec(&self.pose.rotation, self.k.ray(u + du, v + dv));
             let hs = self.scene.caster.cast_among(self.pose.origin, ds, 0.0, FAR, self.movers);
+            let hs = crop::resolve(self.scene, self.movers, self.pose.origin, ds, FAR, hs);
             let c = self.radiance(ds, hs.as_ref());
             (0..3).for_each(|i| acc[i] += 0.25 * c[i]);
         }
@@ -273,8 +277,9 @@ impl Ctx<'_> {
         let mut at = [[0.0; 3]; MAX_PACKET];
         let mut m = 0;
         for (i, s) in surfaces.iter().enumerate() {
-            if let Surface::Lit { p, cos_sun, .. } = *s {
+            if let Surface::Lit { p, cos_sun, object, .. } = *s {
                 if l.sun_up && cos_sun > 0.0 {
+                    let p = crop::shadow_start(self.scene, object, p, l.sun);
                     let d2 =
                         (p[0] - o[0]) * (p[0] - o[0]) + (p[1] - o[1]) * (p[1] - o[1]) + (p[2] - o[2]) * (p[2] - o[2]);
                     lit[m] = ((d2 as f32).to_bits() as u64) << 32 | i as u64;
@@ -362,7 +367,9 @@ impl Ctx<'_> {
     fn radiance(&self, d: Vec3, hit: Option<&Hit>) -> [f64; 3] {
         let s = self.surface(d, hit);
         let beam = match s {
-            Surface::Lit { p, cos_sun, .. } if self.light.sun_up && cos_sun > 0.0 => self.beam(p),
+            Surface::Lit { p, cos_sun, object, .. } if self.light.sun_up && cos_sun > 0.0 => {
+                self.beam(crop::shadow_start(self.scene, object, p, self.light.sun))
+            }
             _ => 0.0,
         };
         self.shade(&s, beam)
@@ -378,7 +385,8 @@ impl Ctx<'_> {
             for _ in 0..SEE_THROUGH {
                 match layers.pane(&kind, tau) {
                     Some(beyond) => {
-                        layers.hit = self.scene.caster.cast_among(self.pose.origin, d, beyond, FAR, self.movers)
+                        let h = self.scene.caster.cast_among(self.pose.origin, d, beyond, FAR, self.movers);
+                        layers.hit = crop::resolve(self.scene, self.movers, self.pose.origin, d, FAR, h);
                     }
                     None => break,
                 }
@@ -416,7 +424,7 @@ impl Ctx<'_> {
                 &mut out[..m],
             );
             for q in 0..m {
-                layers[which[q]].hit = out[q];
+                layers[which[q]].hit = crop::resolve(self.scene, self.movers, self.pose.origin, sub[q], FAR, out[q]);
             }
         }
     }
@@ -446,19 +454,19 @@ impl Ctx<'_> {
             o[1] + hit.distance * d[1] + EPS * nrm[1],
             o[2] + hit.distance * d[2] + EPS * nrm[2],
         ];
-        Surface::Lit { p, n_z: nrm[2], cos_sun, through, fog_path: hit.distance.min(inside), object: hit.object }
+        Surface::Lit { p, n: nrm, d, cos_sun, through, fog_path: hit.distance.min(inside), object: hit.object }
     }
 
     /// Linear RGB of a surface given the unblocked fraction of the sun's beam on it.
     fn shade(&self, s: &Surface, beam: f64) -> [f64; 3] {
         let l = self.light;
-        let (n_z, cos_sun, through, fog_path, object) = match *s {
+        let (p, n, d, cos_sun, through, fog_path, object) = match *s {
             Surface::Sky(c) => return c,
-            Surface::Lit { n_z, cos_sun, through, fog_path, object, .. } => (n_z, cos_sun, through, fog_path, object),
+            Surface::Lit { p, n, d, cos_sun, through, fog_path, object } => {
+                (p, n, d, cos_sun, through, fog_path, object)
+            }
         };
-        let e = lighting::irradiance(l, cos_sun, beam, n_z) * through;
-        let a = self.palette.albedo(self.scene.kind(object));
-        let c = [a[0] * e, a[1] * e, a[2] * e];
+        let c = crop::radiance(self.scene, &self.palette, l, object, p, n, d, cos_sun, beam).map(|v| v * through);
         match l.fog {
             Some(f) => {
                 let t = (-f.beta * fog_path).exp();

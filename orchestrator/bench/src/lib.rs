@@ -16,6 +16,7 @@ pub mod initial_pose;
 pub mod map;
 pub mod nav;
 pub mod overhead;
+pub mod perception;
 pub mod row;
 
 pub use framework::cli;
@@ -24,7 +25,7 @@ pub use overhead::{overhead, OverheadReport};
 
 /// The built-in benchmarks, in the order `agrisim bench --help` lists them.
 pub fn registry() -> Registry {
-    Registry::default().with(&nav::Nav).with(&harvest::Harvest).with(&row::Row)
+    Registry::default().with(&nav::Nav).with(&harvest::Harvest).with(&row::Row).with(&perception::PerceptionBench)
 }
 
 #[cfg(test)]

@@ -68,6 +68,38 @@ enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// A synthetic perception dataset: per frame RGB, depth (16-bit mm), instance masks, camera
+    /// intrinsics and pose, fruit poses; one COCO file (categories: ripeness stages). Seeded
+    /// domain randomization of robot pose, camera mount, sun, weather, crop, exposure.
+    Dataset {
+        #[arg(long, default_value = "models/scenarios/default.toml")]
+        scenario: PathBuf,
+        /// Number of frames.
+        #[arg(long)]
+        frames: u64,
+        /// Seed of every random draw (two runs with one seed write identical files).
+        #[arg(long)]
+        seed: u64,
+        /// Spread the frames over this many greenhouses (seeds scene seed + 0..K), in blocks.
+        #[arg(long, default_value_t = 1)]
+        scenes: u64,
+        /// Image width [px] (default: the scenario's [parameters.camera], else 1280).
+        #[arg(long)]
+        width: Option<u32>,
+        /// Image height [px] (default: the scenario's [parameters.camera], else 720).
+        #[arg(long)]
+        height: Option<u32>,
+        /// Complete the dataset in DIR (same settings): keep its complete frames, render the rest.
+        #[arg(long)]
+        resume: bool,
+        /// Rewrite DIR/annotations.json after every this many frames (and at the end).
+        #[arg(long, default_value_t = 25)]
+        coco_every: u64,
+        #[command(flatten)]
+        dirs: Dirs,
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// The greenhouse scene.
     Scene {
         #[command(subcommand)]
@@ -389,6 +421,19 @@ fn dispatch(cli: Cli, bridges: &Bridges) -> Result<()> {
             for p in snapshot::snapshot(&s, &opts, &out)? {
                 println!("{}", p.display());
             }
+        }
+        Command::Dataset { scenario, frames, seed, scenes, width, height, resume, coco_every, dirs, out } => {
+            let s = Scenario::load(&scenario)?;
+            let opts = run_options(dirs, &target, None, None, BTreeMap::new(), None);
+            let o = agrisim_dataset::Options { frames, seed, scenes, width, height, resume, coco_every, out };
+            let summary = agrisim_dataset::write(&s, &opts, &o, &mut progress_printer())?;
+            println!(
+                "{} frames ({} rendered now), {} annotations -> {}",
+                summary.frames,
+                summary.rendered,
+                summary.annotations,
+                summary.coco.display()
+            );
         }
         Command::Scene { command: SceneCommand::Export { scenario, out } } => {
             let s = Scenario::load(&scenario)?;

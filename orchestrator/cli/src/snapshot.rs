@@ -37,11 +37,8 @@ fn open(s: &Scenario, o: &RunOptions, file: &str, name: &str, pose: [f64; 3]) ->
         value::set(&mut inst, &var("environment")?, &Value::Str(environment))?;
     }
     let given = s.parameters.get(name);
+    // The camera's default mount is the robot's camera_link on the lift carriage (URDF).
     let mut robot = vec![("lift_position".to_string(), LIFT)];
-    if name == "camera" {
-        // On the lift carriage, as on the robot (camera_link at (0.32, 0, 0.60 + lift), agrisim_robot.urdf).
-        robot.extend([("mount_x".to_string(), 0.32), ("mount_z".to_string(), 0.60)]);
-    }
     for side in ["left", "right"] {
         robot.extend(ARMS.iter().enumerate().map(|(i, &q)| (format!("{side}_q{}", i + 1), q)));
     }

@@ -44,6 +44,7 @@ pub mod shape_msgs;
 pub mod std_msgs;
 pub mod tf2_msgs;
 pub mod trajectory_msgs;
+pub mod vision_msgs;
 
 pub use cdr::{CdrError, CdrField, CdrReader, CdrWriter, CDR_LE_HEADER};
 pub use check::check_cdr;

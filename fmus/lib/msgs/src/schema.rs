@@ -76,6 +76,11 @@ msg_table! {
     "agrisim_msgs" / "PlanningScene",
     "agrisim_msgs" / "HarvestStatus",
     "agrisim_msgs" / "PlanResult",
+    "vision_msgs" / "ObjectHypothesis",
+    "vision_msgs" / "ObjectHypothesisWithPose",
+    "vision_msgs" / "BoundingBox3D",
+    "vision_msgs" / "Detection3D",
+    "vision_msgs" / "Detection3DArray",
 }
 
 /// Every type this crate knows, as `pkg/msg/Type`.

@@ -14,6 +14,9 @@ pub struct CastScene {
     pub caster: RayCaster,
     /// Kind per object id (ids dense from 0).
     pub kinds: Vec<Kind>,
+    /// Shape and placement per object id, for the camera's detail inside an object's
+    /// collider (a fruit's shape and calyx, a leaflet's outline).
+    pub geometry: Vec<(Shape, Placement)>,
 }
 
 impl std::fmt::Debug for CastScene {
@@ -26,12 +29,14 @@ impl CastScene {
     /// Any object list with dense ids (for tests and tools).
     pub fn from_objects(objects: &[Object]) -> CastScene {
         let mut kinds = vec![Kind::Obstacle; objects.len()];
+        let mut geometry = vec![(Shape::Sphere { radius: 0.0 }, Placement::IDENTITY); objects.len()];
         for o in objects {
-            if let Some(k) = kinds.get_mut(o.id as usize) {
+            if let (Some(k), Some(g)) = (kinds.get_mut(o.id as usize), geometry.get_mut(o.id as usize)) {
                 *k = o.kind;
+                *g = (o.shape, o.placement);
             }
         }
-        CastScene { caster: RayCaster::new(objects), kinds }
+        CastScene { caster: RayCaster::new(objects), kinds, geometry }
     }
 
     pub fn object_count(&self) -> usize {

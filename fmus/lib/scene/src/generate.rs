@@ -33,6 +33,9 @@ impl Greenhouse {
 // Stream labels, so sub-streams of different purposes never coincide.
 const PLANT: u64 = 1;
 const OBSTACLE: u64 = 2;
+/// The shape of one compound leaf (a stream of its own, so the plant's stream draws what it
+/// always drew and the trusses and fruit stay where they were).
+const LEAFLET: u64 = 3;
 
 /// Thickness of the walls, floor slab and roof [m].
 const SLAB: f64 = 0.2;
@@ -84,7 +87,7 @@ impl Builder {
 
 fn estimate(cfg: &GreenhouseConfig) -> usize {
     let plants = (cfg.row_length / cfg.plant_spacing) as usize;
-    let per_plant = 1 + cfg.leaf_density + cfg.trusses_per_plant * (1 + cfg.fruit_per_truss);
+    let per_plant = 1 + cfg.leaf_density * (2 + 2 * MAX_PAIRS) + cfg.trusses_per_plant * (1 + 2 * cfg.fruit_per_truss);
     let per_row = plants * per_plant + (cfg.row_length / cfg.post_spacing) as usize + 4;
     cfg.rows * per_row + 8 + cfg.obstacles.len() + cfg.random_obstacles + cfg.block_aisles.len()
 }
@@ -163,7 +166,8 @@ fn plant(b: &mut Builder, cfg: &GreenhouseConfig, seed: u64, r: usize, p: usize,
     let stem = Shape::Cylinder { radius: cfg.stem_radius, half_height: 0.5 * h };
     b.push(format!("row{r}/plant{p}/stem"), Kind::Stem, stem, Placement::at(sx, sy, 0.5 * h));
 
-    // Leaves: flat boxes, evenly layered up the stem, random yaw and droop, alternating sides.
+    // Leaves: compound leaves (see [`compound_leaf`]), evenly layered up the stem, random yaw
+    // and droop, alternating sides, each inside the box the single leaf blob used to fill.
     let nl = cfg.leaf_density;
     for k in 0..nl {
         let l = rng.range(0.8, 1.0) * cfg.leaf_size[0].min(cfg.row_width);
@@ -180,13 +184,33 @@ fn plant(b: &mut Builder, cfg: &GreenhouseConfig, seed: u64, r: usize, p: usize,
         let (lo, hi) = probe.aabb();
         let (ext_x, ext_y) = (0.5 * (hi[0] - lo[0]), 0.5 * (hi[1] - lo[1]));
         let room = (half_env - ext_y).max(0.0);
-        obj.translation[1] = y + side * rng.range(0.3, 1.0) * room;
+        // The leaf's base (local -x end) at the stem: its centre half a length out along the
+        // leaf's axis, kept in the row envelope. (The two draws that used to place the blob
+        // are still drawn, so everything drawn after them is where it was.)
+        let (_, _) = (rng.range(0.3, 1.0), rng.range(-0.25, 0.25));
+        let axis = probe.placement.transform_point([0.5 * l, 0.0, 0.0]);
+        let want_y = sy + (axis[1] - y);
+        obj.translation[1] = want_y.clamp(y - room, y + room);
         // Within the row's x range too (the headland stays clear).
         let lx = x - (p as f64 + 0.5) * cfg.plant_spacing + ext_x + 1e-6;
         let hx = lx - 2.0 * ext_x + cfg.row_length - 2e-6;
-        let want = sx + rng.range(-0.25, 0.25) * cfg.plant_spacing;
+        let want = axis[0];
         obj.translation[0] = if lx <= hx { want.clamp(lx, hx) } else { 0.5 * (lx + hx) };
-        b.push(format!("row{r}/plant{p}/leaf{k}"), Kind::Leaf, Shape::Box { half }, obj);
+        let mut shape_rng = Rng::stream(seed, &[LEAFLET, r as u64, p as u64, k as u64]);
+        // 3 or 4 pairs of leaflets by position, not by seed: a scene's object count (and so
+        // its ids) is the same for every seed.
+        let pairs = 3 + (k + p) % 2;
+        for (j, (kind_name, shape, local)) in compound_leaf(half, pairs, &mut shape_rng).into_iter().enumerate() {
+            let pl = Placement {
+                translation: obj.transform_point(local.translation),
+                rotation: quat_mul(rot, local.rotation),
+            };
+            let name = match kind_name {
+                LeafPart::Rachis => format!("row{r}/plant{p}/leaf{k}"),
+                LeafPart::Leaflet => format!("row{r}/plant{p}/leaf{k}_{j}"),
+            };
+            b.push(name, Kind::Leaf, shape, pl);
+        }
     }
 
     // Trusses: levels spread over the fruit band, alternate sides, facing the aisles.
@@ -236,8 +260,129 @@ fn plant(b: &mut Builder, cfg: &GreenhouseConfig, seed: u64, r: usize, p: usize,
                 Shape::Sphere { radius },
                 Placement::at(fx, fy, fz),
             );
+            // The pedicel: from the top of the fruit's collider (where the calyx sits, see
+            // the camera's crop module) up to the nearest point of the truss.
+            let along = ((fx - sx) * cy_ + (fy - sy) * sy_).clamp(0.0, len);
+            let top = [fx, fy, fz + radius];
+            let mut q = [sx + cy_ * along, sy + sy_ * along, zt];
+            // (A fruit right at the truss still gets one, so the count never depends on the
+            // seed.)
+            q[2] = q[2].max(top[2] + 2.0 * PEDICEL_RADIUS);
+            if let Some((shape, pl)) = rod(top, q, PEDICEL_RADIUS) {
+                b.push(format!("row{r}/plant{p}/pedicel{t}_{f}"), Kind::Truss, shape, pl);
+            }
         }
     }
+}
+
+/// Radius of a pedicel [m] (3-4 mm thick: our reading of photographs). SEINet's "Solanum
+/// lycopersicum" gives pedicels 1-1.2 cm long; ours run from the fruit to the truss, as long
+/// as the fruit hangs below it (0-5 cm, more where fruit were moved apart).
+pub const PEDICEL_RADIUS: f64 = 0.002;
+
+/// A cylinder of `radius` from `a` to `b` (None if they are less than a radius apart).
+fn rod(a: [f64; 3], b: [f64; 3], radius: f64) -> Option<(Shape, Placement)> {
+    let v = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    if len < radius {
+        return None;
+    }
+    let u = [v[0] / len, v[1] / len, v[2] / len];
+    // The rotation taking local z onto u: about z x u by acos(u_z).
+    let axis = [-u[1], u[0], 0.0];
+    let s = (axis[0] * axis[0] + axis[1] * axis[1]).sqrt();
+    let rotation = if s < 1e-12 {
+        if u[2] > 0.0 {
+            [0.0, 0.0, 0.0, 1.0]
+        } else {
+            [1.0, 0.0, 0.0, 0.0]
+        }
+    } else {
+        quat_axis_angle([axis[0] / s, axis[1] / s, 0.0], u[2].clamp(-1.0, 1.0).acos())
+    };
+    let translation = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]), 0.5 * (a[2] + b[2])];
+    Some((Shape::Cylinder { radius, half_height: 0.5 * len }, Placement { translation, rotation }))
+}
+
+/// What a part of a compound leaf is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LeafPart {
+    /// Petiole and rachis, one rod from the stem to the terminal leaflet.
+    Rachis,
+    Leaflet,
+}
+
+/// Most pairs of lateral leaflets of a compound leaf.
+pub const MAX_PAIRS: usize = 4;
+/// Half thickness of a leaflet [m] (a tomato leaflet is 0.2-0.3 mm thick; 2 mm keeps rays
+/// and contacts robust).
+pub const LEAFLET_HALF_THICKNESS: f64 = 0.001;
+/// Radius of the petiole and rachis [m] (4-5 mm thick at the base).
+pub const RACHIS_RADIUS: f64 = 0.0025;
+
+/// One tomato leaf inside the box of half extents `half` (local x from the base at -x to the
+/// tip at +x, leaf blade in the xy plane): the petiole and rachis, a terminal leaflet and 3 or
+/// 4 (`pairs`) pairs of lateral leaflets (7 or 9 leaflets), each a thin box whose outline (ovate,
+/// serrate) the camera cuts out of it. Parts in the leaf's frame.
+///
+/// Morphology: SEINet, Arizona flora, "Solanum lycopersicum" (leaves irregularly pinnately
+/// compound, 20-40 cm long, 7-10 cm wide; primary lateral leaflets 3-4(-5) pairs, 2-5 cm long,
+/// 0.8-2.5 cm wide, ovate to elliptic, apex acute-attenuate, margin dentate-crenate; terminal
+/// leaflet usually larger, 3-6 x 1.5-3 cm; petiole 1.2-6 cm) and Britton and Brown,
+/// Illustrated Flora (1913), "Lycopersicon": "the larger [leaflets] 7-9, ovate or
+/// ovate-lanceolate, ... dentate". Small interstitial leaflets are left out. Leaflets are
+/// half as long as wide (the ratios above), the terminal one 0.3 of the leaf, the bare petiole
+/// 0.2 of it; laterals stand 40-60 deg off the rachis toward the tip and grow toward the tip
+/// (our reading of photographs).
+pub fn compound_leaf(half: [f64; 3], pairs: usize, rng: &mut Rng) -> Vec<(LeafPart, Shape, Placement)> {
+    let (hx, hy) = (half[0], half[1]);
+    let len = 2.0 * hx;
+    let pairs = pairs.clamp(1, MAX_PAIRS);
+    let t_len = (0.3 * len).min(2.0 * 2.0 * hy * 0.95);
+    let t_wid = 0.5 * t_len;
+    let mut parts = Vec::with_capacity(2 + 2 * pairs);
+    // Petiole + rachis to the terminal leaflet's base, along local x (local z -> x).
+    let along_x = quat_axis_angle([0.0, 1.0, 0.0], FRAC_PI_2);
+    let r_end = hx - t_len;
+    parts.push((
+        LeafPart::Rachis,
+        Shape::Cylinder { radius: RACHIS_RADIUS.min(half[2]), half_height: 0.5 * (r_end + hx) },
+        Placement { translation: [0.5 * (r_end - hx), 0.0, 0.0], rotation: along_x },
+    ));
+    parts.push((
+        LeafPart::Leaflet,
+        Shape::Box { half: [0.5 * t_len, 0.5 * t_wid, LEAFLET_HALF_THICKNESS] },
+        Placement::at(hx - 0.5 * t_len, 0.0, 0.0),
+    ));
+    let gap = RACHIS_RADIUS;
+    let x_a = -hx + 0.2 * len;
+    for i in 0..pairs {
+        // Nearer the tip: later and larger.
+        let grow = 0.75 + 0.25 * (i + 1) as f64 / pairs as f64;
+        for side in [1.0, -1.0] {
+            let alpha = rng.range(40f64.to_radians(), 60f64.to_radians());
+            let (sa, ca) = alpha.sin_cos();
+            // Longest leaflet (width half its length) whose box stays within the leaf's width.
+            let fit = (hy - gap * sa) / (sa + 0.25 * ca);
+            let l_len = (0.28 * len * grow).min(fit) * rng.range(0.9, 1.0);
+            let l_wid = 0.5 * l_len;
+            let fwd = (gap + l_len) * ca + 0.5 * l_wid * sa;
+            let back = 0.5 * l_wid * sa;
+            let x_b = (hx - 0.6 * t_len - fwd).max(x_a);
+            let x0 = if pairs > 1 { x_a + (x_b - x_a) * i as f64 / (pairs - 1) as f64 } else { x_a };
+            let x0 = x0.clamp(-hx + back, hx - fwd);
+            let d = gap + 0.5 * l_len;
+            // Left leaflets just above the blade's mid-plane, right ones just below: no two
+            // overlap in one plane.
+            let z = side * 2.0 * LEAFLET_HALF_THICKNESS;
+            parts.push((
+                LeafPart::Leaflet,
+                Shape::Box { half: [0.5 * l_len, 0.5 * l_wid, LEAFLET_HALF_THICKNESS] },
+                Placement::axis_angle([x0 + d * ca, side * d * sa, z], [0.0, 0.0, 1.0], side * alpha),
+            ));
+        }
+    }
+    parts
 }
 
 /// Gap kept between neighbouring fruit [m].

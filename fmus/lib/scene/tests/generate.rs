@@ -1,7 +1,8 @@
 //! Determinism, naming, and the layout's promises (free aisles, headland, start pose).
 
+use agrisim_scene::generate::{compound_leaf, LeafPart};
 use agrisim_scene::occupancy::OccupancyMap;
-use agrisim_scene::{generate, GreenhouseConfig, Kind, Object, Shape};
+use agrisim_scene::{generate, GreenhouseConfig, Kind, Object, Placement, Shape};
 
 fn cfg(s: &str) -> GreenhouseConfig {
     GreenhouseConfig::from_toml_str(s).unwrap()
@@ -75,7 +76,15 @@ fn default_scene_counts_and_fruit_heights() {
     let count = |k: fn(&Kind) -> bool| g.objects.iter().filter(|o| k(&o.kind)).count();
     assert_eq!(count(|k| *k == Kind::Stem), plants);
     assert_eq!(count(|k| matches!(k, Kind::Fruit { .. })), plants * 4 * 5);
-    assert_eq!(count(|k| *k == Kind::Leaf), plants * 6);
+    // Compound leaves: per leaf a rachis (named leaf{k}) and 7 or 9 leaflets (leaf{k}_{j}).
+    let rachises = g.objects.iter().filter(|o| o.kind == Kind::Leaf && !o.name.contains('_')).count();
+    assert_eq!(rachises, plants * 6);
+    let leaflets = count(|k| *k == Kind::Leaf) - rachises;
+    assert_eq!(leaflets, plants * 6 / 2 * (7 + 9));
+    // A pedicel per fruit, from the top of its collider up to its truss.
+    let pedicels: Vec<&Object> = g.objects.iter().filter(|o| o.name.contains("/pedicel")).collect();
+    assert_eq!(pedicels.len(), plants * 4 * 5);
+    assert_eq!(count(|k| *k == Kind::Truss), plants * 4 * 6);
     let mut stages = [0usize; 6];
     for o in &g.objects {
         if let Kind::Fruit { ripeness } = o.kind {
@@ -246,4 +255,70 @@ fn fruit_of_a_plant_do_not_interpenetrate() {
     // A handful may keep their place when neither hanging lower nor higher fits the band.
     assert!(overlapping * 1000 < pairs, "{overlapping} of {pairs} fruit pairs interpenetrate");
     eprintln!("{overlapping} of {pairs} same-plant fruit pairs interpenetrate");
+}
+
+#[test]
+fn compound_leaves_have_7_to_9_leaflets_inside_the_leaf() {
+    for (seed, pairs) in [(1, 3), (2, 4), (3, 3), (4, 4)] {
+        let half = [0.14, 0.09, 0.005];
+        let mut rng = agrisim_math::Rng::new(seed);
+        let parts = compound_leaf(half, pairs, &mut rng);
+        let leaflets = parts.iter().filter(|p| p.0 == LeafPart::Leaflet).count();
+        assert_eq!(leaflets, 2 * pairs + 1);
+        assert!((7..=9).contains(&leaflets));
+        assert_eq!(parts.iter().filter(|p| p.0 == LeafPart::Rachis).count(), 1);
+        let mut lateral = 0;
+        for (part, shape, pl) in &parts {
+            let o = Object { id: 0, name: String::new(), kind: Kind::Leaf, shape: *shape, placement: *pl };
+            let (lo, hi) = o.aabb();
+            for i in 0..3 {
+                assert!(lo[i] >= -half[i] - 1e-12 && hi[i] <= half[i] + 1e-12, "{part:?} {lo:?} {hi:?}");
+            }
+            if let (LeafPart::Leaflet, Shape::Box { half: h }) = (part, shape) {
+                // Longer than wide, at most 0.3 of the leaf.
+                assert!(h[0] > h[1] && 2.0 * h[0] <= 0.3 * 2.0 * half[0] + 1e-12);
+                if pl.translation[1].abs() > 1e-9 {
+                    lateral += 1;
+                    // Pointing out from the rachis and toward the tip, 40-60 deg off it.
+                    let tip = o.placement.transform_point([h[0], 0.0, 0.0]);
+                    let dir = [tip[0] - pl.translation[0], tip[1] - pl.translation[1]];
+                    let angle = (dir[1].abs()).atan2(dir[0]).to_degrees();
+                    assert!((40.0..=60.0).contains(&angle), "{angle}");
+                    assert!(dir[1] * pl.translation[1] > 0.0);
+                }
+            }
+        }
+        assert_eq!(lateral, 2 * pairs);
+    }
+}
+
+#[test]
+fn pedicels_rise_from_the_fruit_top_to_the_truss() {
+    let c = cfg("rows = 2\nactive_rows = 2\nwidth = 12.0\nlength = 20.0\nrow_length = 4.0");
+    let g = generate(&c, 3);
+    let mut n = 0;
+    for f in g.objects.iter().filter(|o| matches!(o.kind, Kind::Fruit { .. })) {
+        let Shape::Sphere { radius } = f.shape else { panic!("fruit {} is no sphere", f.name) };
+        let name = f.name.replace("/fruit", "/pedicel");
+        let p = g.objects.iter().find(|o| o.name == name).expect("a pedicel per fruit");
+        let Shape::Cylinder { half_height, .. } = p.shape else { panic!() };
+        let ends = [-half_height, half_height].map(|z| p.placement.transform_point([0.0, 0.0, z]));
+        let (low, high) = if ends[0][2] < ends[1][2] { (ends[0], ends[1]) } else { (ends[1], ends[0]) };
+        let c = f.placement.translation;
+        let top = [c[0], c[1], c[2] + radius];
+        assert!((0..3).all(|i| (low[i] - top[i]).abs() < 1e-9), "{} starts at {low:?}, top {top:?}", p.name);
+        assert!(high[2] > top[2]);
+        // The upper end lies on the truss's axis (or just above a fruit touching it).
+        let truss_name = f.name.split("/fruit").next().unwrap().to_string()
+            + "/truss"
+            + f.name.rsplit("/fruit").next().unwrap().split('_').next().unwrap();
+        let truss = g.objects.iter().find(|o| o.name == truss_name).expect("truss");
+        let local = Placement { translation: truss.placement.translation, rotation: truss.placement.rotation };
+        let m = local.matrix();
+        let d = [0, 1, 2].map(|i| high[i] - local.translation[i]);
+        let off_axis = [0, 1].map(|j| (0..3).map(|i| m[i][j] * d[i]).sum::<f64>());
+        assert!(off_axis[0].hypot(off_axis[1]) < 1e-9 || high[2] - top[2] < 0.0041, "{}", p.name);
+        n += 1;
+    }
+    assert!(n > 100);
 }

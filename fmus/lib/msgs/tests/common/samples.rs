@@ -18,6 +18,9 @@ use agrisim_msgs::shape_msgs::SolidPrimitive;
 use agrisim_msgs::std_msgs::{Float64, Header};
 use agrisim_msgs::tf2_msgs::TFMessage;
 use agrisim_msgs::trajectory_msgs::{JointTrajectory, JointTrajectoryPoint};
+use agrisim_msgs::vision_msgs::{
+    BoundingBox3D, Detection3D, Detection3DArray, ObjectHypothesis, ObjectHypothesisWithPose,
+};
 use agrisim_msgs::{CdrError, Message};
 use std::fmt::Debug;
 
@@ -290,7 +293,55 @@ fn manipulation_samples() -> Vec<Sample> {
 pub fn all_samples() -> Vec<Sample> {
     let mut all = base_samples();
     all.extend(manipulation_samples());
+    all.extend(vision_samples());
     all
+}
+
+fn hypothesis(class_id: &str, score: f64, x: f64, y: f64, z: f64) -> ObjectHypothesisWithPose {
+    let mut cov = [0.0; 36];
+    for i in 0..3 {
+        cov[i * 7] = 2.5e-5 * (i + 1) as f64;
+    }
+    ObjectHypothesisWithPose {
+        hypothesis: ObjectHypothesis { class_id: class_id.into(), score },
+        pose: PoseWithCovariance { pose: pose(x, y, z, Quaternion::IDENTITY), covariance: cov },
+    }
+}
+
+fn tomato(id: &str, class_id: &str, score: f64) -> Detection3D {
+    Detection3D {
+        header: hdr(9, 100_000_000, "camera_color_optical_frame"),
+        results: vec![hypothesis(class_id, score, 0.125, -0.25, 0.75)],
+        bbox: BoundingBox3D {
+            center: pose(0.125, -0.25, 0.75, Quaternion::IDENTITY),
+            size: Vector3 { x: 0.0625, y: 0.0625, z: 0.0625 },
+        },
+        id: id.into(),
+    }
+}
+
+/// Samples of the perception types (vision_msgs).
+fn vision_samples() -> Vec<Sample> {
+    vec![
+        sample("object_hypothesis", ObjectHypothesis { class_id: "ripe".into(), score: 0.875 }),
+        sample("object_hypothesis_with_pose", hypothesis("stage_6", 0.5, 1.0, 2.0, 0.5)),
+        sample(
+            "bounding_box3d",
+            BoundingBox3D {
+                center: pose(1.0, 2.0, 3.0, Quaternion::IDENTITY),
+                size: Vector3 { x: 0.5, y: 0.25, z: 0.125 },
+            },
+        ),
+        sample("detection3d", tomato("17", "stage_5", 0.75)),
+        sample(
+            "detection3d_array",
+            Detection3DArray {
+                header: hdr(9, 100_000_000, "camera_color_optical_frame"),
+                detections: vec![tomato("17", "stage_5", 0.75), tomato("", "stage_1", 0.25)],
+            },
+        ),
+        sample("detection3d_array_empty", Detection3DArray::default()),
+    ]
 }
 
 fn base_samples() -> Vec<Sample> {

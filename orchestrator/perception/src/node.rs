@@ -1,0 +1,289 @@
+//! The perception node: RGB, aligned depth, CameraInfo and TF in; vision_msgs detections in
+//! the camera frame and in the world frame, and the fruit map, out. A frame it cannot use
+//! (no CameraInfo yet, no valid depth, no TF to a world frame, a malformed image) is skipped
+//! and reported on /agrisim/status, never a panic or an error of the run.
+
+use crate::colour::STAGES;
+use crate::detect::{Detection, Detector, DetectorConfig, Frame, Intrinsics};
+use crate::tf::TfBuffer;
+use crate::tracker::{FruitMap, Observation};
+use agrisim_bus::{Bus, Node, Reader};
+use agrisim_error::Result;
+use agrisim_msgs::agrisim::FmuStatus;
+use agrisim_msgs::builtin_interfaces::Time;
+use agrisim_msgs::geometry_msgs::{Point, Pose, PoseWithCovariance, Quaternion, Vector3};
+use agrisim_msgs::sensor_msgs::{CameraInfo, Image};
+use agrisim_msgs::std_msgs::Header;
+use agrisim_msgs::tf2_msgs::TFMessage;
+use agrisim_msgs::vision_msgs::{
+    BoundingBox3D, Detection3D, Detection3DArray, ObjectHypothesis, ObjectHypothesisWithPose,
+};
+use nalgebra::{Isometry3, Point3};
+
+pub const IMAGE: &str = "/camera/color/image_raw";
+pub const DEPTH: &str = "/camera/aligned_depth_to_color/image_raw";
+pub const CAMERA_INFO: &str = "/camera/color/camera_info";
+pub const TF: &str = "/tf";
+pub const TF_STATIC: &str = "/tf_static";
+/// Detections of each frame in the camera's optical frame.
+pub const DETECTIONS: &str = "/perception/detections";
+/// The same detections in the world frame (the first of `world_frames` TF reaches), with
+/// the fruit map's track ids.
+pub const DETECTIONS_WORLD: &str = "/perception/detections_world";
+/// The fruit map: every track, merged over frames, in the world frame.
+pub const FRUIT_MAP: &str = "/perception/fruit_map";
+pub const STATUS: &str = "/agrisim/status";
+
+#[derive(Clone, Debug)]
+pub struct PerceptionConfig {
+    pub detector: DetectorConfig,
+    /// World frames to publish in, first that TF reaches wins (REP 105: map, then odom).
+    pub world_frames: Vec<String>,
+}
+
+impl Default for PerceptionConfig {
+    fn default() -> Self {
+        PerceptionConfig { detector: DetectorConfig::default(), world_frames: vec!["map".into(), "odom".into()] }
+    }
+}
+
+pub struct Perception {
+    config: PerceptionConfig,
+    detector: Detector,
+    tf: TfBuffer,
+    tf_reader: Reader,
+    tf_static_reader: Reader,
+    info: Option<(CameraInfo, Intrinsics)>,
+    seen: [u64; 3],
+    image: Option<Image>,
+    depth: Option<Image>,
+    last_stamp: Option<i64>,
+    map: FruitMap,
+    last_status: String,
+    /// Frames processed and skipped so far.
+    pub frames: u64,
+    pub skipped: u64,
+}
+
+impl Perception {
+    pub fn new(config: PerceptionConfig) -> Perception {
+        Perception {
+            detector: Detector::new(config.detector.clone()),
+            config,
+            tf: TfBuffer::default(),
+            tf_reader: Reader::new(TF),
+            tf_static_reader: Reader::new(TF_STATIC),
+            info: None,
+            seen: [0; 3],
+            image: None,
+            depth: None,
+            last_stamp: None,
+            map: FruitMap::default(),
+            last_status: String::new(),
+            frames: 0,
+            skipped: 0,
+        }
+    }
+
+    /// Reports a skipped frame on /agrisim/status (once per change of reason).
+    fn status(&mut self, bus: &mut Bus, t_ns: i64, message: String) {
+        self.skipped += 1;
+        if message != self.last_status {
+            let msg = FmuStatus {
+                header: Header { stamp: Time::from_nanos(t_ns), frame_id: String::new() },
+                instance: "perception".into(),
+                status: "warning".into(),
+                message: message.clone(),
+            };
+            bus.publish(STATUS, t_ns, &msg);
+            self.last_status = message;
+        }
+    }
+
+    fn ok(&mut self) {
+        self.last_status.clear();
+    }
+
+    /// The frame's pixels and depth as the detector reads them, or why not.
+    fn frame_data(image: &Image, depth: &Image) -> std::result::Result<(Vec<f32>, usize, usize), String> {
+        let (w, h) = (image.width as usize, image.height as usize);
+        if image.encoding != "rgb8" {
+            return Err(format!("colour image encoding {:?}, expected rgb8", image.encoding));
+        }
+        if (image.step as usize) != w * 3 || image.data.len() < w * h * 3 {
+            return Err(format!("colour image {w}x{h} with step {} and {} bytes", image.step, image.data.len()));
+        }
+        if depth.width as usize != w || depth.height as usize != h {
+            return Err(format!("depth {}x{} does not match the colour image {w}x{h}", depth.width, depth.height));
+        }
+        let n = w * h;
+        let z: Vec<f32> = match depth.encoding.as_str() {
+            "32FC1" if depth.data.len() >= n * 4 && depth.step as usize == w * 4 => (0..n)
+                .map(|i| {
+                    let b = [depth.data[4 * i], depth.data[4 * i + 1], depth.data[4 * i + 2], depth.data[4 * i + 3]];
+                    if depth.is_bigendian != 0 {
+                        f32::from_be_bytes(b)
+                    } else {
+                        f32::from_le_bytes(b)
+                    }
+                })
+                .collect(),
+            "16UC1" if depth.data.len() >= n * 2 && depth.step as usize == w * 2 => (0..n)
+                .map(|i| {
+                    let b = [depth.data[2 * i], depth.data[2 * i + 1]];
+                    let mm = if depth.is_bigendian != 0 { u16::from_be_bytes(b) } else { u16::from_le_bytes(b) };
+                    mm as f32 / 1000.0
+                })
+                .collect(),
+            e => return Err(format!("depth encoding {e:?} with {} bytes, expected 32FC1 or 16UC1", depth.data.len())),
+        };
+        Ok((z, w, h))
+    }
+
+    fn process(&mut self, t_ns: i64, bus: &mut Bus, image: &Image, depth: &Image) {
+        let stamp = image.header.stamp.to_nanos();
+        let Some((info, k)) = self.info.clone() else {
+            return self.status(bus, t_ns, format!("frame at t={} s skipped: no CameraInfo yet", stamp as f64 / 1e9));
+        };
+        if info.width != image.width || info.height != image.height {
+            return self.status(
+                bus,
+                t_ns,
+                format!(
+                    "frame skipped: CameraInfo is {}x{}, the image {}x{}",
+                    info.width, info.height, image.width, image.height
+                ),
+            );
+        }
+        let (z, w, h) = match Self::frame_data(image, depth) {
+            Ok(v) => v,
+            Err(e) => return self.status(bus, t_ns, format!("frame skipped: {e}")),
+        };
+        let result = self.detector.detect(&Frame { width: w, height: h, rgb: &image.data, depth: &z, k });
+        if result.valid_depth == 0 {
+            return self.status(bus, t_ns, format!("frame at t={} s skipped: no valid depth", stamp as f64 / 1e9));
+        }
+        self.frames += 1;
+        let camera =
+            if image.header.frame_id.is_empty() { info.header.frame_id.clone() } else { image.header.frame_id.clone() };
+        let header = Header { stamp: image.header.stamp, frame_id: camera.clone() };
+        let dets: Vec<Detection3D> =
+            result.detections.iter().map(|d| detection(&header, d, &Isometry3::identity(), String::new())).collect();
+        bus.publish(DETECTIONS, t_ns, &Detection3DArray { header: header.clone(), detections: dets });
+        let world = self.config.world_frames.iter().find_map(|f| self.tf.lookup(f, &camera).map(|p| (f.clone(), p)));
+        let Some((frame, pose)) = world else {
+            return self.status(
+                bus,
+                t_ns,
+                format!(
+                    "frame's world update skipped: no TF from {camera} to any of {:?} yet",
+                    self.config.world_frames
+                ),
+            );
+        };
+        let obs: Vec<Observation> = result
+            .detections
+            .iter()
+            .map(|d| {
+                let c = pose * Point3::from(d.center);
+                Observation { center: [c.x, c.y, c.z], radius: d.radius, votes: d.votes }
+            })
+            .collect();
+        let ids = self.map.update(&obs, stamp);
+        let wh = Header { stamp: image.header.stamp, frame_id: frame.clone() };
+        let dets: Vec<Detection3D> =
+            result.detections.iter().zip(&ids).map(|(d, id)| detection(&wh, d, &pose, id.to_string())).collect();
+        bus.publish(DETECTIONS_WORLD, t_ns, &Detection3DArray { header: wh.clone(), detections: dets });
+        let tracks: Vec<Detection3D> = self
+            .map
+            .tracks
+            .iter()
+            .map(|t| {
+                let total: f64 = t.votes.iter().sum::<f64>().max(1e-12);
+                let votes = t.votes.map(|v| v / total);
+                let d = Detection {
+                    center: t.center,
+                    radius: t.radius,
+                    stage: 0,
+                    score: 0.0,
+                    votes,
+                    rms: t.spread(),
+                    pixels: 0,
+                    bbox: [0; 4],
+                };
+                detection(&wh, &d, &Isometry3::identity(), t.id.to_string())
+            })
+            .collect();
+        bus.publish(FRUIT_MAP, t_ns, &Detection3DArray { header: wh, detections: tracks });
+        self.ok();
+    }
+}
+
+/// A detection as vision_msgs: one hypothesis per stage with votes, best first (the score the
+/// vote share), the pose the sphere's centre in `pose`'s target frame, the box its cube.
+fn detection(header: &Header, d: &Detection, pose: &Isometry3<f64>, id: String) -> Detection3D {
+    let c = pose * Point3::from(d.center);
+    let position = Point { x: c.x, y: c.y, z: c.z };
+    let center = Pose { position, orientation: Quaternion::IDENTITY };
+    let var = (d.rms * d.rms).max(1e-6);
+    let mut covariance = [0.0; 36];
+    for i in 0..3 {
+        covariance[i * 7] = var;
+    }
+    let mut order: Vec<usize> = (0..6).filter(|&s| d.votes[s] > 0.0).collect();
+    order.sort_by(|a, b| d.votes[*b].total_cmp(&d.votes[*a]).then(b.cmp(a)));
+    let results = order
+        .into_iter()
+        .map(|s| ObjectHypothesisWithPose {
+            hypothesis: ObjectHypothesis { class_id: STAGES[s].into(), score: d.votes[s] },
+            pose: PoseWithCovariance { pose: center, covariance },
+        })
+        .collect();
+    let side = 2.0 * d.radius;
+    Detection3D {
+        header: header.clone(),
+        results,
+        bbox: BoundingBox3D { center, size: Vector3 { x: side, y: side, z: side } },
+        id,
+    }
+}
+
+impl Node for Perception {
+    fn name(&self) -> &str {
+        "perception"
+    }
+
+    fn step(&mut self, t_ns: i64, bus: &mut Bus) -> Result<()> {
+        for m in self.tf_static_reader.take::<TFMessage>(bus)? {
+            self.tf.add(&m);
+        }
+        for m in self.tf_reader.take::<TFMessage>(bus)? {
+            self.tf.add(&m);
+        }
+        if let Some(info) = bus.take_new::<CameraInfo>(CAMERA_INFO, &mut self.seen[2])? {
+            match Intrinsics::from_k(&info.k) {
+                Some(k) => self.info = Some((info, k)),
+                None => self.status(bus, t_ns, format!("CameraInfo with an unusable K {:?} ignored", info.k)),
+            }
+        }
+        if let Some(img) = bus.take_new::<Image>(IMAGE, &mut self.seen[0])? {
+            self.image = Some(img);
+        }
+        if let Some(d) = bus.take_new::<Image>(DEPTH, &mut self.seen[1])? {
+            self.depth = Some(d);
+        }
+        let pair = match (&self.image, &self.depth) {
+            (Some(i), Some(d)) if i.header.stamp == d.header.stamp => {
+                let s = i.header.stamp.to_nanos();
+                (self.last_stamp != Some(s)).then_some(s)
+            }
+            _ => None,
+        };
+        if let Some(stamp) = pair {
+            self.last_stamp = Some(stamp);
+            let (image, depth) = (self.image.take().expect("paired"), self.depth.take().expect("paired"));
+            self.process(t_ns, bus, &image, &depth);
+        }
+        Ok(())
+    }
+}
