@@ -218,13 +218,13 @@ fn a_benchmark_added_to_the_registry_is_listed_and_runs_by_name() {
     let e = registry.run("coin", &bad, false, Exec::InProcess, &mut |_, _| {}).unwrap_err().to_string();
     assert!(e.contains("--p-heads 1.5"), "{e}");
     let e = registry.run("dice", &j, false, Exec::InProcess, &mut |_, _| {}).unwrap_err().to_string();
-    assert!(e.contains("unknown benchmark 'dice' (known: nav, harvest, row, coin)"), "{e}");
+    assert!(e.contains("unknown benchmark 'dice' (known: nav, harvest, row, perception, coin)"), "{e}");
 }
 
 #[test]
 fn the_built_in_benchmarks_and_their_options() {
     let registry = agrisim_bench::registry();
-    assert_eq!(registry.names(), ["nav", "harvest", "row"]);
+    assert_eq!(registry.names(), ["nav", "harvest", "row", "perception"]);
     let mut row = cli::command(&registry, &|c| c).find_subcommand("row").unwrap().clone();
     let help = row.render_long_help().to_string();
     assert!(help.contains("--length") && help.contains("[default: 10]"), "{help}");
