@@ -14,64 +14,26 @@
 //! too when debug logging is on. All of them also stay available, bounded, to
 //! [`Instance::take_log`].
 
-use std::collections::BTreeMap;
 use std::ffi::{c_char, c_void, CStr, CString};
 use std::path::Path;
 use std::ptr;
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
 use super::ffi::{self, Fmi3FmuState, Fmi3Instance, Vr};
 use super::library::{Fmi3Library, Functions};
 use crate::archive::FmuArchive;
-use crate::fmu::error::write_call;
+use crate::fmu::core::{Core, Ctx};
 use crate::fmu::log::{log_callback, LogMessage, LogSink};
 pub use crate::fmu::FmuState;
 use crate::fmu::{FmiError, FmiErrorInfo, InstanceState};
 use crate::fmu::{Status, StepResult};
 use crate::model_description::{FmiVersion, Interface};
 
-/// Call context for messages, formatted only when a message needs it (never on the
-/// per-step success path).
-#[derive(Clone, Copy)]
-enum Ctx {
-    None,
-    At(f64),
-    Step(f64, f64),
-}
-
-impl Ctx {
-    fn text(self) -> Option<String> {
-        match self {
-            Ctx::None => None,
-            Ctx::At(t) => Some(format!("at t={t}")),
-            Ctx::Step(t, h) => Some(format!("at t={t} (h={h})")),
-        }
-    }
-}
-
-static NEXT_INSTANCE_ID: AtomicU64 = AtomicU64::new(1);
-
 /// A live FMU co-simulation instance.
 pub struct Instance {
     handle: Fmi3Instance,
-    state: InstanceState,
-    name: String,
-    model: String,
-    can_get_and_set_state: bool,
-    can_serialize_state: bool,
-    /// `<LogCategories>` of the modelDescription (empty: none declared).
-    log_categories: Vec<String>,
-    /// Debug logging is on: the FMU's debug messages are printed to stderr.
-    debug_logging: bool,
-    /// vr -> variable name, for error messages.
-    names: Arc<BTreeMap<Vr, String>>,
-    /// FMU states by slot, with the wrapper's state when saved (restored with it); `None`
-    /// once freed.
-    fmu_states: Vec<Option<(Fmi3FmuState, InstanceState)>>,
-    id: u64,
-    /// Read by the logger callback via `instanceEnvironment`; boxed so its address is stable.
-    sink: Box<LogSink>,
+    /// Names, the state-machine view, the log sink and saved states (shared with FMI 2).
+    core: Core,
     interface: Interface,
     /// Kept alive as long as the instance; declared last so it is released last.
     lib: Arc<Fmi3Library>,
@@ -135,7 +97,6 @@ impl Instance {
             return Err(fail("fmi3GetVersion", format!("reports FMI version \"{version}\", expected 3.0"), Vec::new()));
         }
         let lib = Arc::new(lib);
-        let names: BTreeMap<Vr, String> = md.variables.iter().map(|v| (v.value_reference, v.name.clone())).collect();
 
         let c_name = CString::new(instance_name)
             .map_err(|_| fail(f_name, "instance name contains a NUL byte".into(), Vec::new()))?;
@@ -145,8 +106,8 @@ impl Instance {
             .map_err(|_| fail(f_name, "resources path contains a NUL byte".into(), Vec::new()))?;
         let missing = || fail(f_name, "the shared library does not export this interface".into(), Vec::new());
 
-        let sink = Box::new(LogSink::default());
-        let env = &*sink as *const LogSink as *mut c_void;
+        let core = Core::new(instance_name, md, logging_on);
+        let env = &*core.sink as *const LogSink as *mut c_void;
         // SAFETY: all strings outlive the call; `env` outlives the instance (see Drop).
         let handle = match interface {
             Interface::CoSimulation => unsafe {
@@ -178,25 +139,10 @@ impl Instance {
             },
         };
         if handle.is_null() {
-            return Err(fail(f_name, "returned NULL (instantiation failed)".into(), sink.take()));
+            return Err(fail(f_name, "returned NULL (instantiation failed)".into(), core.sink.take()));
         }
-        let inst = Instance {
-            handle,
-            state: InstanceState::Instantiated,
-            name: instance_name.to_string(),
-            model: md.model_name.clone(),
-            can_get_and_set_state: md.can_get_and_set_fmu_state,
-            can_serialize_state: md.can_serialize_fmu_state,
-            log_categories: md.log_categories.clone(),
-            debug_logging: logging_on,
-            names: Arc::new(names),
-            fmu_states: Vec::new(),
-            id: NEXT_INSTANCE_ID.fetch_add(1, Ordering::Relaxed),
-            sink,
-            interface,
-            lib,
-        };
-        inst.report(f_name, &[], Ctx::None, 0, Status::Ok);
+        let inst = Instance { handle, core, interface, lib };
+        inst.core.report(f_name, &[], Ctx::None, 0, Status::Ok);
         Ok(inst)
     }
 
@@ -213,19 +159,7 @@ impl Instance {
                 "refused: the shared library does not export this function (not called; instance state unchanged)",
             ));
         };
-        if !self.log_categories.is_empty() {
-            let unknown: Vec<&str> =
-                categories.iter().copied().filter(|c| !self.log_categories.iter().any(|k| k == c)).collect();
-            if !unknown.is_empty() {
-                let detail = format!(
-                    "refused: unknown log categor{} {} (the FMU declares: {})",
-                    if unknown.len() == 1 { "y" } else { "ies" },
-                    unknown.join(", "),
-                    self.log_categories.join(", ")
-                );
-                return Err(self.refuse(F, &[], &detail));
-            }
-        }
+        self.core.check_categories(F, categories)?;
         let c: Vec<CString> = categories
             .iter()
             .map(|c| CString::new(*c))
@@ -234,18 +168,18 @@ impl Instance {
         let ptrs: Vec<*const c_char> = c.iter().map(|c| c.as_ptr()).collect();
         let p = if ptrs.is_empty() { ptr::null() } else { ptrs.as_ptr() };
         self.call(F, &[], Ctx::None, |_, h| unsafe { set(h, on, ptrs.len(), p) })?;
-        self.debug_logging = on;
+        self.core.debug_logging = on;
         Ok(())
     }
 
     /// Number of messages the FMU has sent through the logger callback since instantiation
     /// (with debug logging off: its warnings and errors only).
     pub fn log_count(&self) -> u64 {
-        self.sink.mark()
+        self.core.sink.mark()
     }
 
     pub fn name(&self) -> &str {
-        &self.name
+        &self.core.name
     }
 
     pub fn fmi_version(&self) -> FmiVersion {
@@ -257,30 +191,30 @@ impl Instance {
     }
 
     pub fn model_name(&self) -> &str {
-        &self.model
+        &self.core.model
     }
 
     pub fn state(&self) -> InstanceState {
-        self.state
+        self.core.state
     }
 
     /// The messages logged since the last `take_log` (warnings included), oldest first; at
     /// most the latest 4096.
     pub fn take_log(&mut self) -> Vec<LogMessage> {
-        self.sink.take()
+        self.core.sink.take()
     }
 
     pub fn enter_initialization_mode(&mut self, start_time: f64, stop_time: Option<f64>) -> Result<(), FmiError> {
         self.call("fmi3EnterInitializationMode", &[], Ctx::At(start_time), |f, h| unsafe {
             (f.enter_initialization_mode)(h, false, 0.0, start_time, stop_time.is_some(), stop_time.unwrap_or(0.0))
         })?;
-        self.state = InstanceState::InitializationMode;
+        self.core.state = InstanceState::InitializationMode;
         Ok(())
     }
 
     pub fn exit_initialization_mode(&mut self) -> Result<(), FmiError> {
         self.call("fmi3ExitInitializationMode", &[], Ctx::None, |f, h| unsafe { (f.exit_initialization_mode)(h) })?;
-        self.state = InstanceState::StepMode;
+        self.core.state = InstanceState::StepMode;
         Ok(())
     }
 
@@ -324,22 +258,22 @@ impl Instance {
     /// Instantiated, Initialization Mode, Terminated or Error it is refused up front, leaving
     /// the instance as it was (drop it, or `reset` it, instead).
     pub fn terminate(&mut self) -> Result<(), FmiError> {
-        if self.state != InstanceState::StepMode {
+        if self.core.state != InstanceState::StepMode {
             let detail = format!(
                 "refused: not allowed in state {:?} (FMI 3.0 terminates from Step Mode only; not called; instance state unchanged)",
-                self.state
+                self.core.state
             );
             return Err(self.refuse("fmi3Terminate", &[], &detail));
         }
         self.call("fmi3Terminate", &[], Ctx::None, |f, h| unsafe { (f.terminate)(h) })?;
-        self.state = InstanceState::Terminated;
+        self.core.state = InstanceState::Terminated;
         Ok(())
     }
 
     /// Back to the just-instantiated state (also the way out of an Error).
     pub fn reset(&mut self) -> Result<(), FmiError> {
         self.call("fmi3Reset", &[], Ctx::None, |f, h| unsafe { (f.reset)(h) })?;
-        self.state = InstanceState::Instantiated;
+        self.core.state = InstanceState::Instantiated;
         Ok(())
     }
 
@@ -464,8 +398,7 @@ impl Instance {
         if s.is_null() {
             return Err(self.refuse("fmi3GetFMUState", &[], "the FMU returned a NULL state"));
         }
-        self.fmu_states.push(Some((s, self.state)));
-        Ok(FmuState { slot: self.fmu_states.len() - 1, owner: self.id })
+        Ok(self.core.keep_state(s, self.core.state))
     }
 
     /// Restores a state saved by this instance (and with it the state-machine state it was
@@ -474,7 +407,7 @@ impl Instance {
         let set = self.state_fn("fmi3SetFMUState", |f| f.set_fmu_state)?;
         let (s, saved_in) = self.own_state("fmi3SetFMUState", state)?;
         self.call("fmi3SetFMUState", &[], Ctx::None, |_, h| unsafe { set(h, s) })?;
-        self.state = saved_in;
+        self.core.state = saved_in;
         Ok(())
     }
 
@@ -506,15 +439,14 @@ impl Instance {
         if s.is_null() {
             return Err(self.refuse("fmi3DeserializeFMUState", &[], "the FMU returned a NULL state"));
         }
-        self.fmu_states.push(Some((s, saved_in)));
-        Ok(FmuState { slot: self.fmu_states.len() - 1, owner: self.id })
+        Ok(self.core.keep_state(s, saved_in))
     }
 
     /// Frees a saved state now (otherwise it is freed with the instance).
     pub fn free_state(&mut self, state: FmuState) -> Result<(), FmiError> {
         let free = self.state_fn("fmi3FreeFMUState", |f| f.free_fmu_state)?;
         let (mut s, _) = self.own_state("fmi3FreeFMUState", &state)?;
-        self.fmu_states[state.slot] = None;
+        self.core.fmu_states[state.slot] = None;
         self.call("fmi3FreeFMUState", &[], Ctx::None, |_, h| unsafe { free(h, &mut s) }).map(drop)
     }
 
@@ -530,103 +462,30 @@ impl Instance {
         context: Ctx,
         f: impl FnOnce(&Functions, Fmi3Instance) -> ffi::Fmi3Status,
     ) -> Result<Status, FmiError> {
-        if self.state == InstanceState::Fatal {
-            let mut e = self.refuse(function, vrs, "refused: this instance returned fmi3Fatal earlier and is unusable");
-            e.status = Some(Status::Fatal);
-            e.context = context.text();
-            return Err(e);
-        }
-        let mark = self.sink.mark();
-        let status = Status::from_raw(f(&self.lib.f, self.handle));
-        if status <= Status::Warning {
-            if status == Status::Warning || self.sink.mark() != mark {
-                self.report(function, vrs, context, mark, status);
-            }
-            return Ok(status);
-        }
-        match status {
-            Status::Fatal => self.state = InstanceState::Fatal,
-            Status::Error => self.state = InstanceState::Error,
-            _ => {}
-        }
-        Err(FmiErrorInfo {
-            instance: self.name.clone(),
-            model: self.model.clone(),
-            function: function.to_string(),
-            context: context.text(),
-            variables: self.var_names(vrs),
-            status: Some(status),
-            detail: None,
-            messages: self.sink.since(mark),
-            step: None,
-        }
-        .into())
+        let mark = self.core.before(function, vrs, context)?;
+        let raw = f(&self.lib.f, self.handle);
+        self.core.after(function, vrs, context, mark, raw)
     }
 
-    /// What a call that nobody gets an error from (it succeeded, or it ran in `drop`) logged
-    /// since `mark`, to stderr: every message of status Warning or worse, as one line naming
-    /// instance, model, function, variables and context; debug messages when debug logging
-    /// is on; and a line for a non-OK `status` that came without any message.
-    fn report(&self, function: &str, vrs: &[Vr], context: Ctx, mark: u64, status: Status) {
-        let messages = self.sink.since(mark);
-        let serious = messages.iter().any(|m| m.status >= Status::Warning);
-        let debug = self.debug_logging && !messages.is_empty();
-        if !serious && !debug && status == Status::Ok {
-            return;
-        }
-        let mut call = String::new();
-        let context = context.text();
-        let _ = write_call(&mut call, &self.name, &self.model, function, &self.var_names(vrs), context.as_deref());
-        // eprintln! (not a locked handle) so test harnesses capture it.
-        for m in &messages {
-            if m.status >= Status::Warning {
-                eprintln!("warning: {call} logged {} [{}]: {}", m.status, m.category, m.message.trim());
-            } else if self.debug_logging {
-                eprintln!("FMU '{}' [{}]: {}", self.name, m.category, m.message.trim());
-            }
-        }
-        if status > Status::Ok && !serious {
-            eprintln!("warning: {call} returned {status} (the FMU logged no reason)");
-        }
-    }
-
-    /// An error the wrapper raises itself (no FMU status).
     fn refuse(&self, function: &str, vrs: &[Vr], detail: &str) -> FmiError {
-        FmiErrorInfo {
-            instance: self.name.clone(),
-            model: self.model.clone(),
-            function: function.to_string(),
-            context: None,
-            variables: self.var_names(vrs),
-            status: None,
-            detail: Some(detail.to_string()),
-            messages: Vec::new(),
-            step: None,
-        }
-        .into()
+        self.core.refuse(function, vrs, detail)
     }
 
     fn check_len(&self, function: &str, vrs: &[Vr], n: usize) -> Result<(), FmiError> {
-        if vrs.len() == n {
-            Ok(())
-        } else {
-            Err(self.refuse(function, vrs, &format!("{} value references but {n} values", vrs.len())))
-        }
-    }
-
-    fn var_names(&self, vrs: &[Vr]) -> Vec<String> {
-        vrs.iter().map(|vr| self.names.get(vr).cloned().unwrap_or_else(|| format!("vr {vr}"))).collect()
+        self.core.check_len(function, vrs, n)
     }
 
     /// An optional FMU-state function, refused up front (not called) when a capability flag
     /// it needs is not declared or the library does not export it.
     fn state_fn<T>(&self, function: &str, pick: impl FnOnce(&Functions) -> Option<T>) -> Result<T, FmiError> {
-        self.optional_fn(function, &[(self.can_get_and_set_state, "canGetAndSetFMUState")], pick)
+        self.optional_fn(function, &[(self.core.can_get_and_set_state, "canGetAndSetFMUState")], pick)
     }
 
     fn serial_fns<T>(&self, function: &str, pick: impl FnOnce(&Functions) -> Option<T>) -> Result<T, FmiError> {
-        let needs =
-            [(self.can_serialize_state, "canSerializeFMUState"), (self.can_get_and_set_state, "canGetAndSetFMUState")];
+        let needs = [
+            (self.core.can_serialize_state, "canSerializeFMUState"),
+            (self.core.can_get_and_set_state, "canGetAndSetFMUState"),
+        ];
         self.optional_fn(function, &needs, pick)
     }
 
@@ -636,29 +495,11 @@ impl Instance {
         needs: &[(bool, &str)],
         pick: impl FnOnce(&Functions) -> Option<T>,
     ) -> Result<T, FmiError> {
-        if let Some((_, flag)) = needs.iter().find(|(declared, _)| !declared) {
-            return Err(self.refuse(
-                function,
-                &[],
-                &format!(
-                    "refused: not supported, the FMU declares {flag}=\"false\" (not called; instance state unchanged)"
-                ),
-            ));
-        }
-        pick(&self.lib.f).ok_or_else(|| {
-            self.refuse(
-                function,
-                &[],
-                "refused: the shared library does not export this function (not called; instance state unchanged)",
-            )
-        })
+        self.core.optional(function, needs, pick(&self.lib.f))
     }
 
     fn own_state(&self, function: &str, state: &FmuState) -> Result<(Fmi3FmuState, InstanceState), FmiError> {
-        match self.fmu_states.get(state.slot) {
-            Some(Some(s)) if state.owner == self.id => Ok(*s),
-            _ => Err(self.refuse(function, &[], "the FMU state belongs to another instance or was freed")),
-        }
+        self.core.own_state(function, state)
     }
 }
 
@@ -668,32 +509,32 @@ impl Drop for Instance {
     /// saved FMU states (not after an Error), then frees the instance. Nobody receives an
     /// error from a drop, so whatever the FMU reports here is printed (see `report`).
     fn drop(&mut self) {
-        if self.handle.is_null() || self.state == InstanceState::Fatal {
+        if self.handle.is_null() || self.core.state == InstanceState::Fatal {
             // After fmi3Fatal the standard allows no call at all, not even freeing: leak it.
             return;
         }
         let f = &self.lib.f;
         // SAFETY: the handle is live (never freed before; nulled right after freeing).
         unsafe {
-            if self.state == InstanceState::StepMode {
-                let mark = self.sink.mark();
+            if self.core.state == InstanceState::StepMode {
+                let mark = self.core.sink.mark();
                 let status = Status::from_raw((f.terminate)(self.handle));
-                self.report("fmi3Terminate (on drop)", &[], Ctx::None, mark, status);
+                self.core.report("fmi3Terminate (on drop)", &[], Ctx::None, mark, status);
                 if status == Status::Fatal {
                     return;
                 }
             }
-            if self.state != InstanceState::Error {
+            if self.core.state != InstanceState::Error {
                 if let Some(free) = f.free_fmu_state {
-                    for (s, _) in self.fmu_states.iter_mut().filter_map(Option::take) {
+                    for (s, _) in self.core.fmu_states.iter_mut().filter_map(Option::take) {
                         let mut s = s;
                         let _ = free(self.handle, &mut s);
                     }
                 }
             }
-            let mark = self.sink.mark();
+            let mark = self.core.sink.mark();
             (f.free_instance)(self.handle);
-            self.report("fmi3FreeInstance", &[], Ctx::None, mark, Status::Ok);
+            self.core.report("fmi3FreeInstance", &[], Ctx::None, mark, Status::Ok);
         }
         self.handle = ptr::null_mut();
         // `sink` and then `lib` are dropped after this, i.e. after the FMU can no longer log.
@@ -792,6 +633,6 @@ impl crate::me::ModelExchange for Instance {
     }
 
     fn set_wrapper_state(&mut self, s: InstanceState) {
-        self.state = s;
+        self.core.state = s;
     }
 }
