@@ -107,7 +107,7 @@ def test_row_runs_by_name_with_its_option(tmp_path):
         assert_same_trials(cli, out, 2)
     with pytest.raises(agrisim.AgrisimError, match="row has no option --width"):
         agrisim.bench.run("row", tmp_path / "bad", trials=1, width=1.0)
-    with pytest.raises(agrisim.AgrisimError, match="unknown benchmark 'dice' \\(known: nav, harvest, row\\)"):
+    with pytest.raises(agrisim.AgrisimError, match="unknown benchmark 'dice' \\(known: nav, harvest, row, perception\\)"):
         agrisim.bench.run("dice", tmp_path / "bad")
 
 
