@@ -79,6 +79,7 @@ def main() -> None:
         "opencv_ms_per_frame": round(cv_ms, 3),
         "opencv_blobs": blobs,
         "agrisim_ms_per_frame": ours["ms_per_frame"],
+        "agrisim_first_pass_ms_per_frame": ours.get("first_pass_ms_per_frame"),
         "agrisim_detections": ours["detections"],
         "agrisim_over_opencv": round(ours["ms_per_frame"] / cv_ms, 3),
         "opencv_version": cv2.__version__,

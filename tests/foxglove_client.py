@@ -34,6 +34,17 @@ async def client(url: str, topics: list[str], out: dict, stop: asyncio.Event) ->
                 msg = json.loads(frame)
                 if msg["op"] == "serverInfo":
                     out["serverInfo"] = msg
+                elif msg["op"] == "status" and msg.get("message", "").startswith("Unknown channel ID: "):
+                    # The foxglove crate can advertise a channel a moment before it accepts
+                    # subscriptions to it (seen with channels made while a client is connected):
+                    # ask again, as a viewer would.
+                    cid = int(msg["message"].rsplit(" ", 1)[1])
+                    topic = next((t for t, ch in out["channels"].items() if ch["id"] == cid), None)
+                    if topic in topics:
+                        await asyncio.sleep(0.05)
+                        subscribed[next_id] = topic
+                        await ws.send(json.dumps({"op": "subscribe", "subscriptions": [{"id": next_id, "channelId": cid}]}))
+                        next_id += 1
                 elif msg["op"] == "advertise":
                     subs = []
                     for ch in msg["channels"]:

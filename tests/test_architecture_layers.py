@@ -21,10 +21,14 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 
-ALGORITHMS = {"agrisim-nodes", "agrisim-nav", "agrisim-harvest", "agrisim-manip", "agrisim-trajectory", "agrisim-perception"}
+ALGORITHMS = {"agrisim-nodes", "agrisim-nav", "agrisim-harvest", "agrisim-manip", "agrisim-trajectory", "agrisim-perception", "agrisim-mapping"}
 # The perception node sees images, depth, CameraInfo and TF only: besides the algorithm rule,
 # it must reach no FMU crate at all (the world, the camera: their ground truth).
 PERCEPTION = "agrisim-perception"
+# The depth mapper (the sensed collision scene) likewise: depth, CameraInfo and TF in; the
+# robot's links come from its owner, never from a world output.
+MAPPING = "agrisim-mapping"
+SENSING = (PERCEPTION, MAPPING)
 ENGINE = "agrisim-cosim"
 # The greenhouse libraries: scene generation, ray casting, sun and weather, glTF export.
 SCENE = {"agrisim-scene", "agrisim-raycast", "agrisim-sky", "agrisim-gltf"}
@@ -268,13 +272,14 @@ def test_harness_check_can_fail(metadata):
     ]
 
 
-def perception_violations(graph, fmus):
-    """What the perception node links that could hand it ground truth: the engine, scene
-    generation or any FMU crate (the world FMU above all)."""
+def perception_violations(graph, fmus, crates=SENSING):
+    """What the perception and mapping nodes link that could hand them ground truth: the
+    engine, scene generation or any FMU crate (the world FMU above all)."""
     banned = {ENGINE} | SCENE | set(fmus)
     return [
-        f"{PERCEPTION} depends on {t} ({' -> '.join(path)}): perception sees only messages"
-        for t, path in sorted(reach(graph, PERCEPTION).items())
+        f"{crate} depends on {t} ({' -> '.join(path)}): perception sees only messages"
+        for crate in crates
+        for t, path in sorted(reach(graph, crate).items())
         if t in banned
     ]
 
@@ -291,3 +296,19 @@ def test_perception_links_no_engine_scene_or_world(graph, fmus):
     broken[MESSAGES].add("agrisim-scene")
     found = perception_violations(broken, fmus)
     assert any("agrisim-perception -> agrisim-msgs -> agrisim-scene" in v for v in found), found
+
+
+def test_mapping_links_no_engine_scene_or_world(graph, fmus):
+    """The sensed collision scene (agrisim-mapping) is held to the perception rule."""
+    assert MAPPING in graph
+    assert perception_violations(graph, fmus, (MAPPING,)) == []
+    world = next(name for name, ident in fmus.items() if ident == "Greenhouse")
+    for bad in (world, "agrisim-scene", ENGINE, "agrisim-raycast"):
+        broken = {k: set(v) for k, v in graph.items()}
+        broken[MAPPING].add(bad)
+        assert any(v.startswith(f"{MAPPING} depends on {bad}") for v in perception_violations(broken, fmus)), bad
+    # Through another crate too: the bus reaching the engine.
+    broken = {k: set(v) for k, v in graph.items()}
+    broken[BUS].add(ENGINE)
+    found = perception_violations(broken, fmus)
+    assert any("agrisim-mapping -> agrisim-bus -> agrisim-cosim" in v for v in found), found

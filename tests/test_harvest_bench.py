@@ -44,7 +44,7 @@ def test_files_and_summary(bench):
     for t in ts:
         assert t["outcome"] in ("success", "failure")
         assert (t["failure"] is None) == (t["outcome"] == "success")
-        assert t["failure"] in (None, "planning", "grasp", "handover", "placement", "timeout", "collision", "error")
+        assert t["failure"] in (None, "planning", "grasp", "handover", "placement", "timeout", "collision", "damage", "error")
         assert (bench / t["mcap"]).exists()
         assert len(t["planning_times"]) == t["plans"]
     s = json.loads((bench / "summary.json").read_text())
@@ -58,6 +58,22 @@ def test_files_and_summary(bench):
         lo, hi = wilson(a, b)
         assert abs(s[key][0] - lo) < 1e-12 and abs(s[key][1] - hi) < 1e-12, key
     assert sum(s["failures"].values()) == TRIALS - k
+    # Crop damage (/plant_damage ground truth): totals by kind are the trials' sums; a grip
+    # bruise or a broken stem is a "damage" failure unless the trial failed before (impact
+    # bruises are counted, not failures yet: IMPACT_BRUISE_FAILS in the bench).
+    for kind in ("bruised_by_grip", "bruised_by_impact", "unripe_detached", "stems_broken"):
+        assert s["damage"][kind] == sum(t["damage"].get(kind, 0) for t in ts), kind
+    for t in ts:
+        bruised = t["damage"].get("bruised_by_grip", 0)
+        assert not (t["outcome"] == "success" and (bruised or t["damage"].get("stems_broken", 0)))
+        assert (t["detach_mode"] is None) == (t["detach_force"] is None)
+        assert t["detach_mode"] in (None, "pull", "bend", "twist")
+    modes = [t["detach_mode"] for t in ts if t["detach_mode"]]
+    assert s["detach_modes"] == {m: modes.count(m) for m in set(modes)}
+    forces = [t["detach_force"] for t in ts if t["detach_force"] is not None]
+    assert (s["detach_force_mean"] is None) == (not forces)
+    if forces:
+        assert abs(s["detach_force_mean"] - sum(forces) / len(forces)) < 1e-9
     times = sorted(x for t in ts for x in t["planning_times"])
     assert s["plans"] == len(times)
     if times:

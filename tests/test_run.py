@@ -92,7 +92,9 @@ def test_odometry_drifts_from_ground_truth_and_tf_matches_odom(default_run):
     last = sig[-1][1]
     drift = math.hypot(last["odom_x"] - last["x"], last["odom_y"] - last["y"])
     assert drift > 0.01, drift
-    tfs = [(t, m) for topic, t, m in decoded(default_run) if topic == "/tf"]
+    # /tf also carries robot_state_publisher's robot links (base_link -> ...): the odometry
+    # transform is the message whose parent frame is odom.
+    tfs = [(t, m) for topic, t, m in decoded(default_run) if topic == "/tf" and m.transforms[0].header.frame_id == "odom"]
     odoms = {t: m for topic, t, m in decoded(default_run) if topic == "/odom"}
     assert tfs
     for t, m in tfs:

@@ -240,8 +240,15 @@ impl Arm {
         Ok(())
     }
 
-    /// Runs the control loop from `from_ns` to `to_ns`.
+    /// Runs the control loop from `from_ns` to `to_ns` with no external load.
     pub fn advance(&mut self, from_ns: i64, to_ns: i64, grasp_width: f64) {
+        self.advance_loaded(from_ns, to_ns, grasp_width, &[0.0; 6]);
+    }
+
+    /// Runs the control loop from `from_ns` to `to_ns` with the hand under `load` (force and
+    /// moment about link0's origin, in link0), held over the step; its joint torques are
+    /// taken at the step's start configuration.
+    pub fn advance_loaded(&mut self, from_ns: i64, to_ns: i64, grasp_width: f64, load: &[f64; 6]) {
         let mut start = from_ns;
         let mut len = to_ns.saturating_sub(from_ns);
         if len <= 0 {
@@ -255,6 +262,7 @@ impl Arm {
         }
         let params = self.joint_params();
         let d = self.arm.take().expect("initialized");
+        let ext = crate::load::joint_torques(&d, &self.state.q, load);
         let end_ref = self.reference.end_ns();
         for k in 0..n {
             let s0 = start + ((len as i128 * k as i128) / n as i128) as i64;
@@ -270,7 +278,7 @@ impl Arm {
                 self.errors.samples += 1;
             }
             let inertia = joint_inertia(&d, &self.state.q, 0.5 * self.gripper.width);
-            dynamics::step(&params, &self.mismatch, &inertia, &mut self.state, &sp, dt);
+            dynamics::step(&params, &self.mismatch, &inertia, &mut self.state, &sp, &ext, dt);
             self.gripper.update(dt, grasp_width);
             if self.exec == Exec::Executing && s1 >= end_ref {
                 self.exec = Exec::Succeeded;
@@ -319,6 +327,7 @@ impl Arm {
             io.set_f64(Q[i], self.state.q[i]);
         }
         io.set_f64(FINGER_WIDTH, self.gripper.width);
+        io.set_f64(GRIP_FORCE, self.gripper.force());
         io.set_f64(TRACKING_ERROR_RMS, self.errors.rms());
         let status = if self.rejected_last {
             2
@@ -429,7 +438,10 @@ impl Model for Arm {
             mismatch,
             state: dynamics::JointState { q: q0, ..Default::default() },
             reference: Reference::hold(q0),
-            gripper: Gripper::new(w0, d.max_width(), speed),
+            gripper: Gripper {
+                limit: finite_param(io, MAX_GRIP_FORCE, 0.0, 1000.0)?,
+                ..Gripper::new(w0, d.max_width(), speed)
+            },
             js_schedule: Schedule::new(finite_param(io, JOINT_STATE_RATE, 0.001, 1000.0)?, start_time)?,
             status_schedule: Schedule::new(finite_param(io, STATUS_RATE, 0.001, 1000.0)?, start_time)?,
             noise,
@@ -454,7 +466,11 @@ impl Model for Arm {
         self.poll_trajectory(io, t_ns, log)?;
         self.poll_gripper(io, t_ns, log)?;
         let gw = io.f64(GRASP_WIDTH);
-        self.advance(t_ns, end_ns, if gw.is_finite() { gw } else { 0.0 });
+        let load: [f64; 6] = std::array::from_fn(|k| io.f64(LOAD[k]));
+        if load.iter().any(|v| !v.is_finite()) {
+            return Err(format!("load inputs (load_fx..load_mz) = {load:?} are not finite"));
+        }
+        self.advance_loaded(t_ns, end_ns, if gw.is_finite() { gw } else { 0.0 }, &load);
         self.now_ns = end_ns;
         self.write_outputs(io, end_ns);
         Ok(())

@@ -112,18 +112,20 @@ pub fn integrate(p: &JointParams, inertia: f64, q: f64, qd: f64, tau: f64, dt: f
     (q_new, v)
 }
 
-/// One control period for all joints: torque from the setpoint and the state, then the plant.
+/// One control period for all joints: torque from the setpoint and the state, then the plant
+/// under that torque plus the external torque `ext` (a held load, not known to the controller).
 pub fn step(
     params: &[JointParams; N],
     mm: &ModelMismatch,
     inertia: &[f64; N],
     s: &mut JointState,
     sp: &Setpoint,
+    ext: &[f64; N],
     dt: f64,
 ) {
     for i in 0..N {
         let tau = control_torque(&params[i], mm, inertia[i], (s.q[i], s.qd[i]), (sp.q[i], sp.qd[i], sp.qdd[i]));
-        let (q, v) = integrate(&params[i], inertia[i], s.q[i], s.qd[i], tau, dt);
+        let (q, v) = integrate(&params[i], inertia[i], s.q[i], s.qd[i], tau + ext[i], dt);
         s.q[i] = q;
         s.qd[i] = v;
         s.tau[i] = tau;

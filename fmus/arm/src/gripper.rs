@@ -8,7 +8,8 @@
 //!
 //! Object: the world FMU reports `grasp_width` (width of the object between the fingers, 0 =
 //! none). While closing, the gap cannot go below it: the fingers stall there and squeeze with
-//! `min(max_effort, 70 N)` (max_effort <= 0 means the full continuous force).
+//! `min(max_effort, limit)` (max_effort <= 0 means the full limit); the limit is the
+//! `max_grip_force` parameter, 70 N by default.
 
 /// Continuous grasping force of the Franka Hand [N].
 pub const MAX_FORCE: f64 = 70.0;
@@ -25,11 +26,22 @@ pub struct Gripper {
     pub stalled: bool,
     pub max_width: f64,
     pub speed: f64,
+    /// Force limit [N] (default [`MAX_FORCE`]).
+    pub limit: f64,
 }
 
 impl Gripper {
     pub fn new(width: f64, max_width: f64, speed: f64) -> Gripper {
-        Gripper { width, velocity: 0.0, target: width, max_effort: 0.0, stalled: false, max_width, speed }
+        Gripper {
+            width,
+            velocity: 0.0,
+            target: width,
+            max_effort: 0.0,
+            stalled: false,
+            max_width,
+            speed,
+            limit: MAX_FORCE,
+        }
     }
 
     /// Accepts a command or explains why not (the previous one stays active).
@@ -50,9 +62,9 @@ impl Gripper {
         if !self.stalled {
             0.0
         } else if self.max_effort > 0.0 {
-            self.max_effort.min(MAX_FORCE)
+            self.max_effort.min(self.limit)
         } else {
-            MAX_FORCE
+            self.limit
         }
     }
 
@@ -107,6 +119,11 @@ mod tests {
         }
         assert_eq!(g.width, 0.0);
         assert!(!g.stalled && g.reached_goal() && g.force() == 0.0);
+        // A lower limit caps every command.
+        let mut g = Gripper { limit: 30.0, ..Gripper::new(0.05, 0.08, 0.1) };
+        g.command(0.0, 50.0).unwrap();
+        g.update(1e-3, 0.05);
+        assert!(g.stalled && g.force() == 30.0);
         assert!(g.command(0.09, 10.0).is_err() && g.command(f64::NAN, 10.0).is_err());
     }
 }

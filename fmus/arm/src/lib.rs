@@ -25,6 +25,7 @@ pub mod description;
 pub mod dynamics;
 pub mod gripper;
 pub mod inertia;
+pub mod load;
 pub mod ports;
 pub mod reference;
 pub mod validate;

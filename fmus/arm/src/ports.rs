@@ -71,7 +71,22 @@ agrisim_fmi::variables! { pub VARIABLES {
         .init_depends_on(&[SIDE, GRIPPER_WIDTH0, GRIPPER_COMMAND, GRIPPER_COMMAND_SEQ, Var::TIME])
         .desc("agrisim_msgs/GripperState, with joint_states"),
     GRIPPER_STATE_SEQ = Var::output_discrete("gripper_state_seq", Start::Int64(0)).init_depends_on(&[]),
+    // --- appended: earlier value references stay as they were ---
+    MAX_GRIP_FORCE = Var::param("max_grip_force", Start::Float64(70.0)).unit("N").range(0.0, 1000.0)
+        .desc("Force limit of the gripper: a command's max_effort is capped here (Franka Hand datasheet: continuous grasping force 70 N)"),
+    LOAD_FX = Var::input("load_fx", 0.0).unit("N")
+        .desc("Force a held load exerts on the hand, in {side}_link0 (world FMU: a fruit still on its plant); turned into joint torques"),
+    LOAD_FY = Var::input("load_fy", 0.0).unit("N"),
+    LOAD_FZ = Var::input("load_fz", 0.0).unit("N"),
+    LOAD_MX = Var::input("load_mx", 0.0).unit("N.m").desc("Moment of that load about the origin of {side}_link0, in {side}_link0"),
+    LOAD_MY = Var::input("load_my", 0.0).unit("N.m"),
+    LOAD_MZ = Var::input("load_mz", 0.0).unit("N.m"),
+    GRIP_FORCE = Var::output("grip_force").unit("N").init_depends_on(&[])
+        .desc("Force the fingers squeeze with (0 unless stalled on an object): the gripper's measured force"),
 }}
+
+/// The load inputs (force then moment).
+pub const LOAD: [usize; 6] = [LOAD_FX, LOAD_FY, LOAD_FZ, LOAD_MX, LOAD_MY, LOAD_MZ];
 
 /// What accepting or rejecting a trajectory present at initialization depends on.
 const TRAJECTORY_CHECK: &[usize] = &[SIDE, Q_INIT, TRAJECTORY, TRAJECTORY_SEQ];

@@ -456,6 +456,12 @@ fn part_of(look: &FruitLook, q: Vec3, r: f64) -> FruitPart {
     }
     // Polar angle on the unit sphere the spheroid scales to; arc length from the top.
     let zn = (q[2] / (k * r)).clamp(-1.0, 1.0);
+    // Most of the skin is far below the sepals: 2 sin(theta / 2) = sqrt(2 (1 - zn)) <= theta,
+    // so a chord beyond the sepals (with a margin far above acos's rounding) is skin without
+    // the acos. The answer is the one the acos gives.
+    if (2.0 * (1.0 - zn)).sqrt() * r > look.sepal_length * (1.0 + 1e-9) {
+        return FruitPart::Skin;
+    }
     let theta = zn.acos();
     let rho = theta * r;
     if rho > look.sepal_length {
@@ -492,12 +498,17 @@ fn fruit_albedo(p: &Palette, id: u32, stage: u8, q: Vec3, r: f64) -> ([f64; 3], 
     // end at the bottom; the colour's front waves around the fruit.
     let zn = (q[2] / (look.shape_index * r)).clamp(-1.0, 1.0);
     let below = 0.5 * (zn + 1.0);
-    let phi = q[1].atan2(q[0]);
     let green_top = mix(srgb(p, [132, 168, 70]), srgb(p, [84, 128, 44]), smoothstep(0.55, 0.95, below));
     let mut c = green_top;
     if look.coloured > 0.0 {
-        let wave = 0.05 * (3.0 * phi + look.phase[0]).sin() + 0.03 * (5.0 * phi + look.phase[1]).sin();
-        let front = look.coloured + if look.coloured < 1.0 { wave } else { 0.0 };
+        // (The wave's angle and sines only where the front is drawn with it.)
+        let front = if look.coloured < 1.0 {
+            let phi = q[1].atan2(q[0]);
+            let wave = 0.05 * (3.0 * phi + look.phase[0]).sin() + 0.03 * (5.0 * phi + look.phase[1]).sin();
+            look.coloured + wave
+        } else {
+            look.coloured
+        };
         let t = smoothstep(front + 0.05, front - 0.05, below);
         // Behind the front the colour deepens toward the stage's own.
         let (edge, deep) = match stage {

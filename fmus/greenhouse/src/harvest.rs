@@ -7,11 +7,16 @@
 //!   hand frame: along the approach axis within the pad length, sideways within the pad depth
 //!   (both from the URDF finger geometry, widened by `tol`), and across within `w_prev / 2`.
 //!   `d` is the fruit diameter, `tol` the `grasp_tolerance` parameter. Several candidates:
-//!   the one nearest the pad centre. A fruit on its plant is picked (counted) then. The
-//!   symmetric fingers centre a free fruit between them (it moves along the closing axis to
-//!   the middle); a fruit the other gripper holds stays where it is.
-//! - **Carry**: a held fruit follows the hand that grasped it first, rigidly, at the relative
-//!   pose it had when grasped.
+//!   the one nearest the pad centre. The symmetric fingers centre a free fruit between them
+//!   (it moves along the closing axis to the middle); a fruit the other gripper holds stays
+//!   where it is.
+//! - **Detach** ([`crate::pedicel`]): a fruit grasped on its plant stays attached to its
+//!   truss by its pedicel, a spring-damper joint that loads the hand, until the pull, bend or
+//!   twist at its abscission zone exceeds the fruit's threshold; it is picked (counted) then.
+//!   Opened before that, the gripper leaves it on the plant (it springs back to its rest pose).
+//!   With the pedicel off (`pedicel_enabled = false`) a fruit is picked when the fingers close.
+//! - **Carry**: a held fruit (attached or picked) follows the hand that grasped it first,
+//!   rigidly, at the relative pose it had when grasped.
 //! - **Handover**: a fruit held by one gripper can be grasped by the other by the same rule;
 //!   it is then held by both, still following the first; when the first opens it follows
 //!   the second.
@@ -27,15 +32,21 @@
 //!   interior (harvest_box_link frame, from the URDF) it is placed and from then on rides
 //!   in the box; elsewhere (a leaf, a pipe, the robot's top) it is dropped and frozen there.
 //!   A dropped fruit can be grasped again; a placed one cannot.
+//! - **Damage** (ground truth, [`Damage`]): a fruit is bruised when a gripper holding it
+//!   squeezes with more than `bruise_grip_force`, or when a released fruit reaches more than
+//!   `bruise_impact_speed` before it settles (its impact on the box, the floor or a leaf); a
+//!   picked fruit below `ripe_stage` is an unripe fruit detached. Each fruit counts once per kind.
 
+use crate::pedicel::{Attachment, Load, Mode, PedicelGeometry, PedicelParams};
 use crate::robot_links::{from_rapier, to_rapier};
 use crate::robot_model::{BoxInterior, FingerPads, Side};
 use crate::scene_world::SceneWorld;
 use agrisim_math::vec3::{norm, sub};
 use agrisim_robot::Pose as RPose;
+use agrisim_scene::scene::Kind;
 use rapier3d::parry::bounding_volume::Aabb;
 use rapier3d::prelude::*;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// Speed [m/s] relative to the box below which a released fruit counts as resting.
 pub const REST_SPEED: f64 = 0.02;
@@ -81,6 +92,78 @@ pub struct Gripper {
 pub struct HarvestParams {
     pub grasp_tolerance: f64,
     pub release_margin: f64,
+    pub pedicel: PedicelParams,
+    /// Seed of the per-fruit pedicel thresholds (the scene's seed).
+    pub seed: u64,
+    pub damage: DamageParams,
+}
+
+impl HarvestParams {
+    /// The given grasp rules with the default pedicel and damage figures.
+    pub fn new(grasp_tolerance: f64, release_margin: f64) -> HarvestParams {
+        HarvestParams {
+            grasp_tolerance,
+            release_margin,
+            pedicel: PedicelParams::default(),
+            seed: 0,
+            damage: DamageParams::default(),
+        }
+    }
+}
+
+/// Damage thresholds (the FMU's `bruise_*` and `ripe_stage` parameters).
+///
+/// - `bruise_grip_force`, default 40 N: an estimate. Tomato flesh yields in compression
+///   between two flat plates at some tens of N for firm-ripe fruit and less as it ripens
+///   (Zheng et al., "Study on Mechanical Properties of Tomatoes for the End-Effector Design
+///   of the Harvesting Robot", Agriculture 13(12) 2201, 2023; Li et al., J. Food Eng. 111(1)
+///   82-91, 2012); the Franka Hand's 70 N continuous force (datasheet) is above it, the
+///   harvest node's 20 N below.
+/// - `bruise_impact_speed`, default 2.0 m/s (a free fall of 0.2 m): tomatoes dropped 20 cm
+///   or more onto a hard surface develop internal bruising (Sargent, Brecht and Zoellner,
+///   "Sensitivity of tomatoes at mature-green and breaker ripeness to internal bruising",
+///   J. Amer. Soc. Hort. Sci. 117(1) 119-123, 1992); Lee et al., HortScience 53(9) 1352,
+///   2018, measured the severest impacts (> 10 g) when fruit go into and out of harvest boxes.
+/// - `ripe_stage`, default 5: USDA stage 5 (light red) and 6 (red) are ripe, as the harvest
+///   benchmark's targets.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct DamageParams {
+    pub bruise_grip_force: f64,
+    pub bruise_impact_speed: f64,
+    pub ripe_stage: u8,
+}
+
+impl Default for DamageParams {
+    fn default() -> Self {
+        DamageParams { bruise_grip_force: 40.0, bruise_impact_speed: 2.0, ripe_stage: 5 }
+    }
+}
+
+/// Damage so far: fruit indices by kind (each fruit once per kind).
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Damage {
+    pub grip_bruised: BTreeSet<usize>,
+    pub impact_bruised: BTreeSet<usize>,
+    pub unripe_detached: BTreeSet<usize>,
+    /// The largest grip force that bruised a fruit [N] and the fastest impact that did [m/s].
+    pub peak_grip: f64,
+    pub peak_impact: f64,
+}
+
+impl Damage {
+    /// Fruit bruised by grip or impact (each once).
+    pub fn bruised(&self) -> usize {
+        self.grip_bruised.union(&self.impact_bruised).count()
+    }
+}
+
+/// How the last pedicel broke.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Detachment {
+    pub fruit: usize,
+    pub mode: Mode,
+    /// The load in the step it broke.
+    pub load: Load,
 }
 
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
@@ -95,6 +178,18 @@ pub struct Harvest {
     pub placed: u32,
     pub dropped: u32,
     pub last_placed: Option<usize>,
+    /// Grasped fruit still on their plant, by fruit index.
+    pub attached: BTreeMap<usize, Attachment>,
+    /// The pedicel load on the fruit each gripper holds, this step (None: nothing attached).
+    pub loads: [Option<Load>; 2],
+    /// Grip force each gripper squeezes with [N] (the arm FMU's, an input).
+    pub grip_forces: [f64; 2],
+    pub last_detachment: Option<Detachment>,
+    /// Pedicels broken by pull, bend and twist.
+    pub detached_by: [u32; 3],
+    pub damage: Damage,
+    /// Fastest speed of each falling fruit so far [m/s].
+    fall_speed: BTreeMap<usize, f64>,
 }
 
 /// Whether fingers at gap `w` let go of a fruit of diameter `d` (see the module's rules).
@@ -114,7 +209,19 @@ impl Harvest {
             placed: 0,
             dropped: 0,
             last_placed: None,
+            attached: BTreeMap::new(),
+            loads: [None; 2],
+            grip_forces: [0.0; 2],
+            last_detachment: None,
+            detached_by: [0; 3],
+            damage: Damage::default(),
+            fall_speed: BTreeMap::new(),
         }
+    }
+
+    /// Whether fruit `f` is grasped but still on its plant.
+    pub fn is_attached(&self, f: usize) -> bool {
+        self.attached.contains_key(&f)
     }
 
     pub fn state(&self, fruit: usize) -> FruitState {
@@ -148,6 +255,7 @@ impl Harvest {
         &mut self,
         world: &mut SceneWorld,
         pads: &[FingerPads; 2],
+        pedicels: &[PedicelGeometry],
         hands: &[RPose; 2],
         widths: [f64; 2],
         h: f64,
@@ -161,7 +269,7 @@ impl Harvest {
                 }
             } else if w < prev {
                 if let Some(f) = self.candidate(world, &pads[s], &hands[s], w, prev) {
-                    self.attach(world, side, f, &hands[s]);
+                    self.attach(world, side, f, &hands[s], pedicels);
                 }
             }
             self.grippers[s].width = w;
@@ -211,7 +319,7 @@ impl Harvest {
         found.first().map(|&(_, f)| f)
     }
 
-    fn attach(&mut self, world: &mut SceneWorld, side: Side, f: usize, hand: &RPose) {
+    fn attach(&mut self, world: &mut SceneWorld, side: Side, f: usize, hand: &RPose, pedicels: &[PedicelGeometry]) {
         let body = world.fruit[f].body;
         let pose = from_rapier(world.bodies[body].position());
         let state = self.state(f);
@@ -219,7 +327,13 @@ impl Harvest {
             FruitState::Held { .. } => {}
             FruitState::OnPlant | FruitState::Falling { .. } | FruitState::Dropped | FruitState::Placed { .. } => {
                 if state == FruitState::OnPlant {
-                    self.picked += 1;
+                    if self.params.pedicel.enabled {
+                        let geom = pedicels.get(f).copied().unwrap_or(PedicelGeometry::VERTICAL);
+                        let t = self.params.pedicel.thresholds(self.params.seed, f);
+                        self.attached.insert(f, Attachment::new(pose, world.fruit[f].radius, geom, t));
+                    } else {
+                        self.detached(world, f, None);
+                    }
                 }
                 let b = &mut world.bodies[body];
                 b.set_body_type(RigidBodyType::KinematicPositionBased, true);
@@ -246,6 +360,14 @@ impl Harvest {
             self.fruit.insert(f, FruitState::Held { leader: other });
             return;
         }
+        // Still on its plant: the pedicel takes it back to where it hung.
+        if let Some(a) = self.attached.remove(&f) {
+            let b = &mut world.bodies[world.fruit[f].body];
+            b.set_body_type(RigidBodyType::Fixed, true);
+            b.set_position(to_rapier(&a.rest), true);
+            self.fruit.remove(&f);
+            return;
+        }
         // The fruit is where the hand put it last step; it leaves with the hand's velocity.
         let (from, to) = (self.prev_hands[s].mul(&grip).trans, hands[s].mul(&grip).trans);
         let v = sub(to, from).map(|d| (d / h) as Real);
@@ -255,6 +377,56 @@ impl Harvest {
         b.set_linvel(Vector::new(v[0], v[1], v[2]), true);
         b.set_angvel(Vector::ZERO, true);
         self.fruit.insert(f, FruitState::Falling { rest: 0.0, airborne: 0.0 });
+        self.fall_speed.insert(f, 0.0);
+    }
+
+    /// A pedicel broke (or, with the pedicel off, a fruit was grasped): fruit `f` is picked.
+    fn detached(&mut self, world: &SceneWorld, f: usize, how: Option<(Mode, Load)>) {
+        self.picked += 1;
+        if let Kind::Fruit { ripeness } = world.objects[world.fruit[f].object].kind {
+            if ripeness < self.params.damage.ripe_stage {
+                self.damage.unripe_detached.insert(f);
+            }
+        }
+        if let Some((mode, load)) = how {
+            self.detached_by[mode.code() as usize - 1] += 1;
+            self.last_detachment = Some(Detachment { fruit: f, mode, load });
+        }
+    }
+
+    /// The pedicel loads of the attached fruit with the hands at `hands` after a step of `h`
+    /// s: each either holds (its load is on the hands holding it) or breaks (the fruit is
+    /// picked). Then grip bruising with the grippers' forces `grip_forces`.
+    pub fn pull(&mut self, world: &SceneWorld, hands: &[RPose; 2], grip_forces: [f64; 2], h: f64) {
+        self.loads = [None; 2];
+        self.grip_forces = grip_forces;
+        let attached: Vec<usize> = self.attached.keys().copied().collect();
+        for f in attached {
+            let FruitState::Held { leader } = self.state(f) else { continue };
+            let l = leader as usize;
+            let pose = hands[l].mul(&self.grippers[l].grip);
+            let p = self.params.pedicel;
+            let a = self.attached.get_mut(&f).expect("listed");
+            let load = a.load(&p, &pose, h);
+            if let Some(mode) = load.breaks(&a.thresholds) {
+                self.attached.remove(&f);
+                self.detached(world, f, Some((mode, load)));
+            } else {
+                for s in 0..2 {
+                    if self.grippers[s].held == Some(f) {
+                        self.loads[s] = Some(load);
+                    }
+                }
+            }
+        }
+        for s in 0..2 {
+            if let Some(f) = self.grippers[s].held {
+                if grip_forces[s] > self.params.damage.bruise_grip_force {
+                    self.damage.grip_bruised.insert(f);
+                    self.damage.peak_grip = self.damage.peak_grip.max(grip_forces[s]);
+                }
+            }
+        }
     }
 
     /// Kinematic targets of held and placed fruit for hands at `hands` and the box frame at
@@ -314,13 +486,18 @@ impl Harvest {
             let pose = from_rapier(world.bodies[body].position());
             let p = pose.trans;
             if p[2] - world.fruit[f].radius <= FLOOR_EPS || p[2] < -1.0 {
+                self.landed(f);
                 self.drop_fruit(world, f);
                 continue;
             }
             let v = world.bodies[body].linvel();
+            let speed = norm([v.x as f64, v.y as f64, v.z as f64]);
+            let fastest = self.fall_speed.entry(f).or_insert(0.0);
+            *fastest = fastest.max(speed);
             let rel = sub([v.x as f64, v.y as f64, v.z as f64], box_vel);
             rest = if norm(rel) < REST_SPEED { rest + h } else { 0.0 };
             if rest + 1e-9 >= REST_TIME || airborne >= MAX_FALL_TIME {
+                self.landed(f);
                 let in_box = box_pose.inverse().mul(&pose);
                 if interior.contains(in_box.trans) {
                     world.bodies[body].set_body_type(RigidBodyType::KinematicPositionBased, true);
@@ -334,6 +511,16 @@ impl Harvest {
             } else {
                 self.fruit.insert(f, FruitState::Falling { rest, airborne });
             }
+        }
+    }
+
+    /// A falling fruit came to rest: bruised if it ever went faster than the impact threshold
+    /// (the speed it hit with).
+    fn landed(&mut self, f: usize) {
+        let v = self.fall_speed.remove(&f).unwrap_or(0.0);
+        if v > self.params.damage.bruise_impact_speed {
+            self.damage.impact_bruised.insert(f);
+            self.damage.peak_impact = self.damage.peak_impact.max(v);
         }
     }
 
@@ -362,8 +549,7 @@ mod tests {
 
     #[test]
     fn a_fruit_held_by_both_grippers_is_carried_once() {
-        let mut h =
-            Harvest::new(HarvestParams { grasp_tolerance: 0.0, release_margin: 0.0 }, [0.08; 2], [RPose::IDENTITY; 2]);
+        let mut h = Harvest::new(HarvestParams::new(0.0, 0.0), [0.08; 2], [RPose::IDENTITY; 2]);
         assert_eq!(h.carried().count(), 0);
         h.grippers[1].held = Some(4);
         assert_eq!(h.carried().collect::<Vec<_>>(), [4]);

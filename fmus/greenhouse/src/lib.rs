@@ -17,6 +17,7 @@ pub mod contacts;
 pub mod geometry;
 pub mod ground_truth;
 pub mod harvest;
+pub mod pedicel;
 pub mod planning_scene;
 pub mod ports;
 pub mod robot_links;

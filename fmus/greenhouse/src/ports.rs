@@ -12,6 +12,7 @@ pub const COLLISION_STATE_MIME: &str = "application/x-ros2-cdr-frames; version=1
 pub const POSE_ARRAY_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=geometry_msgs/msg/PoseArray";
 pub const POSE_STAMPED_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=geometry_msgs/msg/PoseStamped";
 pub const PLANNING_SCENE_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=agrisim_msgs/msg/PlanningScene";
+pub const PLANT_DAMAGE_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=agrisim_msgs/msg/PlantDamage";
 
 agrisim_fmi::variables! { pub VARIABLES {
     // --- scene (fixed parameters) ---
@@ -122,6 +123,91 @@ agrisim_fmi::variables! { pub VARIABLES {
     // --- appended: earlier value references stay as they were ---
     CONTACT_CARRIED_STRUCTURE = Var::output_discrete("contact_carried_structure", Start::Int32(0)).init_depends_on(&CONTACTS)
         .desc("Cumulative onsets of a fruit held by a gripper touching posts, pipes, gutters, walls, obstacles, floor (the load swung into the structure)"),
+    // --- plant physics (appended: earlier value references stay as they were; figures and
+    // sources in crate::pedicel and crate::harvest::DamageParams) ---
+    PEDICEL_ENABLED = Var::param("pedicel_enabled", Start::Boolean(true))
+        .desc("A grasped fruit stays on its plant until its pedicel breaks (false: picked when the fingers close)"),
+    PEDICEL_PULL_MEAN = Var::param("pedicel_pull_mean", Start::Float64(20.0)).unit("N").range(0.01, 1000.0)
+        .desc("Mean tension at which a pedicel breaks at its abscission zone (Weng et al. 2024, Agronomy 14:2274)"),
+    PEDICEL_PULL_SD = Var::param("pedicel_pull_sd", Start::Float64(5.0)).unit("N").range(0.0, 1000.0)
+        .desc("Standard deviation of the per-fruit pull threshold (truncated at 20 % of the mean)"),
+    PEDICEL_BEND_MEAN = Var::param("pedicel_bend_mean", Start::Float64(0.15)).unit("N.m").range(1e-4, 100.0)
+        .desc("Mean bending moment at the abscission zone that breaks a pedicel (bending detaches with less force than pulling: Li et al. 2008)"),
+    PEDICEL_BEND_SD = Var::param("pedicel_bend_sd", Start::Float64(0.04)).unit("N.m").range(0.0, 100.0)
+        .desc("Standard deviation of the per-fruit bend threshold"),
+    PEDICEL_TWIST_MEAN = Var::param("pedicel_twist_mean", Start::Float64(0.10)).unit("N.m").range(1e-4, 100.0)
+        .desc("Mean twisting moment that breaks a pedicel (estimate)"),
+    PEDICEL_TWIST_SD = Var::param("pedicel_twist_sd", Start::Float64(0.03)).unit("N.m").range(0.0, 100.0)
+        .desc("Standard deviation of the per-fruit twist threshold"),
+    PEDICEL_STIFFNESS = Var::param("pedicel_stiffness", Start::Float64(500.0)).unit("N/m").range(1.0, 1e6)
+        .desc("Translational stiffness of the fruit on its truss at the abscission zone (estimate)"),
+    PEDICEL_DAMPING = Var::param("pedicel_damping", Start::Float64(2.0)).unit("N.s/m").range(0.0, 1e4)
+        .desc("Translational damping of the pedicel joint"),
+    PEDICEL_BEND_STIFFNESS = Var::param("pedicel_bend_stiffness", Start::Float64(0.3)).unit("N.m/rad").range(1e-4, 1e4)
+        .desc("Bending stiffness of the pedicel joint (estimate)"),
+    PEDICEL_TWIST_STIFFNESS = Var::param("pedicel_twist_stiffness", Start::Float64(0.06)).unit("N.m/rad").range(1e-4, 1e4)
+        .desc("Twisting stiffness of the pedicel joint (estimate)"),
+    PEDICEL_ROT_DAMPING = Var::param("pedicel_rot_damping", Start::Float64(0.005)).unit("N.m.s/rad").range(0.0, 100.0)
+        .desc("Rotational damping of the pedicel joint"),
+    BRUISE_GRIP_FORCE = Var::param("bruise_grip_force", Start::Float64(40.0)).unit("N").range(0.0, 1000.0)
+        .desc("A held fruit squeezed harder than this is bruised (estimate; Zheng et al. 2023, Agriculture 13:2201)"),
+    BRUISE_IMPACT_SPEED = Var::param("bruise_impact_speed", Start::Float64(2.0)).unit("m/s").range(0.0, 100.0)
+        .desc("A released fruit faster than this before it settles is bruised (0.2 m drop: Sargent et al. 1992)"),
+    RIPE_STAGE = Var::param("ripe_stage", Start::Int32(5))
+        .desc("Lowest USDA ripeness stage (1..6) that is ripe; a picked fruit below it is an unripe fruit detached"),
+    LEFT_GRIP_FORCE = Var::input("left_grip_force", 0.0).unit("N")
+        .desc("Force the left gripper squeezes with (arm FMU's grip_force)"),
+    RIGHT_GRIP_FORCE = Var::input("right_grip_force", 0.0).unit("N")
+        .desc("Force the right gripper squeezes with"),
+    LEFT_LOAD_FX = Var::output("left_load_fx").unit("N").init_depends_on(&[])
+        .desc("Force the attached fruit's pedicel exerts on the left hand, in left_link0 (0 when nothing attached)"),
+    LEFT_LOAD_FY = Var::output("left_load_fy").unit("N").init_depends_on(&[]),
+    LEFT_LOAD_FZ = Var::output("left_load_fz").unit("N").init_depends_on(&[]),
+    LEFT_LOAD_MX = Var::output("left_load_mx").unit("N.m").init_depends_on(&[])
+        .desc("Moment of that load about the origin of left_link0, in left_link0"),
+    LEFT_LOAD_MY = Var::output("left_load_my").unit("N.m").init_depends_on(&[]),
+    LEFT_LOAD_MZ = Var::output("left_load_mz").unit("N.m").init_depends_on(&[]),
+    RIGHT_LOAD_FX = Var::output("right_load_fx").unit("N").init_depends_on(&[])
+        .desc("Force the attached fruit's pedicel exerts on the right hand, in right_link0"),
+    RIGHT_LOAD_FY = Var::output("right_load_fy").unit("N").init_depends_on(&[]),
+    RIGHT_LOAD_FZ = Var::output("right_load_fz").unit("N").init_depends_on(&[]),
+    RIGHT_LOAD_MX = Var::output("right_load_mx").unit("N.m").init_depends_on(&[])
+        .desc("Moment of that load about the origin of right_link0, in right_link0"),
+    RIGHT_LOAD_MY = Var::output("right_load_my").unit("N.m").init_depends_on(&[]),
+    RIGHT_LOAD_MZ = Var::output("right_load_mz").unit("N.m").init_depends_on(&[]),
+    LEFT_PEDICEL_PULL = Var::output("left_pedicel_pull").unit("N").init_depends_on(&[])
+        .desc("Tension at the abscission zone of the fruit attached in the left hand (0 when none)"),
+    LEFT_PEDICEL_BEND = Var::output("left_pedicel_bend").unit("N.m").init_depends_on(&[])
+        .desc("Bending moment at that abscission zone"),
+    LEFT_PEDICEL_TWIST = Var::output("left_pedicel_twist").unit("N.m").init_depends_on(&[])
+        .desc("Twisting moment at that abscission zone"),
+    RIGHT_PEDICEL_PULL = Var::output("right_pedicel_pull").unit("N").init_depends_on(&[]),
+    RIGHT_PEDICEL_BEND = Var::output("right_pedicel_bend").unit("N.m").init_depends_on(&[]),
+    RIGHT_PEDICEL_TWIST = Var::output("right_pedicel_twist").unit("N.m").init_depends_on(&[]),
+    DETACHED_PULL_COUNT = Var::output_discrete("detached_pull_count", Start::Int32(0)).init_depends_on(&[])
+        .desc("Pedicels broken by their tension (cumulative)"),
+    DETACHED_BEND_COUNT = Var::output_discrete("detached_bend_count", Start::Int32(0)).init_depends_on(&[])
+        .desc("Pedicels broken by bending (cumulative)"),
+    DETACHED_TWIST_COUNT = Var::output_discrete("detached_twist_count", Start::Int32(0)).init_depends_on(&[])
+        .desc("Pedicels broken by twisting (cumulative)"),
+    LAST_DETACH_MODE = Var::output_discrete("last_detach_mode", Start::Int32(0)).init_depends_on(&[])
+        .desc("How the last pedicel broke: 0 none yet, 1 pull, 2 bend, 3 twist"),
+    LAST_DETACH_FORCE = Var::output("last_detach_force").unit("N").init_depends_on(&[])
+        .desc("Magnitude of the pedicel force on the fruit (= at the gripper) when the last pedicel broke"),
+    LAST_DETACH_MOMENT = Var::output("last_detach_moment").unit("N.m").init_depends_on(&[])
+        .desc("Larger of the bending and twisting moment at the abscission zone when the last pedicel broke"),
+    BRUISED_COUNT = Var::output_discrete("bruised_count", Start::Int32(0)).init_depends_on(&[])
+        .desc("Fruit bruised by grip or impact (ground truth; each fruit once)"),
+    GRIP_BRUISED_COUNT = Var::output_discrete("grip_bruised_count", Start::Int32(0)).init_depends_on(&[])
+        .desc("Fruit squeezed above bruise_grip_force"),
+    IMPACT_BRUISED_COUNT = Var::output_discrete("impact_bruised_count", Start::Int32(0)).init_depends_on(&[])
+        .desc("Released fruit that went faster than bruise_impact_speed before they settled"),
+    UNRIPE_DETACHED_COUNT = Var::output_discrete("unripe_detached_count", Start::Int32(0)).init_depends_on(&[])
+        .desc("Fruit below ripe_stage detached from their plant"),
+    PLANT_DAMAGE = Var::output_discrete("plant_damage", Start::Binary(&[])).mime(PLANT_DAMAGE_MIME).init_depends_on(&[Var::TIME])
+        .desc("agrisim_msgs/PlantDamage (ground truth, for the judge): damage counts by kind and the last detachment, at the start and whenever they change"),
+    PLANT_DAMAGE_SEQ = Var::output_discrete("plant_damage_seq", Start::Int64(0)).init_depends_on(&[])
+        .desc("Sequence number of the newest message in plant_damage"),
 }}
 
 /// The robot's configuration inputs: base pose, lift, arm joints, finger gaps.

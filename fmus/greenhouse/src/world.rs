@@ -8,13 +8,17 @@ use crate::clearance::min_clearance;
 use crate::collision_report::collision_state;
 use crate::contacts::{robot_contacts, Category, ContactTracker, Toucher};
 use crate::ground_truth::{fruit_poses, Target};
-use crate::harvest::{Harvest, HarvestParams};
+use crate::harvest::{DamageParams, Harvest, HarvestParams};
+use crate::pedicel::{PedicelGeometry, PedicelParams};
 use crate::planning_scene::planning_scene;
 use crate::ports::*;
 use crate::robot_links::{base_pose, to_rapier};
 use crate::robot_model::{Coords, RobotModel, Side};
 use crate::scene_world::SceneWorld;
 use agrisim_fmi::{Log, Model, OutPort, Store, Var};
+use agrisim_msgs::agrisim::PlantDamage;
+use agrisim_msgs::builtin_interfaces::Time;
+use agrisim_msgs::std_msgs::Header;
 use agrisim_msgs::Message;
 use agrisim_robot::Pose as RPose;
 use agrisim_scene::config::GreenhouseConfig;
@@ -35,6 +39,8 @@ struct RobotState {
     /// Every link in base_link (FK of `coords`).
     link_in_base: Vec<RPose>,
     hand_links: [usize; 2],
+    /// left_link0 and right_link0: the frames of the load outputs.
+    arm_bases: [usize; 2],
     box_link: usize,
     /// harvest_box_link in the map frame at the end of the last step.
     box_pose: RPose,
@@ -53,6 +59,8 @@ struct Running {
     world: SceneWorld,
     robot: RobotState,
     harvest: Harvest,
+    /// Each fruit's pedicel (by fruit index), from the scene: rebuilt, not serialized.
+    pedicels: Arc<Vec<PedicelGeometry>>,
     /// Kinematic moves of one step (kept to reuse its allocation).
     moves: Vec<(RigidBodyHandle, Pose)>,
     /// Kinematic fruit to keep awake while something falls (reused allocation).
@@ -88,6 +96,9 @@ struct Ports {
     collision: OutPort,
     fruit: OutPort,
     target: OutPort,
+    damage: OutPort,
+    /// CDR of the last published PlantDamage with a zero header (a change publishes).
+    damage_published: Vec<u8>,
 }
 
 impl Ports {
@@ -97,11 +108,13 @@ impl Ports {
             collision: OutPort::new(COLLISION_STATE, COLLISION_STATE_SEQ),
             fruit: OutPort::new(FRUIT_POSES, FRUIT_POSES_SEQ),
             target: OutPort::new(TARGET, TARGET_SEQ),
+            damage: OutPort::new(PLANT_DAMAGE, PLANT_DAMAGE_SEQ),
+            damage_published: Vec::new(),
         }
     }
 
     fn sync(&mut self, io: &mut Store, now_ns: i64, window_ns: i64) {
-        for p in [&mut self.scene, &mut self.collision, &mut self.fruit, &mut self.target] {
+        for p in [&mut self.scene, &mut self.collision, &mut self.fruit, &mut self.target, &mut self.damage] {
             p.sync(io, now_ns, window_ns);
         }
     }
@@ -175,6 +188,61 @@ fn positive_param(io: &Store, i: usize, max: f64) -> Result<f64, String> {
     }
 }
 
+/// The `pedicel_*` parameters.
+fn pedicel_params(io: &Store) -> Result<PedicelParams, String> {
+    let mean = |i: usize, max: f64| {
+        let v = positive_param(io, i, max)?;
+        if v > 0.0 {
+            Ok(v)
+        } else {
+            Err(format!("parameter {} must be positive, got {v}", VARIABLES[i].name))
+        }
+    };
+    Ok(PedicelParams {
+        enabled: io.bool(PEDICEL_ENABLED),
+        pull_mean: mean(PEDICEL_PULL_MEAN, 1000.0)?,
+        pull_sd: positive_param(io, PEDICEL_PULL_SD, 1000.0)?,
+        bend_mean: mean(PEDICEL_BEND_MEAN, 100.0)?,
+        bend_sd: positive_param(io, PEDICEL_BEND_SD, 100.0)?,
+        twist_mean: mean(PEDICEL_TWIST_MEAN, 100.0)?,
+        twist_sd: positive_param(io, PEDICEL_TWIST_SD, 100.0)?,
+        stiffness: mean(PEDICEL_STIFFNESS, 1e6)?,
+        damping: positive_param(io, PEDICEL_DAMPING, 1e4)?,
+        bend_stiffness: mean(PEDICEL_BEND_STIFFNESS, 1e4)?,
+        twist_stiffness: mean(PEDICEL_TWIST_STIFFNESS, 1e4)?,
+        rot_damping: positive_param(io, PEDICEL_ROT_DAMPING, 100.0)?,
+    })
+}
+
+/// Each fruit's pedicel from the scene's objects: `.../pedicel{t}_{f}` belongs to
+/// `.../fruit{t}_{f}`, a rod whose local z runs from the fruit's top up to the truss.
+/// `fruit` lists the fruit's indices into `objects` in fruit order.
+pub fn pedicel_geometry(objects: &[agrisim_scene::scene::Object], fruit: &[usize]) -> Vec<PedicelGeometry> {
+    use agrisim_scene::Shape;
+    let by_name: std::collections::BTreeMap<&str, usize> =
+        objects.iter().enumerate().map(|(i, o)| (o.name.as_str(), i)).collect();
+    fruit
+        .iter()
+        .map(|&f| {
+            let name = objects[f].name.replace("/fruit", "/pedicel");
+            let Some(o) = by_name.get(name.as_str()).map(|&i| &objects[i]) else { return PedicelGeometry::VERTICAL };
+            let Shape::Cylinder { half_height, .. } = o.shape else { return PedicelGeometry::VERTICAL };
+            let [x, y, z, w] = o.placement.rotation;
+            // The quaternion's image of local z.
+            let mut axis = [2.0 * (x * z + w * y), 2.0 * (y * z - w * x), 1.0 - 2.0 * (x * x + y * y)];
+            let n = agrisim_math::vec3::norm(axis);
+            if !(n > 1e-9) {
+                return PedicelGeometry::VERTICAL;
+            }
+            axis = axis.map(|c| c / n);
+            if axis[2] < 0.0 {
+                axis = axis.map(|c| -c);
+            }
+            PedicelGeometry { axis, length: 2.0 * half_height }
+        })
+        .collect()
+}
+
 /// Publication instants at multiples of 1/rate on simulation time.
 fn schedule(io: &Store, i: usize, start_time: f64) -> Result<Schedule, String> {
     Schedule::new(io.f64(i), start_time).map_err(|e| format!("parameter {}: {e}", VARIABLES[i].name))
@@ -184,7 +252,7 @@ impl Running {
     /// Contacts, clearance, ground truth and due messages for time `t`.
     fn report(&mut self, io: &mut Store, t: f64) {
         self.report_contacts(io, t);
-        self.report_harvest(io);
+        self.report_harvest(io, t);
         self.report_ground_truth(io, t);
         if let Some(stamp) = self.scene_schedule.due(t) {
             let [x, y, _] = self.robot.planar;
@@ -195,7 +263,7 @@ impl Running {
         self.ports.sync(io, to_ns(t), self.window_ns);
     }
 
-    fn report_harvest(&mut self, io: &mut Store) {
+    fn report_harvest(&mut self, io: &mut Store, t: f64) {
         let (w, h) = (&self.world, &self.harvest);
         let id = |f: Option<usize>| f.map_or(-1, |f| w.objects[w.fruit[f].object].id.min(i32::MAX as u32) as i32);
         io.set_f64(LEFT_GRASP_WIDTH, h.grasp_width(w, Side::Left));
@@ -207,6 +275,65 @@ impl Running {
         io.set_i32(PLACED_COUNT, count(h.placed));
         io.set_i32(DROPPED_COUNT, count(h.dropped));
         io.set_i32(LAST_PLACED_ID, id(h.last_placed));
+        // The pedicel loads on the hands, in each arm's link0 (about its origin).
+        let r = &self.robot;
+        let base = base_pose(r.planar[0], r.planar[1], r.planar[2]);
+        let outs = [
+            (LEFT_LOAD_FX, [LEFT_PEDICEL_PULL, LEFT_PEDICEL_BEND, LEFT_PEDICEL_TWIST]),
+            (RIGHT_LOAD_FX, [RIGHT_PEDICEL_PULL, RIGHT_PEDICEL_BEND, RIGHT_PEDICEL_TWIST]),
+        ];
+        for (s, (first, az)) in outs.into_iter().enumerate() {
+            let (mut wrench, mut at_az) = ([0.0; 6], [0.0; 3]);
+            if let Some(load) = &h.loads[s] {
+                let link0 = base.mul(&r.link_in_base[r.arm_bases[s]]);
+                let inv = link0.inverse();
+                let f = inv.rotate(load.force);
+                let m = inv.rotate(load.moment_about(link0.trans));
+                wrench = [f[0], f[1], f[2], m[0], m[1], m[2]];
+                at_az = [load.pull, load.bend, load.twist];
+            }
+            // LEFT_LOAD_FX..MZ (and the right's) are consecutive.
+            for (k, v) in wrench.into_iter().enumerate() {
+                io.set_f64(first + k, v);
+            }
+            for (vr, v) in az.into_iter().zip(at_az) {
+                io.set_f64(vr, v);
+            }
+        }
+        io.set_i32(DETACHED_PULL_COUNT, count(h.detached_by[0]));
+        io.set_i32(DETACHED_BEND_COUNT, count(h.detached_by[1]));
+        io.set_i32(DETACHED_TWIST_COUNT, count(h.detached_by[2]));
+        let last = h.last_detachment.as_ref();
+        io.set_i32(LAST_DETACH_MODE, last.map_or(0, |d| d.mode.code()));
+        io.set_f64(LAST_DETACH_FORCE, last.map_or(0.0, |d| agrisim_math::vec3::norm(d.load.force)));
+        io.set_f64(LAST_DETACH_MOMENT, last.map_or(0.0, |d| d.load.bend.max(d.load.twist)));
+        let n = |k: usize| k.min(i32::MAX as usize) as i32;
+        io.set_i32(BRUISED_COUNT, n(h.damage.bruised()));
+        io.set_i32(GRIP_BRUISED_COUNT, n(h.damage.grip_bruised.len()));
+        io.set_i32(IMPACT_BRUISED_COUNT, n(h.damage.impact_bruised.len()));
+        io.set_i32(UNRIPE_DETACHED_COUNT, n(h.damage.unripe_detached.len()));
+        let u = |k: usize| k.min(u32::MAX as usize) as u32;
+        let mut msg = PlantDamage {
+            header: Header::default(),
+            bruised_by_grip: u(h.damage.grip_bruised.len()),
+            bruised_by_impact: u(h.damage.impact_bruised.len()),
+            unripe_detached: u(h.damage.unripe_detached.len()),
+            // Main stems do not break in this model (yet).
+            stems_broken: 0,
+            detached_by_pull: h.detached_by[0],
+            detached_by_bend: h.detached_by[1],
+            detached_by_twist: h.detached_by[2],
+            last_detach_mode: last.map_or("", |d| d.mode.label()).to_string(),
+            last_detach_force: last.map_or(0.0, |d| agrisim_math::vec3::norm(d.load.force)),
+            last_detach_moment: last.map_or(0.0, |d| d.load.bend.max(d.load.twist)),
+        };
+        let key = msg.to_cdr();
+        if key != self.ports.damage_published {
+            let stamp = to_ns(t);
+            msg.header = Header::new(Time::from_nanos(stamp), "map");
+            self.ports.damage.publish(stamp, msg.to_cdr());
+            self.ports.damage_published = key;
+        }
     }
 
     /// One step of `h` seconds with the robot inputs in `io`: kinematics, harvest rules,
@@ -224,7 +351,14 @@ impl Running {
         let base = base_pose(planar[0], planar[1], planar[2]);
         let hands = r.hands(&base);
         let box_pose = base.mul(&r.link_in_base[r.box_link]);
-        self.harvest.grip(&mut self.world, &r.model.pads, &hands, coords.widths, h);
+        self.harvest.grip(&mut self.world, &r.model.pads, &self.pedicels, &hands, coords.widths, h);
+        let grip_forces = [io.f64(LEFT_GRIP_FORCE), io.f64(RIGHT_GRIP_FORCE)];
+        if grip_forces.iter().any(|f| !f.is_finite()) {
+            return Err(format!(
+                "grip force inputs (left_grip_force, right_grip_force) = {grip_forces:?} are not finite"
+            ));
+        }
+        self.harvest.pull(&self.world, &hands, grip_forces, h);
         self.moves.clear();
         if base_moved {
             let body = self.world.robot.base.pose(planar[0], planar[1], planar[2]);
@@ -315,9 +449,24 @@ impl Model for GreenhouseWorld {
         }
         let collision_schedule = schedule(io, COLLISION_RATE, start_time)?;
         let fruit_schedule = schedule(io, FRUIT_RATE, start_time)?;
+        let (cfg, seed) = scene_config(io)?;
         let params = HarvestParams {
             grasp_tolerance: positive_param(io, GRASP_TOLERANCE, 0.05)?,
             release_margin: positive_param(io, RELEASE_MARGIN, 0.05)?,
+            pedicel: pedicel_params(io)?,
+            seed,
+            damage: DamageParams {
+                bruise_grip_force: positive_param(io, BRUISE_GRIP_FORCE, 1000.0)?,
+                bruise_impact_speed: positive_param(io, BRUISE_IMPACT_SPEED, 100.0)?,
+                ripe_stage: match io.i32(RIPE_STAGE) {
+                    s @ 1..=7 => s as u8,
+                    s => {
+                        return Err(format!(
+                            "parameter ripe_stage must be a USDA stage 1..6 (7: none is ripe), got {s}"
+                        ))
+                    }
+                },
+            },
         };
         let physics_dt = positive_param(io, PHYSICS_DT, 0.1)?;
         let scene_schedule = schedule(io, PLANNING_SCENE_RATE, start_time)?;
@@ -332,8 +481,8 @@ impl Model for GreenhouseWorld {
         model.fk(&coords, &mut link_in_base);
         let link = |name: &str| model.link_index(name).ok_or(format!("robot URDF: no link {name}"));
         let hand_links = [link("left_hand")?, link("right_hand")?];
+        let arm_bases = [link("left_link0")?, link("right_link0")?];
         let box_link = link("harvest_box_link")?;
-        let (cfg, seed) = scene_config(io)?;
         let greenhouse = agrisim_scene::generate(&cfg, seed);
         let mut world = SceneWorld::build(&greenhouse.objects, base, base.pose(planar[0], planar[1], planar[2]))?;
         let base_link = base_pose(planar[0], planar[1], planar[2]);
@@ -345,10 +494,13 @@ impl Model for GreenhouseWorld {
             planar,
             link_in_base,
             hand_links,
+            arm_bases,
             box_link,
             physics_dt,
         };
         let harvest = Harvest::new(params, coords.widths, robot.hands(&base_link));
+        let pedicels =
+            Arc::new(pedicel_geometry(&greenhouse.objects, &world.fruit.iter().map(|f| f.object).collect::<Vec<_>>()));
         log.info(format_args!(
             "greenhouse: {} rows, {} objects, {} fruit (seed {seed})",
             cfg.rows,
@@ -360,6 +512,7 @@ impl Model for GreenhouseWorld {
             world,
             robot,
             harvest,
+            pedicels,
             moves: Vec::new(),
             awake: Vec::new(),
             tracker: ContactTracker::default(),

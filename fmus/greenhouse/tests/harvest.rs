@@ -10,7 +10,7 @@ use agrisim_fmu_greenhouse::ports::*;
 use agrisim_fmu_greenhouse::robot_links::from_rapier;
 use agrisim_fmu_greenhouse::robot_model::{Coords, RobotModel, Side, READY_POSE};
 use agrisim_fmu_greenhouse::GreenhouseWorld;
-use agrisim_msgs::agrisim::CollisionState;
+use agrisim_msgs::agrisim::{CollisionState, PlantDamage};
 use agrisim_msgs::Message;
 use agrisim_robot::Pose as RPose;
 
@@ -294,6 +294,12 @@ fn glide(sim: &mut Sim, planar: [f64; 3], a: &Coords, b: &Coords, n: usize, mut 
     }
 }
 
+/// The PlantDamage message the world published in the last step, if any.
+fn newest_damage(sim: &Sim) -> Option<PlantDamage> {
+    let b = agrisim_fmi::port::latest(&sim.io, PLANT_DAMAGE);
+    (!b.is_empty()).then(|| PlantDamage::from_cdr(b).unwrap())
+}
+
 #[test]
 fn grasp_carry_and_place_in_the_box() {
     let (f, planar, c0) = grasp_setup(Side::Left);
@@ -308,7 +314,7 @@ fn grasp_carry_and_place_in_the_box() {
     assert_eq!(sim.io.i32(LEFT_HELD_ID), sim.fruit_id(f));
     assert_eq!(sim.io.f64(LEFT_GRASP_WIDTH), d);
     assert_eq!((sim.io.i32(RIGHT_HELD_ID), sim.io.f64(RIGHT_GRASP_WIDTH)), (-1, 0.0));
-    assert_eq!(sim.io.i32(PICKED_COUNT), 1);
+    assert_eq!(sim.io.i32(PICKED_COUNT), 0, "held, still on its plant");
 
     // Carry it over the box: lift up, arm to a pose above the box interior, the fruit on the TCP.
     let model = RobotModel::load().unwrap();
@@ -316,16 +322,32 @@ fn grasp_carry_and_place_in_the_box() {
     let over = over_the_box(&model, &c);
     let start = sim.fruit_centre(f);
     let mut worst: f64 = 0.0;
+    let mut damage = None;
     glide(&mut sim, planar, &c, &over, 60, |sim, c| {
         worst = worst.max(dist(sim.link_in_map(c, "left_hand_tcp").trans, sim.fruit_centre(f)));
+        damage = newest_damage(sim).or(damage.take());
     });
     assert!(worst < 1e-4, "the fruit follows the TCP (worst offset {worst} m)");
     assert!(dist(start, sim.fruit_centre(f)) > 0.5, "it moved");
+    assert_eq!(sim.io.i32(PICKED_COUNT), 1, "carried away, its pedicel broke");
+    // /plant_damage says the same as the scalar outputs: one break, its mode, force, moment.
+    let pd = damage.take().expect("a PlantDamage message on the break");
+    let breaks = [pd.detached_by_pull, pd.detached_by_bend, pd.detached_by_twist];
+    assert_eq!(breaks.iter().sum::<u32>(), 1, "{pd:?}");
+    let mode = ["pull", "bend", "twist"][breaks.iter().position(|&b| b == 1).unwrap()];
+    assert_eq!(pd.last_detach_mode, mode);
+    assert_eq!(sim.io.i32(LAST_DETACH_MODE), breaks.iter().position(|&b| b == 1).unwrap() as i32 + 1);
+    assert_eq!(
+        (pd.last_detach_force, pd.last_detach_moment),
+        (sim.io.f64(LAST_DETACH_FORCE), sim.io.f64(LAST_DETACH_MOMENT))
+    );
+    assert!(pd.last_detach_force > 0.0 && pd.header.frame_id == "map");
     let c = over;
 
     // Open: it falls into the box and is placed.
     let open = open_left(&mut sim, planar, &c);
     let steps = step_until(&mut sim, PLACED_COUNT, 150, |sim, steps| {
+        damage = newest_damage(sim).or(damage.take());
         if steps == 1 {
             assert_eq!((sim.io.i32(LEFT_HELD_ID), sim.io.f64(LEFT_GRASP_WIDTH)), (-1, 0.0), "released");
         }
@@ -333,6 +355,16 @@ fn grasp_carry_and_place_in_the_box() {
     assert_eq!(sim.io.i32(PLACED_COUNT), 1, "placed within 3 s");
     assert_eq!(sim.io.i32(LAST_PLACED_ID), sim.fruit_id(f));
     assert_eq!(sim.io.i32(DROPPED_COUNT), 0);
+    let pd = damage.unwrap_or(pd);
+    assert_eq!(
+        (pd.bruised_by_grip, pd.bruised_by_impact, pd.unripe_detached, pd.stems_broken),
+        (
+            sim.io.i32(GRIP_BRUISED_COUNT) as u32,
+            sim.io.i32(IMPACT_BRUISED_COUNT) as u32,
+            sim.io.i32(UNRIPE_DETACHED_COUNT) as u32,
+            0
+        )
+    );
     let box_now = sim.link_in_map(&open, "harvest_box_link");
     let in_box = box_now.inverse().transform_point(sim.fruit_centre(f));
     let r = d / 2.0;
@@ -757,4 +789,164 @@ fn a_second_fruit_lands_on_the_first_in_the_box() {
         (sim.io.i32(PICKED_COUNT), sim.io.i32(DROPPED_COUNT), sim.io.i32(LAST_PLACED_ID)),
         (2, 0, sim.fruit_id(b))
     );
+}
+
+/// Lowers the lift by `step` m per step (the hand pulls the grasped fruit down, away from its
+/// truss) until the pedicel breaks or `max` steps; returns the pull outputs seen before.
+fn pull_down(sim: &mut Sim, c: &mut Coords, step: f64, max: usize) -> Vec<f64> {
+    let planar = sim.planar();
+    let mut pulls = vec![];
+    for _ in 0..max {
+        c.lift -= step;
+        sim.set(planar, c);
+        sim.step();
+        if sim.io.i32(PICKED_COUNT) > 0 {
+            break;
+        }
+        pulls.push(sim.io.f64(LEFT_PEDICEL_PULL));
+    }
+    pulls
+}
+
+#[test]
+fn a_grasped_fruit_stays_on_its_plant_until_its_pedicel_breaks() {
+    let (f, planar, c0) = grasp_setup(Side::Left);
+    let mut sim = Sim::start(planar, &c0);
+    let mut c = c0;
+    close(&mut sim, &mut c, Side::Left).expect("held");
+    assert_eq!((sim.io.i32(LEFT_HELD_ID), sim.io.i32(PICKED_COUNT)), (sim.fruit_id(f), 0), "held, still on the plant");
+    let rest = sim.fruit_centre(f);
+    let pulls = pull_down(&mut sim, &mut c, 0.002, 200);
+    assert_eq!(sim.io.i32(PICKED_COUNT), 1, "the pedicel broke within 40 cm");
+    // The load grew as the hand pulled (500 N/m: ~1 N per 2 mm step), and was felt by the hand.
+    assert!(pulls.len() > 5, "{pulls:?}");
+    assert!(pulls.windows(2).all(|w| w[1] >= w[0] - 1e-9), "{pulls:?}");
+    let mode = sim.io.i32(LAST_DETACH_MODE);
+    let force = sim.io.f64(LAST_DETACH_FORCE);
+    println!(
+        "broke in mode {mode} at {force:.2} N after {} steps (last pull {:.2} N)",
+        pulls.len() + 1,
+        pulls.last().unwrap()
+    );
+    assert!(mode == 1 || mode == 2, "pull or bend: {mode}");
+    assert!(force > 2.0 && force < 60.0, "{force}");
+    assert_eq!(sim.io.i32(DETACHED_PULL_COUNT) + sim.io.i32(DETACHED_BEND_COUNT), 1);
+    assert!(dist(rest, sim.fruit_centre(f)) > 0.005, "it moved with the hand");
+    // Detached: no load on the hand any more, the fruit still in it.
+    assert_eq!(sim.io.f64(LEFT_LOAD_FZ), 0.0);
+    assert_eq!(sim.io.i32(LEFT_HELD_ID), sim.fruit_id(f));
+}
+
+#[test]
+fn the_load_on_the_hand_is_the_pedicels_pull() {
+    let (_, planar, c0) = grasp_setup(Side::Left);
+    let mut sim = Sim::start(planar, &c0);
+    let mut c = c0;
+    close(&mut sim, &mut c, Side::Left).expect("held");
+    pull_down(&mut sim, &mut c, 0.002, 4);
+    assert_eq!(sim.io.i32(PICKED_COUNT), 0);
+    // The hand pulled down: the pedicel pulls the fruit (and the hand) up, in left_link0 too
+    // (its z is base_link's); the force's size is the pedicel's tension and shear.
+    let fz = sim.io.f64(LEFT_LOAD_FZ);
+    let f = [LEFT_LOAD_FX, LEFT_LOAD_FY, LEFT_LOAD_FZ].map(|v| sim.io.f64(v));
+    let size = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
+    assert!(fz > 1.0, "{f:?}");
+    assert!(sim.io.f64(LEFT_PEDICEL_PULL) <= size + 1e-9 && sim.io.f64(LEFT_PEDICEL_PULL) > 0.5 * size);
+    assert_eq!(
+        [RIGHT_LOAD_FX, RIGHT_LOAD_FY, RIGHT_LOAD_FZ].map(|v| sim.io.f64(v)),
+        [0.0; 3],
+        "the right hand holds nothing"
+    );
+}
+
+#[test]
+fn opened_before_the_pedicel_breaks_the_fruit_stays_on_its_plant() {
+    let (f, planar, c0) = grasp_setup(Side::Left);
+    let mut sim = Sim::start(planar, &c0);
+    let rest = sim.fruit_centre(f);
+    let mut c = c0;
+    close(&mut sim, &mut c, Side::Left).expect("held");
+    pull_down(&mut sim, &mut c, 0.002, 3);
+    assert_eq!(sim.io.i32(PICKED_COUNT), 0);
+    let open = open_left(&mut sim, planar, &c);
+    sim.step();
+    assert_eq!((sim.io.i32(LEFT_HELD_ID), sim.io.i32(PICKED_COUNT), sim.io.i32(DROPPED_COUNT)), (-1, 0, 0));
+    assert!(dist(rest, sim.fruit_centre(f)) < 1e-6, "back where it hung");
+    for _ in 0..20 {
+        sim.step();
+    }
+    assert!(dist(rest, sim.fruit_centre(f)) < 1e-6, "and stays there");
+    assert_eq!(sim.io.f64(LEFT_LOAD_FZ), 0.0);
+    // It can be grasped again: back to the grasp pose, close.
+    let mut c = Coords { widths: [0.08, open.widths[1]], ..c0 };
+    sim.set(planar, &c);
+    sim.step();
+    close(&mut sim, &mut c, Side::Left).expect("held again");
+}
+
+#[test]
+fn squeezing_above_the_bruise_threshold_bruises_the_held_fruit() {
+    let (_, planar, c0) = grasp_setup(Side::Left);
+    let mut sim = Sim::start(planar, &c0);
+    let mut c = c0;
+    sim.io.set_f64(LEFT_GRIP_FORCE, 20.0);
+    close(&mut sim, &mut c, Side::Left).expect("held");
+    sim.step();
+    assert_eq!((sim.io.i32(BRUISED_COUNT), sim.io.i32(GRIP_BRUISED_COUNT)), (0, 0), "20 N is below 40 N");
+    sim.io.set_f64(LEFT_GRIP_FORCE, 70.0);
+    sim.step();
+    sim.step();
+    assert_eq!((sim.io.i32(BRUISED_COUNT), sim.io.i32(GRIP_BRUISED_COUNT)), (1, 1), "70 N bruises, once");
+    sim.io.set_f64(LEFT_GRIP_FORCE, f64::NAN);
+    assert!(sim.m.do_step(&mut sim.io, sim.t, H, &mut Quiet).is_err(), "a NaN grip force is an error");
+}
+
+/// FMU state serialization with a fruit attached and loaded: saved mid-pull, the rest of the
+/// pull (through the break) restores bit for bit.
+#[test]
+fn serialized_state_restores_with_an_attached_fruit() {
+    let (_, planar, c0) = grasp_setup(Side::Left);
+    let drive = move |io: &mut Store, k: usize| {
+        let mut c = c0;
+        // Steps 0-1: open at the fruit; 2-9: closing 1 cm per step; then the lift pulls down 3 mm per step.
+        c.widths[0] = (0.08 - 0.01 * k.saturating_sub(1) as f64).max(0.0);
+        c.lift -= 0.003 * k.saturating_sub(10) as f64;
+        io.set_f64(BASE_X, planar[0]);
+        io.set_f64(BASE_Y, planar[1]);
+        io.set_f64(BASE_YAW, planar[2]);
+        io.set_f64(LIFT_POSITION, c.lift);
+        for (i, vr) in q_vrs(Side::Left).into_iter().enumerate() {
+            io.set_f64(vr, c.arms[0][i]);
+        }
+        for (i, vr) in q_vrs(Side::Right).into_iter().enumerate() {
+            io.set_f64(vr, c.arms[1][i]);
+        }
+        io.set_f64(LEFT_FINGER_WIDTH, c.widths[0]);
+        io.set_f64(RIGHT_FINGER_WIDTH, c.widths[1]);
+        io.set_f64(LEFT_GRIP_FORCE, if k >= 8 { 20.0 } else { 0.0 });
+    };
+    // Check the drive: attached and loaded at the save point, broken before the end.
+    let mut io = Store::new(GreenhouseWorld::VARIABLES);
+    *io.value_mut(SCENE_VAR) = Value::String(SCENE.to_string());
+    let mut m = GreenhouseWorld::new();
+    drive(&mut io, 0);
+    m.initialize(&mut io, 0.0, &mut Quiet).unwrap();
+    let mut t = 0.0;
+    for k in 0..60 {
+        drive(&mut io, k);
+        m.do_step(&mut io, t, H, &mut Quiet).unwrap();
+        t += H;
+        if k == 15 {
+            assert!(io.i32(LEFT_HELD_ID) >= 0 && io.i32(PICKED_COUNT) == 0 && io.f64(LEFT_PEDICEL_PULL) > 0.0);
+        }
+    }
+    assert_eq!(io.i32(PICKED_COUNT), 1, "the pedicel broke within the run");
+    let n = agrisim_fmi_testing::assert_state_round_trip::<GreenhouseWorld>(
+        &[(SCENE_VAR, Value::String(SCENE.to_string()))],
+        H,
+        16,
+        44,
+        &drive,
+    );
+    assert!(n > 0);
 }

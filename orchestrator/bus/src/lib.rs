@@ -17,6 +17,18 @@ pub use agrisim_error::{err, Context, Error, Result};
 pub use bus::{Bus, Published, Reader, Sample, Tap};
 pub use node::Node;
 pub use policy::{Profile, RecordPolicy};
+
+/// Topics whose publisher sends a message once (or on change) and whose readers need the last
+/// one whenever they join: ROS 2's transient local durability ("latched"). The bridges offer
+/// them so, the recorder marks them so in `offered_qos_profiles`, and the Foxglove view sends
+/// a late subscriber the last message.
+pub const LATCHED_TOPICS: [&str; 5] =
+    ["/tf_static", "/map", "/robot_description", "/scene/markers", "/scene/fruit_markers"];
+
+/// Whether `topic` is one of [`LATCHED_TOPICS`].
+pub fn is_latched(topic: &str) -> bool {
+    LATCHED_TOPICS.contains(&topic)
+}
 pub use recorder::{part_path, Channel, Chunks, Payload, Recorder};
 
 /// `crate::error::...` paths inside this crate.

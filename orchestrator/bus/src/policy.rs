@@ -8,6 +8,9 @@
 //!   rarely changes) and the FMUs' signals (10 Hz);
 //! - `judge`: what the judges read (harvest and navigation status and plans, collision
 //!   states, run status) and the world's and chassis' ground-truth signals at 10 Hz;
+//! - every profile but `none` keeps the viewer topics (`/robot_description`, the greenhouse
+//!   markers): they are published once and again only on change, so a recording opens in
+//!   Foxglove with the robot and the greenhouse drawn, for a few hundred kilobytes;
 //! - `none`: no messages (the file keeps its metadata).
 //!
 //! Decimation keeps a message when at least the period has passed since the last one kept on
@@ -91,9 +94,11 @@ pub const HEAVY_PERIOD: f64 = 5.0;
 /// Period of IMU samples in the `standard` profile \[s\] (50 Hz: noise compresses badly).
 pub const IMU_PERIOD: f64 = 0.02;
 const HEAVY_TYPES: [&str; 2] = ["sensor_msgs/msg/PointCloud2", "sensor_msgs/msg/Image"];
-const JUDGE_TOPICS: [&str; 5] =
-    ["/harvest/status", "/harvest/plans", "/navigate/status", "/collision", "/agrisim/status"];
+const JUDGE_TOPICS: [&str; 6] =
+    ["/harvest/status", "/harvest/plans", "/navigate/status", "/collision", "/plant_damage", "/agrisim/status"];
 const GROUND_TRUTH_SIGNALS: [&str; 2] = ["/fmu/world/signals", "/fmu/chassis/signals"];
+/// Published once or on change, for viewers: kept by every profile but `none`.
+pub const VIEWER_TOPICS: [&str; 3] = ["/robot_description", "/scene/markers", "/scene/fruit_markers"];
 
 impl RecordPolicy {
     pub fn profile(profile: Profile) -> RecordPolicy {
@@ -125,6 +130,7 @@ impl RecordPolicy {
         match self.profile {
             Profile::Full => Rule::Keep,
             Profile::None => Rule::Drop,
+            _ if VIEWER_TOPICS.contains(&topic) => Rule::Keep,
             Profile::Standard if HEAVY_TYPES.contains(&type_name) => Rule::Every(HEAVY_PERIOD),
             Profile::Standard if topic == "/fruits" => Rule::Once,
             Profile::Standard if type_name == "sensor_msgs/msg/Imu" => Rule::Every(IMU_PERIOD),
@@ -180,8 +186,15 @@ mod tests {
         assert_eq!(std.rule("/fmu/imu/signals", "agrisim_msgs/msg/Signals"), Rule::Every(0.1));
         let judge = RecordPolicy::profile(Profile::Judge);
         assert_eq!(judge.rule("/collision", "agrisim_msgs/msg/CollisionState"), Rule::Keep);
+        assert_eq!(judge.rule("/plant_damage", "agrisim_msgs/msg/PlantDamage"), Rule::Keep);
         assert_eq!(judge.rule("/imu", "sensor_msgs/msg/Imu"), Rule::Drop);
         assert_eq!(RecordPolicy::profile(Profile::None).rule("/collision", "x"), Rule::Drop);
+        for topic in VIEWER_TOPICS {
+            for p in [Profile::Full, Profile::Standard, Profile::Judge] {
+                assert_eq!(RecordPolicy::profile(p).rule(topic, "visualization_msgs/msg/MarkerArray"), Rule::Keep);
+            }
+            assert_eq!(RecordPolicy::profile(Profile::None).rule(topic, "std_msgs/msg/String"), Rule::Drop);
+        }
         let custom = RecordPolicy {
             profile: Profile::None,
             include: vec!["/camera/*".into()],

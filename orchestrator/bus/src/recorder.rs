@@ -23,6 +23,9 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 
 /// QoS rosbag2 records for an ordinary reliable, volatile topic (history/depth unknown).
+/// QoS rosbag2 records for a latched topic ([`crate::LATCHED_TOPICS`]): reliable, transient
+/// local, keep last 1, so `ros2 bag play` offers the last message to late subscribers.
+const QOS_LATCHED: &str = "- history: 1\n  depth: 1\n  reliability: 1\n  durability: 1\n  deadline:\n    sec: 2147483647\n    nsec: 4294967295\n  lifespan:\n    sec: 2147483647\n    nsec: 4294967295\n  liveliness: 1\n  liveliness_lease_duration:\n    sec: 2147483647\n    nsec: 4294967295\n  avoid_ros_namespace_conventions: false\n";
 const QOS_VOLATILE: &str = "- history: 3\n  depth: 0\n  reliability: 1\n  durability: 2\n  deadline:\n    sec: 2147483647\n    nsec: 4294967295\n  lifespan:\n    sec: 2147483647\n    nsec: 4294967295\n  liveliness: 1\n  liveliness_lease_duration:\n    sec: 2147483647\n    nsec: 4294967295\n  avoid_ros_namespace_conventions: false\n";
 
 /// Most bytes of messages waiting for the writer thread (about three 1280x720 RGB-D frames):
@@ -371,7 +374,8 @@ impl Sink {
                 id
             }
         };
-        let metadata = BTreeMap::from([("offered_qos_profiles".to_string(), QOS_VOLATILE.to_string())]);
+        let qos = if crate::is_latched(topic) { QOS_LATCHED } else { QOS_VOLATILE };
+        let metadata = BTreeMap::from([("offered_qos_profiles".to_string(), qos.to_string())]);
         let id = self
             .writer
             .add_channel(schema_id, topic, "cdr", &metadata)

@@ -6,7 +6,7 @@
 use agrisim_error::{err, Result};
 use agrisim_ros2::names::Remap;
 use agrisim_ros2::{BridgeConfig, Distro, Mode, Ros2Bridge, Stats};
-use agrisim_session::run::{NodePlan, SystemIo};
+use agrisim_session::run::{NodeFactory, NodePlan, SystemIo};
 use std::collections::BTreeSet;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -64,6 +64,11 @@ pub struct LiveArgs {
     /// 127.0.0.1:8765; give 0.0.0.0:PORT to expose it to the network).
     #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = agrisim_foxglove::DEFAULT_ADDR)]
     pub foxglove: Option<String>,
+    /// Pace the run to the wall clock, FACTOR simulated seconds per wall second (bare: 1,
+    /// real time; 0.5: half speed), so a person can follow it in a viewer; with or without a
+    /// bridge. It only waits: messages, recordings and results are the same without it.
+    #[arg(long, value_name = "FACTOR", num_args = 0..=1, default_missing_value = "1")]
+    pub realtime: Option<f64>,
 }
 
 /// A topic and its ROS 2 type.
@@ -108,6 +113,23 @@ fn outputs_of(node: &str) -> Option<(&'static [Topic], &'static [&'static str])>
 impl LiveArgs {
     /// The run's node plan; `stats` collects each run's bridge statistics.
     pub fn plan(&self, stats: &Arc<Mutex<Vec<Arc<Mutex<Stats>>>>>) -> Result<NodePlan> {
+        let plan = self.links(stats)?;
+        let Some(factor) = self.realtime else { return Ok(plan) };
+        agrisim_nodes::Pace::new(factor)?;
+        // The pacer first among the extra nodes: the bridges send each instant when it is due.
+        let links = plan.extra.clone();
+        let extra: NodeFactory = Arc::new(move |io: &SystemIo| -> Result<Vec<Box<dyn agrisim_bus::Node>>> {
+            let mut nodes: Vec<Box<dyn agrisim_bus::Node>> = vec![Box::new(agrisim_nodes::RealtimePacer::new(factor)?)];
+            if let Some(links) = &links {
+                nodes.extend(links(io)?);
+            }
+            Ok(nodes)
+        });
+        Ok(NodePlan { external: plan.external, extra: Some(extra) })
+    }
+
+    /// The node plan of the live links (bridges, external nodes).
+    fn links(&self, stats: &Arc<Mutex<Vec<Arc<Mutex<Stats>>>>>) -> Result<NodePlan> {
         let external: BTreeSet<String> = self.external.iter().cloned().collect();
         let foxglove: Option<std::net::SocketAddr> = match &self.foxglove {
             Some(a) => Some(a.parse().map_err(|e| err!("--foxglove {a}: not an address IP:PORT ({e})"))?),
@@ -118,9 +140,10 @@ impl LiveArgs {
                 return Err(err!("--external needs --ros2 (the external node talks to the run over ROS 2)"));
             }
             return Ok(match foxglove {
-                Some(addr) => {
-                    NodePlan { external, extra: Some(Arc::new(move |_: &SystemIo| Ok(vec![foxglove_view(addr)?]))) }
-                }
+                Some(addr) => NodePlan {
+                    external,
+                    extra: Some(Arc::new(move |io: &SystemIo| Ok(vec![foxglove_view(addr, io)?]))),
+                },
                 None => NodePlan::default(),
             });
         }
@@ -182,7 +205,7 @@ impl LiveArgs {
             stats.lock().expect("stats lock").push(s);
             let mut nodes: Vec<Box<dyn agrisim_bus::Node>> = vec![Box::new(bridge)];
             if let Some(addr) = foxglove {
-                nodes.push(foxglove_view(addr)?);
+                nodes.push(foxglove_view(addr, inputs)?);
             }
             Ok(nodes)
         };
@@ -190,9 +213,12 @@ impl LiveArgs {
     }
 }
 
-/// The Foxglove live view on `addr`, announced on stderr.
-fn foxglove_view(addr: std::net::SocketAddr) -> Result<Box<dyn agrisim_bus::Node>> {
-    let (view, port) = agrisim_foxglove::FoxgloveView::start(addr)?;
+/// The Foxglove live view on `addr`, announced on stderr; the channels of the system's
+/// topics and the viewer topics exist before a client can connect (see agrisim_foxglove).
+fn foxglove_view(addr: std::net::SocketAddr, io: &SystemIo) -> Result<Box<dyn agrisim_bus::Node>> {
+    let mut known: Vec<(String, String)> = io.outputs.iter().chain(&io.messages).cloned().collect();
+    known.extend(agrisim_session::run::viewer_topics());
+    let (view, port) = agrisim_foxglove::FoxgloveView::start_with(addr, &known)?;
     eprintln!("foxglove: ws://{}:{port} (open it in Foxglove: Open connection, Foxglove WebSocket)", addr.ip());
     Ok(Box::new(view))
 }

@@ -38,6 +38,11 @@ const LINE_TOLERANCE: f64 = 0.005;
 const CARTESIAN_STEP: f64 = 0.01;
 /// Fruit closer than this to the picked one (surface to surface) may be brushed [m].
 const NEIGHBOUR_GAP: f64 = 0.02;
+/// How far from the grasped fruit's centre the hand reaches as it rolls about its own axis
+/// [m]: the Franka Hand is about 0.2 m across the fingers (Franka Emika, FR3 product
+/// manual: hand dimensions) and its palm lies about 0.09 m behind the fingertip centre, so its
+/// corners sweep a sphere of about sqrt(0.1^2 + 0.09^2) = 0.135 m about the grasp point.
+const ROLL_SWEEP: f64 = 0.14;
 /// Rolls about the approach axis tried for a grasp.
 const ROLLS: usize = 12;
 /// Distinct IK solutions asked for per free goal, and their minimum joint-space spread [rad].
@@ -112,6 +117,9 @@ pub struct Motion {
     /// the robot would otherwise block its arm for good): loose, pushed aside, never
     /// planned around.
     loose: Vec<String>,
+    /// The grasp point of a wrist roll being planned: fruit within the hand's sweep of it are
+    /// pushed aside, not planned around (see [`Motion::plan_roll`]).
+    roll_centre: Option<[f64; 3]>,
     /// Safety margin of the sphere checks [m] (the exact check has none).
     padding: f64,
     /// The straight approach (joint path, pre-grasp first) checked by the last pre-grasp plan.
@@ -134,6 +142,7 @@ impl Motion {
             ignore_target: false,
             held: [None, None],
             loose: vec![],
+            roll_centre: None,
             padding: agrisim_manip::checker::DEFAULT_PADDING,
             approach: None,
             meter: Meter::default(),
@@ -205,6 +214,16 @@ impl Motion {
         let mut objs = self.obstacles.clone();
         for o in objs.iter_mut().filter(|o| self.loose.contains(&o.name)) {
             o.kind = ObstacleKind::Soft;
+        }
+        if let Some(c) = self.roll_centre {
+            let c = Vector3::from(c);
+            for o in objs.iter_mut() {
+                if let Shape::Sphere { radius } = o.shape {
+                    if (o.pose.translation.vector - c).norm() < ROLL_SWEEP + radius {
+                        o.kind = ObstacleKind::Soft;
+                    }
+                }
+            }
         }
         if let Some(i) = self.target {
             objs[i].kind = if self.ignore_target { ObstacleKind::Soft } else { ObstacleKind::Target };
@@ -444,6 +463,65 @@ impl Motion {
         other: [f64; DOF],
     ) -> Result<(usize, Planned), String> {
         first_ok(goals, "goal", |g| self.plan_linear(arm, lift, start, g, other))
+    }
+
+    /// Free-space motion to any of the joint configurations `goals`.
+    pub fn plan_joints(
+        &mut self,
+        arm: Arm,
+        lift: f64,
+        start: [f64; DOF],
+        goals: &[[f64; DOF]],
+        other: [f64; DOF],
+    ) -> Result<Planned, String> {
+        self.plan_to_configs(arm, lift, start, goals, other)
+    }
+
+    /// Why `arm` at `q` is no valid configuration (out of limits, or its first contact), or
+    /// None when it is valid: for the reports of a plan without a valid goal.
+    pub fn invalid_reason(&self, arm: Arm, lift: f64, q: &[f64; DOF], other: [f64; DOF]) -> Option<String> {
+        let ctx = self.context(arm, lift, other);
+        if !ctx.arm.within_limits(q) {
+            return Some("out of the joint limits".into());
+        }
+        Checker::new(ctx).contact(q).map(|c| c.describe(&ctx))
+    }
+
+    /// Joint motion of a wrist roll with the grasped fruit at `centre` (base_link): the fruit
+    /// hanging within the hand's sweep of it are pushed aside on their pedicels, as the
+    /// fingers push the target's neighbours at the grasp (the world counts the touches), so
+    /// they are no obstacles. Without this, a truss neighbour beside the palm blocks every
+    /// roll of an arm that grasped from that side. After a planned roll they stay pushed aside
+    /// (the hand rests against them) until [`Motion::end_roll`]; a failed plan leaves the
+    /// scene as it was.
+    pub fn plan_roll(
+        &mut self,
+        arm: Arm,
+        lift: f64,
+        start: [f64; DOF],
+        goals: &[[f64; DOF]],
+        other: [f64; DOF],
+        centre: [f64; 3],
+    ) -> Result<Planned, String> {
+        self.roll_centre = Some(centre);
+        self.rebuild();
+        let r = self.plan_to_configs(arm, lift, start, goals, other);
+        let reason =
+            r.as_ref().err().and_then(|_| goals.first()).and_then(|g| self.invalid_reason(arm, lift, g, other));
+        if r.is_err() {
+            self.end_roll();
+        }
+        r.map_err(|e| match reason {
+            Some(why) => format!("{e}; first roll: {why}"),
+            None => e,
+        })
+    }
+
+    /// The hand has left the fruit a roll pushed aside: they are obstacles again.
+    pub fn end_roll(&mut self) {
+        if self.roll_centre.take().is_some() {
+            self.rebuild();
+        }
     }
 
     /// Free-space motion back to [`HOME`].

@@ -61,6 +61,8 @@ const RECOVERY_BACKOFF: f64 = 0.12;
 #[derive(Debug, Clone, Default)]
 struct ArmView {
     q: Option<[f64; 7]>,
+    /// Measured joint torques (joint_states effort).
+    effort: Option<[f64; 7]>,
     status: TrajectoryStatus,
     gripper: Option<GripperState>,
     seen: [u64; 3],
@@ -107,6 +109,13 @@ pub struct HarvestNode {
     grasp_point: [f64; 3],
     /// The approach the pre-grasp plan chose (position: the target as first seen).
     grasp: TcpGoal,
+    /// Joint torques of the giver right after the grasp (the fruit still hanging unloaded):
+    /// what the detach check compares with.
+    detach_baseline: Option<[f64; 7]>,
+    /// The giver's joints at the grasp (where a roll that did not detach goes back to).
+    grasp_q: [f64; 7],
+    /// How the fruit came off: "bend" (the wrist roll) or "pull" (the retreat).
+    pub detach_motion: &'static str,
     handover_attempts: u32,
     handover_offset: f64,
     release_ns: i64,
@@ -157,6 +166,9 @@ impl HarvestNode {
             regrasp_axes: [[0.0; 3]; 2],
             grasp_point: [0.0; 3],
             grasp: geo::grasp([0.0; 3], side),
+            detach_baseline: None,
+            grasp_q: [0.0; 7],
+            detach_motion: "",
             handover_attempts: 0,
             handover_offset: 0.0,
             release_ns: 0,
@@ -250,17 +262,25 @@ impl HarvestNode {
             let mut seen = v.seen;
             if let Some(js) = bus.take_new::<JointState>(&arm.topic("joint_states"), &mut seen[0])? {
                 let mut q = [0.0; 7];
-                let mut found = 0;
+                let mut tau = [0.0; 7];
+                let (mut found, mut efforts) = (0, 0);
                 for (i, n) in names.iter().enumerate() {
                     if let Some(k) = js.name.iter().position(|m| m == n) {
                         if let Some(&x) = js.position.get(k) {
                             q[i] = x;
                             found += 1;
                         }
+                        if let Some(&e) = js.effort.get(k) {
+                            tau[i] = e;
+                            efforts += 1;
+                        }
                     }
                 }
                 if found == 7 {
                     v.q = Some(q);
+                }
+                if efforts == 7 {
+                    v.effort = Some(tau);
                 }
             }
             if let Some(st) = bus.take_new::<TrajectoryStatus>(&arm.topic("trajectory_status"), &mut seen[1])? {
@@ -275,6 +295,10 @@ impl HarvestNode {
     }
 
     fn enter(&mut self, stage: Stage, t_ns: i64, bus: &mut Bus, detail: &str) {
+        // The fruit a wrist roll pushed aside stay so while the hand backs out of the plant.
+        if !matches!(stage, Stage::Detach | Stage::Retreat) {
+            self.motion.end_roll();
+        }
         self.stage = stage;
         self.stage_start_ns = t_ns;
         self.step_in_stage = 0;
@@ -299,6 +323,7 @@ impl HarvestNode {
 
     fn fail(&mut self, f: Failure, t_ns: i64, bus: &mut Bus, detail: String) {
         self.publish_status(t_ns, bus, "failure", f.name(), &detail);
+        self.motion.end_roll();
         self.stage = Stage::Failed;
         self.stop_base(t_ns, bus);
     }
@@ -510,7 +535,7 @@ impl HarvestNode {
     /// function in [`stages`]), unless the stage has run out of time.
     ///
     /// ```text
-    /// recover -> select_target -> position_base -> pre_grasp -> approach -> grasp -> retreat
+    /// recover -> select_target -> position_base -> pre_grasp -> approach -> grasp -> detach -> retreat
     ///                                                               ^          |
     ///                                                               +- regrasp +  (closed on nothing)
     /// retreat -> handover_pose -> handover -> transfer -> release -> done
@@ -532,6 +557,7 @@ impl HarvestNode {
             Stage::Approach => self.run_approach(first, t_ns, bus),
             Stage::Grasp => self.run_grasp(first, t_ns, bus),
             Stage::Regrasp => self.run_regrasp(t_ns, bus),
+            Stage::Detach => self.run_detach(t_ns, bus),
             Stage::Retreat => self.run_retreat(first, t_ns, bus),
             Stage::HandoverPose => self.run_handover_pose(t_ns, bus),
             Stage::Handover => self.run_handover(t_ns, bus),

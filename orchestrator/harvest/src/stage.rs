@@ -12,6 +12,10 @@ pub enum Stage {
     Grasp,
     /// Open, back off and approach again after the gripper closed on nothing.
     Regrasp,
+    /// Bend the held fruit off its plant (a wrist roll about the approach axis, which turns the
+    /// fruit about a horizontal axis through its centre: bending at the pedicel), and check by
+    /// the arm's joint torques whether it came off; the retreat pulls (the fallback) otherwise.
+    Detach,
     Retreat,
     HandoverPose,
     Handover,
@@ -31,6 +35,7 @@ impl Stage {
             Stage::Approach => "approach",
             Stage::Grasp => "grasp",
             Stage::Regrasp => "regrasp",
+            Stage::Detach => "detach",
             Stage::Retreat => "retreat",
             Stage::HandoverPose => "handover_pose",
             Stage::Handover => "handover",

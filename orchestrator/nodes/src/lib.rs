@@ -6,6 +6,7 @@ mod fault_injector;
 mod goal_publisher;
 mod map_server;
 mod odom_tf;
+mod pacer;
 mod robot_state;
 mod task_publisher;
 
@@ -14,6 +15,7 @@ pub use fault_injector::{FaultInjector, Injection};
 pub use goal_publisher::GoalPublisher;
 pub use map_server::MapServer;
 pub use odom_tf::OdomTf;
+pub use pacer::{Pace, RealtimePacer};
 pub use robot_state::RobotStatePublisher;
 pub use task_publisher::TaskPublisher;
 

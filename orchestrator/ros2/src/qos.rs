@@ -20,7 +20,7 @@ pub enum Kind {
 
 /// The kind of `topic` carrying `ros_type`.
 pub fn kind_of(topic: &str, ros_type: &str) -> Kind {
-    if matches!(topic, "/tf_static" | "/map" | "/robot_description") {
+    if agrisim_bus::is_latched(topic) {
         return Kind::Latched;
     }
     match ros_type {

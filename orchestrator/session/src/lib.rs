@@ -12,6 +12,7 @@ pub mod run;
 pub mod scenario;
 pub mod scene;
 pub mod session;
+pub mod viewer;
 
 pub use agrisim_bus::{Profile, RecordPolicy};
 pub use run::{prepare, RunOptions, RunSummary};

@@ -8,7 +8,7 @@ use agrisim_cosim::system::ticks_of;
 use agrisim_cosim::{LoadOptions, Master, System};
 use agrisim_error::{err, Context, Result};
 use agrisim_msgs::{sensor_msgs::Image, Message};
-use agrisim_nodes::{CommandScript, FaultInjector, OdomTf};
+use agrisim_nodes::{CommandScript, FaultInjector, OdomTf, RobotStatePublisher};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -146,10 +146,62 @@ pub fn default_nodes(s: &Scenario) -> Vec<Box<dyn Node>> {
     ]
 }
 
+/// What a plain `agrisim run` shows viewers (RViz, Foxglove; live and in the MCAP): the
+/// robot (robot_state_publisher: /robot_description, /joint_states, the links' TF) and the
+/// greenhouse ([`crate::viewer::SceneView`]: /scene/markers, /scene/fruit_markers).
+pub fn viewer_nodes(s: &Scenario) -> Result<Vec<Box<dyn Node>>> {
+    let gh = crate::scene::generate_scene(s)?;
+    Ok(vec![Box::new(RobotStatePublisher::agrisim()), Box::new(crate::viewer::SceneView::new(&gh))])
+}
+
+/// The topics and ROS 2 types the [`viewer_nodes`] (and the map -> odom of a plain run) publish.
+pub fn viewer_topics() -> Vec<(String, String)> {
+    use agrisim_msgs::sensor_msgs::JointState;
+    use agrisim_msgs::tf2_msgs::TFMessage;
+    use agrisim_msgs::visualization_msgs::MarkerArray;
+    use agrisim_msgs::Message;
+    let tf = TFMessage::TYPE_NAME;
+    // robot_state_publisher's (agrisim_nodes::RobotStatePublisher).
+    [
+        ("/robot_description", agrisim_msgs::std_msgs::String::TYPE_NAME),
+        ("/joint_states", JointState::TYPE_NAME),
+        ("/tf", tf),
+        (crate::viewer::TF_STATIC, tf),
+        (crate::viewer::SCENE_MARKERS, MarkerArray::TYPE_NAME),
+        (crate::viewer::FRUIT_MARKERS, MarkerArray::TYPE_NAME),
+    ]
+    .map(|(t, ty)| (t.to_string(), ty.to_string()))
+    .to_vec()
+}
+
 /// Builds the session for a scenario with the algorithm layer's `nodes`, recording to `mcap`.
 /// Setup errors come back before any file is written; from here on the MCAP exists and is
 /// finished whatever happens.
 pub fn prepare(s: &Scenario, o: &RunOptions, mcap: &Path, nodes: Vec<Box<dyn Node>>) -> Result<Session> {
+    prepare_with(s, o, mcap, nodes, false)
+}
+
+/// The start pose \[m, m, rad\] of the component with start-pose parameters (the mobile base),
+/// from the parameters the run applies.
+fn start_pose(params: &BTreeMap<String, BTreeMap<String, toml::Value>>) -> Option<[f64; 3]> {
+    params.values().find_map(|p| {
+        let v: Vec<f64> = START_POSE
+            .iter()
+            .filter_map(|n| p.get(*n).and_then(|v| v.as_float().or(v.as_integer().map(|i| i as f64))))
+            .collect();
+        <[f64; 3]>::try_from(v).ok()
+    })
+}
+
+/// [`prepare`]; with `map_odom`, map -> odom fixed at the start pose unless a node localizes
+/// ([`crate::viewer::with_map_odom`]).
+fn prepare_with(
+    s: &Scenario,
+    o: &RunOptions,
+    mcap: &Path,
+    nodes: Vec<Box<dyn Node>>,
+    map_odom: bool,
+) -> Result<Session> {
     let seed = o.seed.unwrap_or(s.seed);
     let lo = load_options(s, o);
     let mut system = System::load(&s.system_path(), &lo)?;
@@ -203,6 +255,8 @@ pub fn prepare(s: &Scenario, o: &RunOptions, mcap: &Path, nodes: Vec<Box<dyn Nod
         scalars: scalars.into_iter().collect(),
         outputs: outputs.into_iter().collect(),
     };
+    // Before the external and extra nodes: `--external map_odom` leaves it to an outside localizer.
+    let nodes = if map_odom { crate::viewer::with_map_odom(nodes, start_pose(&params)) } else { nodes };
     let nodes = o.nodes.apply(nodes, &inputs)?;
     let mut session = Session::new(master, nodes, recorder, types);
     session.master.initialize()?;
@@ -225,7 +279,9 @@ pub fn run(s: &Scenario, o: &RunOptions, out_dir: &Path, progress: impl FnMut(u6
     let duration = o.duration.unwrap_or(s.duration);
     let steps = ticks_of(duration, s.timing.step, "duration")
         .map_err(|_| err!("duration {duration} s is not a whole number of {} s steps", s.timing.step))?;
-    let mut session = prepare(s, o, &mcap, default_nodes(s))?;
+    let mut nodes = viewer_nodes(s)?;
+    nodes.extend(default_nodes(s));
+    let mut session = prepare_with(s, o, &mcap, nodes, true)?;
     let mut progress = progress;
     let result = session.run(steps, |k| progress(k, steps));
     let finish = session.recorder_finish();

@@ -207,7 +207,14 @@ fn the_world_sees_the_lift_after_its_step() {
     let names = |m: &Master, rs: &[usize]| rs.iter().map(|&r| m.system.routes[r].label.clone()).collect::<Vec<_>>();
     assert_eq!(
         names(&master, &master.order().delayed),
-        ["world.left_grasp_width -> arm_left.grasp_width", "world.right_grasp_width -> arm_right.grasp_width"]
+        ["left", "right"]
+            .iter()
+            .flat_map(|s| {
+                std::iter::once(format!("world.{s}_grasp_width -> arm_{s}.grasp_width")).chain(
+                    ["fx", "fy", "fz", "mx", "my", "mz"].map(|k| format!("world.{s}_load_{k} -> arm_{s}.load_{k}")),
+                )
+            })
+            .collect::<Vec<_>>()
     );
     assert!(master.order().init_loops.is_empty());
     master.initialize().unwrap();

@@ -142,6 +142,29 @@ ros_message! {
 }
 
 ros_message! {
+    /// `agrisim_msgs/msg/PlantDamage`: ground truth of what the harvest did to the crop,
+    /// cumulative since the start (counts per kind) and the last pedicel break. For the
+    /// judge only: algorithm nodes never read it.
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct PlantDamage = "agrisim_msgs/msg/PlantDamage" {
+        pub header: Header,
+        pub bruised_by_grip: u32,
+        pub bruised_by_impact: u32,
+        pub unripe_detached: u32,
+        pub stems_broken: u32,
+        pub detached_by_pull: u32,
+        pub detached_by_bend: u32,
+        pub detached_by_twist: u32,
+        /// "" (none yet), pull, bend or twist.
+        pub last_detach_mode: String,
+        /// Pedicel force on the fruit when it broke [N].
+        pub last_detach_force: f64,
+        /// Larger of the bending and twisting moment at the abscission zone then [N m].
+        pub last_detach_moment: f64,
+    }
+}
+
+ros_message! {
     /// `agrisim_msgs/msg/PlanResult`: one motion plan a task node asked for and its result;
     /// `optional` plans have a fallback, so their failure does not fail the task.
     /// `planning_time`: the simulated time the plan took [s] (the node's own account; a

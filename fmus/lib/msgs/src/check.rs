@@ -5,7 +5,7 @@ use crate::cdr::CdrError;
 use crate::message::Message;
 use crate::{
     agrisim, builtin_interfaces, control_msgs, geometry_msgs, nav_msgs, rosgraph_msgs, sensor_msgs, shape_msgs,
-    std_msgs, tf2_msgs, trajectory_msgs, vision_msgs,
+    std_msgs, tf2_msgs, trajectory_msgs, vision_msgs, visualization_msgs,
 };
 
 /// `Some(Ok(()))` when `bytes` decode as `type_name` (`pkg/msg/Type`), `Some(Err)` when they
@@ -61,11 +61,19 @@ pub fn check_cdr(type_name: &str, bytes: &[u8]) -> Option<Result<(), CdrError>> 
         "agrisim_msgs/msg/PlanningScene" => ok::<agrisim::PlanningScene>(bytes),
         "agrisim_msgs/msg/HarvestStatus" => ok::<agrisim::HarvestStatus>(bytes),
         "agrisim_msgs/msg/PlanResult" => ok::<agrisim::PlanResult>(bytes),
+        "agrisim_msgs/msg/PlantDamage" => ok::<agrisim::PlantDamage>(bytes),
         "vision_msgs/msg/ObjectHypothesis" => ok::<vision_msgs::ObjectHypothesis>(bytes),
         "vision_msgs/msg/ObjectHypothesisWithPose" => ok::<vision_msgs::ObjectHypothesisWithPose>(bytes),
         "vision_msgs/msg/BoundingBox3D" => ok::<vision_msgs::BoundingBox3D>(bytes),
         "vision_msgs/msg/Detection3D" => ok::<vision_msgs::Detection3D>(bytes),
         "vision_msgs/msg/Detection3DArray" => ok::<vision_msgs::Detection3DArray>(bytes),
+        "std_msgs/msg/String" => ok::<std_msgs::String>(bytes),
+        "std_msgs/msg/ColorRGBA" => ok::<std_msgs::ColorRGBA>(bytes),
+        "sensor_msgs/msg/CompressedImage" => ok::<sensor_msgs::CompressedImage>(bytes),
+        "visualization_msgs/msg/UVCoordinate" => ok::<visualization_msgs::UVCoordinate>(bytes),
+        "visualization_msgs/msg/MeshFile" => ok::<visualization_msgs::MeshFile>(bytes),
+        "visualization_msgs/msg/Marker" => ok::<visualization_msgs::Marker>(bytes),
+        "visualization_msgs/msg/MarkerArray" => ok::<visualization_msgs::MarkerArray>(bytes),
         _ => None,
     }
 }

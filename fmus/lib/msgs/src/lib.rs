@@ -32,6 +32,7 @@ pub mod dynamic;
 pub mod message;
 pub mod planar;
 pub mod schema;
+pub mod type_hash;
 
 pub mod agrisim;
 pub mod builtin_interfaces;
@@ -45,8 +46,10 @@ pub mod std_msgs;
 pub mod tf2_msgs;
 pub mod trajectory_msgs;
 pub mod vision_msgs;
+pub mod visualization_msgs;
 
 pub use cdr::{CdrError, CdrField, CdrReader, CdrWriter, CDR_LE_HEADER};
 pub use check::check_cdr;
 pub use message::{mime_type, mime_type_for, type_name_from_mime, Message, MIME_PREFIX};
 pub use schema::{all_type_names, msg_text, ros2msg_schema};
+pub use type_hash::{type_hash, type_hashes, TypeHashError};

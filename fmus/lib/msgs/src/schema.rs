@@ -76,11 +76,19 @@ msg_table! {
     "agrisim_msgs" / "PlanningScene",
     "agrisim_msgs" / "HarvestStatus",
     "agrisim_msgs" / "PlanResult",
+    "agrisim_msgs" / "PlantDamage",
     "vision_msgs" / "ObjectHypothesis",
     "vision_msgs" / "ObjectHypothesisWithPose",
     "vision_msgs" / "BoundingBox3D",
     "vision_msgs" / "Detection3D",
     "vision_msgs" / "Detection3DArray",
+    "std_msgs" / "String",
+    "std_msgs" / "ColorRGBA",
+    "sensor_msgs" / "CompressedImage",
+    "visualization_msgs" / "UVCoordinate",
+    "visualization_msgs" / "MeshFile",
+    "visualization_msgs" / "Marker",
+    "visualization_msgs" / "MarkerArray",
 }
 
 /// Every type this crate knows, as `pkg/msg/Type`.

@@ -114,3 +114,46 @@ ros_message! {
         pub roi: RegionOfInterest,
     }
 }
+
+ros_message! {
+    /// `sensor_msgs/msg/CompressedImage`: an encoded image (`format` "jpeg", "png", ...);
+    /// here only as a part of `visualization_msgs/Marker` (its texture).
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct CompressedImage = "sensor_msgs/msg/CompressedImage" {
+        pub header: Header,
+        pub format: String,
+        pub data: Vec<u8>,
+    }
+}
+
+/// The pinhole model of a [`CameraInfo`]'s K, as the algorithm nodes read a camera: pixel
+/// (u, v) has its centre at (u + 0.5, v + 0.5), as the camera FMU renders it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pinhole {
+    pub fx: f64,
+    pub fy: f64,
+    pub cx: f64,
+    pub cy: f64,
+}
+
+impl Pinhole {
+    /// From a row-major K; `None` unless the focal lengths are positive and all are finite.
+    pub fn from_k(k: &[f64; 9]) -> Option<Pinhole> {
+        let p = Pinhole { fx: k[0], fy: k[4], cx: k[2], cy: k[5] };
+        (p.fx > 0.0 && p.fy > 0.0 && [p.fx, p.fy, p.cx, p.cy].iter().all(|v| v.is_finite())).then_some(p)
+    }
+
+    pub fn from_camera_info(info: &CameraInfo) -> Option<Pinhole> {
+        Pinhole::from_k(&info.k)
+    }
+
+    /// The point at pixel (u, v) (its centre) with depth z, in the optical frame.
+    pub fn unproject(&self, u: usize, v: usize, z: f64) -> [f64; 3] {
+        [(u as f64 + 0.5 - self.cx) / self.fx * z, (v as f64 + 0.5 - self.cy) / self.fy * z, z]
+    }
+
+    /// The image position of a point of the optical frame (z > 0).
+    pub fn project(&self, p: [f64; 3]) -> [f64; 2] {
+        [self.fx * p[0] / p[2] + self.cx, self.fy * p[1] / p[2] + self.cy]
+    }
+}

@@ -1,4 +1,5 @@
-//! `std_msgs`: the common stamped-data header, and Float64 for scalars on the bridge.
+//! `std_msgs`: the common stamped-data header, Float64 for scalars on the bridge, String
+//! (the robot description) and ColorRGBA (markers).
 
 use crate::builtin_interfaces::Time;
 use crate::message::ros_message;
@@ -8,7 +9,7 @@ ros_message! {
     #[derive(Debug, Default, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
     pub struct Header = "std_msgs/msg/Header" {
         pub stamp: Time,
-        pub frame_id: String,
+        pub frame_id: std::string::String,
     }
 }
 
@@ -21,7 +22,32 @@ ros_message! {
 }
 
 impl Header {
-    pub fn new(stamp: Time, frame_id: impl Into<String>) -> Self {
+    pub fn new(stamp: Time, frame_id: impl Into<std::string::String>) -> Self {
         Self { stamp, frame_id: frame_id.into() }
+    }
+}
+
+ros_message! {
+    /// `std_msgs/msg/String`: one string (`/robot_description` carries the URDF in it).
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct String = "std_msgs/msg/String" {
+        pub data: std::string::String,
+    }
+}
+
+ros_message! {
+    /// `std_msgs/msg/ColorRGBA`: a colour, channels in \[0, 1\] (`a` = 1 opaque).
+    #[derive(Debug, Default, Clone, Copy, PartialEq)]
+    pub struct ColorRGBA = "std_msgs/msg/ColorRGBA" {
+        pub r: f32,
+        pub g: f32,
+        pub b: f32,
+        pub a: f32,
+    }
+}
+
+impl ColorRGBA {
+    pub const fn new(r: f32, g: f32, b: f32, a: f32) -> Self {
+        Self { r, g, b, a }
     }
 }

@@ -38,6 +38,9 @@ pub fn report_html(g: &agrisim_scene::Greenhouse, sum: &HarvestSummary, results:
             format!("{}; {:.3}", sum.plans, sum.thinking_time_mean),
         ),
         ("plant touches per trial".to_string(), per_kind(&sum.touches_per_trial)),
+        ("crop damage (all trials)".to_string(), count_kinds(&sum.damage)),
+        ("pedicel breaks by mode (trials)".to_string(), count_kinds(&sum.detach_modes)),
+        ("mean detach force [N]".to_string(), opt(sum.detach_force_mean)),
         ("joint tracking RMS mean [rad]".to_string(), format!("{:.2e}", sum.tracking_rms_mean)),
         (
             "wall-clock figures".to_string(),
@@ -52,6 +55,7 @@ pub fn report_html(g: &agrisim_scene::Greenhouse, sum: &HarvestSummary, results:
         ("Harvested by visibility class".to_string(), rate_table(["class", "trials", "harvested"], classes)),
         ("Failure taxonomy (trials not harvested)".to_string(), count_table(["category", "trials"], &sum.failures)),
         ("Time to harvest (successful trials, simulated)".to_string(), bar_chart(&times, 5.0, "time to harvest [s]")),
+        ("Detachment per trial".to_string(), detach_table(results)),
     ]);
     let traces: Vec<TrialTrace> = results
         .iter()
@@ -76,6 +80,36 @@ pub fn report_html(g: &agrisim_scene::Greenhouse, sum: &HarvestSummary, results:
         &traces,
         &sections,
     )
+}
+
+/// "kind n, kind m" of whole counts ("none" when empty).
+fn count_kinds(m: &std::collections::BTreeMap<String, u64>) -> String {
+    if m.is_empty() {
+        return "none".into();
+    }
+    m.iter().map(|(k, v)| format!("{k} {v}")).collect::<Vec<_>>().join(", ")
+}
+
+/// One row per trial: how its pedicel broke, the force and moment then, and its damage.
+fn detach_table(results: &[HarvestTrial]) -> String {
+    let esc = |s: &str| s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;");
+    let mut html = String::from(
+        "<table><tr><th>trial</th><th>detach mode</th><th>detach force [N]</th><th>moment [N m]</th><th>damage</th></tr>",
+    );
+    for t in results {
+        let damage: std::collections::BTreeMap<String, u64> =
+            t.damage.iter().filter(|(_, v)| **v > 0).map(|(k, v)| (k.clone(), *v)).collect();
+        html.push_str(&format!(
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
+            t.trial,
+            esc(t.detach_mode.as_deref().unwrap_or("-")),
+            t.detach_force.map_or("-".into(), |f| format!("{f:.2}")),
+            t.detach_moment.map_or("-".into(), |f| format!("{f:.3}")),
+            esc(&count_kinds(&damage)),
+        ));
+    }
+    html.push_str("</table>");
+    html
 }
 
 #[cfg(test)]

@@ -47,6 +47,13 @@ pub struct HarvestSummary {
     pub tracking_rms_mean: f64,
     /// Mean per trial of the scene objects the robot began to touch, by kind.
     pub touches_per_trial: BTreeMap<String, f64>,
+    /// Crop damage over all trials, by kind (bruised_by_grip, bruised_by_impact,
+    /// unripe_detached, stems_broken).
+    pub damage: BTreeMap<String, u64>,
+    /// Trials whose last pedicel broke by each mode (pull, bend, twist).
+    pub detach_modes: BTreeMap<String, u64>,
+    /// Mean over trials with a break of the largest pedicel force at a break [N].
+    pub detach_force_mean: Option<f64>,
     pub time_to_harvest_mean: Option<f64>,
     pub rtf: f64,
     pub sim_time: f64,
@@ -130,6 +137,24 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, results: &[HarvestTrial]) -> Har
                 *m.entry(k.clone()).or_insert(0.0) += *v as f64 / n.max(1) as f64;
             }
             m
+        },
+        damage: {
+            let mut m: BTreeMap<String, u64> = BTreeMap::new();
+            for (k, v) in results.iter().flat_map(|t| t.damage.iter()) {
+                *m.entry(k.clone()).or_insert(0) += v;
+            }
+            m
+        },
+        detach_modes: {
+            let mut m: BTreeMap<String, u64> = BTreeMap::new();
+            for mode in results.iter().filter_map(|t| t.detach_mode.as_ref()) {
+                *m.entry(mode.clone()).or_insert(0) += 1;
+            }
+            m
+        },
+        detach_force_mean: {
+            let f: Vec<f64> = results.iter().filter_map(|t| t.detach_force).collect();
+            (!f.is_empty()).then(|| f.iter().sum::<f64>() / f.len() as f64)
         },
         tracking_rms_mean: if n == 0 {
             0.0

@@ -16,12 +16,19 @@ use agrisim_bus::{Node, Reader};
 use agrisim_error::Result;
 use agrisim_harvest::HarvestNode;
 use agrisim_math::Rng;
-use agrisim_msgs::agrisim::CollisionState;
+use agrisim_msgs::agrisim::{CollisionState, PlantDamage};
 use agrisim_nodes::TaskPublisher;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
+
+/// Whether a fruit bruised by its impact fails the trial. Not yet: the harvest node drops the
+/// fruit from 0.13 m above the rim of the 0.25 m deep box (geometry::DROP_ABOVE), a fall of
+/// about 0.35 m onto the empty box floor, 2.6 m/s, above the world's 2.0 m/s bruise threshold:
+/// every placed fruit is impact-bruised until the node lowers the fruit into the box. Counted
+/// and reported meanwhile; grip bruises and broken stems fail the trial.
+pub const IMPACT_BRUISE_FAILS: bool = false;
 
 /// Simulated-time limit of one harvest [s].
 pub const TRIAL_TIMEOUT: f64 = 120.0;
@@ -69,6 +76,23 @@ pub struct HarvestTrial {
     /// call damage risk. Counted, not failures (only base and structure contacts fail).
     #[serde(default)]
     pub touches: BTreeMap<String, u64>,
+    /// Crop damage at the end of the trial, by kind (bruised_by_grip, bruised_by_impact,
+    /// unripe_detached, stems_broken), from /plant_damage (world ground truth). A bruise
+    /// or a broken stem fails the trial ("damage").
+    #[serde(default)]
+    pub damage: BTreeMap<String, u64>,
+    /// How the last pedicel of the trial broke (pull, bend, twist); None when none broke.
+    #[serde(default)]
+    pub detach_mode: Option<String>,
+    /// Largest pedicel force on the fruit at a break in the trial [N] (/plant_damage).
+    #[serde(default)]
+    pub detach_force: Option<f64>,
+    /// Largest bending or twisting moment at the abscission zone at a break [N m].
+    #[serde(default)]
+    pub detach_moment: Option<f64>,
+    /// Pedicel force at each break as (simulated time [s], force [N]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub detach_events: Vec<(f64, f64)>,
     /// RMS joint tracking error of the last trajectory of each arm [rad].
     pub tracking_rms: [f64; 2],
     pub sim_time: f64,
@@ -117,6 +141,8 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
     let mut path = vec![[m.number(chassis, "x")?, m.number(chassis, "y")?]];
     let mut reports = Reports::subscribe(&mut m.bus);
     let mut collisions = Reader::subscribe(&mut m.bus, "/collision");
+    let mut damage_reader = Reader::subscribe(&mut m.bus, "/plant_damage");
+    let mut damage = DamageLog::default();
     let mut judged: Option<(Option<String>, String)> = None;
     let mut time_to_harvest = None;
     let mut touches = Touches::default();
@@ -125,6 +151,9 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
             m.advance()?;
             path.push([m.number(chassis, "x")?, m.number(chassis, "y")?]);
             reports.read(&mut m, &node_name)?;
+            for d in damage_reader.take::<PlantDamage>(&mut m.bus)? {
+                damage.update(&d);
+            }
             // The base must touch nothing; the arms may brush plants (counted, not failures).
             // Every collision state counts, however short the contact.
             for cs in collisions.take::<CollisionState>(&mut m.bus)? {
@@ -189,9 +218,15 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
         failure = Some("placement".into());
         detail = "the node reported success but the world has not placed the target fruit".into();
     }
+    if failure.is_none() {
+        if let Some(why) = damage.failure(IMPACT_BRUISE_FAILS) {
+            failure = Some("damage".into());
+            detail = why;
+        }
+    }
     let planning = if failure.as_deref() == Some("planning") || reports.plans.iter().any(|p| !p.ok && !p.optional) {
         "failed"
-    } else if failure.is_none() || failure.as_deref() == Some("placement") {
+    } else if failure.is_none() || matches!(failure.as_deref(), Some("placement" | "damage")) {
         // Placement is judged after the node's last motion: every plan was made.
         "ok"
     } else {
@@ -211,6 +246,11 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
         placed_count: placed,
         contacts,
         touches: touches.by_kind,
+        damage: damage.by_kind(),
+        detach_mode: damage.mode.clone(),
+        detach_force: damage.force,
+        detach_moment: damage.moment,
+        detach_events: damage.events.clone(),
         tracking_rms: tracking,
         sim_time,
         wall_time: wall.elapsed().as_secs_f64(),
@@ -260,11 +300,104 @@ impl HarvestTrial {
             placed_count: 0,
             contacts: BTreeMap::new(),
             touches: BTreeMap::new(),
+            damage: BTreeMap::new(),
+            detach_mode: None,
+            detach_force: None,
+            detach_moment: None,
+            detach_events: vec![],
             tracking_rms: [0.0; 2],
             sim_time: 0.0,
             wall_time: 0.0,
             mcap: format!("trials/{index:04}.mcap"),
             path: vec![],
         }
+    }
+}
+
+/// What the judge keeps of /plant_damage: the last message and every pedicel break.
+#[derive(Default)]
+struct DamageLog {
+    last: PlantDamage,
+    mode: Option<String>,
+    force: Option<f64>,
+    moment: Option<f64>,
+    events: Vec<(f64, f64)>,
+}
+
+impl DamageLog {
+    fn update(&mut self, d: &PlantDamage) {
+        let breaks = |m: &PlantDamage| m.detached_by_pull + m.detached_by_bend + m.detached_by_twist;
+        if breaks(d) > breaks(&self.last) && !d.last_detach_mode.is_empty() {
+            self.mode = Some(d.last_detach_mode.clone());
+            self.force = Some(self.force.map_or(d.last_detach_force, |f| f.max(d.last_detach_force)));
+            self.moment = Some(self.moment.map_or(d.last_detach_moment, |f| f.max(d.last_detach_moment)));
+            self.events.push((d.header.stamp.as_secs_f64(), d.last_detach_force));
+        }
+        self.last = d.clone();
+    }
+
+    fn by_kind(&self) -> BTreeMap<String, u64> {
+        let d = &self.last;
+        [
+            ("bruised_by_grip", d.bruised_by_grip),
+            ("bruised_by_impact", d.bruised_by_impact),
+            ("unripe_detached", d.unripe_detached),
+            ("stems_broken", d.stems_broken),
+        ]
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v as u64))
+        .collect()
+    }
+
+    /// A bruised fruit (by impact only if `impact_fails`) or a broken main stem fails the trial.
+    fn failure(&self, impact_fails: bool) -> Option<String> {
+        let d = &self.last;
+        let bruised = d.bruised_by_grip + if impact_fails { d.bruised_by_impact } else { 0 };
+        (bruised > 0 || d.stems_broken > 0).then(|| {
+            format!(
+                "crop damaged: {} fruit bruised by grip, {} by impact, {} main stem(s) broken",
+                d.bruised_by_grip, d.bruised_by_impact, d.stems_broken
+            )
+        })
+    }
+}
+
+#[cfg(test)]
+mod damage_tests {
+    use super::*;
+
+    /// `mode`: how the newest of the `pull` + `bend` breaks went.
+    fn msg(pull: u32, bend: u32, mode: &str, force: f64, grip: u32) -> PlantDamage {
+        PlantDamage {
+            detached_by_pull: pull,
+            detached_by_bend: bend,
+            last_detach_mode: mode.into(),
+            last_detach_force: force,
+            bruised_by_grip: grip,
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn breaks_are_logged_once_and_bruises_fail() {
+        let mut log = DamageLog::default();
+        log.update(&msg(0, 0, "", 0.0, 0));
+        assert_eq!(log.mode, None);
+        assert_eq!(log.failure(true), None);
+        log.update(&msg(0, 1, "bend", 6.0, 0));
+        // The same break again (a republished message) is not a second event.
+        log.update(&msg(0, 1, "bend", 6.0, 0));
+        log.update(&msg(1, 1, "pull", 9.0, 0));
+        assert_eq!(log.mode.as_deref(), Some("pull"));
+        assert_eq!(log.force, Some(9.0));
+        assert_eq!(log.events.len(), 2);
+        assert_eq!(log.by_kind()["bruised_by_grip"], 0);
+        log.update(&msg(1, 1, "pull", 9.0, 1));
+        assert!(log.failure(false).unwrap().contains("1 fruit bruised by grip"));
+        assert_eq!(log.by_kind()["bruised_by_grip"], 1);
+        let mut impact = DamageLog::default();
+        impact.update(&PlantDamage { bruised_by_impact: 1, ..Default::default() });
+        assert_eq!(impact.failure(false), None);
+        assert!(impact.failure(true).unwrap().contains("1 by impact"));
     }
 }

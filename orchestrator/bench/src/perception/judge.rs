@@ -50,6 +50,10 @@ pub struct FruitResult {
     pub predicted_stage: Option<u8>,
     /// 3-D centre error [mm].
     pub error_mm: Option<f64>,
+    /// Its part along the camera's ray to the true centre, signed (+: the estimate is too
+    /// far) [mm]: depth-fit bias shows here, segmentation errors in the lateral rest.
+    #[serde(default)]
+    pub ray_error_mm: Option<f64>,
     /// Pixel position (for the overlay).
     pub uv: [f64; 2],
     pub radius_px: f64,
@@ -230,6 +234,11 @@ pub fn judge_frame(
             detected: m.is_some(),
             predicted_stage: m.map(|di| det[di].1),
             error_mm: m.map(|di| 1000.0 * dist(det[di].0, *c)),
+            ray_error_mm: m.map(|di| {
+                let n = dist(*c, [0.0; 3]).max(1e-9);
+                let d = det[di].0;
+                1000.0 * ((d[0] - c[0]) * c[0] + (d[1] - c[1]) * c[1] + (d[2] - c[2]) * c[2]) / n
+            }),
             uv,
             radius_px: rpx,
         });

@@ -53,7 +53,10 @@ pub fn report_html(s: &PerceptionSummary, results: &[PerceptionRecord]) -> Strin
     );
     h.push_str("<h2>3-D centre error</h2><table><tr><th>distance</th><th>n</th><th>p50 mm</th><th>p95 mm</th><th>max mm</th></tr>");
     let o = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.1}"));
-    for (k, e) in &s.centre_error_by_distance {
+    let within: Vec<(String, &super::summary::ErrorStats)> =
+        s.centre_error_within_1m_by_stage.iter().map(|(k, e)| (format!("within 1 m, stage {k}"), e)).collect();
+    let by_distance = s.centre_error_by_distance.iter().map(|(k, e)| (k.clone(), e));
+    for (k, e) in by_distance.chain(within) {
         let _ = write!(
             h,
             "<tr><td>{k}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
@@ -63,7 +66,15 @@ pub fn report_html(s: &PerceptionSummary, results: &[PerceptionRecord]) -> Strin
             o(e.max_mm)
         );
     }
-    h.push_str("</table><h2>Frames</h2><p>Green: found; magenta: missed; red cross: false detection.</p>");
+    let sp = &s.centre_error_split_within_1m;
+    let _ = write!(
+        h,
+        "</table><p>Within 1 m: along the ray median {} mm (signed), p95 {} mm; across it p95 {} mm.</p>",
+        o(sp.ray_median_signed_mm),
+        o(sp.ray_p95_mm),
+        o(sp.lateral_p95_mm)
+    );
+    h.push_str("<h2>Frames</h2><p>Green: found; magenta: missed; red cross: false detection.</p>");
     for r in results {
         let png = format!("trials/{:04}.png", r.line.trial);
         let _ = write!(

@@ -66,8 +66,39 @@ pub struct PerceptionSummary {
     /// 3-D centre error of found fruit by centre depth: "<0.75 m", "0.75-1.0 m", "1.0-1.5 m",
     /// and "within_1m".
     pub centre_error_by_distance: BTreeMap<String, ErrorStats>,
+    /// Within 1 m, the error split: along the ray (signed median = the fit's depth bias, p95
+    /// of its size) and across it (p95).
+    pub centre_error_split_within_1m: ErrorSplit,
+    /// Within 1 m, the centre error of found fruit by USDA stage ("1".."6") and of the ripe
+    /// ones (stages 5-6, the harvest's targets) together: partly coloured fruit are placed
+    /// from part of their surface.
+    pub centre_error_within_1m_by_stage: BTreeMap<String, ErrorStats>,
     /// The node's wall time per frame in the trials [ms]: mean over trials.
     pub node_ms_per_frame: Option<f64>,
+}
+
+#[derive(Serialize, Clone, Debug)]
+pub struct ErrorSplit {
+    pub ray_median_signed_mm: Option<f64>,
+    pub ray_p95_mm: Option<f64>,
+    pub lateral_p95_mm: Option<f64>,
+}
+
+fn split(found: &[&&FruitResult]) -> ErrorSplit {
+    let near: Vec<(f64, f64)> =
+        found.iter().filter(|f| f.depth <= 1.0).filter_map(|f| Some((f.error_mm?, f.ray_error_mm?))).collect();
+    let sorted = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v
+    };
+    let signed = sorted(near.iter().map(|p| p.1).collect());
+    let ray = sorted(near.iter().map(|p| p.1.abs()).collect());
+    let lateral = sorted(near.iter().map(|p| (p.0 * p.0 - p.1 * p.1).max(0.0).sqrt()).collect());
+    ErrorSplit {
+        ray_median_signed_mm: percentile(&signed, 0.5),
+        ray_p95_mm: percentile(&ray, 0.95),
+        lateral_p95_mm: percentile(&lateral, 0.95),
+    }
 }
 
 pub fn summarize(w: &Whole<PerceptionSetup>, results: &[PerceptionRecord]) -> PerceptionSummary {
@@ -147,6 +178,18 @@ pub fn summarize(w: &Whole<PerceptionSetup>, results: &[PerceptionRecord]) -> Pe
         ripe_precision: rate(ripe_true, ripe_calls + ripe_fp),
         stage_accuracy: rate(stage_ok, found.len() as u64),
         ripe_accuracy: rate(ripe_ok, found.len() as u64),
+        centre_error_split_within_1m: split(&found),
+        centre_error_within_1m_by_stage: {
+            let mut by: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+            for f in found.iter().filter(|f| f.depth <= 1.0) {
+                let e = f.error_mm.unwrap_or(f64::NAN);
+                by.entry(f.stage.to_string()).or_default().push(e);
+                if is_ripe(f.stage) {
+                    by.entry("ripe".into()).or_default().push(e);
+                }
+            }
+            by.into_iter().map(|(k, v)| (k, errors(v))).collect()
+        },
         centre_error_by_distance: by_dist.into_iter().map(|(k, v)| (k, errors(v))).collect(),
         node_ms_per_frame: (!times.is_empty()).then(|| times.iter().sum::<f64>() / times.len() as f64),
     }

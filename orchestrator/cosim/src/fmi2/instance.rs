@@ -475,35 +475,26 @@ impl crate::me::ModelExchange for Instance {
 crate::fmu::delegate_fmu_instance!(Instance);
 
 impl Drop for Instance {
-    /// As for FMI 3: terminate only from Step Mode, free saved states (not after an Error),
-    /// free the instance; nothing at all after a fatal status.
+    /// See `Core::release`; `sink` and then `lib` are dropped after this, i.e. after the
+    /// FMU can no longer log.
     fn drop(&mut self) {
-        if self.handle.is_null() || self.core.state == InstanceState::Fatal {
+        if self.handle.is_null() {
             return;
         }
-        let f = &self.lib.f;
-        // SAFETY: the handle is live (nulled right after freeing).
-        unsafe {
-            if self.core.state == InstanceState::StepMode {
-                let mark = self.core.sink.mark();
-                let status = Status::from_raw((f.terminate)(self.handle));
-                self.core.report("fmi2Terminate (on drop)", &[], Ctx::None, mark, status);
-                if status == Status::Fatal {
-                    return;
+        let (f, h) = (&self.lib.f, self.handle);
+        // SAFETY: the handle is live (never freed before; nulled right after freeing), and
+        // each call has the fmi2 signature of its symbol.
+        self.core.release(
+            "fmi2",
+            || unsafe { (f.terminate)(h) },
+            f.free_fmu_state.map(|free| {
+                move |s| {
+                    let mut s = s;
+                    let _ = unsafe { free(h, &mut s) };
                 }
-            }
-            if self.core.state != InstanceState::Error {
-                if let Some(free) = f.free_fmu_state {
-                    for (s, _) in self.core.fmu_states.iter_mut().filter_map(Option::take) {
-                        let mut s = s;
-                        let _ = free(self.handle, &mut s);
-                    }
-                }
-            }
-            let mark = self.core.sink.mark();
-            (f.free_instance)(self.handle);
-            self.core.report("fmi2FreeInstance", &[], Ctx::None, mark, Status::Ok);
-        }
+            }),
+            || unsafe { (f.free_instance)(h) },
+        );
         self.handle = ptr::null_mut();
     }
 }

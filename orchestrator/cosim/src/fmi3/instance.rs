@@ -504,40 +504,27 @@ impl Instance {
 }
 
 impl Drop for Instance {
-    /// Terminates only from Step Mode (FMI 3.0 allows fmi3Terminate nowhere else among our
-    /// states: not in Instantiated, Initialization Mode, Terminated or Error), frees the
-    /// saved FMU states (not after an Error), then frees the instance. Nobody receives an
-    /// error from a drop, so whatever the FMU reports here is printed (see `report`).
+    /// See `Core::release`; `sink` and then `lib` are dropped after this, i.e. after the
+    /// FMU can no longer log.
     fn drop(&mut self) {
-        if self.handle.is_null() || self.core.state == InstanceState::Fatal {
-            // After fmi3Fatal the standard allows no call at all, not even freeing: leak it.
+        if self.handle.is_null() {
             return;
         }
-        let f = &self.lib.f;
-        // SAFETY: the handle is live (never freed before; nulled right after freeing).
-        unsafe {
-            if self.core.state == InstanceState::StepMode {
-                let mark = self.core.sink.mark();
-                let status = Status::from_raw((f.terminate)(self.handle));
-                self.core.report("fmi3Terminate (on drop)", &[], Ctx::None, mark, status);
-                if status == Status::Fatal {
-                    return;
+        let (f, h) = (&self.lib.f, self.handle);
+        // SAFETY: the handle is live (never freed before; nulled right after freeing), and
+        // each call has the fmi3 signature of its symbol.
+        self.core.release(
+            "fmi3",
+            || unsafe { (f.terminate)(h) },
+            f.free_fmu_state.map(|free| {
+                move |s| {
+                    let mut s = s;
+                    let _ = unsafe { free(h, &mut s) };
                 }
-            }
-            if self.core.state != InstanceState::Error {
-                if let Some(free) = f.free_fmu_state {
-                    for (s, _) in self.core.fmu_states.iter_mut().filter_map(Option::take) {
-                        let mut s = s;
-                        let _ = free(self.handle, &mut s);
-                    }
-                }
-            }
-            let mark = self.core.sink.mark();
-            (f.free_instance)(self.handle);
-            self.core.report("fmi3FreeInstance", &[], Ctx::None, mark, Status::Ok);
-        }
+            }),
+            || unsafe { (f.free_instance)(h) },
+        );
         self.handle = ptr::null_mut();
-        // `sink` and then `lib` are dropped after this, i.e. after the FMU can no longer log.
     }
 }
 

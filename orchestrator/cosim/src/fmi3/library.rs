@@ -75,19 +75,15 @@ impl Fmi3Library {
     /// The functions of `interface` are required; the other interface's are optional.
     pub fn load(path: &Path, interface: crate::model_description::Interface) -> Result<Fmi3Library, String> {
         let lib = crate::fmu::library::open(path)?;
+        // SAFETY (both): each field's type below is the FMI 3.0 signature of its symbol.
         macro_rules! sym {
             ($name:literal) => {
-                // SAFETY: the type is the FMI 3.0 signature of this symbol.
-                match unsafe { lib.get(concat!($name, "\0").as_bytes()) } {
-                    Ok(s) => *s,
-                    Err(_) => return Err(format!("shared library '{}' does not export {}", path.display(), $name)),
-                }
+                unsafe { crate::fmu::library::symbol(&lib, path, $name)? }
             };
         }
         macro_rules! opt_sym {
             ($name:literal) => {
-                // SAFETY: as above.
-                unsafe { lib.get(concat!($name, "\0").as_bytes()) }.ok().map(|s| *s)
+                unsafe { crate::fmu::library::optional_symbol(&lib, $name) }
             };
         }
         let f = Functions {

@@ -191,6 +191,42 @@ impl Core {
         self.refuse(function, vrs, &format!("refused: {what} (not called; instance state unchanged)"))
     }
 
+    /// What dropping an instance does, in FMI 2 and 3 alike: terminate only from Step Mode
+    /// (neither standard allows it in the other states we track), free the saved FMU states
+    /// (not after an Error), then free the instance; nothing at all after a fatal status, for
+    /// which the standards allow no further call, not even freeing (the instance leaks).
+    /// Nobody receives an error from a drop, so what the FMU reports is printed (see `report`).
+    /// `prefix` is "fmi2" or "fmi3"; the closures make the version's calls on the live handle.
+    pub(crate) fn release(
+        &mut self,
+        prefix: &str,
+        terminate: impl FnOnce() -> std::ffi::c_int,
+        free_state: Option<impl FnMut(*mut c_void)>,
+        free_instance: impl FnOnce(),
+    ) {
+        if self.state == InstanceState::Fatal {
+            return;
+        }
+        if self.state == InstanceState::StepMode {
+            let mark = self.sink.mark();
+            let status = Status::from_raw(terminate());
+            self.report(&format!("{prefix}Terminate (on drop)"), &[], Ctx::None, mark, status);
+            if status == Status::Fatal {
+                return;
+            }
+        }
+        if self.state != InstanceState::Error {
+            if let Some(mut free) = free_state {
+                for (s, _) in self.fmu_states.iter_mut().filter_map(Option::take) {
+                    free(s);
+                }
+            }
+        }
+        let mark = self.sink.mark();
+        free_instance();
+        self.report(&format!("{prefix}FreeInstance"), &[], Ctx::None, mark, Status::Ok);
+    }
+
     pub(crate) fn keep_state(&mut self, s: *mut c_void, saved_in: InstanceState) -> FmuState {
         self.fmu_states.push(Some((s, saved_in)));
         FmuState { slot: self.fmu_states.len() - 1, owner: self.id }

@@ -18,6 +18,27 @@ pub(crate) fn open(path: &Path) -> Result<libloading::Library, String> {
     }
 }
 
+/// A symbol every FMU of its version must export; the error names the binary and symbol.
+///
+/// # Safety
+/// `T` must be the standard's C signature of `name`.
+pub(crate) unsafe fn symbol<T: Copy>(lib: &libloading::Library, path: &Path, name: &str) -> Result<T, String> {
+    // SAFETY: as the caller promises.
+    match unsafe { lib.get::<T>(name.as_bytes()) } {
+        Ok(s) => Ok(*s),
+        Err(_) => Err(format!("shared library '{}' does not export {name}", path.display())),
+    }
+}
+
+/// A symbol an FMU exports only for the capabilities it declares.
+///
+/// # Safety
+/// As for [`symbol`].
+pub(crate) unsafe fn optional_symbol<T: Copy>(lib: &libloading::Library, name: &str) -> Option<T> {
+    // SAFETY: as the caller promises.
+    unsafe { lib.get::<T>(name.as_bytes()) }.ok().map(|s| *s)
+}
+
 fn dlopen(path: &Path) -> Result<libloading::Library, libloading::Error> {
     // SAFETY: loading runs the library's initialisers; FMU binaries are trusted code by the
     // nature of co-simulation.

@@ -6,21 +6,24 @@
 
 use agrisim_msgs::agrisim::{
     CollisionObject, CollisionState, Contact, FmuStatus, GripperState, HarvestStatus, NavigationStatus, PlanResult,
-    PlanningScene, Signals, TrajectoryStatus,
+    PlanningScene, PlantDamage, Signals, TrajectoryStatus,
 };
 use agrisim_msgs::builtin_interfaces::{Duration, Time};
 use agrisim_msgs::control_msgs::GripperCommand;
 use agrisim_msgs::geometry_msgs::*;
 use agrisim_msgs::nav_msgs::{MapMetaData, OccupancyGrid, Odometry, Path};
 use agrisim_msgs::rosgraph_msgs::Clock;
-use agrisim_msgs::sensor_msgs::{CameraInfo, Image, Imu, JointState, PointCloud2, PointField, RegionOfInterest};
+use agrisim_msgs::sensor_msgs::{
+    CameraInfo, CompressedImage, Image, Imu, JointState, PointCloud2, PointField, RegionOfInterest,
+};
 use agrisim_msgs::shape_msgs::SolidPrimitive;
-use agrisim_msgs::std_msgs::{Float64, Header};
+use agrisim_msgs::std_msgs::{ColorRGBA, Float64, Header};
 use agrisim_msgs::tf2_msgs::TFMessage;
 use agrisim_msgs::trajectory_msgs::{JointTrajectory, JointTrajectoryPoint};
 use agrisim_msgs::vision_msgs::{
     BoundingBox3D, Detection3D, Detection3DArray, ObjectHypothesis, ObjectHypothesisWithPose,
 };
+use agrisim_msgs::visualization_msgs::{Marker, MarkerArray, MeshFile, UVCoordinate};
 use agrisim_msgs::{CdrError, Message};
 use std::fmt::Debug;
 
@@ -287,6 +290,22 @@ fn manipulation_samples() -> Vec<Sample> {
                 planning_time: 0.0123,
             },
         ),
+        sample(
+            "plant_damage",
+            PlantDamage {
+                header: hdr(41, 250_000_000, "map"),
+                bruised_by_grip: 1,
+                bruised_by_impact: 2,
+                unripe_detached: 1,
+                stems_broken: 0,
+                detached_by_pull: 3,
+                detached_by_bend: 4,
+                detached_by_twist: 0,
+                last_detach_mode: "bend".into(),
+                last_detach_force: 6.5,
+                last_detach_moment: 0.375,
+            },
+        ),
     ]
 }
 
@@ -294,6 +313,7 @@ pub fn all_samples() -> Vec<Sample> {
     let mut all = base_samples();
     all.extend(manipulation_samples());
     all.extend(vision_samples());
+    all.extend(visualization_samples());
     all
 }
 
@@ -505,5 +525,67 @@ fn base_samples() -> Vec<Sample> {
                 roi: RegionOfInterest::default(),
             },
         ),
+    ]
+}
+
+/// Samples of the viewer types (std_msgs String and ColorRGBA, visualization_msgs).
+fn visualization_samples() -> Vec<Sample> {
+    let red = ColorRGBA::new(0.75, 0.125, 0.0, 1.0);
+    let list = Marker {
+        header: hdr(3, 0, "map"),
+        ns: "fruit".into(),
+        id: 7,
+        r#type: Marker::SPHERE_LIST,
+        action: Marker::ADD,
+        pose: pose(0.0, 0.0, 0.0, Quaternion::IDENTITY),
+        scale: Vector3 { x: 0.0625, y: 0.0625, z: 0.0625 },
+        color: ColorRGBA::new(1.0, 1.0, 1.0, 1.0),
+        frame_locked: true,
+        points: vec![Point { x: 1.5, y: -2.0, z: 0.75 }, Point { x: 1.5, y: -2.25, z: 1.0 }],
+        colors: vec![red, ColorRGBA::new(0.25, 0.5, 0.0, 0.5)],
+        ..Default::default()
+    };
+    let everything = Marker {
+        header: hdr(4, 250_000_000, "base_link"),
+        ns: "robot".into(),
+        id: -1,
+        r#type: Marker::TRIANGLE_LIST,
+        action: Marker::MODIFY,
+        pose: pose(1.0, 2.0, 3.0, q(0.5, 0.5, 0.5, 0.5)),
+        scale: Vector3 { x: 1.0, y: 1.0, z: 1.0 },
+        color: red,
+        lifetime: Duration::new(2, 500_000_000),
+        frame_locked: false,
+        points: vec![
+            Point { x: 0.0, y: 0.0, z: 0.0 },
+            Point { x: 1.0, y: 0.0, z: 0.0 },
+            Point { x: 0.0, y: 1.0, z: 0.0 },
+        ],
+        colors: vec![],
+        texture_resource: "embedded://leaf.png".into(),
+        texture: CompressedImage { header: hdr(4, 0, "camera"), format: "png".into(), data: vec![137, 80, 78, 71] },
+        uv_coordinates: vec![
+            UVCoordinate { u: 0.0, v: 0.0 },
+            UVCoordinate { u: 1.0, v: 0.0 },
+            UVCoordinate { u: 0.0, v: 1.0 },
+        ],
+        text: "tomato".into(),
+        mesh_resource: "package://agrisim/leaf.stl".into(),
+        mesh_file: MeshFile { filename: "leaf.stl".into(), data: vec![1, 2, 3] },
+        mesh_use_embedded_materials: true,
+    };
+    vec![
+        sample("string", agrisim_msgs::std_msgs::String { data: "<robot name=\"r\"/>".into() }),
+        sample("color_rgba", red),
+        sample(
+            "compressed_image",
+            CompressedImage { header: hdr(5, 0, "camera"), format: "jpeg".into(), data: vec![255, 216, 255] },
+        ),
+        sample("uv_coordinate", UVCoordinate { u: 0.25, v: 0.75 }),
+        sample("mesh_file", MeshFile { filename: "a.dae".into(), data: vec![9, 8] }),
+        sample("marker_sphere_list", list.clone()),
+        sample("marker_everything", everything.clone()),
+        sample("marker_array", MarkerArray { markers: vec![list, everything] }),
+        sample("marker_array_empty", MarkerArray::default()),
     ]
 }
