@@ -337,13 +337,6 @@ def crop(img: np.ndarray, r: dict, dpr: float) -> np.ndarray:
 MIN_PIXELS = 150
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "issue 37: Studio 1.48's player counts 1 message on /scene/markers and on /tf_static (the merged latched "
-    "message, which holds map->odom at stamp 0, as a plain client decodes it), yet its 3-D panels draw none of the "
-    "markers (0 plant px; no posts either); frame_locked false does not change it (tried: 0 px); with followTf=map "
-    "the robot and /points are not drawn either, so the panels' transform tree lacks map->odom: the latched "
-    "/tf_static and /scene/markers, sent once when the player subscribes, appear not to reach the 3-D panels "
-    "(robot_description, drawn from the URDF's own joints, does)"))
 def test_live_view_in_foxglove_shows_the_robot_and_the_plants(browser, served, live_run):
     url, run_log = live_run
     root, base = served

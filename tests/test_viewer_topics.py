@@ -5,7 +5,7 @@ the recorded MCAP by decoders no one here wrote (mcap-ros2-support, rosbags):
   primitives, so a viewer needs no files;
 * /joint_states: every movable joint (wheels, steering, lift, both arms, fingers);
 * /tf + /tf_static: every URDF link reachable from base_link, and base_link from map (map ->
-  odom fixed at the start pose: no localizer);
+  odom fixed at the start: no localizer), placing the robot at its start pose;
 * /scene/markers and /scene/fruit_markers: the greenhouse as instanced MarkerArrays, the
   fruit where the world's ground truth (/fruits) puts them, under 2 MB;
 * the recording profiles keep them; and no algorithm node reads the scene markers.
@@ -98,9 +98,16 @@ def test_joint_states_and_tf_cover_the_whole_robot(messages):
 
 
 
+def _yaw(q) -> float:
+    return math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y**2 + q.z**2))
+
+
 def test_tf_tree_joins_map_to_base_link_at_the_start_pose(mcap_file, messages):
-    """A plain run has no localizer: map -> odom is published once, on /tf_static, at the
-    chassis's start pose (x0, y0, yaw0 as applied), and odom has no other parent."""
+    """A plain run has no localizer: map -> odom is published once, on /tf_static, and odom
+    has no other parent; with the first odom -> base_link it puts the robot at the chassis's
+    start pose (x0, y0, yaw0 as applied) in the map, where the greenhouse markers are drawn
+    (the odometry starts at that pose in map coordinates: map -> odom is then the identity,
+    not the start pose again)."""
     msgs, _ = messages
     with open(mcap_file, "rb") as f:
         params = {m.name: m.metadata for m in make_reader(f).iter_metadata() if m.name.startswith("agrisim.parameters.")}
@@ -109,17 +116,23 @@ def test_tf_tree_joins_map_to_base_link_at_the_start_pose(mcap_file, messages):
     x0, y0, yaw0 = (float(starts[0][k]) for k in ("x0", "y0", "yaw0"))
     odom_parents = [(topic, tr) for topic in ("/tf", "/tf_static") for _, m, _ in msgs[topic] for tr in m.transforms if tr.child_frame_id == "odom"]
     assert [(topic, tr.header.frame_id) for topic, tr in odom_parents] == [("/tf_static", "map")]
-    tr = odom_parents[0][1].transform
-    q = tr.rotation
-    yaw = math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y**2 + q.z**2))
-    assert (tr.translation.x, tr.translation.y, tr.translation.z) == pytest.approx((x0, y0, 0.0), abs=1e-9)
-    assert yaw == pytest.approx(yaw0, abs=1e-9)
+    mo = odom_parents[0][1].transform
+    assert mo.translation.z == 0.0
+    first = min(((t, tr) for t, m, _ in msgs["/tf"] for tr in m.transforms if tr.child_frame_id == "base_link"), key=lambda x: x[0])[1]
+    assert first.header.frame_id == "odom"
+    ob = first.transform
+    a, b = _yaw(mo.rotation), _yaw(ob.rotation)
+    x = mo.translation.x + math.cos(a) * ob.translation.x - math.sin(a) * ob.translation.y
+    y = mo.translation.y + math.sin(a) * ob.translation.x + math.cos(a) * ob.translation.y
+    assert (x, y) == pytest.approx((x0, y0), abs=1e-6), f"map -> base_link at the start ({x}, {y}), start pose ({x0}, {y0})"
+    assert math.remainder(a + b - yaw0, 2 * math.pi) == pytest.approx(0.0, abs=1e-6)
     parent = {tr.child_frame_id: tr.header.frame_id for topic in ("/tf", "/tf_static") for _, m, _ in msgs[topic] for tr in m.transforms}
     frame, chain = "base_link", ["base_link"]
     while frame in parent and len(chain) < 50:
         frame = parent[frame]
         chain.append(frame)
     assert chain == ["base_link", "odom", "map"]
+
 
 def _points(marker):
     return [(p.x, p.y, p.z) for p in marker.points]

@@ -1,10 +1,10 @@
 //! Detachment in isolation, against the configured (literature-based) distributions: every
 //! fruit of a scene, on its own pedicel (the scene's geometry, the FMU's per-fruit
 //! thresholds), is pulled straight off, bent off and twisted off in small steps by the joint
-//! model the world FMU runs. Reported: the force and moment at detachment. Checked: the means
-//! and spreads match the configured distributions within their sampling error, each motion
-//! breaks the pedicel in its own mode, and bending detaches at a lower force at the gripper
-//! than pulling.
+//! model the world FMU runs. Reported: the force and moment at detachment. Checked: each fruit
+//! comes off at its own drawn threshold, the means and spreads match the configured
+//! distributions within their sampling error, each motion breaks the pedicel in its own mode,
+//! and bending detaches at a lower force at the gripper than pulling.
 
 use agrisim_fmu_greenhouse::pedicel::{Attachment, Mode, PedicelParams, AZ_OFFSET};
 use agrisim_fmu_greenhouse::world::pedicel_geometry;
@@ -68,12 +68,16 @@ fn pull_bend_and_twist_detach_at_the_configured_loads() {
         let (mode, f, _, _) =
             detach(&mut att, &p, |k| RPose::from_translation(sub(rest.trans, scale(a, 1e-4 * k as f64))));
         assert_eq!(mode, Mode::Pull, "fruit {i}");
+        // Each fruit comes off at its own drawn threshold, within one step of the ramp.
+        let within = |load: f64, threshold: f64, step: f64| load >= threshold && load < threshold + step + 1e-9;
+        assert!(within(f, t.pull, p.stiffness * 1e-4), "fruit {i}: pulled off at {f} N, threshold {}", t.pull);
         pull_f.push(f);
         // Bend: the fruit swung about the abscission zone, sideways to the pedicel, at 0.05 rad/s.
         let side = normalize(cross(a, if a[2].abs() < 0.9 { [0.0, 0.0, 1.0] } else { [1.0, 0.0, 0.0] }));
         let mut att = new();
         let (mode, _, m, _) = detach(&mut att, &p, |k| rotated_about(&rest, side, 1e-3 * k as f64, az));
         assert_eq!(mode, Mode::Bend, "fruit {i}");
+        assert!(within(m, t.bend, p.bend_stiffness * 1e-3), "fruit {i}: bent off at {m} N m, threshold {}", t.bend);
         bend_m.push(m);
         // The gripper holds the fruit at its centre: the force there that makes this moment.
         bend_f.push(m / norm(sub(rest.trans, az)));
@@ -81,6 +85,11 @@ fn pull_bend_and_twist_detach_at_the_configured_loads() {
         let mut att = new();
         let (mode, _, _, m) = detach(&mut att, &p, |k| rotated_about(&rest, a, 2e-3 * k as f64, az));
         assert_eq!(mode, Mode::Twist, "fruit {i}");
+        assert!(
+            within(m, t.twist, p.twist_stiffness * 2e-3),
+            "fruit {i}: twisted off at {m} N m, threshold {}",
+            t.twist
+        );
         twist_m.push(m);
         assert!(norm(sub(add(rest.trans, [0.0, 0.0, radius]), az)) <= AZ_OFFSET + 1e-9);
     }

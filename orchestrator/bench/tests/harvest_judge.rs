@@ -2,6 +2,9 @@
 //! (/harvest/status, /harvest/plans) and the world's ground truth. A scripted node that
 //! publishes the same messages is judged the same way, and ground truth has the last word.
 //!
+//! By sight, no node can read ground truth: the bus is sealed, and a node that reads a
+//! ground-truth topic fails its trial.
+//!
 //! Needs the packed FMUs (target/fmu, written by `agrisim fmu pack`, which scripts/setup runs).
 
 use agrisim_bench::framework::{OptionValues, Trial};
@@ -9,7 +12,7 @@ use agrisim_bench::harvest::{builtin_node, run_with, HarvestSetup, HarvestTrial,
 use agrisim_bench::trial_seed;
 use agrisim_bus::{Bus, Node};
 use agrisim_error::Result;
-use agrisim_harvest::topics;
+use agrisim_harvest::{topics, HarvestNode, Task};
 use agrisim_msgs::agrisim::{HarvestStatus, PlanResult};
 use agrisim_msgs::builtin_interfaces::Time;
 use agrisim_msgs::std_msgs::Header;
@@ -59,6 +62,15 @@ struct Bench {
 
 impl Bench {
     fn new() -> Bench {
+        let mut b = Bench::of("harvest.toml");
+        // The judge's checks need a harvest that succeeds: a fruit in plain view.
+        b.scenario.harvest.visibility = vec!["free".into()];
+        b.setup = HarvestSetup::new(&b.scenario).unwrap();
+        b
+    }
+
+    /// The scenario `models/scenarios/<file>` as it is.
+    fn of(file: &str) -> Bench {
         let fmu_dir = root().join("target/fmu");
         assert!(
             fmu_dir.join("Greenhouse.fmu").exists(),
@@ -66,9 +78,7 @@ impl Bench {
             fmu_dir.display()
         );
         let dir = tempfile::tempdir().unwrap();
-        let mut scenario = Scenario::load(&root().join("models/scenarios/harvest.toml")).unwrap();
-        // The judge's checks need a harvest that succeeds: a fruit in plain view.
-        scenario.harvest.visibility = vec!["free".into()];
+        let scenario = Scenario::load(&root().join("models/scenarios").join(file)).unwrap();
         let options = RunOptions {
             fmu_dir,
             cache_dir: dir.path().join("cache"),
@@ -83,7 +93,7 @@ impl Bench {
         Bench { scenario, options, setup, dir }
     }
 
-    fn trial(&self, name: &str, node: &dyn Fn(usize, u64) -> Box<dyn Node>, timeout: f64) -> HarvestTrial {
+    fn trial(&self, name: &str, node: &dyn Fn(Task, u64) -> Box<dyn Node>, timeout: f64) -> HarvestTrial {
         let options = OptionValues::default();
         let t = Trial {
             scenario: &self.scenario,
@@ -208,4 +218,32 @@ fn a_scripted_node_is_judged_from_its_messages_and_the_ground_truth() {
     let silent = b.trial("silent", &|_, _| Box::new(Scripted { script: vec![] }), 1.0);
     assert_eq!((silent.failure.as_deref(), silent.plans, silent.time_to_harvest), (Some("timeout"), 0, None));
     assert!((silent.sim_time - 1.0).abs() < 1e-9, "{}", silent.sim_time);
+}
+
+/// Harvest by sight: the task is a region, the node finds its fruit with the perception node
+/// and plans in the mapping node's scene, all under the ground-truth seal; the judge finds the
+/// fruit it placed from the world. A node that reads ground truth fails the trial.
+#[test]
+fn a_harvest_by_sight_is_sealed_from_ground_truth() {
+    let b = Bench::of("harvest_sight.toml");
+    assert!(b.scenario.harvest.sight);
+    // The ground-truth node, in a sight trial: it asks the world for its target.
+    let cheat = b.trial("cheat", &|_, seed| Box::new(HarvestNode::new(0, seed)), 10.0);
+    assert_eq!(cheat.failure.as_deref(), Some("error"), "{cheat:?}");
+    assert!(cheat.detail.contains("node harvest read the ground-truth topic /target_fruit"), "{}", cheat.detail);
+    assert!(cheat.sim_time < 1.0, "stopped at its first read, not at {} s", cheat.sim_time);
+
+    // The built-in node by sight, seed 1 trial 0 (deterministic): it picks a ripe fruit of
+    // its region, placed within 15 mm by perception, and the world has it in the box.
+    let t = b.trial("sight", &builtin_node, TRIAL_TIMEOUT);
+    assert!(t.sight && t.region.is_some());
+    assert_eq!(t.outcome, "success", "{t:?}");
+    let id = t.chosen_id.expect("the node named its target");
+    let (stage, c) = b.setup.fruit[&id];
+    let r = t.region.unwrap();
+    assert!(
+        stage >= 5 && (0..3).all(|k| r[k][0] <= c[k] && c[k] <= r[k][1]),
+        "fruit {id} stage {stage} at {c:?}, region {r:?}"
+    );
+    assert!(t.target_error_mm.unwrap() < 15.0, "{:?}", t.target_error_mm);
 }

@@ -41,6 +41,12 @@ pub struct Bus {
     queues: BTreeMap<String, Queue>,
     /// Messages a reader could not decode (skipped, not fatal), for the run's status log.
     rejected: Vec<String>,
+    /// Ground truth is sealed: nodes may not read it ([`crate::ground_truth`]).
+    sealed: bool,
+    /// The node whose step is running (None: the judge, a bridge, the engine).
+    reader: Option<String>,
+    /// Ground-truth reads by a node under the seal, since the last check.
+    breaches: std::cell::RefCell<Vec<String>>,
 }
 
 /// Messages of one topic kept for its readers, and where each reader is.
@@ -97,6 +103,9 @@ impl Reader {
 
     /// Every message since the last call, oldest first, as published.
     pub fn take_samples(&mut self, bus: &mut Bus) -> Vec<Sample> {
+        if bus.refused(&self.topic) {
+            return vec![];
+        }
         let id = self.join(bus, true);
         let q = bus.queues.get_mut(&self.topic).expect("joined");
         let from = q.cursors[id];
@@ -164,12 +173,49 @@ impl Bus {
     }
 
     pub fn latest(&self, topic: &str) -> Option<&Sample> {
+        if self.refused(topic) {
+            return None;
+        }
         self.latest.get(topic)
+    }
+
+    /// From now on, nodes cannot read ground truth ([`crate::ground_truth`]): a read during a
+    /// node's step gets nothing and is a breach ([`Bus::take_breaches`]). Judges and bridges,
+    /// reading outside node steps, still can.
+    pub fn seal_ground_truth(&mut self) {
+        self.sealed = true;
+    }
+
+    pub fn is_sealed(&self) -> bool {
+        self.sealed
+    }
+
+    /// The node whose step runs now (`None` when it returns).
+    pub fn set_reader(&mut self, node: Option<&str>) {
+        self.reader = node.map(str::to_string);
+    }
+
+    /// Ground-truth reads the seal refused since the last call: "node N read T".
+    pub fn take_breaches(&mut self) -> Vec<String> {
+        std::mem::take(&mut *self.breaches.borrow_mut())
+    }
+
+    /// Whether a read of `topic` now is refused by the seal (and noted as a breach).
+    fn refused(&self, topic: &str) -> bool {
+        let Some(node) = self.reader.as_deref().filter(|_| self.sealed && crate::ground_truth::is_ground_truth(topic))
+        else {
+            return false;
+        };
+        self.breaches.borrow_mut().push(format!("node {node} read the ground-truth topic {topic}"));
+        true
     }
 
     /// The latest message on `topic` if it is newer than `seen` (updated), decoded; one
     /// that does not decode is skipped and reported ([`Bus::take_rejected`]).
     pub fn take_new<M: Message>(&mut self, topic: &str, seen: &mut u64) -> Result<Option<M>> {
+        if self.refused(topic) {
+            return Ok(None);
+        }
         match self.latest.get(topic) {
             Some(s) if s.seq > *seen => {
                 *seen = s.seq;
@@ -239,6 +285,36 @@ impl Bus {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_sealed_bus_refuses_ground_truth_to_nodes_only() {
+        use agrisim_msgs::geometry_msgs::PoseArray;
+        let mut bus = Bus::default();
+        bus.publish("/fruits", 1, &PoseArray::default());
+        bus.publish("/points_like", 1, &PoseArray::default());
+        bus.seal_ground_truth();
+        // A node's step: the ground truth is not there, and the read is a breach.
+        bus.set_reader(Some("harvest"));
+        let mut seen = 0;
+        assert_eq!(bus.take_new::<PoseArray>("/fruits", &mut seen).unwrap(), None);
+        assert!(bus.latest("/camera/labels").is_none());
+        let mut r = Reader::new("/fmu/world/signals");
+        assert!(r.take_samples(&mut bus).is_empty());
+        let mut other = 0;
+        assert!(bus.take_new::<PoseArray>("/points_like", &mut other).unwrap().is_some());
+        bus.set_reader(None);
+        assert_eq!(
+            bus.take_breaches(),
+            [
+                "node harvest read the ground-truth topic /fruits",
+                "node harvest read the ground-truth topic /camera/labels",
+                "node harvest read the ground-truth topic /fmu/world/signals"
+            ]
+        );
+        // The judge, outside node steps, reads it.
+        assert!(bus.take_new::<PoseArray>("/fruits", &mut seen).unwrap().is_some());
+        assert!(bus.take_breaches().is_empty());
+    }
 
     #[test]
     fn tap_takes_every_new_message_of_every_kept_topic_once() {

@@ -8,6 +8,7 @@
 
 pub mod bus;
 pub mod check;
+pub mod ground_truth;
 pub mod node;
 pub mod policy;
 mod record_queue;

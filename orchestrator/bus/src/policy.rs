@@ -93,7 +93,13 @@ fn matches(pattern: &str, topic: &str) -> bool {
 pub const HEAVY_PERIOD: f64 = 5.0;
 /// Period of IMU samples in the `standard` profile \[s\] (50 Hz: noise compresses badly).
 pub const IMU_PERIOD: f64 = 0.02;
+/// Period of maps that grow along the run (the fruit map, a sensed planning scene) in the
+/// `standard` profile \[s\]: each message holds everything so far.
+pub const MAP_PERIOD: f64 = 5.0;
 const HEAVY_TYPES: [&str; 2] = ["sensor_msgs/msg/PointCloud2", "sensor_msgs/msg/Image"];
+/// Period of per-frame detections in the `standard` profile \[s\].
+pub const DETECTIONS_PERIOD: f64 = 1.0;
+const MAP_TOPICS: [&str; 2] = ["/perception/fruit_map", "/mapping/planning_scene"];
 const JUDGE_TOPICS: [&str; 6] =
     ["/harvest/status", "/harvest/plans", "/navigate/status", "/collision", "/plant_damage", "/agrisim/status"];
 const GROUND_TRUTH_SIGNALS: [&str; 2] = ["/fmu/world/signals", "/fmu/chassis/signals"];
@@ -132,6 +138,8 @@ impl RecordPolicy {
             Profile::None => Rule::Drop,
             _ if VIEWER_TOPICS.contains(&topic) => Rule::Keep,
             Profile::Standard if HEAVY_TYPES.contains(&type_name) => Rule::Every(HEAVY_PERIOD),
+            Profile::Standard if MAP_TOPICS.contains(&topic) => Rule::Every(MAP_PERIOD),
+            Profile::Standard if type_name == "vision_msgs/msg/Detection3DArray" => Rule::Every(DETECTIONS_PERIOD),
             Profile::Standard if topic == "/fruits" => Rule::Once,
             Profile::Standard if type_name == "sensor_msgs/msg/Imu" => Rule::Every(IMU_PERIOD),
             Profile::Standard if signals => Rule::Every(0.1),
@@ -182,6 +190,7 @@ mod tests {
         assert_eq!(std.rule("/points", "sensor_msgs/msg/PointCloud2"), Rule::Every(5.0));
         assert_eq!(std.rule("/cmd_vel", "geometry_msgs/msg/Twist"), Rule::Keep);
         assert_eq!(std.rule("/fruits", "geometry_msgs/msg/PoseArray"), Rule::Once);
+        assert_eq!(std.rule("/mapping/planning_scene", "agrisim_msgs/msg/PlanningScene"), Rule::Every(MAP_PERIOD));
         assert_eq!(std.rule("/imu", "sensor_msgs/msg/Imu"), Rule::Every(0.02));
         assert_eq!(std.rule("/fmu/imu/signals", "agrisim_msgs/msg/Signals"), Rule::Every(0.1));
         let judge = RecordPolicy::profile(Profile::Judge);

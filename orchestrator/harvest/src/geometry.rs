@@ -32,10 +32,26 @@ pub const RETREATS: [[f64; 2]; 3] = [[0.14, 0.02], [0.14, 0.0], [0.08, 0.0]];
 pub const LIFT_TRANSFER: f64 = 0.3;
 /// Handover point relative to the arm bases' midpoint (x forward, z above the arm bases) [m].
 pub const HANDOVER: [f64; 2] = [0.42, 0.30];
-/// Harvest box: centre of its opening on base_link and the drop height above it [m]
-/// (rear enclosure at x -0.35, crate 0.4 x 0.6 x 0.25 on a 0.72 m deck).
+/// Harvest box: centre of its opening on base_link [m] (rear enclosure at x -0.35, crate
+/// 0.4 x 0.6 x 0.25 on a 0.72 m deck).
 pub const BOX_TOP: [f64; 3] = [-0.35, 0.0, 0.97];
-pub const DROP_ABOVE: f64 = 0.13;
+/// The box's inside: floor height on base_link and half sizes of the opening (x, y) [m]
+/// (walls and bottom 0.01 m thick in the URDF; checked below).
+pub const BOX_FLOOR: f64 = 0.73;
+pub const BOX_INNER_HALF: [f64; 2] = [0.19, 0.29];
+/// How far the released fruit falls [m]: its bottom this far above the box floor, or above
+/// the fruit already under it. A free fall of 3 cm lands at 0.77 m/s; the fruit may sit
+/// 15 mm either way along the pads from where the node believes (the handover attempts'
+/// offsets), so at worst 4.5 cm, 0.94 m/s, well under the world's 2.0 m/s bruise speed (a
+/// 0.2 m drop, Sargent et al. 1992). Dropped from 0.13 m above the rim (0.35 m, 2.6 m/s)
+/// every fruit was impact-bruised.
+pub const PLACE_GAP: f64 = 0.03;
+/// The hand comes over the box this far above the place pose, pointing down, then goes
+/// straight down to it [m] (the fruit then 4 cm above the rim over an empty box).
+pub const PLACE_DESCENT: f64 = 0.25;
+/// Height added to every place pose for the second round of goals, where none of the first
+/// could be reached [m] (a fall of at most 7.5 cm then, 1.2 m/s).
+pub const PLACE_HIGHER: f64 = 0.03;
 /// Gripper opening for approach [m] (Franka Hand maximum).
 pub const OPEN_WIDTH: f64 = 0.08;
 
@@ -144,44 +160,62 @@ pub fn handover_goals(point: [f64; 3], giver_side: f64) -> (TcpGoal, TcpGoal) {
     (giver, taker)
 }
 
-/// Spots over the box a fruit is dropped from (each at two heights): a 3 x 3 grid over the
-/// 0.38 x 0.58 m opening, the centre first, used in turn, so the fruit spread over the floor
-/// of the box. With the centre and four spots toward the corners, the five heaps reached
-/// the rim after about 96 fruit of a 10 m row segment and every later fruit rolled off (82
-/// placement failures).
-pub const DROP_SPOTS: usize = 9;
+/// Spots in the box a fruit is put down at (x, y from the centre of its opening) [m]: a 3 x 3
+/// grid, the centre first, used in turn, so the fruit spread over the floor of the box. (With
+/// the centre and four spots toward the corners, the five heaps reached the rim after about
+/// 96 fruit of a 10 m row segment and every later fruit rolled off: 82 placement failures.)
+/// The hand goes down into the box to put the fruit down, so the grid keeps the arm off the
+/// walls: a scan of the place poses every 3 cm (the test below checks the grid) found both
+/// arms reach them straight down at -0.09..+0.06 m across (toward the arms, the forearm
+/// meets the front wall) and -0.16..+0.16 m along the box.
+pub const PLACE_SPOTS: [(f64, f64); 9] = [
+    (0.0, 0.0),
+    (0.06, 0.15),
+    (-0.08, -0.15),
+    (0.06, -0.15),
+    (-0.08, 0.15),
+    (0.0, 0.15),
+    (0.0, -0.15),
+    (0.06, 0.0),
+    (-0.08, 0.0),
+];
+pub const DROP_SPOTS: usize = PLACE_SPOTS.len();
 
-/// Drop poses above the harvest box, pointing down, roll free: every spot of the grid, then
-/// the same 0.1 m higher.
-pub fn drop_goals() -> Vec<TcpGoal> {
+/// Height of the centre of a fruit of `radius` put down at (x, y) (base frame) when it comes to
+/// rest on the floor of the box or on the highest of the fruit already in it, `heap`
+/// (centre, radius; base frame), that it would touch on the way down.
+pub fn rest_height(x: f64, y: f64, radius: f64, heap: &[([f64; 3], f64)]) -> f64 {
+    heap.iter().fold(BOX_FLOOR + radius, |z, &(c, r)| {
+        let (d2, reach) = ((c[0] - x).powi(2) + (c[1] - y).powi(2), radius + r);
+        if d2 < reach * reach {
+            z.max(c[2] + (reach * reach - d2).sqrt())
+        } else {
+            z
+        }
+    })
+}
+
+/// Place poses in the harvest box, pointing down, roll free: for a held fruit of `radius`
+/// whose centre is `below_tcp` below the TCP, the TCP where the fruit's bottom is
+/// [`PLACE_GAP`] above where it would come to rest (the floor, or the fruit of `heap` under
+/// it) at every spot of [`PLACE_SPOTS`], then the same [`PLACE_HIGHER`] higher. The hand comes
+/// in [`PLACE_DESCENT`] above each (as a pre-grasp stand-off) and goes straight down.
+pub fn place_goals(radius: f64, below_tcp: f64, heap: &[([f64; 3], f64)]) -> Vec<TcpGoal> {
     let mut v = vec![];
-    for dz in [0.0, 0.1] {
-        for (dx, dy) in [
-            (0.0, 0.0),
-            (0.11, 0.19),
-            (-0.11, -0.19),
-            (0.11, -0.19),
-            (-0.11, 0.19),
-            (0.0, 0.19),
-            (0.0, -0.19),
-            (0.11, 0.0),
-            (-0.11, 0.0),
-        ] {
-            v.push(TcpGoal {
-                position: [BOX_TOP[0] + dx, BOX_TOP[1] + dy, BOX_TOP[2] + DROP_ABOVE + dz],
-                approach: [0.0, 0.0, -1.0],
-                x_axis: None,
-            });
+    for dz in [0.0, PLACE_HIGHER] {
+        for (dx, dy) in PLACE_SPOTS {
+            let (x, y) = (BOX_TOP[0] + dx, BOX_TOP[1] + dy);
+            let z = rest_height(x, y, radius, heap) + PLACE_GAP + below_tcp + dz;
+            v.push(TcpGoal { position: [x, y, z], approach: [0.0, 0.0, -1.0], x_axis: None });
         }
     }
-    debug_assert_eq!(v.len(), 2 * DROP_SPOTS);
     v
 }
 
 /// Whether a point (base frame) lies inside the harvest box's opening footprint, below its rim.
 pub fn in_box(p: [f64; 3]) -> bool {
-    (p[0] - BOX_TOP[0]).abs() < 0.19
-        && (p[1] - BOX_TOP[1]).abs() < 0.29
+    (p[0] - BOX_TOP[0]).abs() < BOX_INNER_HALF[0]
+        && (p[1] - BOX_TOP[1]).abs() < BOX_INNER_HALF[1]
         && p[2] < BOX_TOP[2]
         && p[2] > BOX_TOP[2] - 0.26
 }
@@ -210,6 +244,76 @@ mod tests {
                 && (b[2] + 0.25 - BOX_TOP[2]).abs() < 1e-9,
             "{b:?}"
         );
+    }
+
+    /// The box's inside as the URDF has it: the top of its bottom and the inner faces of its
+    /// walls.
+    #[test]
+    fn box_inside_matches_the_urdf() {
+        let robot = Robot::from_urdf_str(include_str!("../../../models/robot/agrisim_robot.urdf")).unwrap();
+        let b = robot.fk(&BTreeMap::new()).unwrap()["harvest_box_link"].trans;
+        let (mut floor, mut half) = (f64::NEG_INFINITY, [f64::INFINITY; 2]);
+        for c in robot.colliders("harvest_box_link").unwrap() {
+            let agrisim_robot::Shape::Box { size } = c.shape else { panic!("the box is made of boxes") };
+            let o = c.origin.trans;
+            if size[2] < size[0].min(size[1]) {
+                floor = floor.max(b[2] + o[2] + 0.5 * size[2]);
+            }
+            for i in 0..2 {
+                if size[i] < size[2].min(size[1 - i]) {
+                    half[i] = half[i].min(o[i].abs() - 0.5 * size[i]);
+                }
+            }
+        }
+        assert!((floor - BOX_FLOOR).abs() < 1e-9, "floor {floor}");
+        assert!((0..2).all(|i| (half[i] - BOX_INNER_HALF[i]).abs() < 1e-9), "inside half sizes {half:?}");
+    }
+
+    /// Onto the empty floor the released fruit falls [`PLACE_GAP`]; wherever it sits along
+    /// the pads (15 mm either way of the belief) and in either round of goals, it falls at
+    /// most 8 cm, under 1.3 m/s (the world bruises above 2.0 m/s), and it is inside the box,
+    /// clear of the floor, before it is let go.
+    #[test]
+    fn the_fruit_is_put_down_gently() {
+        for r in [0.025, 0.04] {
+            for below in [-0.005, 0.01, 0.025] {
+                let goals = place_goals(r, below, &[]);
+                assert_eq!(goals.len(), 2 * DROP_SPOTS);
+                for (i, g) in goals.iter().enumerate() {
+                    let fall = g.position[2] - below - r - BOX_FLOOR;
+                    if i < DROP_SPOTS {
+                        assert!((fall - PLACE_GAP).abs() < 1e-12, "goal {i}: {fall}");
+                    }
+                    for actual in [below - 0.015, below + 0.015] {
+                        let fall = g.position[2] - actual - r - BOX_FLOOR;
+                        assert!(fall > 0.0 && fall <= 0.08, "goal {i}, r {r}: falls {fall} m");
+                        assert!((2.0 * 9.81 * fall).sqrt() < 1.3);
+                        assert!(in_box([g.position[0], g.position[1], g.position[2] - actual]), "goal {i}");
+                    }
+                    let over = g.position[2] + PLACE_DESCENT - below - 0.015 - r - BOX_TOP[2];
+                    assert!(over > 0.02, "goal {i}: the fruit comes in {over} m over the rim");
+                }
+            }
+        }
+    }
+
+    /// A fruit already under a spot raises its place pose by what the new fruit rests on;
+    /// one beside it, out of the new fruit's way down, does not.
+    #[test]
+    fn the_fruit_is_put_down_on_the_fruit_already_there() {
+        let r = 0.03;
+        let empty = place_goals(r, 0.01, &[]);
+        let under = [BOX_TOP[0], BOX_TOP[1], BOX_FLOOR + r];
+        let on_one = place_goals(r, 0.01, &[(under, r)]);
+        assert!((on_one[0].position[2] - empty[0].position[2] - 2.0 * r).abs() < 1e-12);
+        assert!((1..2 * DROP_SPOTS).filter(|&i| i != DROP_SPOTS).all(|i| on_one[i] == empty[i]));
+        // Half a radius aside: it rests on its flank, lower than on its top.
+        let aside = [under[0] + 0.5 * r, under[1], under[2]];
+        let z = rest_height(BOX_TOP[0], BOX_TOP[1], r, &[(aside, r)]);
+        assert!(z > BOX_FLOOR + r + 0.05 && z < under[2] + 2.0 * r, "{z}");
+        // Two radii aside: out of the way.
+        let beside = [under[0] + 2.0 * r + 1e-3, under[1], under[2]];
+        assert_eq!(rest_height(BOX_TOP[0], BOX_TOP[1], r, &[(beside, r)]), BOX_FLOOR + r);
     }
 
     /// Every grasp candidate is a unit approach into the row (toward the fruit's side), and

@@ -8,15 +8,18 @@
 //!   trajectory_msgs/JointTrajectory;
 //! * [`base`]: fine positioning of the holonomic base;
 //! * [`stage`]: stages and failure categories; [`node`]: the state machine;
-//! * [`row`]: the whole-row harvest, the node taken through a list of fruit.
+//! * [`row`]: the whole-row harvest, the node taken through a list of fruit;
+//! * [`sight`]: harvest by sight: a region for a task, the perception node's fruit map, the
+//!   mapping node's sensed scene.
 
 pub mod base;
 pub mod geometry;
 pub mod motion;
 pub mod node;
 pub mod row;
+pub mod sight;
 pub mod stage;
 
-pub use node::{topics, HarvestNode};
+pub use node::{topics, HarvestNode, Task};
 pub use row::RowNode;
 pub use stage::{Failure, Stage};

@@ -23,6 +23,7 @@
 
 use super::geometry::{self as geo, TcpGoal};
 use super::motion::{Arm, Motion, Planned};
+use super::sight::{self, Region, Seen};
 use super::stage::{Failure, Stage};
 use agrisim_bus::Bus;
 use agrisim_bus::Node;
@@ -35,6 +36,7 @@ use agrisim_msgs::control_msgs::GripperCommand;
 use agrisim_msgs::geometry_msgs::{PoseStamped, Twist};
 use agrisim_msgs::sensor_msgs::JointState;
 use agrisim_msgs::std_msgs::Header;
+use agrisim_msgs::vision_msgs::Detection3DArray;
 
 mod stages;
 
@@ -57,6 +59,18 @@ const STAGE_TIMEOUT: f64 = 25.0;
 /// is (a row harvest's recovery) [m].
 const RECOVERY_BACKOFF: f64 = 0.12;
 
+/// What the node is asked to harvest.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Task {
+    /// Fruit `index` of the world's fruit list: its pose from `/target_fruit` and the
+    /// collision scene from `/planning_scene`, both the world's ground truth (as the paper
+    /// hands the target over). For isolating manipulation from perception.
+    Fruit(usize),
+    /// A ripe fruit the node finds itself in this box of the map frame, by sight: the
+    /// perception node's fruit map and the mapping node's sensed scene ([`crate::sight`]).
+    Region(Region),
+}
+
 /// What the node knows of one arm, from its messages.
 #[derive(Debug, Clone, Default)]
 struct ArmView {
@@ -75,6 +89,7 @@ struct ArmView {
 }
 
 pub struct HarvestNode {
+    task: Task,
     fruit_index: usize,
     side: f64,
     motion: Motion,
@@ -131,14 +146,39 @@ pub struct HarvestNode {
     /// Simulated planning time of this exchange step so far [s]: a trajectory planned now
     /// starts this long after the step.
     step_thinking: f64,
+    /// By sight: the fruit map as last published, the chosen track and its radius, the scan
+    /// stop and when its dwell began, the aisle line the scan stands on, and the allowed
+    /// sphere last sent to the mapper.
+    fruit_map: Vec<Seen>,
+    fruit_map_seen: u64,
+    track: Option<String>,
+    target_r: f64,
+    scan: usize,
+    dwell_from: Option<i64>,
+    aisle_y: f64,
+    allowed_sent: Option<([f64; 3], f64)>,
 }
 
 impl HarvestNode {
     /// Harvests fruit `fruit_index` (the world's fruit list); `seed` drives the planners'
     /// sampling. The side of the robot the fruit is on is learned from the target's pose.
     pub fn new(fruit_index: usize, seed: u64) -> HarvestNode {
+        HarvestNode::with_task(Task::Fruit(fruit_index), seed)
+    }
+
+    /// Harvests a ripe fruit it finds in `region` (map frame) by sight.
+    pub fn by_sight(region: Region, seed: u64) -> HarvestNode {
+        HarvestNode::with_task(Task::Region(region), seed)
+    }
+
+    pub fn with_task(task: Task, seed: u64) -> HarvestNode {
         let side = 1.0;
+        let fruit_index = match task {
+            Task::Fruit(i) => i,
+            Task::Region(_) => 0,
+        };
         HarvestNode {
+            task,
             fruit_index,
             side,
             motion: Motion::new(seed),
@@ -178,6 +218,37 @@ impl HarvestNode {
             cost: CostModel::CALIBRATED,
             work_mark: Work::default(),
             step_thinking: 0.0,
+            fruit_map: vec![],
+            fruit_map_seen: 0,
+            track: None,
+            target_r: 0.0,
+            scan: 0,
+            dwell_from: None,
+            aisle_y: 0.0,
+            allowed_sent: None,
+        }
+    }
+
+    /// The region of a harvest by sight.
+    fn region(&self) -> Option<Region> {
+        match self.task {
+            Task::Region(r) => Some(r),
+            Task::Fruit(_) => None,
+        }
+    }
+
+    /// `target_id` of the status: the world's fruit index, -1 for a fruit found by sight.
+    fn target_id(&self) -> i32 {
+        match self.task {
+            Task::Fruit(i) => i as i32,
+            Task::Region(_) => -1,
+        }
+    }
+
+    fn scene_topic(&self) -> &'static str {
+        match self.task {
+            Task::Fruit(_) => topics::SCENE,
+            Task::Region(_) => sight::topics::SENSED_SCENE,
         }
     }
 
@@ -238,17 +309,30 @@ impl HarvestNode {
     }
 
     fn read(&mut self, bus: &mut Bus) -> Result<()> {
-        if let Some(p) = bus.take_new::<PoseStamped>(topics::TARGET, &mut self.target_seen)? {
-            if p.header.stamp.to_nanos() > self.target_after_ns {
-                self.target_map = Some([p.pose.position.x, p.pose.position.y, p.pose.position.z]);
-                self.target_stamp_ns = p.header.stamp.to_nanos();
+        if self.region().is_none() {
+            if let Some(p) = bus.take_new::<PoseStamped>(topics::TARGET, &mut self.target_seen)? {
+                if p.header.stamp.to_nanos() > self.target_after_ns {
+                    self.target_map = Some([p.pose.position.x, p.pose.position.y, p.pose.position.z]);
+                    self.target_stamp_ns = p.header.stamp.to_nanos();
+                }
+            }
+        } else if let Some(m) = bus.take_new::<Detection3DArray>(sight::topics::FRUIT_MAP, &mut self.fruit_map_seen)? {
+            self.fruit_map = sight::fruit_of(&m, "map");
+            // The chosen fruit's estimate improves as the base comes closer: follow it until
+            // the pre-grasp is planned.
+            let following = self.stage == Stage::PositionBase || (self.stage == Stage::PreGrasp && !self.planned);
+            if let (Some(id), true) = (&self.track, following) {
+                if let Some(f) = self.fruit_map.iter().find(|f| &f.id == id) {
+                    self.target_map = Some(f.center);
+                    self.target_r = f.radius;
+                }
             }
         }
         if let Some(p) = bus.take_new::<PoseStamped>(topics::POSE, &mut self.pose_seen)? {
             self.pose = Some(Pose2::from(&p.pose));
         }
         let mut seen = self.scene_seen;
-        if let Some(s) = bus.take_new::<PlanningScene>(topics::SCENE, &mut seen)? {
+        if let Some(s) = bus.take_new::<PlanningScene>(self.scene_topic(), &mut seen)? {
             self.scene_at_ns = s.header.stamp.to_nanos();
             self.scene = Some(s);
         }
@@ -311,7 +395,7 @@ impl HarvestNode {
         let msg = HarvestStatus {
             header: Header { stamp: Time::from_nanos(t_ns), frame_id: "map".into() },
             stage: self.stage.name().into(),
-            target_id: self.fruit_index as i32,
+            target_id: self.target_id(),
             target_name: self.target_name.clone(),
             outcome: outcome.into(),
             failure_category: category.into(),
@@ -328,10 +412,10 @@ impl HarvestNode {
         self.stop_base(t_ns, bus);
     }
 
-    fn succeed(&mut self, t_ns: i64, bus: &mut Bus) {
+    fn succeed(&mut self, t_ns: i64, bus: &mut Bus, detail: &str) {
         self.stage = Stage::Done;
         self.boxed += 1;
-        self.publish_status(t_ns, bus, "success", "", "fruit in the box");
+        self.publish_status(t_ns, bus, "success", "", detail);
     }
 
     fn stop_base(&self, t_ns: i64, bus: &mut Bus) {
@@ -496,9 +580,28 @@ impl HarvestNode {
         self.scene.is_some() && self.scene_at_ns >= since_ns
     }
 
+    /// The planner's scene: the world's, or by sight the sensed one with the perceived target
+    /// in it (the mapper left its voxels out).
     fn update_scene(&mut self) {
         if let (Some(scene), Some(pose)) = (&self.scene, self.pose) {
-            self.motion.set_scene(scene, pose);
+            match (self.region(), self.target_map) {
+                (Some(_), Some(c)) => self.motion.set_scene(&sight::with_target(scene, c, self.target_r), pose),
+                _ => self.motion.set_scene(scene, pose),
+            }
+        }
+    }
+
+    /// By sight: tells the mapper which fruit to leave out of the sensed scene (the target,
+    /// from choosing it until it is in the box), when that changes.
+    fn publish_allowed(&mut self, t_ns: i64, bus: &mut Bus) {
+        if self.region().is_none() {
+            return;
+        }
+        let active = !matches!(self.stage, Stage::Recover | Stage::SelectTarget | Stage::Done | Stage::Failed);
+        let want = self.target_map.filter(|_| active).map(|c| (c, self.target_r));
+        if want != self.allowed_sent {
+            bus.publish(sight::topics::ALLOWED, t_ns, &sight::allowed(Time::from_nanos(t_ns), want));
+            self.allowed_sent = want;
         }
     }
 
@@ -580,10 +683,23 @@ impl Node for HarvestNode {
         self.step_thinking = 0.0;
         if self.target_name.is_empty() {
             // First exchange: report the first stage like every later one.
-            self.target_name = format!("fruit[{}]", self.fruit_index);
-            self.enter(Stage::SelectTarget, t_ns, bus, &format!("fruit {} of the world's list", self.fruit_index));
+            let detail = match self.task {
+                Task::Fruit(i) => {
+                    self.target_name = format!("fruit[{i}]");
+                    format!("fruit {i} of the world's list")
+                }
+                Task::Region(r) => {
+                    self.target_name = "by sight".into();
+                    format!(
+                        "a ripe fruit in x {:.2}..{:.2}, y {:.2}..{:.2}, z {:.2}..{:.2} m (map)",
+                        r.x[0], r.x[1], r.y[0], r.y[1], r.z[0], r.z[1]
+                    )
+                }
+            };
+            self.enter(Stage::SelectTarget, t_ns, bus, &detail);
         }
         self.run_stage(t_ns, bus);
+        self.publish_allowed(t_ns, bus);
         Ok(())
     }
 }

@@ -60,6 +60,8 @@ pub enum Failure {
     Placement,
     Timeout,
     Collision,
+    /// By sight: no ripe fruit was found in the task's region.
+    NotDetected,
 }
 
 impl Failure {
@@ -71,6 +73,7 @@ impl Failure {
             Failure::Placement => "placement",
             Failure::Timeout => "timeout",
             Failure::Collision => "collision",
+            Failure::NotDetected => "not_detected",
         }
     }
 }

@@ -61,12 +61,25 @@ impl DepthFrame {
     /// z forward, x right, y down), in single precision as a point cloud carries them;
     /// pixels without a return are left out. Also gives the camera origin.
     pub fn points(&self, k: &Intrinsics, camera_pose: &Isometry3<f64>) -> ([f32; 3], Vec<[f32; 3]>) {
-        let mut out = Vec::with_capacity(self.z.len());
+        self.points_every(k, camera_pose, 1)
+    }
+
+    /// [`points`](Self::points) of every `stride`-th pixel of every `stride`-th row (MoveIt's
+    /// depth-image octomap updater skips pixels the same way): stride^2 fewer rays, and at
+    /// the crop's distance still several points per voxel.
+    pub fn points_every(
+        &self,
+        k: &Intrinsics,
+        camera_pose: &Isometry3<f64>,
+        stride: usize,
+    ) -> ([f32; 3], Vec<[f32; 3]>) {
+        let stride = stride.max(1);
+        let mut out = Vec::with_capacity(self.z.len() / (stride * stride));
         let rx: Vec<f64> = (0..self.width).map(|u| (u as f64 + 0.5 - k.cx) / k.fx).collect();
-        for v in 0..self.height {
+        for v in (0..self.height).step_by(stride) {
             let ry = (v as f64 + 0.5 - k.cy) / k.fy;
             let row = &self.z[v * self.width..(v + 1) * self.width];
-            for (u, &z) in row.iter().enumerate() {
+            for (u, &z) in row.iter().enumerate().step_by(stride) {
                 if !(z > 0.0 && z.is_finite()) {
                     continue;
                 }

@@ -9,7 +9,9 @@
 //!   the padding, allowed objects (the fruit to grasp) left out.
 //! - Export: the occupied voxels merged into boxes, as an `agrisim_msgs/PlanningScene` the
 //!   harvest planner reads like the ground-truth `/planning_scene`.
-//! - [`node::DepthMapper`]: the node that does this on the bus.
+//! - [`node::DepthMapper`]: the node that does this on the bus, for one or more cameras, its
+//!   self-filter from `/robot_description` and TF ([`robot`]), its allowed objects from
+//!   `/harvest/allowed`.
 //!
 //! The voxel walk and the update follow OctoMap's arithmetic, so a scan gives the same voxel
 //! states (bit-identical log-odds) as OctoMap's `insertPointCloud` at the same resolution and
@@ -17,16 +19,19 @@
 //! (`agrisim-mapping-bench` is its agrisim side).
 //!
 //! Unknown space counts as free (MoveIt's default); the allowed objects and the robot links
-//! are the caller's (the URDF, joint states and the perceived fruit), never world outputs.
+//! come from messages (the URDF, TF from the joint states, the fruit the harvest node
+//! grasps), never world outputs.
 
 pub mod depth;
 pub mod map;
 pub mod node;
 pub mod ray;
+pub mod robot;
 pub mod shape;
 
 pub use depth::{DepthFrame, Intrinsics};
 pub use map::{MapConfig, Occupancy, OccupancyMap, ScanStats, VoxelBox, OCCUPIED_KIND};
-pub use node::{DepthMapper, MapperConfig};
+pub use node::{CameraTopics, DepthMapper, MapperConfig};
 pub use ray::{Grid, Key};
+pub use robot::RobotShapes;
 pub use shape::{Primitive, Shape, Sphere};

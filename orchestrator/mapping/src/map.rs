@@ -250,7 +250,20 @@ impl OccupancyMap {
         camera_pose: &Isometry3<f64>,
         robot: &[Primitive],
     ) -> ScanStats {
-        let (origin, points) = depth.points(k, camera_pose);
+        self.insert_depth_every(depth, k, camera_pose, robot, 1)
+    }
+
+    /// [`insert_depth`](Self::insert_depth) with every `stride`-th pixel of every `stride`-th
+    /// row ([`DepthFrame::points_every`]).
+    pub fn insert_depth_every(
+        &mut self,
+        depth: &DepthFrame,
+        k: &Intrinsics,
+        camera_pose: &Isometry3<f64>,
+        robot: &[Primitive],
+        stride: usize,
+    ) -> ScanStats {
+        let (origin, points) = depth.points_every(k, camera_pose, stride);
         self.insert_cloud(&origin, &points, robot)
     }
 

@@ -9,15 +9,16 @@ use agrisim_mapping::{
 };
 use agrisim_msgs::agrisim::{FmuStatus, PlanningScene};
 use agrisim_msgs::builtin_interfaces::Time;
-use agrisim_msgs::geometry_msgs::{Quaternion as Q, Transform, TransformStamped, Vector3};
 use agrisim_msgs::sensor_msgs::{CameraInfo, Image};
 use agrisim_msgs::shape_msgs::SolidPrimitive;
 use agrisim_msgs::std_msgs::Header;
-use agrisim_msgs::tf2_msgs::TFMessage;
 use agrisim_msgs::Message;
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3 as V3};
 use proptest::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
+
+mod common;
+use common::tf;
 
 const W: usize = 64;
 const H: usize = 48;
@@ -335,20 +336,6 @@ proptest! {
             (m.known().iter().map(|(k, l)| (*k, l.to_bits())).collect::<Vec<_>>(), m.planning_scene(Header::default(), 0.01).to_cdr())
         };
         prop_assert_eq!(run(), run());
-    }
-}
-
-fn tf(parent: &str, child: &str, pose: &Isometry3<f64>) -> TFMessage {
-    let (t, q) = (pose.translation.vector, pose.rotation.quaternion());
-    TFMessage {
-        transforms: vec![TransformStamped {
-            header: Header { frame_id: parent.into(), ..Default::default() },
-            child_frame_id: child.into(),
-            transform: Transform {
-                translation: Vector3 { x: t.x, y: t.y, z: t.z },
-                rotation: Q { x: q.i, y: q.j, z: q.k, w: q.w },
-            },
-        }],
     }
 }
 

@@ -39,11 +39,66 @@ pub struct PerceptionConfig {
     pub detector: DetectorConfig,
     /// World frames to publish in, first that TF reaches wins (REP 105: map, then odom).
     pub world_frames: Vec<String>,
+    /// The cameras read, by namespace: `/<ns>/color/image_raw`,
+    /// `/<ns>/aligned_depth_to_color/image_raw`, `/<ns>/color/camera_info` (the RealSense
+    /// driver's names). Every camera's detections go into one fruit map.
+    pub cameras: Vec<String>,
+    /// Tracks in the published fruit map have merged at least this many observations (a
+    /// fruit seen once may be a false detection).
+    pub confirm: u32,
+    /// The fruit map is published at most this often [s] (0: after every frame); it holds
+    /// every fruit seen so far, so it grows along the row.
+    pub map_period: f64,
 }
 
 impl Default for PerceptionConfig {
     fn default() -> Self {
-        PerceptionConfig { detector: DetectorConfig::default(), world_frames: vec!["map".into(), "odom".into()] }
+        PerceptionConfig {
+            detector: DetectorConfig::default(),
+            world_frames: vec!["map".into(), "odom".into()],
+            cameras: vec!["camera".into()],
+            confirm: 1,
+            map_period: 0.0,
+        }
+    }
+}
+
+impl PerceptionConfig {
+    /// The default detector on the cameras `namespaces`, publishing tracks seen at least twice.
+    pub fn for_cameras(namespaces: &[&str]) -> PerceptionConfig {
+        PerceptionConfig {
+            cameras: namespaces.iter().map(|n| n.to_string()).collect(),
+            confirm: 2,
+            ..PerceptionConfig::default()
+        }
+    }
+}
+
+/// One camera's topics and what arrived of its current frame.
+struct CameraInput {
+    image_topic: String,
+    depth_topic: String,
+    info_topic: String,
+    info: Option<(CameraInfo, Intrinsics)>,
+    seen: [u64; 3],
+    image: Option<Image>,
+    depth: Option<Image>,
+    last_stamp: Option<i64>,
+}
+
+impl CameraInput {
+    fn new(ns: &str) -> CameraInput {
+        let ns = ns.trim_matches('/');
+        CameraInput {
+            image_topic: format!("/{ns}/color/image_raw"),
+            depth_topic: format!("/{ns}/aligned_depth_to_color/image_raw"),
+            info_topic: format!("/{ns}/color/camera_info"),
+            info: None,
+            seen: [0; 3],
+            image: None,
+            depth: None,
+            last_stamp: None,
+        }
     }
 }
 
@@ -53,12 +108,9 @@ pub struct Perception {
     tf: TfBuffer,
     tf_reader: Reader,
     tf_static_reader: Reader,
-    info: Option<(CameraInfo, Intrinsics)>,
-    seen: [u64; 3],
-    image: Option<Image>,
-    depth: Option<Image>,
-    last_stamp: Option<i64>,
+    cameras: Vec<CameraInput>,
     map: FruitMap,
+    last_map_ns: Option<i64>,
     last_status: String,
     /// Frames processed and skipped so far.
     pub frames: u64,
@@ -69,16 +121,13 @@ impl Perception {
     pub fn new(config: PerceptionConfig) -> Perception {
         Perception {
             detector: Detector::new(config.detector.clone()),
+            cameras: config.cameras.iter().map(|ns| CameraInput::new(ns)).collect(),
             config,
             tf: TfBuffer::default(),
             tf_reader: Reader::new(TF),
             tf_static_reader: Reader::new(TF_STATIC),
-            info: None,
-            seen: [0; 3],
-            image: None,
-            depth: None,
-            last_stamp: None,
             map: FruitMap::default(),
+            last_map_ns: None,
             last_status: String::new(),
             frames: 0,
             skipped: 0,
@@ -140,9 +189,9 @@ impl Perception {
         Ok((z, w, h))
     }
 
-    fn process(&mut self, t_ns: i64, bus: &mut Bus, image: &Image, depth: &Image) {
+    fn process(&mut self, t_ns: i64, bus: &mut Bus, cam: usize, image: &Image, depth: &Image) {
         let stamp = image.header.stamp.to_nanos();
-        let Some((info, k)) = self.info.clone() else {
+        let Some((info, k)) = self.cameras[cam].info.clone() else {
             return self.status(bus, t_ns, format!("frame at t={} s skipped: no CameraInfo yet", stamp as f64 / 1e9));
         };
         if info.width != image.width || info.height != image.height {
@@ -194,10 +243,17 @@ impl Perception {
         let dets: Vec<Detection3D> =
             result.detections.iter().zip(&ids).map(|(d, id)| detection(&wh, d, &pose, id.to_string())).collect();
         bus.publish(DETECTIONS_WORLD, t_ns, &Detection3DArray { header: wh.clone(), detections: dets });
+        let period_ns = (self.config.map_period * 1e9) as i64;
+        if self.last_map_ns.is_some_and(|last| t_ns - last < period_ns) {
+            return self.ok();
+        }
+        self.last_map_ns = Some(t_ns);
+        let confirm = self.config.confirm;
         let tracks: Vec<Detection3D> = self
             .map
             .tracks
             .iter()
+            .filter(|t| t.merged >= confirm)
             .map(|t| {
                 let total: f64 = t.votes.iter().sum::<f64>().max(1e-12);
                 let votes = t.votes.map(|v| v / total);
@@ -260,29 +316,36 @@ impl Node for Perception {
         for m in self.tf_reader.take::<TFMessage>(bus)? {
             self.tf.add(&m);
         }
-        if let Some(info) = bus.take_new::<CameraInfo>(CAMERA_INFO, &mut self.seen[2])? {
-            match Intrinsics::from_k(&info.k) {
-                Some(k) => self.info = Some((info, k)),
-                None => self.status(bus, t_ns, format!("CameraInfo with an unusable K {:?} ignored", info.k)),
+        for cam in 0..self.cameras.len() {
+            let c = &mut self.cameras[cam];
+            if let Some(info) = bus.take_new::<CameraInfo>(&c.info_topic, &mut c.seen[2])? {
+                match Intrinsics::from_k(&info.k) {
+                    Some(k) => c.info = Some((info, k)),
+                    None => {
+                        let why = format!("CameraInfo on {} with an unusable K {:?} ignored", c.info_topic, info.k);
+                        self.status(bus, t_ns, why);
+                    }
+                }
             }
-        }
-        if let Some(img) = bus.take_new::<Image>(IMAGE, &mut self.seen[0])? {
-            self.image = Some(img);
-        }
-        if let Some(d) = bus.take_new::<Image>(DEPTH, &mut self.seen[1])? {
-            self.depth = Some(d);
-        }
-        let pair = match (&self.image, &self.depth) {
-            (Some(i), Some(d)) if i.header.stamp == d.header.stamp => {
-                let s = i.header.stamp.to_nanos();
-                (self.last_stamp != Some(s)).then_some(s)
+            let c = &mut self.cameras[cam];
+            if let Some(img) = bus.take_new::<Image>(&c.image_topic, &mut c.seen[0])? {
+                c.image = Some(img);
             }
-            _ => None,
-        };
-        if let Some(stamp) = pair {
-            self.last_stamp = Some(stamp);
-            let (image, depth) = (self.image.take().expect("paired"), self.depth.take().expect("paired"));
-            self.process(t_ns, bus, &image, &depth);
+            if let Some(d) = bus.take_new::<Image>(&c.depth_topic, &mut c.seen[1])? {
+                c.depth = Some(d);
+            }
+            let pair = match (&c.image, &c.depth) {
+                (Some(i), Some(d)) if i.header.stamp == d.header.stamp => {
+                    let s = i.header.stamp.to_nanos();
+                    (c.last_stamp != Some(s)).then_some(s)
+                }
+                _ => None,
+            };
+            if let Some(stamp) = pair {
+                c.last_stamp = Some(stamp);
+                let (image, depth) = (c.image.take().expect("paired"), c.depth.take().expect("paired"));
+                self.process(t_ns, bus, cam, &image, &depth);
+            }
         }
         Ok(())
     }

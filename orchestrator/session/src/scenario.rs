@@ -146,11 +146,20 @@ pub struct HarvestSettings {
     /// Visibility classes targets are drawn from (free, partly_occluded, behind_stem); all
     /// by default. `["free"]` is close to the paper's experiment (fruit in plain view).
     pub visibility: Vec<String>,
+    /// Harvest by sight: the task is a 1 m stretch of the row on one side, not a fruit; the
+    /// node finds a ripe fruit there with the perception node's fruit map and plans in the
+    /// mapping node's scene sensed from depth. The system must carry the row cameras
+    /// (`camera_left`, `camera_right`, as models/systems/harvest_sight.ssd). Off: the node is
+    /// handed the world's target and planning scene (ground truth, as the paper).
+    pub sight: bool,
 }
 
 impl Default for HarvestSettings {
     fn default() -> Self {
-        HarvestSettings { visibility: ["free", "partly_occluded", "behind_stem"].map(String::from).to_vec() }
+        HarvestSettings {
+            visibility: ["free", "partly_occluded", "behind_stem"].map(String::from).to_vec(),
+            sight: false,
+        }
     }
 }
 

@@ -236,7 +236,16 @@ impl Hooks for Link<'_> {
         if message_instant {
             for (n, wall) in self.nodes.iter_mut().zip(self.node_wall.iter_mut()) {
                 let start = std::time::Instant::now();
-                n.step(t_ns, self.bus).map_err(|e| err!("node {} at t={}: {e}", n.name(), t_ns as f64 / 1e9))?;
+                self.bus.set_reader(Some(n.name()));
+                let stepped = n.step(t_ns, self.bus);
+                self.bus.set_reader(None);
+                stepped.map_err(|e| err!("node {} at t={}: {e}", n.name(), t_ns as f64 / 1e9))?;
+                if let Some(b) = self.bus.take_breaches().into_iter().next() {
+                    return Err(err!(
+                        "at t={} s {b}: ground truth is sealed in this run (the algorithm layer never sees it)",
+                        t_ns as f64 / 1e9
+                    ));
+                }
                 *wall = start.elapsed().as_secs_f64();
             }
         }

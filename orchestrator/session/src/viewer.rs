@@ -25,6 +25,7 @@ use agrisim_bus::{Bus, Node};
 use agrisim_error::Result;
 use agrisim_msgs::builtin_interfaces::Time;
 use agrisim_msgs::geometry_msgs::{Point, PoseArray, Quaternion, Transform, TransformStamped, Vector3};
+use agrisim_msgs::nav_msgs::Odometry;
 use agrisim_msgs::std_msgs::{ColorRGBA, Header};
 use agrisim_msgs::tf2_msgs::TFMessage;
 use agrisim_msgs::visualization_msgs::{Marker, MarkerArray};
@@ -354,6 +355,8 @@ impl Node for SceneView {
 
 /// Static transforms (tf2_msgs/TFMessage, latched).
 pub const TF_STATIC: &str = "/tf_static";
+/// The wheel odometry (nav_msgs/Odometry, odom -> base_link), as agrisim_nodes::OdomTf reads it.
+const ODOM: &str = "/odom";
 /// The names ([`Node::name`]) of the nodes that publish map -> odom: agrisim_nav's
 /// localization node, and its navigator (which may embed one).
 pub const LOCALIZERS: [&str; 2] = ["localization", "navigator"];
@@ -363,26 +366,40 @@ pub fn localizes(nodes: &[Box<dyn Node>]) -> bool {
     nodes.iter().any(|n| LOCALIZERS.contains(&n.name()))
 }
 
-/// map -> odom, fixed at the start pose, for a run without localization (REP 105: odom
-/// starts at the robot's initial pose, the chassis's x0, y0, yaw0 in the map frame; with no
-/// localizer to correct the drift, map -> odom stays where it started). It joins the
-/// markers' `map` frame to the robot's tree, so a viewer that follows base_link draws the
-/// greenhouse. Published once on `/tf_static` (latched), at the first step, with the static
-/// transforms published before it in that step (robot_state_publisher's): the bus keeps one
-/// message of a latched topic for a reader that joins later (the Foxglove view), so that
-/// message carries the whole static tree. Only for runs without a localizer: a frame with
-/// two parents breaks the tree ([`with_map_odom`]).
+/// map -> odom, fixed at the start, for a run without localization: the transform that puts
+/// the odometry's first pose on the robot's start pose (the chassis's x0, y0, yaw0 in the map
+/// frame), map -> odom = start * odom_0^-1. agrisim's odometry (the chassis, the odometry
+/// adapter) starts at the start pose itself, in map coordinates, so this is the identity
+/// there; an odometry that starts at zero (REP 105's usual odom) gets the start pose. With no
+/// localizer to correct the drift, map -> odom stays where it started. It joins the markers'
+/// `map` frame to the robot's tree, so a viewer that follows base_link draws the greenhouse
+/// where the robot sees it. Published once on `/tf_static` (latched), at the step of the
+/// first `/odom`, with the static transforms published before it (robot_state_publisher's):
+/// the bus keeps one message of a latched topic for a reader that joins later (the Foxglove
+/// view), so that message carries the whole static tree. Only for runs without a localizer:
+/// a frame with two parents breaks the tree ([`with_map_odom`]).
 pub struct StaticMapOdom {
     pose: [f64; 3],
     sent: bool,
     seen: u64,
+    odom_seen: u64,
+    /// The static transforms seen so far, by child frame (no odom).
+    statics: BTreeMap<String, TransformStamped>,
 }
 
 impl StaticMapOdom {
     /// `start`: x \[m\], y \[m\], yaw \[rad\] of the base at the start, in the map frame.
     pub fn new(start: [f64; 3]) -> StaticMapOdom {
-        StaticMapOdom { pose: start, sent: false, seen: 0 }
+        StaticMapOdom { pose: start, sent: false, seen: 0, odom_seen: 0, statics: BTreeMap::new() }
     }
+}
+
+/// map -> odom (x, y, yaw) that maps the odometry pose `odom` onto the map pose `start`:
+/// start * odom^-1, in the plane.
+pub fn map_odom(start: [f64; 3], odom: [f64; 3]) -> [f64; 3] {
+    let yaw = start[2] - odom[2];
+    let (s, c) = yaw.sin_cos();
+    [start[0] - (c * odom[0] - s * odom[1]), start[1] - (s * odom[0] + c * odom[1]), yaw]
 }
 
 impl Node for StaticMapOdom {
@@ -391,18 +408,28 @@ impl Node for StaticMapOdom {
     }
 
     fn step(&mut self, t_ns: i64, bus: &mut Bus) -> Result<()> {
-        if !self.sent {
-            let mut transforms = bus.take_new::<TFMessage>(TF_STATIC, &mut self.seen)?.map_or(vec![], |m| m.transforms);
-            transforms.retain(|t| t.child_frame_id != "odom");
-            let [x, y, yaw] = self.pose;
-            transforms.push(TransformStamped {
-                header: Header { stamp: Time::from_nanos(t_ns), frame_id: FRAME.into() },
-                child_frame_id: "odom".into(),
-                transform: Transform { translation: Vector3 { x, y, z: 0.0 }, rotation: Quaternion::from_yaw(yaw) },
-            });
-            bus.publish(TF_STATIC, t_ns, &TFMessage { transforms });
-            self.sent = true;
+        if self.sent {
+            return Ok(());
         }
+        if let Some(m) = bus.take_new::<TFMessage>(TF_STATIC, &mut self.seen)? {
+            for t in m.transforms.into_iter().filter(|t| t.child_frame_id != "odom") {
+                self.statics.insert(t.child_frame_id.clone(), t);
+            }
+        }
+        let Some(odom) = bus.take_new::<Odometry>(ODOM, &mut self.odom_seen)? else {
+            return Ok(());
+        };
+        let p = &odom.pose.pose;
+        let [x, y, yaw] = map_odom(self.pose, [p.position.x, p.position.y, p.orientation.yaw()]);
+        let mut transforms: Vec<TransformStamped> = self.statics.values().cloned().collect();
+        transforms.push(TransformStamped {
+            header: Header { stamp: Time::from_nanos(t_ns), frame_id: FRAME.into() },
+            child_frame_id: "odom".into(),
+            transform: Transform { translation: Vector3 { x, y, z: 0.0 }, rotation: Quaternion::from_yaw(yaw) },
+        });
+        bus.publish(TF_STATIC, t_ns, &TFMessage { transforms });
+        self.sent = true;
+        self.statics.clear();
         Ok(())
     }
 }
@@ -573,18 +600,21 @@ mod tests {
     }
 
     /// Every transform published on /tf and /tf_static by `nodes` stepping at 0 and 0.1 s,
-    /// the robot having moved 0.3 m forward and turned 0.2 rad by wheel odometry.
-    fn transforms(mut nodes: Vec<Box<dyn Node>>) -> (Vec<(String, TransformStamped)>, Vec<String>) {
-        use agrisim_msgs::nav_msgs::Odometry;
+    /// with the wheel odometry's pose (x, y, yaw) at those times on /odom.
+    fn transforms_with(
+        mut nodes: Vec<Box<dyn Node>>,
+        odom_poses: [[f64; 3]; 2],
+    ) -> (Vec<(String, TransformStamped)>, Vec<String>) {
         let mut bus = Bus::default();
         let mut tap = agrisim_bus::Tap::default();
-        let mut odom = Odometry { child_frame_id: "base_link".into(), ..Default::default() };
-        odom.header.frame_id = "odom".into();
-        odom.pose.pose.position.x = 0.3;
-        odom.pose.pose.orientation = Quaternion::from_yaw(0.2);
-        bus.publish("/odom", 0, &odom);
         let mut out = Vec::new();
-        for t in [0, 100_000_000] {
+        for (t, [x, y, yaw]) in [0, 100_000_000].into_iter().zip(odom_poses) {
+            let mut odom = Odometry { child_frame_id: "base_link".into(), ..Default::default() };
+            odom.header = Header { stamp: Time::from_nanos(t), frame_id: "odom".into() };
+            odom.pose.pose.position.x = x;
+            odom.pose.pose.position.y = y;
+            odom.pose.pose.orientation = Quaternion::from_yaw(yaw);
+            bus.publish(ODOM, t, &odom);
             for n in &mut nodes {
                 n.step(t, &mut bus).unwrap();
             }
@@ -597,21 +627,15 @@ mod tests {
         (out, nodes.iter().map(|n| n.name().to_string()).collect())
     }
 
-    /// A plain run (robot_state_publisher, odom -> base_link from /odom, no localizer): map ->
-    /// odom on /tf_static at the start pose joins map to base_link, and the chain places
-    /// base_link at the start pose composed with the odometry.
-    #[test]
-    fn without_a_localizer_map_odom_is_the_start_pose_and_joins_map_to_base_link() {
-        let start = [1.0, 2.0, 0.5];
-        let nodes: Vec<Box<dyn Node>> =
-            vec![Box::new(agrisim_nodes::RobotStatePublisher::agrisim()), Box::new(agrisim_nodes::OdomTf::default())];
-        let (tf, _) = transforms(with_map_odom(nodes, Some(start)));
+    /// [`transforms_with`] an odometry that starts at zero and moves 0.3 m forward, turning 0.2 rad.
+    fn transforms(nodes: Vec<Box<dyn Node>>) -> (Vec<(String, TransformStamped)>, Vec<String>) {
+        transforms_with(nodes, [[0.0; 3], [0.3, 0.0, 0.2]])
+    }
+
+    /// map -> base_link (x, y, yaw) through the last transform of each frame, and its root.
+    fn map_base(tf: &[(String, TransformStamped)]) -> ([f64; 3], String) {
         let parent: BTreeMap<&str, &TransformStamped> =
             tf.iter().map(|(_, t)| (t.child_frame_id.as_str(), t)).collect();
-        let map_odom: Vec<_> = tf.iter().filter(|(_, t)| t.child_frame_id == "odom").collect();
-        assert_eq!(map_odom.len(), 1, "map -> odom once: {map_odom:?}");
-        assert_eq!((map_odom[0].0.as_str(), map_odom[0].1.header.frame_id.as_str()), (TF_STATIC, "map"));
-        // base_link up to its root, composing the 2-D poses.
         let (mut frame, mut pose) = ("base_link", [0.0, 0.0, 0.0]);
         while let Some(t) = parent.get(frame) {
             let (tr, yaw) = (&t.transform.translation, t.transform.rotation.yaw());
@@ -619,9 +643,52 @@ mod tests {
             pose = [tr.x + c * pose[0] - s * pose[1], tr.y + s * pose[0] + c * pose[1], yaw + pose[2]];
             frame = t.header.frame_id.as_str();
         }
-        assert_eq!(frame, "map", "base_link's root");
+        (pose, frame.to_string())
+    }
+
+    /// A plain run (robot_state_publisher, odom -> base_link from /odom, no localizer): map ->
+    /// odom on /tf_static joins map to base_link, and the chain places base_link at the start
+    /// pose moved by the odometry since the start, whether the odometry starts at zero (REP
+    /// 105's usual odom) or at the start pose in map coordinates (agrisim's chassis and odometry
+    /// adapter: map -> odom is then the identity, not the start pose again).
+    #[test]
+    fn without_a_localizer_map_odom_puts_base_link_at_the_start_pose_moved_by_odometry() {
+        let start = [1.0, 2.0, 0.5];
         let want = [1.0 + 0.3 * 0.5f64.cos(), 2.0 + 0.3 * 0.5f64.sin(), 0.7];
-        assert!((0..3).all(|k| (pose[k] - want[k]).abs() < 1e-9), "map -> base_link {pose:?}, want {want:?}");
+        let nodes = || -> Vec<Box<dyn Node>> {
+            vec![Box::new(agrisim_nodes::RobotStatePublisher::agrisim()), Box::new(agrisim_nodes::OdomTf::default())]
+        };
+        for (odom, map_odom_want) in [([[0.0; 3], [0.3, 0.0, 0.2]], start), ([start, want], [0.0; 3])] {
+            let (tf, _) = transforms_with(with_map_odom(nodes(), Some(start)), odom);
+            let map_odom: Vec<_> = tf.iter().filter(|(_, t)| t.child_frame_id == "odom").collect();
+            assert_eq!(map_odom.len(), 1, "map -> odom once: {map_odom:?}");
+            assert_eq!((map_odom[0].0.as_str(), map_odom[0].1.header.frame_id.as_str()), (TF_STATIC, "map"));
+            let (tr, q) = (&map_odom[0].1.transform.translation, &map_odom[0].1.transform.rotation);
+            let got = [tr.x, tr.y, q.yaw()];
+            assert!(
+                (0..3).all(|k| (got[k] - map_odom_want[k]).abs() < 1e-9),
+                "map -> odom {got:?}, want {map_odom_want:?}"
+            );
+            // The one /tf_static message a late reader gets holds robot_state_publisher's too.
+            let last_static: BTreeSet<&str> = tf
+                .iter()
+                .filter(|(topic, t)| topic == TF_STATIC && t.header.frame_id == map_odom[0].1.header.frame_id)
+                .map(|(_, t)| t.child_frame_id.as_str())
+                .collect();
+            assert!(last_static.contains("odom"));
+            assert!(
+                tf.iter().any(|(topic, t)| topic == TF_STATIC && t.child_frame_id != "odom"),
+                "no static robot transforms"
+            );
+            let (pose, root) = map_base(&tf);
+            assert_eq!(root, "map", "base_link's root");
+            assert!((0..3).all(|k| (pose[k] - want[k]).abs() < 1e-9), "map -> base_link {pose:?}, want {want:?}");
+        }
+        // map_odom itself: start * odom^-1 puts the odometry's pose on the start.
+        let m = map_odom([3.0, -1.0, 1.2], [0.5, 0.25, -0.4]);
+        let (c, s) = (m[2].cos(), m[2].sin());
+        let back = [m[0] + c * 0.5 - s * 0.25, m[1] + s * 0.5 + c * 0.25, m[2] - 0.4];
+        assert!((0..3).all(|k| (back[k] - [3.0, -1.0, 1.2][k]).abs() < 1e-12), "{back:?}");
     }
 
     /// A node that publishes map -> odom on /tf as agrisim_nav's localizer does.

@@ -6,6 +6,7 @@
 //! Unknown keys are errors, and every error names the key, so a typo never silently falls
 //! back to a default.
 
+use crate::family::FamilyConfig;
 use serde::Deserialize;
 
 /// A box obstacle standing on the floor, placed by the scenario.
@@ -60,6 +61,16 @@ pub struct GreenhouseConfig {
     /// Headland path between the front wall (x = 0) and the row starts [m].
     pub headland: f64,
 
+    // --- Crop ---------------------------------------------------------------------------------
+    /// Crop preset (`crate::crop`): "loose_round" (the default), "truss" or "cherry". Sets the
+    /// crop fields (trusses_per_plant, fruit_per_truss, fruit_radius, fruit_radius_spread,
+    /// fruit_radius_limits, leaf_density, leaf_size) that the table does not give itself.
+    /// Applied by [`GreenhouseConfig::from_toml_str`].
+    pub crop: String,
+    /// `[greenhouse.family]`: ranges the crop and layout are drawn from, per scene seed
+    /// (`crate::family`). Drawn by [`GreenhouseConfig::from_toml_str`].
+    pub family: Option<FamilyConfig>,
+
     // --- Plants -------------------------------------------------------------------------------
     /// Distance between plants along a row [m] (2.5 plants/m^2-type spacing: 0.5 m).
     pub plant_spacing: f64,
@@ -72,6 +83,8 @@ pub struct GreenhouseConfig {
     pub fruit_radius: f64,
     /// Relative spread of fruit radius (1 sigma, fraction of `fruit_radius`).
     pub fruit_radius_spread: f64,
+    /// Every fruit's radius stays within these factors of `fruit_radius`.
+    pub fruit_radius_limits: [f64; 2],
     /// Fruit centre heights stay within this band [m] (reachable by the arms).
     pub fruit_height: [f64; 2],
     /// Weights of the six USDA ripeness stages: green, breakers, turning, pink, light red, red.
@@ -115,6 +128,8 @@ impl Default for GreenhouseConfig {
     fn default() -> Self {
         GreenhouseConfig {
             seed: 1,
+            crop: "loose_round".into(),
+            family: None,
             length: 70.0,
             width: 55.0,
             height: 10.0,
@@ -133,6 +148,7 @@ impl Default for GreenhouseConfig {
             fruit_per_truss: 5,
             fruit_radius: 0.03,
             fruit_radius_spread: 0.1,
+            fruit_radius_limits: [0.6, 1.4],
             fruit_height: [0.5, 1.8],
             ripeness: [0.25, 0.1, 0.1, 0.1, 0.15, 0.3],
             leaf_density: 6,
@@ -156,12 +172,63 @@ impl Default for GreenhouseConfig {
 }
 
 impl GreenhouseConfig {
-    /// Parses the keys of a `[greenhouse]` table ("" gives the default) and validates them.
-    /// Errors name the offending key, e.g. `greenhouse.rows: ...`.
+    /// Parses the keys of a `[greenhouse]` table ("" gives the default), applies its crop
+    /// preset (`crop`: to the crop fields the table does not give) and its family draw
+    /// (`[greenhouse.family]`, for the table's `seed`), and validates the result. Errors name
+    /// the offending key, e.g. `greenhouse.rows: ...`.
     pub fn from_toml_str(s: &str) -> Result<GreenhouseConfig, String> {
-        let cfg: GreenhouseConfig = toml::from_str(s).map_err(|e| describe_toml_error(s, &e))?;
+        let mut cfg: GreenhouseConfig = toml::from_str(s).map_err(|e| describe_toml_error(s, &e))?;
+        let table: toml::Table = toml::from_str(s).map_err(|e| describe_toml_error(s, &e))?;
+        let explicit = |k: &str| table.contains_key(k);
+        let crop = crate::crop::preset(&cfg.crop).ok_or_else(|| {
+            format!("greenhouse.crop: unknown crop {:?}; known: {}", cfg.crop, crate::crop::CROPS.join(", "))
+        })?;
+        cfg.apply_crop(&crop, &explicit);
+        if let Some(family) = cfg.family.clone() {
+            let draw = family.draw(cfg.seed, &explicit)?;
+            cfg.apply_draw(&draw);
+        }
         cfg.validate()?;
         Ok(cfg)
+    }
+
+    /// Sets every crop field for which `explicit(key)` is false (the scenario did not give
+    /// the key itself) to the preset's value.
+    fn apply_crop(&mut self, c: &crate::crop::Crop, explicit: &dyn Fn(&str) -> bool) {
+        let set = |k: &str| !explicit(k);
+        if set("trusses_per_plant") {
+            self.trusses_per_plant = c.trusses_per_plant;
+        }
+        if set("fruit_per_truss") {
+            self.fruit_per_truss = c.fruit_per_truss;
+        }
+        if set("fruit_radius") {
+            self.fruit_radius = c.fruit_radius;
+        }
+        if set("fruit_radius_spread") {
+            self.fruit_radius_spread = c.fruit_radius_spread;
+        }
+        if set("fruit_radius_limits") {
+            self.fruit_radius_limits = c.fruit_radius_limits;
+        }
+        if set("leaf_density") {
+            self.leaf_density = c.leaf_density;
+        }
+        if set("leaf_size") {
+            self.leaf_size = c.leaf_size;
+        }
+    }
+
+    /// Sets the values a family drew.
+    fn apply_draw(&mut self, d: &crate::family::FamilyDraw) {
+        self.aisle_width = d.aisle_width.unwrap_or(self.aisle_width);
+        self.fruit_per_truss = d.fruit_per_truss.unwrap_or(self.fruit_per_truss);
+        self.leaf_density = d.leaf_density.unwrap_or(self.leaf_density);
+        self.fruit_radius = d.fruit_radius.unwrap_or(self.fruit_radius);
+        self.fruit_height[0] = d.fruit_height_low.unwrap_or(self.fruit_height[0]);
+        self.fruit_height[1] = d.fruit_height_high.unwrap_or(self.fruit_height[1]);
+        self.trusses_per_plant = d.trusses_per_plant.unwrap_or(self.trusses_per_plant);
+        self.plant_spacing = d.plant_spacing.unwrap_or(self.plant_spacing);
     }
 
     /// Distance between neighbouring row lines [m].
@@ -212,6 +279,19 @@ impl GreenhouseConfig {
             if !(a.is_finite() && b.is_finite() && a > 0.0 && a <= b) {
                 return err(k, format!("must be [low, high] with 0 < low <= high, got [{a}, {b}]"));
             }
+        }
+        if crate::crop::preset(&self.crop).is_none() {
+            return err("crop", format!("unknown crop {:?}; known: {}", self.crop, crate::crop::CROPS.join(", ")));
+        }
+        if let Some(f) = &self.family {
+            f.validate()?;
+        }
+        let [lo, hi] = self.fruit_radius_limits;
+        if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && lo <= 1.0 && hi >= 1.0) {
+            return err(
+                "fruit_radius_limits",
+                format!("must be [low, high] with 0 < low <= 1 <= high, got [{lo}, {hi}]"),
+            );
         }
         if !self.leaf_size.iter().all(|v| v.is_finite() && *v > 0.0) {
             return err("leaf_size", format!("[length, width] must be positive, got {:?}", self.leaf_size));

@@ -231,7 +231,8 @@ fn plant(b: &mut Builder, cfg: &GreenhouseConfig, seed: u64, r: usize, p: usize,
         b.push(format!("row{r}/plant{p}/truss{t}"), Kind::Truss, truss, Placement { translation: c, rotation: rot });
         let nf = cfg.fruit_per_truss;
         for f in 0..nf {
-            let radius = cfg.fruit_radius * (1.0 + cfg.fruit_radius_spread * rng.scene_normal()).clamp(0.6, 1.4);
+            let [k_lo, k_hi] = cfg.fruit_radius_limits;
+            let radius = cfg.fruit_radius * (1.0 + cfg.fruit_radius_spread * rng.scene_normal()).clamp(k_lo, k_hi);
             let d = len * (0.35 + 0.65 * (f as f64 + 0.5) / nf.max(1) as f64);
             let mut fx = sx + cy_ * d + rng.range(-0.02, 0.02);
             let mut fy = sy + sy_ * d + rng.range(-0.02, 0.02);

@@ -12,12 +12,16 @@
 //! ```
 
 pub mod config;
+pub mod crop;
+pub mod family;
 pub mod generate;
 pub mod layout;
 pub mod occupancy;
 pub mod scene;
 
 pub use config::{GreenhouseConfig, ObstacleConfig};
+pub use crop::Crop;
+pub use family::FamilyConfig;
 pub use generate::{generate, Greenhouse};
 pub use layout::{Aisle, Layout, Row};
 pub use scene::{Kind, Object, Placement, Shape};

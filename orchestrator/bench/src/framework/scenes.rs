@@ -97,13 +97,47 @@ pub struct SceneResult {
     pub scene_seed: u64,
     pub trials: u64,
     pub successes: u64,
+    /// The scene's greenhouse drawn from the scenario's `[greenhouse.family]` (absent when the
+    /// scenario has no family): what success can be read against.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub draw: Option<FamilyDraw>,
+}
+
+/// The values a scenario family drew for one scene (`agrisim_scene::family`).
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct FamilyDraw {
+    pub aisle_width: f64,
+    pub fruit_per_truss: usize,
+    pub leaf_density: usize,
+    pub fruit_radius: f64,
+    pub fruit_height: [f64; 2],
+    pub trusses_per_plant: usize,
+    pub plant_spacing: f64,
+}
+
+/// Scene `s`'s family draw, if its greenhouse is drawn from a family.
+fn family_draw(s: &Scenario) -> Option<FamilyDraw> {
+    let c = agrisim_scene::GreenhouseConfig::from_toml_str(&s.scene_toml()).ok()?;
+    c.family.as_ref()?;
+    Some(FamilyDraw {
+        aisle_width: c.aisle_width,
+        fruit_per_truss: c.fruit_per_truss,
+        leaf_density: c.leaf_density,
+        fruit_radius: c.fruit_radius,
+        fruit_height: c.fruit_height,
+        trusses_per_plant: c.trusses_per_plant,
+        plant_spacing: c.plant_spacing,
+    })
 }
 
 /// Per-scene results of `outcomes` ((scene, success) per trial) and the cluster-bootstrap
 /// 95 % interval of the success rate over scenes (seeded by the benchmark's `seed`).
 pub fn by_scene(s: &Scenario, scenes: u64, seed: u64, outcomes: &[(u64, bool)]) -> (Vec<SceneResult>, [f64; 2]) {
     let mut per: Vec<SceneResult> = (0..scenes.max(1))
-        .map(|k| SceneResult { scene: k, scene_seed: base_seed(&in_scene(s, k)), trials: 0, successes: 0 })
+        .map(|k| {
+            let sk = in_scene(s, k);
+            SceneResult { scene: k, scene_seed: base_seed(&sk), trials: 0, successes: 0, draw: family_draw(&sk) }
+        })
         .collect();
     for &(k, ok) in outcomes {
         if let Some(r) = per.get_mut(k as usize) {
@@ -114,4 +148,30 @@ pub fn by_scene(s: &Scenario, scenes: u64, seed: u64, outcomes: &[(u64, bool)]) 
     let clusters: Vec<(u64, u64)> = per.iter().filter(|r| r.trials > 0).map(|r| (r.successes, r.trials)).collect();
     let ci = cluster_bootstrap95(&clusters, RESAMPLES, seed ^ 0xB007_57A9);
     (per, ci)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// A family's scenes report their draws, scene k being the draw for greenhouse seed + k;
+    /// a scenario without a family reports none.
+    #[test]
+    fn family_scenes_report_their_draw() {
+        let text = "[system]\nfile = \"a.ssd\"\n[greenhouse]\n[greenhouse.family]\nfruit_per_truss = [3, 8]\naisle_width = [1.6, 2.2]\n";
+        let s = Scenario::parse(text, Path::new("family.toml")).unwrap();
+        let (per, _) = by_scene(&s, 8, 1, &[]);
+        let draws: Vec<FamilyDraw> = per.iter().map(|r| r.draw.clone().expect("a family scene has a draw")).collect();
+        for (r, d) in per.iter().zip(&draws) {
+            let mut t = s.greenhouse.clone();
+            t.insert("seed".into(), toml::Value::Integer(r.scene_seed as i64));
+            let c = agrisim_scene::GreenhouseConfig::from_toml_str(&toml::to_string(&t).unwrap()).unwrap();
+            assert_eq!((d.fruit_per_truss, d.aisle_width), (c.fruit_per_truss, c.aisle_width));
+            assert!((3..=8).contains(&d.fruit_per_truss) && (1.6..=2.2).contains(&d.aisle_width));
+        }
+        assert!(draws.windows(2).any(|w| w[0] != w[1]), "the scenes drew one greenhouse: {draws:?}");
+        let plain = Scenario::parse("[system]\nfile = \"a.ssd\"\n", Path::new("x.toml")).unwrap();
+        assert!(by_scene(&plain, 2, 1, &[]).0.iter().all(|r| r.draw.is_none()));
+    }
 }

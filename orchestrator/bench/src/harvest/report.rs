@@ -17,6 +17,18 @@ pub fn report_html(g: &agrisim_scene::Greenhouse, sum: &HarvestSummary, results:
         ("scenario".to_string(), sum.scenario.clone()),
         ("seed".to_string(), sum.seed.to_string()),
         (
+            "perception".to_string(),
+            if sum.perception_in_loop {
+                format!(
+                    "in the loop: the node found its fruit by sight and planned in the sensed scene; target error p50 {} mm, p95 {} mm",
+                    opt(sum.target_error_mm_p50),
+                    opt(sum.target_error_mm_p95)
+                )
+            } else {
+                "ground truth: the node was handed the world's target and planning scene".to_string()
+            },
+        ),
+        (
             "trials x scenes".to_string(),
             format!("{} in {} scene(s), {} distinct targets", sum.trials, sum.scenes, sum.distinct_targets),
         ),

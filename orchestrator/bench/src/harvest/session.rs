@@ -6,15 +6,40 @@ use crate::initial_pose::initial_estimate;
 use crate::map::grid_message;
 use agrisim_bus::Node;
 use agrisim_error::Result;
+use agrisim_mapping::{DepthMapper, MapperConfig};
 use agrisim_nav::{Localizer, NavConfig};
 use agrisim_nodes::{FaultInjector, MapServer, OdomTf, RobotStatePublisher, TaskPublisher};
+use agrisim_perception::{Perception, PerceptionConfig};
 use agrisim_session::{prepare, RunOptions};
 use std::path::Path;
+
+/// The row cameras of a harvest by sight (models/systems/harvest_sight.ssd).
+pub const SIGHT_CAMERAS: [&str; 2] = ["camera_left", "camera_right"];
+
+/// The nodes that see for a harvest by sight: perception (fruit map) and mapping (sensed
+/// planning scene, with the robot's links filtered out and the harvest node's target allowed).
+pub fn sight_nodes() -> Result<Vec<Box<dyn Node>>> {
+    // Every 4th pixel and row: 5 mm between rays at the crop's 0.6 m, under the 1 cm voxels.
+    // The scene: what the arms can reach from the base (1.5 m around base_link), once a second.
+    // Rays beyond 1.2 m (through the row into the next aisle) only clear space out of reach.
+    let map = agrisim_mapping::MapConfig { max_range: 1.2, ..Default::default() };
+    let mapper = DepthMapper::new(MapperConfig {
+        map,
+        pixel_stride: 4,
+        scene_period: 1.0,
+        scene_around: Some(("base_link".into(), 1.5)),
+        ..MapperConfig::for_cameras(&SIGHT_CAMERAS)
+    })
+    .map_err(|e| agrisim_error::err!("harvest by sight: mapping node: {e}"))?;
+    let perception = PerceptionConfig { map_period: 0.5, ..PerceptionConfig::for_cameras(&SIGHT_CAMERAS) };
+    Ok(vec![Box::new(Perception::new(perception)), Box::new(mapper)])
+}
 
 /// Trial `t`'s harvest system, ready to run from `start` (x, y, yaw of base_link): the map
 /// server, odometry TF, the localizer started from a seeded estimate of the start pose (never
 /// the true one), the robot state publisher, `harvest` (the node under test), the fault
-/// injector, and `task` (what tells an external node its task), recording into `mcap`.
+/// injector, and `task` (what tells an external node its task), recording into `mcap`. By
+/// sight (`[harvest] sight`), the perception and mapping nodes on the row cameras too.
 pub fn harvest_session(
     t: &Trial<HarvestSetup>,
     start: [f64; 3],
@@ -42,5 +67,13 @@ pub fn harvest_session(
     if let Some(t) = task {
         nodes.push(Box::new(t));
     }
-    prepare(&s, &RunOptions { seed: Some(seed), ..t.run.clone() }, mcap, nodes)
+    if s.harvest.sight {
+        nodes.extend(sight_nodes()?);
+    }
+    let mut m = prepare(&s, &RunOptions { seed: Some(seed), ..t.run.clone() }, mcap, nodes)?;
+    // By sight no node may read the world's answers: a read fails the trial, naming it.
+    if s.harvest.sight {
+        m.bus.seal_ground_truth();
+    }
+    Ok(m)
 }

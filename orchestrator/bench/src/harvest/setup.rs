@@ -12,6 +12,9 @@ pub struct HarvestSetup {
     pub layout: agrisim_scene::Layout,
     pub map: OccupancyMap,
     pub candidates: Vec<HarvestTarget>,
+    /// Every fruit of the scene by object id: USDA stage and centre (the judge's ground truth
+    /// for a fruit the node chose itself).
+    pub fruit: std::collections::BTreeMap<u32, (u8, [f64; 3])>,
 }
 
 impl HarvestSetup {
@@ -32,6 +35,14 @@ impl HarvestSetup {
         if candidates.is_empty() {
             return Err(err!("scenario {}: no ripe fruit of the visibility classes {classes:?} faces an aisle at a harvestable height", s.path.display()));
         }
-        Ok(HarvestSetup { layout: g.layout, map, candidates })
+        let fruit = g
+            .objects
+            .iter()
+            .filter_map(|o| match o.kind {
+                agrisim_scene::Kind::Fruit { ripeness } => Some((o.id, (ripeness, o.placement.translation))),
+                _ => None,
+            })
+            .collect();
+        Ok(HarvestSetup { layout: g.layout, map, candidates, fruit })
     }
 }

@@ -12,6 +12,14 @@ use std::collections::BTreeMap;
 #[derive(Debug, Clone, Serialize)]
 pub struct HarvestSummary {
     pub scenario: String,
+    /// Perception in the loop (`[harvest] sight`): the node found its fruit with the
+    /// perception node and planned in the mapping node's sensed scene. Off: it was handed the
+    /// world's target and planning scene (ground truth).
+    pub perception_in_loop: bool,
+    /// By sight: distance from the node's target estimate to the nearest fruit's true centre
+    /// [mm], median and 95th percentile over the trials that chose a fruit.
+    pub target_error_mm_p50: Option<f64>,
+    pub target_error_mm_p95: Option<f64>,
     pub seed: u64,
     pub trials: u64,
     pub successes: u64,
@@ -91,8 +99,13 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, results: &[HarvestTrial]) -> Har
     let wall: f64 = results.iter().map(|t| t.wall_time).sum();
     let tth: Vec<f64> = results.iter().filter_map(|t| t.time_to_harvest).collect();
     let rate = |a: u64, b: u64| if b == 0 { 0.0 } else { a as f64 / b as f64 };
+    let mut target_errors: Vec<f64> = results.iter().filter_map(|t| t.target_error_mm).collect();
+    target_errors.sort_by(f64::total_cmp);
     HarvestSummary {
         scenario: s.name.clone(),
+        perception_in_loop: s.harvest.sight,
+        target_error_mm_p50: percentile(&target_errors, 0.5),
+        target_error_mm_p95: percentile(&target_errors, 0.95),
         seed,
         trials: n,
         successes: ok,

@@ -9,29 +9,38 @@
 use super::judge::{base_contact, Reports, Touches, COLLISION_COUNTERS, SOFT_COUNTERS};
 use super::session::harvest_session;
 use super::setup::HarvestSetup;
-use super::targets::{draw, HarvestTarget};
+use super::targets::{draw, HarvestTarget, HEIGHT_RANGE, RIPE_STAGE};
 use crate::framework::report::decimate;
 use crate::framework::Trial;
 use agrisim_bus::{Node, Reader};
 use agrisim_error::Result;
-use agrisim_harvest::HarvestNode;
+use agrisim_harvest::sight::Region;
+use agrisim_harvest::{HarvestNode, Task};
 use agrisim_math::Rng;
 use agrisim_msgs::agrisim::{CollisionState, PlantDamage};
+use agrisim_msgs::vision_msgs::Detection3DArray;
 use agrisim_nodes::TaskPublisher;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
-/// Whether a fruit bruised by its impact fails the trial. Not yet: the harvest node drops the
-/// fruit from 0.13 m above the rim of the 0.25 m deep box (geometry::DROP_ABOVE), a fall of
-/// about 0.35 m onto the empty box floor, 2.6 m/s, above the world's 2.0 m/s bruise threshold:
-/// every placed fruit is impact-bruised until the node lowers the fruit into the box. Counted
-/// and reported meanwhile; grip bruises and broken stems fail the trial.
-pub const IMPACT_BRUISE_FAILS: bool = false;
+/// Whether a fruit bruised by its impact fails the trial (as grip bruises and broken stems
+/// do): yes. The harvest node lowers the fruit into the box and lets go of it 3 cm above the
+/// floor or the fruit already there (agrisim_harvest::geometry::PLACE_GAP), a fall of at most
+/// about 5 cm, 1 m/s, well under the world's 2.0 m/s bruise speed; where it finds no way down
+/// into the box it drops the fruit from over the rim, and such a drop may bruise it. (Dropped
+/// from 0.13 m above the rim, 2.6 m/s, every fruit was impact-bruised.)
+pub const IMPACT_BRUISE_FAILS: bool = true;
 
 /// Simulated-time limit of one harvest [s].
 pub const TRIAL_TIMEOUT: f64 = 120.0;
+/// Length along the row of a harvest-by-sight task's region [m] ("a ripe fruit on your
+/// left, within this 1 m of row").
+pub const REGION_LENGTH: f64 = 1.0;
+/// A grasp that failed on a target estimate farther than this from the fruit's true centre
+/// failed on the estimate: mislocalized [m] (a picking attempt fails beyond about 15 mm).
+pub const MISLOCALIZED: f64 = 0.015;
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct HarvestTrial {
@@ -44,6 +53,18 @@ pub struct HarvestTrial {
     pub fruit_id: u32,
     pub fruit_name: String,
     pub fruit: [f64; 3],
+    /// Harvest by sight: the node was given `region` (x, y, z ranges in the map frame, around
+    /// the drawn fruit above) and chose its fruit itself.
+    #[serde(default)]
+    pub sight: bool,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub region: Option<[[f64; 2]; 3]>,
+    /// By sight: the fruit nearest the target the node last asked the mapper to allow
+    /// (/harvest/allowed), its id and how far that estimate was from its true centre [mm].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub chosen_id: Option<u32>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target_error_mm: Option<f64>,
     /// What lies between the fruit and its aisle: free, partly_occluded, behind_stem.
     #[serde(default)]
     pub visibility: String,
@@ -104,13 +125,35 @@ pub struct HarvestTrial {
     pub path: Vec<[f64; 2]>,
 }
 
-/// The harvest node under test: `fruit_index` is the task (the target the paper hands over),
-/// `seed` the trial's seed. Any node that speaks the harvest topics can take its place.
-pub type HarvestNodeFactory<'a> = &'a dyn Fn(usize, u64) -> Box<dyn Node>;
+/// The harvest node under test: the task (the fruit the paper hands over, or a region to
+/// harvest by sight) and the trial's seed. Any node that speaks the harvest topics can take
+/// its place.
+pub type HarvestNodeFactory<'a> = &'a dyn Fn(Task, u64) -> Box<dyn Node>;
 
 /// The built-in harvest node.
-pub fn builtin_node(fruit_index: usize, seed: u64) -> Box<dyn Node> {
-    Box::new(HarvestNode::new(fruit_index, seed))
+pub fn builtin_node(task: Task, seed: u64) -> Box<dyn Node> {
+    Box::new(HarvestNode::with_task(task, seed))
+}
+
+/// The task of a harvest by sight around `target`: [`REGION_LENGTH`] of its row holding it at
+/// a seeded place (never centred on it, never within 0.15 m of an end), from the row's plant
+/// line to the aisle's centre line, at the harvestable heights.
+pub fn region_of(target: &HarvestTarget, layout: &agrisim_scene::Layout, seed: u64) -> Region {
+    let mut rng = Rng::new(seed ^ 0x0052_4547_494f_4e00); // "REGION"
+    let x0 = target.center[0] - 0.15 - (REGION_LENGTH - 0.3) * rng.uniform();
+    let aisle_y = target.start[1];
+    let row_y = layout
+        .rows
+        .iter()
+        .filter(|r| r.active)
+        .map(|r| r.y)
+        .min_by(|a, b| (a - target.center[1]).abs().total_cmp(&(b - target.center[1]).abs()))
+        .unwrap_or(target.center[1]);
+    Region {
+        x: [x0, x0 + REGION_LENGTH],
+        y: [row_y.min(aisle_y), row_y.max(aisle_y)],
+        z: [HEIGHT_RANGE.0, HEIGHT_RANGE.1],
+    }
 }
 
 /// Runs trial `t` into `mcap` with the built-in harvest node.
@@ -126,10 +169,13 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
     let wall = Instant::now();
     let mut rng = Rng::new(seed);
     let target = draw(&setup.candidates, &setup.layout, &mut rng).expect("candidates checked non-empty");
-    let harvest = node(target.fruit_index, seed);
+    let region = s.harvest.sight.then(|| region_of(&target, &setup.layout, seed));
+    let harvest = node(region.map_or(Task::Fruit(target.fruit_index), Task::Region), seed);
     let node_name = harvest.name().to_string();
     // An external node takes the harvest node's place: it is told the task the same way.
-    let task = t.run.nodes.external.contains(&node_name).then(|| TaskPublisher::new(target.fruit_index));
+    // (By sight it is not told the fruit: an external node by sight has no region message yet.)
+    let task =
+        (t.run.nodes.external.contains(&node_name) && region.is_none()).then(|| TaskPublisher::new(target.fruit_index));
     let mut m = harvest_session(t, target.start, mcap, harvest, task)?;
     let (world, arm_l, arm_r) = (
         m.component("world", "harvest benchmark")?,
@@ -143,6 +189,9 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
     let mut collisions = Reader::subscribe(&mut m.bus, "/collision");
     let mut damage_reader = Reader::subscribe(&mut m.bus, "/plant_damage");
     let mut damage = DamageLog::default();
+    let mut allowed = Reader::subscribe(&mut m.bus, agrisim_harvest::sight::topics::ALLOWED);
+    // By sight: the node's last target estimate, and the fruit nearest it (id, error [m]).
+    let mut chosen: Option<(u32, f64)> = None;
     let mut judged: Option<(Option<String>, String)> = None;
     let mut time_to_harvest = None;
     let mut touches = Touches::default();
@@ -154,10 +203,17 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
             for d in damage_reader.take::<PlantDamage>(&mut m.bus)? {
                 damage.update(&d);
             }
+            for a in allowed.take::<Detection3DArray>(&mut m.bus)? {
+                if let Some(d) = a.detections.first() {
+                    let p = &d.bbox.center.position;
+                    chosen = nearest_fruit(&setup.fruit, [p.x, p.y, p.z]);
+                }
+            }
             // The base must touch nothing; the arms may brush plants (counted, not failures).
             // Every collision state counts, however short the contact.
             for cs in collisions.take::<CollisionState>(&mut m.bus)? {
-                touches.update(&cs, |id| id == target.object_id);
+                let own = chosen.map_or(target.object_id, |c| c.0);
+                touches.update(&cs, |id| id == own);
                 if let Some(why) = base_contact(&cs) {
                     judged = Some((Some("collision".into()), why));
                     return Ok(());
@@ -195,7 +251,15 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
         }
         placed = m.number(world, "placed_count")? as i64;
         let placed_id = m.number(world, "last_placed_id")? as i64;
-        if placed > 0 && placed_id != target.object_id as i64 {
+        // The task's fruit: the one handed over, or by sight a ripe one of the region.
+        let right = match region {
+            None => placed_id == target.object_id as i64,
+            Some(r) => u32::try_from(placed_id)
+                .ok()
+                .and_then(|id| setup.fruit.get(&id))
+                .is_some_and(|&(stage, c)| stage >= RIPE_STAGE && r.contains(c)),
+        };
+        if placed > 0 && !right {
             placed = 0;
         }
         tracking = [m.number(arm_l, "tracking_error_rms")?, m.number(arm_r, "tracking_error_rms")?];
@@ -216,7 +280,16 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
     // Ground truth has the last word: the node believing in success is not enough.
     if failure.is_none() && placed == 0 {
         failure = Some("placement".into());
-        detail = "the node reported success but the world has not placed the target fruit".into();
+        detail = if region.is_some() {
+            "the node reported success but the world has placed no ripe fruit of the region".into()
+        } else {
+            "the node reported success but the world has not placed the target fruit".into()
+        };
+    }
+    // By sight, a grasp that missed a fruit the node had placed more than MISLOCALIZED away
+    // failed on perception: mislocalized.
+    if failure.as_deref() == Some("grasp") && chosen.is_some_and(|c| c.1 > MISLOCALIZED) {
+        failure = Some("mislocalized".into());
     }
     if failure.is_none() {
         if let Some(why) = damage.failure(IMPACT_BRUISE_FAILS) {
@@ -257,8 +330,20 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
         mcap: mcap.file_name().map(|f| format!("trials/{}", f.to_string_lossy())).unwrap_or_default(),
         path: decimate(&path, 10),
         scene: t.scene,
+        sight: region.is_some(),
+        region: region.map(|r| [r.x, r.y, r.z]),
+        chosen_id: chosen.map(|c| c.0),
+        target_error_mm: chosen.map(|c| c.1 * 1e3),
         ..HarvestTrial::of_target(index, seed, &target)
     })
+}
+
+/// The fruit of `fruit` nearest `p`, and its distance [m].
+fn nearest_fruit(fruit: &BTreeMap<u32, (u8, [f64; 3])>, p: [f64; 3]) -> Option<(u32, f64)> {
+    fruit
+        .iter()
+        .map(|(&id, &(_, c))| (id, ((c[0] - p[0]).powi(2) + (c[1] - p[1]).powi(2) + (c[2] - p[2]).powi(2)).sqrt()))
+        .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
 }
 
 /// The record of a trial whose process died: an error, with its target (drawn as the trial
@@ -285,6 +370,10 @@ impl HarvestTrial {
             fruit_id: target.object_id,
             fruit_name: target.name.clone(),
             fruit: target.center,
+            sight: false,
+            region: None,
+            chosen_id: None,
+            target_error_mm: None,
             visibility: target.visibility.name().into(),
             start: target.start,
             outcome: "failure".into(),
@@ -349,14 +438,15 @@ impl DamageLog {
         .collect()
     }
 
-    /// A bruised fruit (by impact only if `impact_fails`) or a broken main stem fails the trial.
+    /// A bruised fruit (by impact only if `impact_fails`), a broken main stem or an unripe fruit
+    /// detached fails the trial.
     fn failure(&self, impact_fails: bool) -> Option<String> {
         let d = &self.last;
         let bruised = d.bruised_by_grip + if impact_fails { d.bruised_by_impact } else { 0 };
-        (bruised > 0 || d.stems_broken > 0).then(|| {
+        (bruised > 0 || d.stems_broken > 0 || d.unripe_detached > 0).then(|| {
             format!(
-                "crop damaged: {} fruit bruised by grip, {} by impact, {} main stem(s) broken",
-                d.bruised_by_grip, d.bruised_by_impact, d.stems_broken
+                "crop damaged: {} fruit bruised by grip, {} by impact, {} main stem(s) broken, {} unripe fruit detached",
+                d.bruised_by_grip, d.bruised_by_impact, d.stems_broken, d.unripe_detached
             )
         })
     }

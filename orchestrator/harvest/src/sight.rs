@@ -1,0 +1,249 @@
+//! Harvest by sight: the task names a region of the row, not a fruit. The node looks for
+//! ripe fruit there in the perception node's fruit map (`vision_msgs/Detection3DArray` on
+//! `/perception/fruit_map`), plans in the collision scene the mapping node builds from depth
+//! (`/mapping/planning_scene`), and asks the mapper to leave its target out of that scene
+//! (`/harvest/allowed`), as MoveIt allows the object being grasped. Nothing here reads the
+//! world's ground truth.
+
+use agrisim_msgs::agrisim::{CollisionObject, PlanningScene};
+use agrisim_msgs::builtin_interfaces::Time;
+use agrisim_msgs::geometry_msgs::{Point, Pose, Quaternion, Vector3};
+use agrisim_msgs::shape_msgs::SolidPrimitive;
+use agrisim_msgs::std_msgs::Header;
+use agrisim_msgs::vision_msgs::{BoundingBox3D, Detection3D, Detection3DArray};
+
+pub mod topics {
+    /// The perception node's fruit map (map frame).
+    pub const FRUIT_MAP: &str = "/perception/fruit_map";
+    /// The mapping node's sensed planning scene (map frame).
+    pub const SENSED_SCENE: &str = "/mapping/planning_scene";
+    /// The fruit the node is about to grasp, for the mapper to leave out (map frame).
+    pub const ALLOWED: &str = "/harvest/allowed";
+}
+
+/// Classes the perception node gives ripe fruit (USDA stages 5 and 6).
+pub const RIPE_CLASSES: [&str; 2] = ["light_red", "red"];
+/// Share of a track's ripeness votes that must be ripe classes.
+pub const RIPE_SHARE: f64 = 0.5;
+/// Lift positions the scan stops at [m]: the row-facing lift camera (42 deg vertical field of
+/// view, about 0.7 m of plant at the row's distance) covers the harvestable heights
+/// (0.55-1.75 m) in three stops.
+pub const SCAN_LIFTS: [f64; 3] = [0.0, 0.4, 0.8];
+/// Time at each scan stop once base and lift are in place [s]: four frames at 5 Hz.
+pub const SCAN_DWELL: f64 = 0.8;
+/// The allowed sphere is the fruit's perceived radius grown by this [m]: the fit's error and
+/// the voxels (1 cm) its surface lies in.
+pub const ALLOWED_MARGIN: f64 = 0.02;
+/// Scene object id of the perceived target added to the sensed scene.
+pub const TARGET_OBJECT: &str = "perceived_target";
+/// Sensed space this close to the target's surface is what the fingers push aside on the
+/// way in (leaflets, the calyx, the truss and neighbouring fruit), as the planner treats
+/// leaves, trusses and touching fruit in the ground-truth scene [m]: about the Franka Hand's
+/// finger length.
+pub const HAND_ZONE: f64 = 0.05;
+/// Sensed boxes longer than this [m] stay obstacles even near the target: long runs are
+/// stems, wires and structure, not foliage.
+pub const PUSHABLE_SIZE: f64 = 0.06;
+/// Scene kind of sensed boxes the hand may push aside (see [`HAND_ZONE`]).
+pub const PUSHED_KIND: &str = "pushed";
+
+/// A box of the map frame: where the task's fruit may be.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Region {
+    pub x: [f64; 2],
+    pub y: [f64; 2],
+    pub z: [f64; 2],
+}
+
+impl Region {
+    pub fn contains(&self, p: [f64; 3]) -> bool {
+        [self.x, self.y, self.z].iter().zip(p).all(|(r, v)| r[0] <= v && v <= r[1])
+    }
+
+    pub fn centre(&self) -> [f64; 3] {
+        [self.x, self.y, self.z].map(|r| 0.5 * (r[0] + r[1]))
+    }
+}
+
+/// A fruit of the perception node's map.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Seen {
+    /// The track id (stable across frames).
+    pub id: String,
+    pub center: [f64; 3],
+    pub radius: f64,
+    /// Share of the track's ripeness votes in [`RIPE_CLASSES`].
+    pub ripe: f64,
+}
+
+/// The fruit of a fruit map in `frame` (others are skipped: the node plans in the map frame).
+pub fn fruit_of(map: &Detection3DArray, frame: &str) -> Vec<Seen> {
+    if map.header.frame_id.trim_start_matches('/') != frame {
+        return vec![];
+    }
+    map.detections
+        .iter()
+        .filter_map(|d| {
+            let p = &d.bbox.center.position;
+            let size = [d.bbox.size.x, d.bbox.size.y, d.bbox.size.z];
+            let radius = 0.5 * size.iter().cloned().fold(0.0, f64::max);
+            let ripe = d
+                .results
+                .iter()
+                .filter(|h| RIPE_CLASSES.contains(&h.hypothesis.class_id.as_str()))
+                .map(|h| h.hypothesis.score)
+                .sum();
+            let center = [p.x, p.y, p.z];
+            (center.iter().all(|v| v.is_finite()) && radius > 0.0).then(|| Seen {
+                id: d.id.clone(),
+                center,
+                radius,
+                ripe,
+            })
+        })
+        .collect()
+}
+
+/// The fruit to pick: ripe, inside `region`; of those the one nearest the aisle line
+/// `aisle_y` (least plant in front of it), then nearest the region's centre along the row.
+pub fn choose(seen: &[Seen], region: &Region, aisle_y: f64) -> Option<Seen> {
+    let cx = region.centre()[0];
+    seen.iter()
+        .filter(|s| s.ripe > RIPE_SHARE && region.contains(s.center))
+        .min_by(|a, b| {
+            let key = |s: &Seen| ((s.center[1] - aisle_y).abs(), (s.center[0] - cx).abs());
+            let (ka, kb) = (key(a), key(b));
+            ka.0.total_cmp(&kb.0).then(ka.1.total_cmp(&kb.1)).then(a.id.cmp(&b.id))
+        })
+        .cloned()
+}
+
+/// `/harvest/allowed`: the target as a sphere (its box's half size the radius, grown by
+/// [`ALLOWED_MARGIN`]); none: an empty array.
+pub fn allowed(stamp: Time, target: Option<([f64; 3], f64)>) -> Detection3DArray {
+    let header = Header { stamp, frame_id: "map".into() };
+    let detections = target
+        .map(|(c, r)| {
+            let side = 2.0 * (r + ALLOWED_MARGIN);
+            Detection3D {
+                header: header.clone(),
+                results: vec![],
+                bbox: BoundingBox3D {
+                    center: Pose { position: Point { x: c[0], y: c[1], z: c[2] }, orientation: Quaternion::IDENTITY },
+                    size: Vector3 { x: side, y: side, z: side },
+                },
+                id: TARGET_OBJECT.into(),
+            }
+        })
+        .into_iter()
+        .collect();
+    Detection3DArray { header, detections }
+}
+
+/// The sensed scene with the perceived target in it as a fruit sphere, so the planner treats
+/// it as in the ground-truth scene (the hand may touch it, and it goes with the hand once
+/// held); small sensed boxes within [`HAND_ZONE`] of its surface become [`PUSHED_KIND`].
+pub fn with_target(scene: &PlanningScene, c: [f64; 3], r: f64) -> PlanningScene {
+    let mut s = scene.clone();
+    for o in &mut s.objects {
+        let d = &o.primitive.dimensions;
+        if o.primitive.r#type != SolidPrimitive::BOX || d.len() < 3 || d.iter().any(|&v| v > PUSHABLE_SIZE) {
+            continue;
+        }
+        // Boxes of the sensed scene are axis-aligned: the nearest point is a clamp.
+        let p = &o.pose.position;
+        let near =
+            [p.x, p.y, p.z].into_iter().zip(d).zip(c).map(|((m, &size), q)| q.clamp(m - 0.5 * size, m + 0.5 * size));
+        let dist = near.zip(c).map(|(n, q)| (n - q).powi(2)).sum::<f64>().sqrt();
+        if dist <= r + HAND_ZONE {
+            o.kind = PUSHED_KIND.into();
+        }
+    }
+    s.objects.push(CollisionObject {
+        id: TARGET_OBJECT.into(),
+        kind: "fruit".into(),
+        primitive: SolidPrimitive { r#type: SolidPrimitive::SPHERE, dimensions: vec![r], ..Default::default() },
+        pose: Pose { position: Point { x: c[0], y: c[1], z: c[2] }, orientation: Quaternion::IDENTITY },
+    });
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use agrisim_msgs::vision_msgs::{ObjectHypothesis, ObjectHypothesisWithPose};
+
+    fn track(id: &str, c: [f64; 3], r: f64, votes: &[(&str, f64)]) -> Detection3D {
+        Detection3D {
+            header: Header::default(),
+            results: votes
+                .iter()
+                .map(|(k, s)| ObjectHypothesisWithPose {
+                    hypothesis: ObjectHypothesis { class_id: k.to_string(), score: *s },
+                    ..Default::default()
+                })
+                .collect(),
+            bbox: BoundingBox3D {
+                center: Pose { position: Point { x: c[0], y: c[1], z: c[2] }, orientation: Quaternion::IDENTITY },
+                size: Vector3 { x: 2.0 * r, y: 2.0 * r, z: 2.0 * r },
+            },
+            id: id.into(),
+        }
+    }
+
+    #[test]
+    fn the_nearest_ripe_fruit_in_the_region_is_chosen() {
+        let region = Region { x: [1.0, 2.0], y: [0.2, 1.0], z: [0.5, 1.8] };
+        let map = Detection3DArray {
+            header: Header { frame_id: "map".into(), ..Default::default() },
+            detections: vec![
+                // ripe, in the region, deep in the row
+                track("1", [1.5, 0.7, 1.0], 0.03, &[("red", 0.9), ("pink", 0.1)]),
+                // ripe, in the region, nearest the aisle (y = 0): the one
+                track("2", [1.8, 0.4, 1.2], 0.03, &[("light_red", 0.6), ("turning", 0.4)]),
+                // nearer still but green
+                track("3", [1.5, 0.3, 1.0], 0.03, &[("green", 1.0)]),
+                // ripe and nearer, but outside the region along the row
+                track("4", [2.3, 0.3, 1.0], 0.03, &[("red", 1.0)]),
+                // half ripe votes: not ripe enough
+                track("5", [1.2, 0.35, 1.0], 0.03, &[("red", 0.5), ("pink", 0.5)]),
+            ],
+        };
+        let seen = fruit_of(&map, "map");
+        assert_eq!(seen.len(), 5);
+        assert!((seen[1].radius - 0.03).abs() < 1e-12 && (seen[1].ripe - 0.6).abs() < 1e-12);
+        assert_eq!(choose(&seen, &region, 0.0).map(|s| s.id), Some("2".into()));
+        // Another frame than the map's is not read.
+        let odom = Detection3DArray { header: Header { frame_id: "odom".into(), ..Default::default() }, ..map };
+        assert!(fruit_of(&odom, "map").is_empty());
+        assert_eq!(choose(&[], &region, 0.0), None);
+    }
+
+    #[test]
+    fn the_target_is_allowed_and_added_to_the_scene() {
+        let a = allowed(Time::from_nanos(5), Some(([1.0, 2.0, 3.0], 0.03)));
+        assert_eq!(a.detections.len(), 1);
+        assert!((a.detections[0].bbox.size.x - 2.0 * (0.03 + ALLOWED_MARGIN)).abs() < 1e-12);
+        assert!(allowed(Time::from_nanos(5), None).detections.is_empty());
+        let s = with_target(&PlanningScene::default(), [1.0, 2.0, 3.0], 0.03);
+        assert_eq!((s.objects.len(), s.objects[0].kind.as_str()), (1, "fruit"));
+        assert_eq!(s.objects[0].primitive.dimensions, vec![0.03]);
+        // A leaflet-sized box 6 cm from the centre is pushed aside; one 10 cm away, and a
+        // long one (a stem's run) as near, stay obstacles.
+        let slab = |x: f64, size: f64| CollisionObject {
+            id: format!("occupied/{x}"),
+            kind: "occupied".into(),
+            primitive: SolidPrimitive {
+                r#type: SolidPrimitive::BOX,
+                dimensions: vec![size, 0.02, 0.01],
+                ..Default::default()
+            },
+            pose: Pose { position: Point { x: 1.0 + x, y: 2.0, z: 3.0 }, orientation: Quaternion::IDENTITY },
+        };
+        let sensed =
+            PlanningScene { objects: vec![slab(0.07, 0.02), slab(0.11, 0.02), slab(0.1, 0.12)], ..Default::default() };
+        let kinds: Vec<String> =
+            with_target(&sensed, [1.0, 2.0, 3.0], 0.03).objects.iter().map(|o| o.kind.clone()).collect();
+        assert_eq!(kinds, ["pushed", "occupied", "occupied", "fruit"]);
+    }
+}
