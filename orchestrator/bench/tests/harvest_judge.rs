@@ -239,7 +239,7 @@ fn a_harvest_by_sight_is_sealed_from_ground_truth() {
     assert!(t.sight && t.region.is_some());
     assert_eq!(t.outcome, "success", "{t:?}");
     let id = t.chosen_id.expect("the node named its target");
-    let (stage, c) = b.setup.fruit[&id];
+    let (stage, c) = (b.setup.fruit[&id].stage, b.setup.fruit[&id].center);
     let r = t.region.unwrap();
     assert!(
         stage >= 5 && (0..3).all(|k| r[k][0] <= c[k] && c[k] <= r[k][1]),

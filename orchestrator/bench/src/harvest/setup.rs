@@ -12,9 +12,18 @@ pub struct HarvestSetup {
     pub layout: agrisim_scene::Layout,
     pub map: OccupancyMap,
     pub candidates: Vec<HarvestTarget>,
-    /// Every fruit of the scene by object id: USDA stage and centre (the judge's ground truth
-    /// for a fruit the node chose itself).
-    pub fruit: std::collections::BTreeMap<u32, (u8, [f64; 3])>,
+    /// Every fruit of the scene by object id (the judge's ground truth for a fruit the node
+    /// chose itself).
+    pub fruit: std::collections::BTreeMap<u32, TrueFruit>,
+}
+
+/// A fruit as the world has it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrueFruit {
+    /// USDA ripeness stage (1-6).
+    pub stage: u8,
+    pub center: [f64; 3],
+    pub radius: f64,
 }
 
 impl HarvestSetup {
@@ -38,8 +47,10 @@ impl HarvestSetup {
         let fruit = g
             .objects
             .iter()
-            .filter_map(|o| match o.kind {
-                agrisim_scene::Kind::Fruit { ripeness } => Some((o.id, (ripeness, o.placement.translation))),
+            .filter_map(|o| match (o.kind, o.shape) {
+                (agrisim_scene::Kind::Fruit { ripeness }, agrisim_scene::Shape::Sphere { radius }) => {
+                    Some((o.id, TrueFruit { stage: ripeness, center: o.placement.translation, radius }))
+                }
                 _ => None,
             })
             .collect();

@@ -8,7 +8,7 @@
 
 use super::judge::{base_contact, Reports, Touches, COLLISION_COUNTERS, SOFT_COUNTERS};
 use super::session::harvest_session;
-use super::setup::HarvestSetup;
+use super::setup::{HarvestSetup, TrueFruit};
 use super::targets::{draw, HarvestTarget, HEIGHT_RANGE, RIPE_STAGE};
 use crate::framework::report::decimate;
 use crate::framework::Trial;
@@ -65,6 +65,9 @@ pub struct HarvestTrial {
     pub chosen_id: Option<u32>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub target_error_mm: Option<f64>,
+    /// By sight: the radius the node gave its target, and that fruit's true radius [mm].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target_radius_mm: Option<[f64; 2]>,
     /// What lies between the fruit and its aisle: free, partly_occluded, behind_stem.
     #[serde(default)]
     pub visibility: String,
@@ -190,8 +193,10 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
     let mut damage_reader = Reader::subscribe(&mut m.bus, "/plant_damage");
     let mut damage = DamageLog::default();
     let mut allowed = Reader::subscribe(&mut m.bus, agrisim_harvest::sight::topics::ALLOWED);
-    // By sight: the node's last target estimate, and the fruit nearest it (id, error [m]).
+    // By sight: the node's last target estimate, and the fruit nearest it (id, error [m]),
+    // with the radius the node gave it and the true one [m].
     let mut chosen: Option<(u32, f64)> = None;
+    let mut radii: Option<[f64; 2]> = None;
     let mut judged: Option<(Option<String>, String)> = None;
     let mut time_to_harvest = None;
     let mut touches = Touches::default();
@@ -207,6 +212,8 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
                 if let Some(d) = a.detections.first() {
                     let p = &d.bbox.center.position;
                     chosen = nearest_fruit(&setup.fruit, [p.x, p.y, p.z]);
+                    let said = 0.5 * d.bbox.size.x - agrisim_harvest::sight::ALLOWED_MARGIN;
+                    radii = chosen.map(|(id, _)| [said, setup.fruit[&id].radius]);
                 }
             }
             // The base must touch nothing; the arms may brush plants (counted, not failures).
@@ -257,7 +264,7 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
             Some(r) => u32::try_from(placed_id)
                 .ok()
                 .and_then(|id| setup.fruit.get(&id))
-                .is_some_and(|&(stage, c)| stage >= RIPE_STAGE && r.contains(c)),
+                .is_some_and(|f| f.stage >= RIPE_STAGE && r.contains(f.center)),
         };
         if placed > 0 && !right {
             placed = 0;
@@ -334,15 +341,19 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
         region: region.map(|r| [r.x, r.y, r.z]),
         chosen_id: chosen.map(|c| c.0),
         target_error_mm: chosen.map(|c| c.1 * 1e3),
+        target_radius_mm: radii.map(|r| r.map(|v| v * 1e3)),
         ..HarvestTrial::of_target(index, seed, &target)
     })
 }
 
 /// The fruit of `fruit` nearest `p`, and its distance [m].
-fn nearest_fruit(fruit: &BTreeMap<u32, (u8, [f64; 3])>, p: [f64; 3]) -> Option<(u32, f64)> {
+fn nearest_fruit(fruit: &BTreeMap<u32, TrueFruit>, p: [f64; 3]) -> Option<(u32, f64)> {
     fruit
         .iter()
-        .map(|(&id, &(_, c))| (id, ((c[0] - p[0]).powi(2) + (c[1] - p[1]).powi(2) + (c[2] - p[2]).powi(2)).sqrt()))
+        .map(|(&id, f)| {
+            let c = f.center;
+            (id, ((c[0] - p[0]).powi(2) + (c[1] - p[1]).powi(2) + (c[2] - p[2]).powi(2)).sqrt())
+        })
         .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
 }
 
@@ -374,6 +385,7 @@ impl HarvestTrial {
             region: None,
             chosen_id: None,
             target_error_mm: None,
+            target_radius_mm: None,
             visibility: target.visibility.name().into(),
             start: target.start,
             outcome: "failure".into(),
