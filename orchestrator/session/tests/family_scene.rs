@@ -11,20 +11,13 @@ use agrisim_scene::{GreenhouseConfig, Kind};
 use agrisim_session::scene::generate_scene;
 use agrisim_session::Scenario;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().unwrap()
-}
+mod common;
+use common::root;
 
 fn fmu_dir() -> PathBuf {
-    let d = root().join("target/fmu");
-    assert!(
-        d.join("Greenhouse.fmu").exists(),
-        "{} has no packed FMUs: run `target/release/agrisim fmu pack`",
-        d.display()
-    );
-    d
+    common::fmu_dir("Greenhouse.fmu")
 }
 
 /// The world alone, its fruit list as a system output.

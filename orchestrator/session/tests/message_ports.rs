@@ -13,16 +13,13 @@ use agrisim_msgs::sensor_msgs::Imu;
 use agrisim_msgs::Message;
 use agrisim_session::Scenario;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-fn root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").canonicalize().unwrap()
-}
+mod common;
+use common::root;
 
 fn fmu_dir() -> PathBuf {
-    let d = root().join("target/fmu");
-    assert!(d.join("Imu.fmu").exists(), "{} has no packed FMUs: run `target/release/agrisim fmu pack`", d.display());
-    d
+    common::fmu_dir("Imu.fmu")
 }
 
 /// A system of the world and the IMU whose base pose and yaw rate come from system inputs.
