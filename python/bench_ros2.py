@@ -10,6 +10,10 @@ package), in a private network namespace with only loopback (needs `unshare -n`)
   20,000 points, IMU, joint states) over DDS on loopback: a best-effort subscriber counts what
   arrives against what the bridge published.
 
+The round trip and the sensor suite are measured over Zenoh too (`--zenoh`, rmw_zenoh's
+format), beside DDS on the same runs: an Eclipse Zenoh peer (the `eclipse-zenoh` package,
+tests/zenoh_node.py) plays the same parts on tcp/127.0.0.1:7447.
+
     .venv/bin/python python/bench_ros2.py [--json OUT]     (runs itself inside `unshare -n`)
 """
 
@@ -92,12 +96,58 @@ def peer(cmd: list[str], mode: str, seconds: float = 600) -> dict:
     return {"ticks": ticks, "counters": counters, "returncode": proc.returncode, "stderr": stderr, "t_first": t_first, "t_end": time.perf_counter()}
 
 
+ZENOH = "tcp/127.0.0.1:7447"
+SENSOR_TOPICS = ["/points", "/camera/color/image_raw", "/camera/aligned_depth_to_color/image_raw", "/camera/labels"]
+
+
+def peer_zenoh(cmd: list[str], mode: str, seconds: float = 600) -> dict:
+    """The peer of `peer` over Zenoh: 'echo' answers every /clock with a /cmd_vel; 'sensors'
+    counts sensor samples and bytes (not decoded)."""
+    import zenoh_node
+    from ros2_idl import Twist
+
+    proc = subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True)
+    session = zenoh_node.open_session(ZENOH, proc, timeout=60)
+    node = zenoh_node.ZenohNode(session, 0, "bench_peer")
+    clock = session.declare_subscriber("0/clock/*/*")
+    node.token("MS", "/clock", "rosgraph_msgs/msg/Clock")
+    cmd_w = node.writer("/cmd_vel", "geometry_msgs/msg/Twist") if mode == "echo" else None
+    subs = {t: session.declare_subscriber(f"0/{t.strip('/')}/*/*") for t in SENSOR_TOPICS} if mode == "sensors" else {}
+    counters = {t: [0, 0] for t in subs}
+    t_first = None
+    deadline = time.monotonic() + seconds
+    while proc.poll() is None and time.monotonic() < deadline:
+        got = False
+        while clock.try_recv() is not None:
+            got = True
+            if cmd_w is not None:
+                cmd_w.write(Twist())
+        now = time.perf_counter()
+        for t, sub in subs.items():
+            while (smp := sub.try_recv()) is not None:
+                got = True
+                t_first = t_first or now
+                counters[t][0] += 1
+                counters[t][1] += len(smp.payload)
+        if not got:
+            time.sleep(0.0001)
+    stderr = proc.communicate()[1]
+    session.close()
+    return {"counters": counters, "returncode": proc.returncode, "stderr": stderr, "t_first": t_first, "t_end": time.perf_counter()}
+
+
 def inside(part: str) -> dict:
     out: dict = {}
     with tempfile.TemporaryDirectory() as d:
         stats = Path(d) / "stats.json"
         if part == "sensors":
             return sensors(d, stats)
+        if part == "zenoh_sensors":
+            return sensors(d, stats, zenoh=True)
+        if part == "zenoh_link":
+            r = peer_zenoh([AGRISIM, "run", "--duration", "30", "--record", "none", "--zenoh", "--zenoh-listen", ZENOH, "--external", "command_script", "--ros2-stats", str(stats), "--out", d + "/rt"], "echo")
+            s = json.loads(stats.read_text())
+            return {"round_trip_ms": s["round_trip_ms"] | {"lockstep_timeouts": s["lockstep_timeouts"], "returncode": r["returncode"]}}
         # 1. Round trip, lockstep, default greenhouse (clouds included), 30 s simulated.
         r = peer([AGRISIM, "run", "--duration", "30", "--record", "none", "--ros2", "--external", "command_script", "--ros2-stats", str(stats), "--out", d + "/rt"], "echo")
         s = json.loads(stats.read_text())
@@ -111,10 +161,14 @@ def inside(part: str) -> dict:
     return out
 
 
-def sensors(d: str, stats: Path) -> dict:
-    """3. The full sensor suite over DDS (free running: nobody is waited for), 3 s simulated."""
+def sensors(d: str, stats: Path, zenoh: bool = False) -> dict:
+    """3. The full sensor suite over DDS or Zenoh (free running: nobody is waited for), 3 s simulated."""
     if True:
-        r = peer([AGRISIM, "run", "--scenario", str(REPO / "models/scenarios/sensors.toml"), "--duration", "3", "--record", "none", "--ros2", "--ros2-stats", str(stats), "--out", d + "/sens"], "sensors")
+        run = [AGRISIM, "run", "--scenario", str(REPO / "models/scenarios/sensors.toml"), "--duration", "3", "--record", "none", "--ros2-stats", str(stats), "--out", d + "/sens"]
+        if zenoh:
+            r = peer_zenoh(run + ["--zenoh", "--zenoh-listen", ZENOH], "sensors")
+        else:
+            r = peer(run + ["--ros2"], "sensors")
         s = json.loads(stats.read_text())
         wall = r["t_end"] - (r["t_first"] or r["t_end"])
         per = {}
@@ -146,11 +200,13 @@ def main() -> None:
         return json.loads(r.stdout.strip().splitlines()[-1])
 
     res = part("link")
+    res["zenoh"] = part("zenoh_link")
     # Large best-effort messages need socket buffers to match (as on a real ROS 2 machine):
     # the subscriber's default (the kernel's 208 KB), then 4 MB (this machine's rmem_max).
     res["sensor_suite_default_buffers"] = part("sensors")
     big = '<CycloneDDS><Domain><Internal><SocketReceiveBufferSize min="4MB"/></Internal></Domain></CycloneDDS>'
     res["sensor_suite_4MB_receive_buffer"] = part("sensors", dict(os.environ, CYCLONEDDS_URI=big))
+    res["zenoh_sensor_suite"] = part("zenoh_sensors")
     print(json.dumps(res, indent=2))
     if a.json:
         Path(a.json).write_text(json.dumps(res, indent=2))

@@ -2,7 +2,8 @@
 ROS 2 Nav2 stack: it starts `agrisim bench nav --ros2 --external navigator` (so both share
 this process's network namespace), takes /goal_pose, /odom and /clock from it, and answers
 every /clock tick with one /cmd_vel and one /navigate/status (lockstep), as Nav2's
-controller and navigator would. Received point clouds are saved (raw CDR) for the test to compare with the
+controller and navigator would (with `--zenoh ENDPOINT`: the same over `--zenoh`, as an
+rmw_zenoh node, tests/zenoh_node.py). Received point clouds are saved (raw CDR) for the test to compare with the
 MCAP.
 
 Path: a Manhattan route from the headland start (along the headland to the goal's aisle,
@@ -40,14 +41,24 @@ def yaw_of(q) -> float:
 
 
 class Navigator:
-    def __init__(self, domain: int):
-        dp = DomainParticipant(domain)
-        self.clock = DataReader(dp, Topic(dp, "rt/clock", Clock), qos=RELIABLE)
-        self.odom = DataReader(dp, Topic(dp, "rt/odom", Odometry), qos=RELIABLE)
-        self.goal_r = DataReader(dp, Topic(dp, "rt/goal_pose", PoseStamped), qos=RELIABLE)
-        self.points = DataReader(dp, Topic(dp, "rt/points", PointCloud2), qos=BEST_EFFORT)
-        self.cmd = DataWriter(dp, Topic(dp, "rt/cmd_vel", Twist), qos=RELIABLE)
-        self.status = DataWriter(dp, Topic(dp, "rt/navigate/status", NavigationStatus), qos=RELIABLE)
+    def __init__(self, domain: int, zenoh_node=None):
+        if zenoh_node is not None:
+            # Over Zenoh as an rmw_zenoh node (tests/zenoh_node.py), the same messages.
+            n = zenoh_node
+            self.clock = n.reader("/clock", Clock, "rosgraph_msgs/msg/Clock")
+            self.odom = n.reader("/odom", Odometry, "nav_msgs/msg/Odometry")
+            self.goal_r = n.reader("/goal_pose", PoseStamped, "geometry_msgs/msg/PoseStamped")
+            self.points = n.reader("/points", PointCloud2, "sensor_msgs/msg/PointCloud2")
+            self.cmd = n.writer("/cmd_vel", "geometry_msgs/msg/Twist")
+            self.status = n.writer("/navigate/status", "agrisim_msgs/msg/NavigationStatus")
+        else:
+            dp = DomainParticipant(domain)
+            self.clock = DataReader(dp, Topic(dp, "rt/clock", Clock), qos=RELIABLE)
+            self.odom = DataReader(dp, Topic(dp, "rt/odom", Odometry), qos=RELIABLE)
+            self.goal_r = DataReader(dp, Topic(dp, "rt/goal_pose", PoseStamped), qos=RELIABLE)
+            self.points = DataReader(dp, Topic(dp, "rt/points", PointCloud2), qos=BEST_EFFORT)
+            self.cmd = DataWriter(dp, Topic(dp, "rt/cmd_vel", Twist), qos=RELIABLE)
+            self.status = DataWriter(dp, Topic(dp, "rt/navigate/status", NavigationStatus), qos=RELIABLE)
         self.pose = None
         self.goal = None
         self.waypoints: list[tuple[float, float]] = []
@@ -103,11 +114,21 @@ def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("--domain", type=int, default=0)
     ap.add_argument("--clouds", type=Path, required=True, help="where received clouds go (JSON of hex)")
+    ap.add_argument("--zenoh", metavar="ENDPOINT", help="talk to the run over Zenoh (--zenoh) at ENDPOINT, not DDS")
     ap.add_argument("agrisim", nargs=argparse.REMAINDER)
     a = ap.parse_args()
     cmd = [x for x in a.agrisim if x != "--"]
-    nav = Navigator(a.domain)
-    proc = subprocess.Popen(cmd)
+    session = None
+    if a.zenoh:
+        import zenoh_node
+
+        # The run listens first; the navigator connects to it.
+        proc = subprocess.Popen(cmd)
+        session = zenoh_node.open_session(a.zenoh, proc, timeout=60)
+        nav = Navigator(a.domain, zenoh_node.ZenohNode(session, a.domain, "external_navigator"))
+    else:
+        nav = Navigator(a.domain)
+        proc = subprocess.Popen(cmd)
     try:
         deadline = time.monotonic() + 600
         while proc.poll() is None and time.monotonic() < deadline:
@@ -124,6 +145,8 @@ def main() -> int:
             proc.kill()
         proc.wait()
     nav.drain()
+    if session is not None:
+        session.close()
     a.clouds.write_text(json.dumps({k: v.hex() for k, v in nav.clouds.items()}))
     print(json.dumps({"ticks": nav.ticks, "clouds": len(nav.clouds), "returncode": proc.returncode}))
     return proc.returncode

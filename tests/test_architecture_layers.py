@@ -4,7 +4,8 @@ which (normal dependencies, followed transitively through the workspace).
   fmus/ (environment, robot, sensors)  <-  orchestrator/cosim (engine)
   orchestrator/bus (messages)  <-  algorithm nodes (nodes, nav, manip, trajectory, harvest, perception)
   session (engine + bus)  <-  bench  <-  cli, python (the pyo3 package; siblings on top)
-  bus  <-  bridges (ros2: DDS, foxglove: WebSocket): they carry messages, like a node
+  bus  <-  bridges (link: what the ROS 2 links share; ros2: DDS; zenoh: Zenoh; foxglove: WebSocket):
+           they carry messages, like a node
 
 The engine and the message layer do not know each other; algorithms never link the engine,
 the FMU export layer or scene generation, so any of them can be swapped for a ROS 2 node.
@@ -38,7 +39,7 @@ MATH = "agrisim-math"
 MESSAGES = "agrisim-msgs"
 BUS = "agrisim-bus"
 PYTHON = "agrisim-python"
-BRIDGES = {"agrisim-ros2", "agrisim-foxglove"}
+BRIDGES = {"agrisim-link", "agrisim-ros2", "agrisim-zenoh", "agrisim-foxglove"}
 ABOVE = {"agrisim-session", "agrisim-bench", "agrisim-dataset", "agrisim", PYTHON}
 
 # crate -> crates it must not reach (directly or through other workspace crates), and why.

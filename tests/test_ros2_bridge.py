@@ -51,22 +51,28 @@ def exact_odometry(tmp_path_factory) -> Path:
     return path
 
 
-def external_nav_trial(scenario: Path, out: Path, clouds: Path) -> subprocess.CompletedProcess:
-    cmd = [str(agrisim_bin()), "bench", "nav", "--scenario", str(scenario), "--trials", "1", "--seed", "3", "--record", "standard", "--in-process", "--ros2", "--external", "navigator", "--out", str(out)]
-    return netns.run([PY, str(HERE / "ros2_external_nav.py"), "--clouds", str(clouds), "--", *cmd], timeout=300, capture_output=True, text=True)
+def external_nav_trial(scenario: Path, out: Path, clouds: Path, link: tuple[str, ...] = ("--ros2",), peer: tuple[str, ...] = ()) -> subprocess.CompletedProcess:
+    """The nav trial with tests/ros2_external_nav.py as its navigator, over the `link` options
+    (DDS by default; `peer` tells the navigator how to reach it)."""
+    cmd = [str(agrisim_bin()), "bench", "nav", "--scenario", str(scenario), "--trials", "1", "--seed", "3", "--record", "standard", "--in-process", *link, "--external", "navigator", "--out", str(out)]
+    return netns.run([PY, str(HERE / "ros2_external_nav.py"), *peer, "--clouds", str(clouds), "--", *cmd], timeout=300, capture_output=True, text=True)
 
 
-def test_external_navigator_over_cyclone_dds(exact_odometry, tmp_path):
-    r = external_nav_trial(exact_odometry, tmp_path / "a", tmp_path / "clouds.json")
+def assert_navigator_judged(r: subprocess.CompletedProcess, out: Path) -> None:
+    """The harness judged the external node: success needs its 'succeeded' status and the true
+    base centre within the goal tolerance; every tick answered in time, nothing rejected."""
     assert r.returncode == 0, r.stdout + r.stderr
     report = json.loads(r.stdout.strip().splitlines()[-1])
-    trial = json.loads((tmp_path / "a/trials.jsonl").read_text())
-    # The harness judged the external node: success needs its 'succeeded' status and the true
-    # base centre within the goal tolerance.
+    trial = json.loads((out / "trials.jsonl").read_text())
     assert trial["outcome"] == "success", trial
     assert trial["time_to_goal"] > 10.0 and trial["path_length"] > 5.0
     assert report["ticks"] == round(trial["sim_time"] / 0.1) + 1
     assert "0 rejected, 0 lockstep timeouts" in r.stderr, r.stderr
+
+
+def test_external_navigator_over_cyclone_dds(exact_odometry, tmp_path):
+    r = external_nav_trial(exact_odometry, tmp_path / "a", tmp_path / "clouds.json")
+    assert_navigator_judged(r, tmp_path / "a")
     # The clouds that crossed DDS are the recorded ones, byte for byte (CDR header included).
     received = {k: bytes.fromhex(v) for k, v in json.loads((tmp_path / "clouds.json").read_text()).items()}
     recorded = decoded_messages(tmp_path / "a/trials/0000.mcap", "/points")

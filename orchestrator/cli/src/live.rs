@@ -5,7 +5,7 @@
 
 use agrisim_error::{err, Result};
 use agrisim_ros2::names::Remap;
-use agrisim_ros2::{BridgeConfig, Distro, Mode, Ros2Bridge, Stats};
+use agrisim_ros2::{BridgeConfig, Distro, Mode, Ros2Bridge, Stats, Topics};
 use agrisim_session::run::{NodeFactory, NodePlan, SystemIo};
 use std::collections::BTreeSet;
 use std::sync::{Arc, Mutex};
@@ -19,30 +19,50 @@ pub struct LiveArgs {
     /// of `--external` nodes) are taken from ROS 2 peers.
     #[arg(long)]
     pub ros2: bool,
+    /// Bridge the run to ROS 2 over Zenoh, in rmw_zenoh's format (peers with
+    /// RMW_IMPLEMENTATION=rmw_zenoh_cpp): the same topics as --ros2, on keys
+    /// `<domain>/<topic>/<type>/RIHS01_<hash>`, with liveliness tokens. The --ros2-* options
+    /// (domain, mode, timeout, rate, remap, subscribe, lockstep, stats) apply to it too, also
+    /// spelt --zenoh-*.
+    #[arg(long, conflicts_with = "ros2")]
+    pub zenoh: bool,
+    /// Zenoh: endpoints to listen on ("none": no listener, e.g. beside a running rmw_zenohd).
+    #[arg(long, value_name = "ENDPOINT", default_value = agrisim_zenoh::DEFAULT_LISTEN)]
+    pub zenoh_listen: Vec<String>,
+    /// Zenoh: endpoints to connect to (a router such as rmw_zenohd: tcp/127.0.0.1:7447).
+    #[arg(long, value_name = "ENDPOINT")]
+    pub zenoh_connect: Vec<String>,
+    /// Zenoh session mode: peer, client or router (router: rmw_zenoh peers that want a
+    /// router find one in the run).
+    #[arg(long, value_name = "MODE", default_value = "peer", value_parser = ["peer", "client", "router"])]
+    pub zenoh_session: String,
+    /// Zenoh: find peers by multicast scouting on the LAN (off: only the endpoints above).
+    #[arg(long)]
+    pub zenoh_multicast: bool,
     /// DDS domain (ROS_DOMAIN_ID).
-    #[arg(long, value_name = "ID", default_value_t = 0, env = "ROS_DOMAIN_ID")]
+    #[arg(long, value_name = "ID", default_value_t = 0, env = "ROS_DOMAIN_ID", alias = "zenoh-domain")]
     pub ros2_domain: u16,
     /// lockstep: at each message instant wait for the peers' answers (deterministic);
     /// realtime: pace the simulation to the wall clock (as the paper ran).
-    #[arg(long, value_name = "MODE", default_value = "lockstep", value_parser = ["lockstep", "realtime"])]
+    #[arg(long, value_name = "MODE", default_value = "lockstep", value_parser = ["lockstep", "realtime"], alias = "zenoh-mode")]
     pub ros2_mode: String,
     /// Lockstep: how long to wait for the answers at one instant [s, wall time].
-    #[arg(long, value_name = "SECONDS", default_value_t = 1.0)]
+    #[arg(long, value_name = "SECONDS", default_value_t = 1.0, alias = "zenoh-timeout")]
     pub ros2_timeout: f64,
     /// Lockstep: how long to wait for the peers before the first instant [s, wall time].
-    #[arg(long, value_name = "SECONDS", default_value_t = 30.0)]
+    #[arg(long, value_name = "SECONDS", default_value_t = 30.0, alias = "zenoh-startup-timeout")]
     pub ros2_startup_timeout: f64,
     /// Realtime: simulated seconds per wall second.
-    #[arg(long, value_name = "FACTOR", default_value_t = 1.0)]
+    #[arg(long, value_name = "FACTOR", default_value_t = 1.0, alias = "zenoh-rate")]
     pub ros2_rate: f64,
     /// Rename a topic on the ROS 2 side: FROM:=TO (e.g. /cmd_vel:=/robot/cmd_vel).
-    #[arg(long = "ros2-remap", value_name = "FROM:=TO")]
+    #[arg(long = "ros2-remap", alias = "zenoh-remap", value_name = "FROM:=TO")]
     pub remap: Vec<String>,
     /// Also take TOPIC (of ROS 2 type pkg/msg/Type) from ROS 2 peers: TOPIC=TYPE.
-    #[arg(long = "ros2-subscribe", value_name = "TOPIC=TYPE")]
+    #[arg(long = "ros2-subscribe", alias = "zenoh-subscribe", value_name = "TOPIC=TYPE")]
     pub subscribe: Vec<String>,
     /// Lockstep waits for these topics (default: the replaced nodes' command outputs).
-    #[arg(long = "ros2-lockstep", value_name = "TOPIC")]
+    #[arg(long = "ros2-lockstep", alias = "zenoh-lockstep", value_name = "TOPIC")]
     pub lockstep: Vec<String>,
     /// Talk on every network interface, not only loopback (exposes the run to the network).
     #[arg(long)]
@@ -53,10 +73,11 @@ pub struct LiveArgs {
     pub ros2_distro: String,
     /// Write the bridge's statistics to FILE (JSON): messages and bytes per topic, received,
     /// rejected, lockstep round trips [s].
-    #[arg(long, value_name = "FILE")]
+    #[arg(long, value_name = "FILE", alias = "zenoh-stats")]
     pub ros2_stats: Option<std::path::PathBuf>,
     /// Turn off a built-in node so an external one (over --ros2) takes its place: navigator,
-    /// harvest (told its fruit on /harvest/task), command_script, odom_tf,
+    /// harvest (told its fruit on /harvest/task; by sight its region on /harvest/task_region),
+    /// command_script, odom_tf,
     /// robot_state_publisher, map_server, goal_publisher.
     #[arg(long = "external", value_name = "NODE")]
     pub external: Vec<String>,
@@ -135,9 +156,9 @@ impl LiveArgs {
             Some(a) => Some(a.parse().map_err(|e| err!("--foxglove {a}: not an address IP:PORT ({e})"))?),
             None => None,
         };
-        if !self.ros2 {
+        if !self.ros2 && !self.zenoh {
             if !external.is_empty() {
-                return Err(err!("--external needs --ros2 (the external node talks to the run over ROS 2)"));
+                return Err(err!("--external needs --ros2 or --zenoh (the external node talks to the run over ROS 2)"));
             }
             return Ok(match foxglove {
                 Some(addr) => NodePlan {
@@ -182,6 +203,7 @@ impl LiveArgs {
         let startup_timeout = Duration::from_secs_f64(self.ros2_startup_timeout);
         let distro = Distro::parse(&self.ros2_distro).map_err(|e| err!("--ros2-distro: {e}"))?;
         let stats = stats.clone();
+        let zenoh = self.zenoh.then(|| zenoh_options(self));
         let factory = move |inputs: &SystemIo| -> Result<Vec<Box<dyn agrisim_bus::Node>>> {
             let mut inbound: Vec<(String, String)> = inputs.messages.clone();
             for t in &extra_inbound {
@@ -189,21 +211,36 @@ impl LiveArgs {
                     inbound.push(t.clone());
                 }
             }
-            let config = BridgeConfig {
-                domain,
+            let topics = Topics {
                 mode,
                 inbound,
                 inbound_scalars: inputs.scalars.clone(),
                 outbound: inputs.outputs.clone(),
                 lockstep: lockstep.clone(),
                 remap: remap.clone(),
-                loopback_only,
                 startup_timeout,
-                distro,
             };
-            let (bridge, s) = Ros2Bridge::new(config)?;
+            let (bridge, s): (Box<dyn agrisim_bus::Node>, _) = match &zenoh {
+                Some((listen, connect, session_mode, multicast_scouting)) => {
+                    let config = agrisim_zenoh::ZenohConfig {
+                        domain: domain.into(),
+                        topics,
+                        listen: listen.clone(),
+                        connect: connect.clone(),
+                        session_mode: session_mode.clone(),
+                        multicast_scouting: *multicast_scouting,
+                    };
+                    let (bridge, s) = agrisim_zenoh::ZenohBridge::new(config)?;
+                    (Box::new(bridge), s)
+                }
+                None => {
+                    let config = BridgeConfig { domain, topics, loopback_only, distro };
+                    let (bridge, s) = Ros2Bridge::new(config)?;
+                    (Box::new(bridge), s)
+                }
+            };
             stats.lock().expect("stats lock").push(s);
-            let mut nodes: Vec<Box<dyn agrisim_bus::Node>> = vec![Box::new(bridge)];
+            let mut nodes: Vec<Box<dyn agrisim_bus::Node>> = vec![bridge];
             if let Some(addr) = foxglove {
                 nodes.push(foxglove_view(addr, inputs)?);
             }
@@ -211,6 +248,12 @@ impl LiveArgs {
         };
         Ok(NodePlan { external, extra: Some(Arc::new(factory)) })
     }
+}
+
+/// The Zenoh session's endpoints, mode and scouting (`--zenoh-listen none`: no listener).
+fn zenoh_options(a: &LiveArgs) -> (Vec<String>, Vec<String>, String, bool) {
+    let listen = a.zenoh_listen.iter().filter(|e| e.as_str() != "none").cloned().collect();
+    (listen, a.zenoh_connect.clone(), a.zenoh_session.clone(), a.zenoh_multicast)
 }
 
 /// The Foxglove live view on `addr`, announced on stderr; the channels of the system's

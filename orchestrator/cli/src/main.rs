@@ -380,11 +380,11 @@ fn bench(registry: &Registry, m: &clap::ArgMatches, bridges: &Bridges) -> Result
     let s = Scenario::load(&a.scenario_path(b))?;
     let mut o = run_options(dirs, &target, None, None, swaps.fmus.into_iter().collect(), log.categories());
     o.record = record.profile;
-    // The live links run one trial at a time: trials would share the DDS topics and the port.
-    let linked = live.ros2 || live.foxglove.is_some();
+    // The live links run one trial at a time: trials would share the topics and the port.
+    let linked = live.ros2 || live.zenoh || live.foxglove.is_some();
     if linked && a.jobs.is_some_and(|j| j > 1) {
         return Err(agrisim_error::err!(
-            "--ros2 and --foxglove run one trial at a time (trials would share the DDS topics and the port): use --jobs 1"
+            "--ros2, --zenoh and --foxglove run one trial at a time (trials would share the topics and the port): use --jobs 1"
         ));
     }
     o.nodes = live.plan(bridges)?;

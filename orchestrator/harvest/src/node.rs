@@ -157,6 +157,11 @@ pub struct HarvestNode {
     dwell_from: Option<i64>,
     aisle_y: f64,
     allowed_sent: Option<([f64; 3], f64)>,
+    /// By sight: where earlier tasks of a row aimed (picked there, or failed on), so the
+    /// next task does not choose the same fruit again ([`sight::choose`]).
+    tried: Vec<[f64; 3]>,
+    /// Why the task failed, once it has.
+    pub(crate) failure: Option<Failure>,
 }
 
 impl HarvestNode {
@@ -226,6 +231,8 @@ impl HarvestNode {
             dwell_from: None,
             aisle_y: 0.0,
             allowed_sent: None,
+            tried: vec![],
+            failure: None,
         }
     }
 
@@ -263,12 +270,23 @@ impl HarvestNode {
         self.stage
     }
 
-    /// Goes on to fruit `fruit_index` (a row harvest): what the node knows of the robot, its
-    /// planner's random stream and its work count carry over; the task starts afresh with
-    /// [`Stage::Recover`] (let go, arms home), then selects the new target. Target messages
-    /// sent before `t_ns` are of the old fruit.
+    /// Why the task failed (`None` while it runs or after a success).
+    pub fn failure(&self) -> Option<Failure> {
+        self.failure
+    }
+
+    /// Goes on to fruit `fruit_index` (a row harvest handed its fruit): see [`Self::next_task`].
     pub fn next_target(&mut self, fruit_index: usize, t_ns: i64, bus: &mut Bus) {
-        let mut fresh = HarvestNode::new(fruit_index, 0).with_cost(self.cost);
+        self.next_task(Task::Fruit(fruit_index), t_ns, bus)
+    }
+
+    /// Goes on to `task` (a row harvest): what the node knows of the robot and, by sight, of
+    /// the crop (the fruit map, the places already tried), its planner's random stream and
+    /// its work count carry over; the task starts afresh with [`Stage::Recover`] (let go,
+    /// arms home), then selects the new target. Target messages sent before `t_ns` are of
+    /// the old fruit.
+    pub fn next_task(&mut self, task: Task, t_ns: i64, bus: &mut Bus) {
+        let mut fresh = HarvestNode::with_task(task, 0).with_cost(self.cost);
         std::mem::swap(&mut fresh.motion, &mut self.motion);
         fresh.motion.set_held(Arm::Left, None);
         fresh.motion.set_held(Arm::Right, None);
@@ -280,11 +298,28 @@ impl HarvestNode {
         (fresh.lift, fresh.lift_target, fresh.target_seen) = (self.lift, self.lift, self.target_seen);
         fresh.target_after_ns = t_ns;
         (fresh.work_mark, fresh.boxed) = (self.work_mark, self.boxed);
-        fresh.target_name = format!("fruit[{fruit_index}]");
+        (fresh.fruit_map, fresh.fruit_map_seen) = (std::mem::take(&mut self.fruit_map), self.fruit_map_seen);
+        fresh.tried = std::mem::take(&mut self.tried);
+        if let (Task::Region(_), Some(aim)) = (self.task, self.target_map) {
+            fresh.tried.push(aim);
+        }
+        // The old target is no longer to be left out of the sensed scene.
+        if self.allowed_sent.is_some() {
+            bus.publish(sight::topics::ALLOWED, t_ns, &sight::allowed(Time::from_nanos(t_ns), None));
+        }
+        let why = match task {
+            Task::Fruit(i) => {
+                fresh.target_name = format!("fruit[{i}]");
+                // The world answers with the new fruit's pose from the next exchange on.
+                bus.set_scalar(topics::TARGET_ID, i as f64);
+                format!("next: fruit {i} of the world's list")
+            }
+            Task::Region(r) => {
+                format!("next: a ripe fruit in x {:.2}..{:.2}, y {:.2}..{:.2}", r.x[0], r.x[1], r.y[0], r.y[1])
+            }
+        };
         *self = fresh;
-        // The world answers with the new fruit's pose from the next exchange on.
-        bus.set_scalar(topics::TARGET_ID, fruit_index as f64);
-        self.enter(Stage::Recover, t_ns, bus, &format!("next: fruit {fruit_index} of the world's list"));
+        self.enter(Stage::Recover, t_ns, bus, &why);
     }
 
     fn giver(&self) -> Arm {
@@ -406,6 +441,7 @@ impl HarvestNode {
     }
 
     fn fail(&mut self, f: Failure, t_ns: i64, bus: &mut Bus, detail: String) {
+        self.failure = Some(f);
         self.publish_status(t_ns, bus, "failure", f.name(), &detail);
         self.motion.end_roll();
         self.stage = Stage::Failed;

@@ -1,21 +1,48 @@
-//! The whole-row harvest: one [`HarvestNode`] taken through a list of fruit, one after the
-//! other, moving the base between picks. After each fruit, picked or not, the node lets go
-//! of anything it holds and brings both arms home before it selects the next
-//! ([`Stage::Recover`]). Every fruit's stages and outcome go to `/harvest/status` with its
-//! `target_id`, as in the single-fruit task, so one judge reads both.
+//! The whole-row harvest: one [`HarvestNode`] taken through a row segment, moving the base
+//! between picks. After each pick, successful or not, the node lets go of anything it holds
+//! and brings both arms home before it selects the next ([`Stage::Recover`]). Every pick's
+//! stages and outcome go to `/harvest/status`, as in the single-fruit task, so one judge
+//! reads both.
 //!
-//! The node is told the fruit to pick, in order (the world's fruit-list indices, as the
-//! paper hands over a target); their poses it learns one at a time from `/target_fruit`.
+//! Two ways to be told the work:
+//! * [`RowNode::new`]: the fruit to pick, in order (the world's fruit-list indices, as the
+//!   paper hands over a target); their poses the node learns one at a time from
+//!   `/target_fruit` (ground truth, for isolating manipulation);
+//! * [`RowNode::by_sight`]: the segment as 1 m regions of row, and nothing else. In each
+//!   region the node picks ripe fruit it finds itself ([`Task::Region`]) until its scan finds
+//!   none left untried, or [`MAX_FAILURES_PER_REGION`] picks in a row fail there; then it
+//!   drives on to the next region. When the last region is done it reports the outcome
+//!   [`FINISHED`].
 
-use super::node::HarvestNode;
-use super::stage::Stage;
+use super::node::{topics, HarvestNode, Task};
+use super::sight::Region;
+use super::stage::{Failure, Stage};
 use agrisim_bus::{Bus, Node};
 use agrisim_error::Result;
+use agrisim_msgs::agrisim::HarvestStatus;
+use agrisim_msgs::builtin_interfaces::Time;
+use agrisim_msgs::std_msgs::Header;
+
+/// By sight: consecutive failed picks in one region after which the node moves on (each
+/// failure's fruit is tried no more, but a region whose fruit all fail would otherwise take
+/// the segment's whole time).
+pub const MAX_FAILURES_PER_REGION: u32 = 3;
+/// By sight: picks tried in one region at most (a region of a dense truss crop holds about
+/// ten ripe fruit within reach).
+pub const MAX_PICKS_PER_REGION: u32 = 16;
+/// `/harvest/status` outcome of a row by sight once every region is done.
+pub const FINISHED: &str = "finished";
+
+/// The work of a row node.
+enum Plan {
+    /// Fruit-list indices, in order, and the index of the current one.
+    Fruit { targets: Vec<usize>, current: usize },
+    /// Regions in order, the current one, and the picks and consecutive failures in it.
+    Regions { regions: Vec<Region>, current: usize, picks: u32, failures: u32, finished: bool },
+}
 
 pub struct RowNode {
-    targets: Vec<usize>,
-    /// Index into `targets` of the fruit being harvested.
-    current: usize,
+    plan: Plan,
     inner: HarvestNode,
 }
 
@@ -23,7 +50,30 @@ impl RowNode {
     /// Harvests `targets` (fruit-list indices) in this order; `seed` drives the planners.
     pub fn new(targets: Vec<usize>, seed: u64) -> RowNode {
         let first = targets.first().copied().unwrap_or(0);
-        RowNode { targets, current: 0, inner: HarvestNode::new(first, seed) }
+        RowNode { plan: Plan::Fruit { targets, current: 0 }, inner: HarvestNode::new(first, seed) }
+    }
+
+    /// Harvests the ripe fruit it finds in `regions`, one region after the other.
+    pub fn by_sight(regions: Vec<Region>, seed: u64) -> RowNode {
+        let first = regions.first().copied().unwrap_or(Region { x: [0.0; 2], y: [0.0; 2], z: [0.0; 2] });
+        RowNode {
+            plan: Plan::Regions { regions, current: 0, picks: 1, failures: 0, finished: false },
+            inner: HarvestNode::by_sight(first, seed),
+        }
+    }
+
+    /// By sight, after a pick ended: the region to work in next, if any.
+    fn next_region(&mut self) -> Option<Region> {
+        let failure = self.inner.failure();
+        let Plan::Regions { regions, current, picks, failures, .. } = &mut self.plan else { return None };
+        *failures = if failure.is_some() { *failures + 1 } else { 0 };
+        let exhausted = failure == Some(Failure::NotDetected);
+        if exhausted || *failures >= MAX_FAILURES_PER_REGION || *picks >= MAX_PICKS_PER_REGION {
+            *current += 1;
+            (*picks, *failures) = (0, 0);
+        }
+        *picks += 1;
+        regions.get(*current).copied()
     }
 }
 
@@ -33,13 +83,71 @@ impl Node for RowNode {
     }
 
     fn step(&mut self, t_ns: i64, bus: &mut Bus) -> Result<()> {
-        if self.targets.is_empty() {
-            return Ok(());
-        }
-        if matches!(self.inner.stage(), Stage::Done | Stage::Failed) && self.current + 1 < self.targets.len() {
-            self.current += 1;
-            self.inner.next_target(self.targets[self.current], t_ns, bus);
+        let ended = matches!(self.inner.stage(), Stage::Done | Stage::Failed);
+        match &mut self.plan {
+            Plan::Fruit { targets, .. } if targets.is_empty() => return Ok(()),
+            Plan::Fruit { targets, current } => {
+                if ended && *current + 1 < targets.len() {
+                    *current += 1;
+                    let next = targets[*current];
+                    self.inner.next_target(next, t_ns, bus);
+                }
+            }
+            Plan::Regions { finished: true, .. } => return Ok(()),
+            Plan::Regions { .. } if ended => match self.next_region() {
+                Some(r) => self.inner.next_task(Task::Region(r), t_ns, bus),
+                None => {
+                    if let Plan::Regions { finished, regions, .. } = &mut self.plan {
+                        *finished = true;
+                        let msg = HarvestStatus {
+                            header: Header { stamp: Time::from_nanos(t_ns), frame_id: "map".into() },
+                            stage: Stage::Done.name().into(),
+                            target_id: -1,
+                            target_name: "row".into(),
+                            outcome: FINISHED.into(),
+                            failure_category: String::new(),
+                            detail: format!("every one of the {} regions done", regions.len()),
+                            plans: 0,
+                        };
+                        bus.publish(topics::STATUS, t_ns, &msg);
+                    }
+                    return Ok(());
+                }
+            },
+            Plan::Regions { .. } => {}
         }
         self.inner.step(t_ns, bus)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn region(x: f64) -> Region {
+        Region { x: [x, x + 1.0], y: [0.0, 1.0], z: [0.55, 1.75] }
+    }
+
+    /// The region rule: stay while picks succeed, move on when the scan finds nothing, after
+    /// MAX_FAILURES_PER_REGION failures in a row, or after MAX_PICKS_PER_REGION picks.
+    #[test]
+    fn regions_advance_on_nothing_found_repeated_failures_or_the_pick_cap() {
+        let mut row = RowNode::by_sight(vec![region(0.0), region(1.0), region(2.0)], 1);
+        let next = |row: &mut RowNode, f: Option<Failure>| {
+            row.inner.failure = f;
+            row.next_region().map(|r| r.x[0])
+        };
+        assert_eq!(next(&mut row, None), Some(0.0));
+        assert_eq!(next(&mut row, Some(Failure::Planning)), Some(0.0));
+        assert_eq!(next(&mut row, None), Some(0.0)); // a success resets the failure count
+        assert_eq!(next(&mut row, Some(Failure::NotDetected)), Some(1.0));
+        for _ in 1..MAX_FAILURES_PER_REGION {
+            assert_eq!(next(&mut row, Some(Failure::Grasp)), Some(1.0));
+        }
+        assert_eq!(next(&mut row, Some(Failure::Grasp)), Some(2.0));
+        for _ in 1..MAX_PICKS_PER_REGION {
+            assert_eq!(next(&mut row, None), Some(2.0));
+        }
+        assert_eq!(next(&mut row, None), None);
     }
 }

@@ -60,6 +60,11 @@ impl Region {
         [self.x, self.y, self.z].iter().zip(p).all(|(r, v)| r[0] <= v && v <= r[1])
     }
 
+    /// Whether `p` lies at least `margin` inside every face.
+    pub fn holds(&self, p: [f64; 3], margin: f64) -> bool {
+        [self.x, self.y, self.z].iter().zip(p).all(|(r, v)| r[0] + margin <= v && v <= r[1] - margin)
+    }
+
     pub fn centre(&self) -> [f64; 3] {
         [self.x, self.y, self.z].map(|r| 0.5 * (r[0] + r[1]))
     }
@@ -104,18 +109,34 @@ pub fn fruit_of(map: &Detection3DArray, frame: &str) -> Vec<Seen> {
         .collect()
 }
 
-/// The fruit to pick: ripe, inside `region`; of those the one nearest the aisle line
-/// `aisle_y` (least plant in front of it), then nearest the region's centre along the row.
-pub fn choose(seen: &[Seen], region: &Region, aisle_y: f64) -> Option<Seen> {
+/// A fruit of the map this close to a place the node has already tried (picked there, or
+/// failed on) is taken for that fruit and not chosen again [m]: about a fruit's radius, so
+/// the next fruit of a truss (its centre a diameter away) is still chosen.
+pub const TRIED_RADIUS: f64 = 0.025;
+/// A fruit is chosen only when its estimated centre lies this far inside the region [m]:
+/// the perception's centre error (p95 about 12 mm in the harvest by sight) could otherwise
+/// put a fruit just outside the task's stretch of row inside it.
+pub const REGION_MARGIN: f64 = 0.015;
+
+/// The fruit to pick: ripe, [`REGION_MARGIN`] inside `region`, not within [`TRIED_RADIUS`]
+/// of a place in `tried`; of those the one nearest the aisle line `aisle_y` (least plant in front of it),
+/// then nearest the region's centre along the row.
+pub fn choose(seen: &[Seen], region: &Region, aisle_y: f64, tried: &[[f64; 3]]) -> Option<Seen> {
     let cx = region.centre()[0];
+    let untried = |s: &&Seen| tried.iter().all(|p| dist(*p, s.center) > TRIED_RADIUS);
     seen.iter()
-        .filter(|s| s.ripe > RIPE_SHARE && region.contains(s.center))
+        .filter(|s| s.ripe > RIPE_SHARE && region.holds(s.center, REGION_MARGIN))
+        .filter(untried)
         .min_by(|a, b| {
             let key = |s: &Seen| ((s.center[1] - aisle_y).abs(), (s.center[0] - cx).abs());
             let (ka, kb) = (key(a), key(b));
             ka.0.total_cmp(&kb.0).then(ka.1.total_cmp(&kb.1)).then(a.id.cmp(&b.id))
         })
         .cloned()
+}
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum::<f64>().sqrt()
 }
 
 /// `/harvest/allowed`: the target as a sphere (its box's half size the radius, grown by
@@ -212,11 +233,28 @@ mod tests {
         let seen = fruit_of(&map, "map");
         assert_eq!(seen.len(), 5);
         assert!((seen[1].radius - 0.03).abs() < 1e-12 && (seen[1].ripe - 0.6).abs() < 1e-12);
-        assert_eq!(choose(&seen, &region, 0.0).map(|s| s.id), Some("2".into()));
+        assert_eq!(choose(&seen, &region, 0.0, &[]).map(|s| s.id), Some("2".into()));
+        // Tried there already (picked, or failed on): the next one, 1 being within
+        // TRIED_RADIUS of its try only when that try was at it.
+        assert_eq!(choose(&seen, &region, 0.0, &[[1.81, 0.41, 1.2]]).map(|s| s.id), Some("1".into()));
+        assert_eq!(choose(&seen, &region, 0.0, &[[1.81, 0.41, 1.2], [1.5, 0.7, 1.02]]), None);
+        assert_eq!(
+            choose(&seen, &region, 0.0, &[[1.8, 0.4, 1.2 + 1.5 * TRIED_RADIUS]]).map(|s| s.id),
+            Some("2".into())
+        );
+        // Ripe and nearest the aisle, but within REGION_MARGIN of the region's end: its true
+        // centre may lie outside the task's stretch.
+        let edge = track("6", [2.0 - 0.5 * REGION_MARGIN, 0.25, 1.0], 0.03, &[("red", 1.0)]);
+        let with_edge: Vec<Seen> = seen
+            .iter()
+            .cloned()
+            .chain(fruit_of(&Detection3DArray { detections: vec![edge], ..map.clone() }, "map"))
+            .collect();
+        assert_eq!(choose(&with_edge, &region, 0.0, &[]).map(|s| s.id), Some("2".into()));
         // Another frame than the map's is not read.
         let odom = Detection3DArray { header: Header { frame_id: "odom".into(), ..Default::default() }, ..map };
         assert!(fruit_of(&odom, "map").is_empty());
-        assert_eq!(choose(&[], &region, 0.0), None);
+        assert_eq!(choose(&[], &region, 0.0, &[]), None);
     }
 
     #[test]

@@ -46,7 +46,7 @@ fn main() {
     for r in 0..repeats {
         found = 0;
         for (i, d) in &frames {
-            let f = Frame { width: i.width as usize, height: i.height as usize, rgb: &i.data, depth: d, k };
+            let f = Frame { width: i.width as usize, height: i.height as usize, rgb: &i.data, depth: d, k, up: None };
             found += det.detect(&f).detections.len();
         }
         if r == 0 {

@@ -1,8 +1,9 @@
 //! Colour: which pixels may be tomato (CIELAB: chroma and hue angle, so a segment does not
-//! depend on one exact colour or on the exposure) and which USDA ripeness stage a segment
-//! shows (the HSV hue of its sRGB pixels; CIELAB's hue angle puts light red and red at the
-//! same angle, HSV's separates them, and a common scale of the three channels, as light
-//! and shadow give, leaves it unchanged).
+//! depend on one exact colour or on the exposure) and which USDA colour class a pixel of
+//! skin shows (the HSV hue of its sRGB pixels; CIELAB's hue angle puts light red and red at
+//! the same angle, HSV's separates them, and a common scale of the three channels, as light
+//! and shadow give, leaves it unchanged). A fruit's stage is read from how much of its
+//! surface shows which class ([`crate::ripeness`]), not from its pixels' votes alone.
 
 /// The six USDA ripeness stages ("United States Standards for Grades of Fresh Tomatoes",
 /// colour classification), as `vision_msgs` class ids.

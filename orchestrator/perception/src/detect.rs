@@ -1,7 +1,8 @@
 //! One frame: fruit-coloured pixels with depth, grouped into depth-connected components,
-//! each fitted with a sphere and classified by its hue votes.
+//! each fitted with a sphere, its ripeness from the coloured fraction of the skin on it.
 
-use crate::colour::{classify, stage_votes, FruitColour, Linearize};
+use crate::colour::{classify, FruitColour, Linearize};
+use crate::ripeness::{ripeness, stage_shares, surface_below, Ripeness};
 use crate::sphere::{fit_sphere, SphereBounds};
 
 /// Pinhole intrinsics (CameraInfo's K).
@@ -15,6 +16,9 @@ pub struct Frame<'a> {
     pub rgb: &'a [u8],
     pub depth: &'a [f32],
     pub k: Intrinsics,
+    /// The world's up (unit) in the camera's frame, from TF; `None`: the optical frame's -y
+    /// (a level camera).
+    pub up: Option<[f64; 3]>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -57,10 +61,15 @@ impl Default for DetectorConfig {
 pub struct Detection {
     pub center: [f64; 3],
     pub radius: f64,
-    /// USDA stage 1..=6 with the most votes, and its share.
+    /// USDA stage 1..=6 most likely (0: unknown, too little skin seen), and its
+    /// probability lowered by a poor fit.
     pub stage: u8,
     pub score: f64,
+    /// Probability of each stage (index 0 = stage 1) from the coloured fraction of the skin
+    /// ([`crate::ripeness`]); all 0 when unknown.
     pub votes: [f64; 6],
+    /// The fronts fitted to the skin, if enough of it told its colour.
+    pub ripeness: Option<Ripeness>,
     pub rms: f64,
     pub pixels: usize,
     /// Image box (u_min, v_min, u_max, v_max) of the segment.
@@ -169,7 +178,7 @@ impl Detector {
                     }
                     n = m;
                 }
-                d
+                self.ripen(f, d)
             })
             .collect();
         out
@@ -179,14 +188,52 @@ impl Detector {
     /// from its blossom end, so its colour segment is a part of its cap, and a sphere through
     /// a part of a cap is poorly placed across the view. Every pixel near the fitted sphere's
     /// image whose point lies on its surface (within a few noise widths) is the same fruit,
-    /// green or not; the sphere fitted again to them all keeps the segment's colour votes.
+    /// green or not; the sphere is fitted again to them all.
     /// (Growing over all depth-continuous pixels instead reached leaves and calyces: the
     /// perception benchmark's centre error p95 rose from 13 to 14 mm.) Returns the detection
     /// and the count of pixels it now rests on.
     fn grow(&self, f: &Frame, d: Detection, members: usize) -> (Detection, usize) {
+        let all = self.on_surface(f, &d);
+        // A fit through a tenth more of the surface or less moves little.
+        if all.len() * 10 <= members * 11 {
+            return (d, members);
+        }
+        let c = d.center;
+        match fit_sphere(&self.points(f, &all), &self.config.sphere) {
+            Some(s)
+                if s.rms <= self.config.max_rms
+                    && s.inlier_fraction >= self.config.min_inliers
+                    && !s.at_bound
+                    && d2(s.center, c).sqrt() < d.radius =>
+            {
+                (Detection { center: s.center, radius: s.radius, rms: s.rms, ..d }, all.len())
+            }
+            _ => (d, members),
+        }
+    }
+
+    /// The stage of a placed fruit from its skin (every pixel on its sphere, green or not):
+    /// each pixel's fraction of the surface below it along the world's up, and its colour.
+    fn ripen(&self, f: &Frame, d: Detection) -> Detection {
+        let up = f.up.unwrap_or([0.0, -1.0, 0.0]);
+        let skin = self.on_surface(f, &d);
+        let r = ripeness(skin.iter().map(|&i| {
+            let p = f.k.unproject(i % f.width, i / f.width, f.depth[i] as f64);
+            (surface_below(p, d.center, d.radius, up), [f.rgb[3 * i], f.rgb[3 * i + 1], f.rgb[3 * i + 2]])
+        }));
+        let votes = r.as_ref().map_or([0.0; 6], stage_shares);
+        let (stage, p) = if r.is_some() { classify(&votes) } else { (0, 0.0) };
+        // Score: the stage's probability, lowered by a poor fit.
+        let score = p * (1.0 - 0.5 * (d.rms / self.config.max_rms)).clamp(0.0, 1.0);
+        Detection { stage, score, votes, ripeness: r, ..d }
+    }
+
+    /// The pixels near a sphere's image whose points lie on its surface (within a few noise
+    /// widths of its fit).
+    fn on_surface(&self, f: &Frame, d: &Detection) -> Vec<usize> {
         let c = d.center;
         if c[2] <= d.radius {
-            return (d, members);
+            return vec![];
         }
         let uv = f.k.project(c);
         let rpx = 1.15 * d.radius * f.k.fx.max(f.k.fy) / (c[2] - d.radius);
@@ -208,21 +255,7 @@ impl Detector {
                 }
             }
         }
-        // A fit through a tenth more of the surface or less moves little.
-        if all.len() * 10 <= members * 11 {
-            return (d, members);
-        }
-        match fit_sphere(&self.points(f, &all), &self.config.sphere) {
-            Some(s)
-                if s.rms <= self.config.max_rms
-                    && s.inlier_fraction >= self.config.min_inliers
-                    && !s.at_bound
-                    && d2(s.center, c).sqrt() < d.radius =>
-            {
-                (Detection { center: s.center, radius: s.radius, rms: s.rms, ..d }, all.len())
-            }
-            _ => (d, members),
-        }
+        all
     }
 
     /// One fruit seen in parts (a pedicel, leaf or highlight across it, or a split of a
@@ -321,8 +354,8 @@ impl Detector {
         members.iter().map(|&i| f.k.unproject(i % f.width, i / f.width, f.depth[i] as f64)).collect()
     }
 
-    /// A sphere through one segment's points, classified by its pixels' hue votes; `Err` when
-    /// the fit fails or is poor.
+    /// A sphere through one segment's points (its stage comes later, from its whole skin:
+    /// [`Self::ripen`]); `Err` when the fit fails or is poor.
     fn fit_one(&self, f: &Frame, members: &[usize]) -> Result<Detection, ()> {
         let c = &self.config;
         let pts = self.points(f, members);
@@ -330,10 +363,6 @@ impl Detector {
         if s.rms > c.max_rms || s.inlier_fraction < c.min_inliers || s.at_bound {
             return Err(());
         }
-        let votes = stage_votes(members.iter().map(|&i| [f.rgb[3 * i], f.rgb[3 * i + 1], f.rgb[3 * i + 2]]));
-        let (stage, share) = classify(&votes);
-        // Score: the vote share, lowered by a poor fit.
-        let score = share * (1.0 - 0.5 * (s.rms / c.max_rms)).clamp(0.0, 1.0);
         let mut bbox = [usize::MAX, usize::MAX, 0, 0];
         for &i in members {
             let (u, v) = (i % f.width, i / f.width);
@@ -342,9 +371,10 @@ impl Detector {
         Ok(Detection {
             center: s.center,
             radius: s.radius,
-            stage,
-            score,
-            votes,
+            stage: 0,
+            score: 0.0,
+            votes: [0.0; 6],
+            ripeness: None,
             rms: s.rms,
             pixels: members.len(),
             bbox,
@@ -441,7 +471,7 @@ mod tests {
             best
         });
         let mut det = Detector::new(DetectorConfig::default());
-        let r = det.detect(&Frame { width: w, height: h, rgb: &rgb, depth: &depth, k });
+        let r = det.detect(&Frame { width: w, height: h, rgb: &rgb, depth: &depth, k, up: None });
         assert_eq!(r.detections.len(), 2, "{:?}", r.detections);
         assert_eq!(r.valid_depth, w * h);
         for (c, rad, col) in fruit {
@@ -453,7 +483,7 @@ mod tests {
         }
         // No depth: nothing found, and the frame says so.
         let none = vec![0f32; w * h];
-        let r = det.detect(&Frame { width: w, height: h, rgb: &rgb, depth: &none, k });
+        let r = det.detect(&Frame { width: w, height: h, rgb: &rgb, depth: &none, k, up: None });
         assert!(r.detections.is_empty() && r.valid_depth == 0);
     }
 
@@ -472,7 +502,7 @@ mod tests {
             hit(d, c, r).map_or(WALL, |t| (t, [190, 26, 20]))
         });
         let mut det = Detector::new(DetectorConfig::default());
-        let found = det.detect(&Frame { width: w, height: h, rgb: &rgb, depth: &depth, k });
+        let found = det.detect(&Frame { width: w, height: h, rgb: &rgb, depth: &depth, k, up: None });
         assert_eq!(found.detections.len(), 1, "{:?}", found.detections);
         let d = &found.detections[0];
         assert!(d2(d.center, c).sqrt() < 0.004, "{d:?}");
@@ -491,10 +521,45 @@ mod tests {
             hit(d, c, r).map_or(WALL, |t| (t, if t * d[1] - c[1] > 0.4 * r { [215, 110, 50] } else { [120, 150, 60] }))
         });
         let mut det = Detector::new(DetectorConfig::default());
-        let found = det.detect(&Frame { width: w, height: h, rgb: &rgb, depth: &depth, k });
+        let found = det.detect(&Frame { width: w, height: h, rgb: &rgb, depth: &depth, k, up: None });
         assert_eq!(found.detections.len(), 1, "{:?}", found.detections);
         let d = &found.detections[0];
         assert!(d2(d.center, c).sqrt() < 0.003, "{d:?}");
         assert!((d.radius - r).abs() < 0.003, "{d:?}");
+    }
+
+    /// A pink fruit (coloured from its bottom over 45 % of its surface, its deep pink of red's
+    /// hue) and a light red one (75 %), seen by a camera pitched 40 deg up at them: most of
+    /// what it sees is coloured, and the stage is read from the front's height along the
+    /// world's up (from TF), not from the share of coloured pixels.
+    #[test]
+    fn ripeness_is_read_along_the_worlds_up() {
+        let (w, h) = (200usize, 160usize);
+        let k = Intrinsics { fx: 300.0, fy: 300.0, cx: 100.0, cy: 80.0 };
+        let pitch = 40f64.to_radians();
+        let up = [0.0, -pitch.cos(), pitch.sin()];
+        for (fraction, stage) in [(0.45, 4u8), (0.75, 5)] {
+            let (c, r) = ([0.0, 0.0, 0.5], 0.03);
+            let (rgb, depth) = render(w, h, k, |_, d| {
+                hit(d, c, r).map_or(WALL, |t| {
+                    let p = [t * d[0] - c[0], t * d[1] - c[1], t - c[2]];
+                    let below = 0.5 * ((p[0] * up[0] + p[1] * up[1] + p[2] * up[2]) / r + 1.0);
+                    (t, if below < fraction { [232, 104, 84] } else { [132, 168, 70] })
+                })
+            });
+            let mut det = Detector::new(DetectorConfig::default());
+            let found = det.detect(&Frame { width: w, height: h, rgb: &rgb, depth: &depth, k, up: Some(up) });
+            assert_eq!(found.detections.len(), 1, "{:?}", found.detections);
+            let d = &found.detections[0];
+            let pink = d.ripeness.expect("skin seen").pink;
+            assert!((pink.fraction - fraction).abs() < 0.04, "{fraction}: {pink:?}");
+            assert_eq!(d.stage, stage, "{d:?}");
+            if stage == 4 {
+                let coloured = rgb.chunks_exact(3).filter(|p| p[0] == 232).count();
+                let green = rgb.chunks_exact(3).filter(|p| p[0] == 132).count();
+                assert!(coloured > green, "mostly coloured in view: {coloured} vs {green}");
+                assert!(d.votes[4] + d.votes[5] < 0.1, "{d:?}");
+            }
+        }
     }
 }

@@ -5,8 +5,9 @@
 //! Per frame ([`detect`]): pixels whose CIELAB colour may be a tomato ([`colour`]), grouped
 //! into components connected in the image and in depth, each fitted with a robust sphere on
 //! its depth points ([`sphere`]: the visible cap, radius 20-45 mm), its USDA ripeness stage
-//! from the hue votes of its pixels. Across frames ([`tracker`]): detections moved into the
-//! world frame by TF ([`tf`]) and merged into a fruit map with stable ids.
+//! from the coloured fraction of its surface ([`ripeness`]: the height of the colour's front
+//! on the sphere, along the world's up from TF). Across frames ([`tracker`]): detections
+//! moved into the world frame by TF ([`tf`]) and merged into a fruit map with stable ids.
 //!
 //! Classical and calibrated to the simulated camera's colours: green fruit (stage 1) look like
 //! the foliage in colour and are not found; touching fruit of one colour at one depth may be
@@ -15,6 +16,7 @@
 pub mod colour;
 pub mod detect;
 pub mod node;
+pub mod ripeness;
 pub mod sphere;
 pub mod tf;
 pub mod tracker;

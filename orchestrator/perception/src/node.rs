@@ -18,7 +18,7 @@ use agrisim_msgs::tf2_msgs::TFMessage;
 use agrisim_msgs::vision_msgs::{
     BoundingBox3D, Detection3D, Detection3DArray, ObjectHypothesis, ObjectHypothesisWithPose,
 };
-use nalgebra::{Isometry3, Point3};
+use nalgebra::{Isometry3, Point3, Vector3 as Vec3};
 
 pub const IMAGE: &str = "/camera/color/image_raw";
 pub const DEPTH: &str = "/camera/aligned_depth_to_color/image_raw";
@@ -208,18 +208,23 @@ impl Perception {
             Ok(v) => v,
             Err(e) => return self.status(bus, t_ns, format!("frame skipped: {e}")),
         };
-        let result = self.detector.detect(&Frame { width: w, height: h, rgb: &image.data, depth: &z, k });
+        let camera =
+            if image.header.frame_id.is_empty() { info.header.frame_id.clone() } else { image.header.frame_id.clone() };
+        let world = self.config.world_frames.iter().find_map(|f| self.tf.lookup(f, &camera).map(|p| (f.clone(), p)));
+        // The world's up in the camera frame: ripeness is read along it (REP 103: z up).
+        let up = world.as_ref().map(|(_, p)| {
+            let u = p.rotation.inverse() * Vec3::z();
+            [u.x, u.y, u.z]
+        });
+        let result = self.detector.detect(&Frame { width: w, height: h, rgb: &image.data, depth: &z, k, up });
         if result.valid_depth == 0 {
             return self.status(bus, t_ns, format!("frame at t={} s skipped: no valid depth", stamp as f64 / 1e9));
         }
         self.frames += 1;
-        let camera =
-            if image.header.frame_id.is_empty() { info.header.frame_id.clone() } else { image.header.frame_id.clone() };
         let header = Header { stamp: image.header.stamp, frame_id: camera.clone() };
         let dets: Vec<Detection3D> =
             result.detections.iter().map(|d| detection(&header, d, &Isometry3::identity(), String::new())).collect();
         bus.publish(DETECTIONS, t_ns, &Detection3DArray { header: header.clone(), detections: dets });
-        let world = self.config.world_frames.iter().find_map(|f| self.tf.lookup(f, &camera).map(|p| (f.clone(), p)));
         let Some((frame, pose)) = world else {
             return self.status(
                 bus,
@@ -263,6 +268,7 @@ impl Perception {
                     stage: 0,
                     score: 0.0,
                     votes,
+                    ripeness: None,
                     rms: t.spread(),
                     pixels: 0,
                     bbox: [0; 4],
@@ -275,8 +281,8 @@ impl Perception {
     }
 }
 
-/// A detection as vision_msgs: one hypothesis per stage with votes, best first (the score the
-/// vote share), the pose the sphere's centre in `pose`'s target frame, the box its cube.
+/// A detection as vision_msgs: one hypothesis per stage with a probability, best first (the
+/// score that probability; none when the stage is unknown), the pose the sphere's centre in `pose`'s target frame, the box its cube.
 fn detection(header: &Header, d: &Detection, pose: &Isometry3<f64>, id: String) -> Detection3D {
     let c = pose * Point3::from(d.center);
     let position = Point { x: c.x, y: c.y, z: c.z };

@@ -1,6 +1,7 @@
 //! The fruit map: detections from many frames, in a fixed frame, associated to tracks with
 //! stable ids; each track's centre is a running mean that refuses outliers once it has a few
-//! observations, and its ripeness the sum of the frames' votes.
+//! observations, and its ripeness the sum of the frames' stage probabilities (normalised:
+//! their mean over the frames, each frame's from the coloured fraction it saw).
 
 /// One fruit of the map.
 #[derive(Clone, Debug, PartialEq)]

@@ -24,6 +24,7 @@ pub mod names;
 pub mod qos;
 pub mod raw;
 
+pub use agrisim_link::Topics;
 pub use bridge::{BridgeConfig, Mode, Ros2Bridge, Stats};
 pub use graph::Distro;
 

@@ -6,9 +6,9 @@
 //! within the time limit. Planning success means every motion the trial asked for was
 //! planned.
 
-use super::judge::{base_contact, Reports, Touches, COLLISION_COUNTERS, SOFT_COUNTERS};
+use super::judge::{base_contact, Aims, DamageLog, Reports, Touches, COLLISION_COUNTERS, SOFT_COUNTERS};
 use super::session::harvest_session;
-use super::setup::{HarvestSetup, TrueFruit};
+use super::setup::HarvestSetup;
 use super::targets::{draw, HarvestTarget, HEIGHT_RANGE, RIPE_STAGE};
 use crate::framework::report::decimate;
 use crate::framework::Trial;
@@ -17,8 +17,7 @@ use agrisim_error::Result;
 use agrisim_harvest::sight::Region;
 use agrisim_harvest::{HarvestNode, Task};
 use agrisim_math::Rng;
-use agrisim_msgs::agrisim::{CollisionState, PlantDamage};
-use agrisim_msgs::vision_msgs::Detection3DArray;
+use agrisim_msgs::agrisim::CollisionState;
 use agrisim_nodes::TaskPublisher;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -68,6 +67,13 @@ pub struct HarvestTrial {
     /// By sight: the radius the node gave its target, and that fruit's true radius [mm].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub target_radius_mm: Option<[f64; 2]>,
+    /// By sight: the true USDA stage of `chosen_id` (a stage below ripe is a wrong ripeness
+    /// call by perception, not a grasp that took a neighbour).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub chosen_stage: Option<u8>,
+    /// The fruit the world last placed in the box (its id and true stage), whichever it was.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub placed: Option<(u32, u8)>,
     /// What lies between the fruit and its aisle: free, partly_occluded, behind_stem.
     #[serde(default)]
     pub visibility: String,
@@ -175,10 +181,12 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
     let region = s.harvest.sight.then(|| region_of(&target, &setup.layout, seed));
     let harvest = node(region.map_or(Task::Fruit(target.fruit_index), Task::Region), seed);
     let node_name = harvest.name().to_string();
-    // An external node takes the harvest node's place: it is told the task the same way.
-    // (By sight it is not told the fruit: an external node by sight has no region message yet.)
-    let task =
-        (t.run.nodes.external.contains(&node_name) && region.is_none()).then(|| TaskPublisher::new(target.fruit_index));
+    // An external node takes the harvest node's place: it is told the task the same way (by
+    // sight the region on /harvest/task_region, never the fruit).
+    let task = t.run.nodes.external.contains(&node_name).then(|| match region {
+        Some(r) => TaskPublisher::region([r.x, r.y, r.z]),
+        None => TaskPublisher::new(target.fruit_index),
+    });
     let mut m = harvest_session(t, target.start, mcap, harvest, task)?;
     let (world, arm_l, arm_r) = (
         m.component("world", "harvest benchmark")?,
@@ -192,7 +200,7 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
     let mut collisions = Reader::subscribe(&mut m.bus, "/collision");
     let mut damage_reader = Reader::subscribe(&mut m.bus, "/plant_damage");
     let mut damage = DamageLog::default();
-    let mut allowed = Reader::subscribe(&mut m.bus, agrisim_harvest::sight::topics::ALLOWED);
+    let mut aims = Aims::subscribe(&mut m.bus);
     // By sight: the node's last target estimate, and the fruit nearest it (id, error [m]),
     // with the radius the node gave it and the true one [m].
     let mut chosen: Option<(u32, f64)> = None;
@@ -205,16 +213,10 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
             m.advance()?;
             path.push([m.number(chassis, "x")?, m.number(chassis, "y")?]);
             reports.read(&mut m, &node_name)?;
-            for d in damage_reader.take::<PlantDamage>(&mut m.bus)? {
-                damage.update(&d);
-            }
-            for a in allowed.take::<Detection3DArray>(&mut m.bus)? {
-                if let Some(d) = a.detections.first() {
-                    let p = &d.bbox.center.position;
-                    chosen = nearest_fruit(&setup.fruit, [p.x, p.y, p.z]);
-                    let said = 0.5 * d.bbox.size.x - agrisim_harvest::sight::ALLOWED_MARGIN;
-                    radii = chosen.map(|(id, _)| [said, setup.fruit[&id].radius]);
-                }
+            damage.read(&mut damage_reader, &mut m.bus)?;
+            if let Some(a) = aims.newest(&mut m.bus, &setup.fruit)? {
+                chosen = Some((a.id, a.error));
+                radii = Some([a.radius, setup.fruit[&a.id].radius]);
             }
             // The base must touch nothing; the arms may brush plants (counted, not failures).
             // Every collision state counts, however short the contact.
@@ -252,12 +254,17 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
     let mut contacts = BTreeMap::new();
     let mut placed = 0;
     let mut tracking = [0.0; 2];
+    let mut placed_fruit = None;
     let mut probe = || -> Result<()> {
         for c in COLLISION_COUNTERS.iter().chain(SOFT_COUNTERS.iter()) {
             contacts.insert(c.to_string(), m.number(world, c)? as i64);
         }
         placed = m.number(world, "placed_count")? as i64;
         let placed_id = m.number(world, "last_placed_id")? as i64;
+        placed_fruit = u32::try_from(placed_id)
+            .ok()
+            .filter(|_| placed > 0)
+            .and_then(|id| setup.fruit.get(&id).map(|f| (id, f.stage)));
         // The task's fruit: the one handed over, or by sight a ripe one of the region.
         let right = match region {
             None => placed_id == target.object_id as i64,
@@ -342,19 +349,10 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
         chosen_id: chosen.map(|c| c.0),
         target_error_mm: chosen.map(|c| c.1 * 1e3),
         target_radius_mm: radii.map(|r| r.map(|v| v * 1e3)),
+        chosen_stage: chosen.and_then(|c| setup.fruit.get(&c.0)).map(|f| f.stage),
+        placed: placed_fruit,
         ..HarvestTrial::of_target(index, seed, &target)
     })
-}
-
-/// The fruit of `fruit` nearest `p`, and its distance [m].
-fn nearest_fruit(fruit: &BTreeMap<u32, TrueFruit>, p: [f64; 3]) -> Option<(u32, f64)> {
-    fruit
-        .iter()
-        .map(|(&id, f)| {
-            let c = f.center;
-            (id, ((c[0] - p[0]).powi(2) + (c[1] - p[1]).powi(2) + (c[2] - p[2]).powi(2)).sqrt())
-        })
-        .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
 }
 
 /// The record of a trial whose process died: an error, with its target (drawn as the trial
@@ -386,6 +384,8 @@ impl HarvestTrial {
             chosen_id: None,
             target_error_mm: None,
             target_radius_mm: None,
+            chosen_stage: None,
+            placed: None,
             visibility: target.visibility.name().into(),
             start: target.start,
             outcome: "failure".into(),
@@ -412,94 +412,5 @@ impl HarvestTrial {
             mcap: format!("trials/{index:04}.mcap"),
             path: vec![],
         }
-    }
-}
-
-/// What the judge keeps of /plant_damage: the last message and every pedicel break.
-#[derive(Default)]
-struct DamageLog {
-    last: PlantDamage,
-    mode: Option<String>,
-    force: Option<f64>,
-    moment: Option<f64>,
-    events: Vec<(f64, f64)>,
-}
-
-impl DamageLog {
-    fn update(&mut self, d: &PlantDamage) {
-        let breaks = |m: &PlantDamage| m.detached_by_pull + m.detached_by_bend + m.detached_by_twist;
-        if breaks(d) > breaks(&self.last) && !d.last_detach_mode.is_empty() {
-            self.mode = Some(d.last_detach_mode.clone());
-            self.force = Some(self.force.map_or(d.last_detach_force, |f| f.max(d.last_detach_force)));
-            self.moment = Some(self.moment.map_or(d.last_detach_moment, |f| f.max(d.last_detach_moment)));
-            self.events.push((d.header.stamp.as_secs_f64(), d.last_detach_force));
-        }
-        self.last = d.clone();
-    }
-
-    fn by_kind(&self) -> BTreeMap<String, u64> {
-        let d = &self.last;
-        [
-            ("bruised_by_grip", d.bruised_by_grip),
-            ("bruised_by_impact", d.bruised_by_impact),
-            ("unripe_detached", d.unripe_detached),
-            ("stems_broken", d.stems_broken),
-        ]
-        .into_iter()
-        .map(|(k, v)| (k.to_string(), v as u64))
-        .collect()
-    }
-
-    /// A bruised fruit (by impact only if `impact_fails`), a broken main stem or an unripe fruit
-    /// detached fails the trial.
-    fn failure(&self, impact_fails: bool) -> Option<String> {
-        let d = &self.last;
-        let bruised = d.bruised_by_grip + if impact_fails { d.bruised_by_impact } else { 0 };
-        (bruised > 0 || d.stems_broken > 0 || d.unripe_detached > 0).then(|| {
-            format!(
-                "crop damaged: {} fruit bruised by grip, {} by impact, {} main stem(s) broken, {} unripe fruit detached",
-                d.bruised_by_grip, d.bruised_by_impact, d.stems_broken, d.unripe_detached
-            )
-        })
-    }
-}
-
-#[cfg(test)]
-mod damage_tests {
-    use super::*;
-
-    /// `mode`: how the newest of the `pull` + `bend` breaks went.
-    fn msg(pull: u32, bend: u32, mode: &str, force: f64, grip: u32) -> PlantDamage {
-        PlantDamage {
-            detached_by_pull: pull,
-            detached_by_bend: bend,
-            last_detach_mode: mode.into(),
-            last_detach_force: force,
-            bruised_by_grip: grip,
-            ..Default::default()
-        }
-    }
-
-    #[test]
-    fn breaks_are_logged_once_and_bruises_fail() {
-        let mut log = DamageLog::default();
-        log.update(&msg(0, 0, "", 0.0, 0));
-        assert_eq!(log.mode, None);
-        assert_eq!(log.failure(true), None);
-        log.update(&msg(0, 1, "bend", 6.0, 0));
-        // The same break again (a republished message) is not a second event.
-        log.update(&msg(0, 1, "bend", 6.0, 0));
-        log.update(&msg(1, 1, "pull", 9.0, 0));
-        assert_eq!(log.mode.as_deref(), Some("pull"));
-        assert_eq!(log.force, Some(9.0));
-        assert_eq!(log.events.len(), 2);
-        assert_eq!(log.by_kind()["bruised_by_grip"], 0);
-        log.update(&msg(1, 1, "pull", 9.0, 1));
-        assert!(log.failure(false).unwrap().contains("1 fruit bruised by grip"));
-        assert_eq!(log.by_kind()["bruised_by_grip"], 1);
-        let mut impact = DamageLog::default();
-        impact.update(&PlantDamage { bruised_by_impact: 1, ..Default::default() });
-        assert_eq!(impact.failure(false), None);
-        assert!(impact.failure(true).unwrap().contains("1 by impact"));
     }
 }

@@ -10,6 +10,14 @@ use crate::framework::report::{bar_chart, count_table, interval, opt, per_kind, 
 pub fn report_html(g: &agrisim_scene::Greenhouse, sum: &RowSummary, results: &[RowTrial]) -> String {
     let rows = vec![
         ("scenario".to_string(), sum.scenario.clone()),
+        (
+            "mode".to_string(),
+            if sum.perception_in_loop {
+                "by sight: perception and the sensed scene in the loop; the node finds the fruit".to_string()
+            } else {
+                "ground truth: the node is handed the reachable ripe fruit".to_string()
+            },
+        ),
         ("segments x length".to_string(), format!("{} x {} m", sum.segments, sum.segment_length)),
         ("ripe fruit reachable / harvested".to_string(), format!("{} / {}", sum.targets, sum.harvested)),
         (
@@ -23,6 +31,14 @@ pub fn report_html(g: &agrisim_scene::Greenhouse, sum: &RowSummary, results: &[R
         ),
         ("plant touches per fruit".to_string(), per_kind(&sum.touches_per_fruit)),
         ("dropped fruit".to_string(), sum.dropped.to_string()),
+        (
+            "fruit detached / unripe detached (share)".to_string(),
+            format!("{} / {} ({:.3})", sum.detached, sum.unripe_detached, sum.unripe_share),
+        ),
+        (
+            "unripe in the box / ripe in the box outside the targets".to_string(),
+            format!("{} / {}", sum.unripe_placed, sum.other_ripe_placed),
+        ),
         ("segments ended".to_string(), format!("{:?}", sum.segments_ended)),
         ("wall-clock figures".to_string(), "in summary.json (rtf, wall_time)".to_string()),
     ];

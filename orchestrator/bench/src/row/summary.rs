@@ -30,6 +30,16 @@ pub struct RowSummary {
     pub cycle_time_p95: Option<f64>,
     pub touches_per_fruit: BTreeMap<String, f64>,
     pub dropped: i64,
+    /// By sight (`[harvest] sight`): the node found the fruit itself in stretches of the
+    /// segment; otherwise it was handed the reachable ripe fruit (ground truth).
+    pub perception_in_loop: bool,
+    /// Fruit taken off their plants, of them unripe (damage), and their share.
+    pub detached: u64,
+    pub unripe_detached: u64,
+    pub unripe_share: f64,
+    /// Unripe fruit in the box, and ripe ones outside the reachable targets.
+    pub unripe_placed: u64,
+    pub other_ripe_placed: u64,
     pub thinking_time_per_fruit: f64,
     pub rtf: f64,
     pub sim_time: f64,
@@ -71,6 +81,8 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, length: f64, results: &[RowTrial
     cycles.sort_by(f64::total_cmp);
     let sim: f64 = results.iter().map(|t| t.sim_time).sum();
     let wall: f64 = results.iter().map(|t| t.wall_time).sum();
+    let detached: u64 = results.iter().map(|t| t.detached).sum();
+    let unripe_detached: u64 = results.iter().map(|t| t.unripe_detached).sum();
     let clusters: Vec<(u64, u64)> =
         results.iter().filter(|t| t.targets > 0).map(|t| (t.harvested, t.targets)).collect();
     RowSummary {
@@ -92,6 +104,12 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, length: f64, results: &[RowTrial
         cycle_time_p95: percentile(&cycles, 0.95),
         touches_per_fruit: touches,
         dropped: results.iter().map(|t| t.dropped).sum(),
+        perception_in_loop: s.harvest.sight,
+        detached,
+        unripe_detached,
+        unripe_share: if detached == 0 { 0.0 } else { unripe_detached as f64 / detached as f64 },
+        unripe_placed: results.iter().map(|t| t.unripe_placed).sum(),
+        other_ripe_placed: results.iter().map(|t| t.other_ripe_placed).sum(),
         thinking_time_per_fruit: results.iter().map(|t| t.thinking_time).sum::<f64>() / targets.max(1) as f64,
         rtf: if wall > 0.0 { sim / wall } else { 0.0 },
         sim_time: sim,

@@ -5,14 +5,16 @@
 //! contacts come from the world's counters (structure, arm-arm, carried fruit: they end the
 //! segment) and `/collision` (plant touches, counted).
 
-use super::segment::draw_segment;
+use super::segment::{draw_segment, regions_of};
 use crate::framework::Trial;
-use crate::harvest::judge::{base_contact, Touches, COLLISION_COUNTERS};
+use crate::harvest::judge::{base_contact, Aims, DamageLog, Touches, COLLISION_COUNTERS};
 use crate::harvest::session::harvest_session;
+use crate::harvest::targets::RIPE_STAGE;
 use crate::harvest::HarvestSetup;
+use agrisim_bus::Node;
 use agrisim_bus::Reader;
 use agrisim_error::{err, Result};
-use agrisim_harvest::{topics, RowNode};
+use agrisim_harvest::{row, topics, RowNode};
 use agrisim_math::Rng;
 use agrisim_msgs::agrisim::{CollisionState, HarvestStatus, PlanResult};
 use serde::{Deserialize, Serialize};
@@ -23,6 +25,9 @@ use std::time::Instant;
 /// Simulated time a segment may take per fruit, and on top [s].
 pub const TIME_PER_FRUIT: f64 = 90.0;
 pub const TIME_EXTRA: f64 = 60.0;
+/// By sight, simulated time a segment may take per region on top (driving there, the scan
+/// and the scan that finds nothing left) [s].
+pub const TIME_PER_REGION: f64 = 20.0;
 /// How long the judge waits after the last outcome for released fruit to come to rest [s]
 /// (the world settles a fruit still moving after 10 s).
 const SETTLE_LIMIT: f64 = 11.0;
@@ -41,6 +46,18 @@ pub struct RowFruit {
     pub detail: String,
     /// When the world placed it in the box [s].
     pub placed_at: Option<f64>,
+}
+
+/// By sight: one pick the node tried, and the fruit nearest its target then.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct RowAttempt {
+    /// When the node reported its outcome [s].
+    pub at: f64,
+    /// The fruit nearest the target it asked the mapper to allow, its true USDA stage and
+    /// how far the estimate was from its centre [mm]; none when it chose nothing.
+    pub chosen: Option<(u32, u8, f64)>,
+    pub outcome: String,
+    pub failure: Option<String>,
 }
 
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
@@ -67,6 +84,23 @@ pub struct RowTrial {
     /// Plant objects the robot began to touch, by kind.
     pub touches: BTreeMap<String, u64>,
     pub dropped: i64,
+    /// Fruit whose pedicel broke (every pick that took a fruit off its plant).
+    #[serde(default)]
+    pub detached: u64,
+    /// Unripe fruit detached (world ground truth; damage), and unripe fruit in the box.
+    #[serde(default)]
+    pub unripe_detached: u64,
+    #[serde(default)]
+    pub unripe_placed: u64,
+    /// Ripe fruit in the box that were not among the segment's reachable targets.
+    #[serde(default)]
+    pub other_ripe_placed: u64,
+    /// By sight: the node found the fruit itself in regions of the segment.
+    #[serde(default)]
+    pub sight: bool,
+    /// By sight: every pick the node tried.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub attempts: Vec<RowAttempt>,
     /// Simulated planning time the node charged [s].
     pub thinking_time: f64,
     pub fruit: Vec<RowFruit>,
@@ -88,15 +122,30 @@ pub fn run(t: &Trial<HarvestSetup>, mcap: &Path) -> Result<RowTrial> {
     let wall = Instant::now();
     let seg = draw_segment(setup, length, &mut Rng::new(seed))
         .ok_or_else(|| err!("scenario {}: no aisle with reachable ripe fruit", s.path.display()))?;
-    let node = RowNode::new(seg.targets.iter().map(|t| t.fruit_index).collect(), seed);
-    let mut m = harvest_session(t, seg.start, mcap, Box::new(node), None)?;
+    // By sight the node is given the segment's stretches of row, not its fruit.
+    let regions = s.harvest.sight.then(|| regions_of(&seg, &setup.layout));
+    let node: Box<dyn Node> = match &regions {
+        Some(r) => Box::new(RowNode::by_sight(r.clone(), seed)),
+        None => Box::new(RowNode::new(seg.targets.iter().map(|t| t.fruit_index).collect(), seed)),
+    };
+    let mut m = harvest_session(t, seg.start, mcap, node, None)?;
     let (world, chassis) = (m.component("world", "row benchmark")?, m.component("chassis", "row benchmark")?);
     let step = s.timing.step;
-    let timeout = TIME_PER_FRUIT * seg.targets.len() as f64 + TIME_EXTRA;
+    let timeout = TIME_PER_FRUIT * seg.targets.len() as f64
+        + TIME_PER_REGION * regions.as_ref().map_or(0, |r| r.len()) as f64
+        + TIME_EXTRA;
     let max_ticks = (timeout / step).round() as u64;
     let mut statuses = Reader::subscribe(&mut m.bus, topics::STATUS);
     let mut plans = Reader::subscribe(&mut m.bus, topics::PLANS);
     let mut collisions = Reader::subscribe(&mut m.bus, "/collision");
+    let mut damage_reader = Reader::subscribe(&mut m.bus, "/plant_damage");
+    let mut aims = Aims::subscribe(&mut m.bus);
+    let mut damage = DamageLog::default();
+    // By sight: the fruit nearest the node's current target (id, error [m]), its tries, and
+    // whether it has reported the row done.
+    let mut chosen: Option<(u32, f64)> = None;
+    let mut attempts: Vec<RowAttempt> = vec![];
+    let mut finished = false;
     let ids: BTreeSet<u32> = seg.targets.iter().map(|t| t.object_id).collect();
     let mut outcomes: BTreeMap<i32, HarvestStatus> = BTreeMap::new();
     let mut placed: BTreeMap<u32, f64> = BTreeMap::new();
@@ -112,9 +161,24 @@ pub fn run(t: &Trial<HarvestSetup>, mcap: &Path) -> Result<RowTrial> {
             if k % 10 == 1 {
                 path.push([m.number(chassis, "x")?, m.number(chassis, "y")?]);
             }
+            damage.read(&mut damage_reader, &mut m.bus)?;
+            // The target stays the pick's until its outcome is recorded.
+            if let Some(a) = aims.newest(&mut m.bus, &setup.fruit)? {
+                chosen = Some((a.id, a.error));
+            }
             for st in statuses.take::<HarvestStatus>(&mut m.bus)? {
-                if st.outcome == "success" || st.outcome == "failure" {
+                if regions.is_some() && (st.outcome == "success" || st.outcome == "failure") {
+                    attempts.push(RowAttempt {
+                        at: k as f64 * step,
+                        chosen: chosen.map(|(id, e)| (id, setup.fruit[&id].stage, e * 1e3)),
+                        outcome: st.outcome.clone(),
+                        failure: (st.outcome == "failure").then(|| st.failure_category.clone()),
+                    });
+                    chosen = None;
+                } else if st.outcome == "success" || st.outcome == "failure" {
                     outcomes.entry(st.target_id).or_insert(st);
+                } else if regions.is_some() && st.outcome == row::FINISHED {
+                    finished = true;
                 }
             }
             thinking += plans.take::<PlanResult>(&mut m.bus)?.iter().map(|p| p.planning_time).sum::<f64>();
@@ -142,7 +206,11 @@ pub fn run(t: &Trial<HarvestSetup>, mcap: &Path) -> Result<RowTrial> {
             }
             // Done when every fruit has its outcome and every picked fruit has come to rest
             // (placed or dropped), or SETTLE_LIMIT after the last outcome.
-            if seg.targets.iter().all(|t| outcomes.contains_key(&(t.fruit_index as i32))) {
+            let all_told = match regions {
+                Some(_) => finished,
+                None => seg.targets.iter().all(|t| outcomes.contains_key(&(t.fruit_index as i32))),
+            };
+            if all_told {
                 let done_at = *all_done.get_or_insert(k);
                 let resting = m.number(world, "picked_count")? <= n + m.number(world, "dropped_count")?;
                 if resting || (k - done_at) as f64 * step >= SETTLE_LIMIT {
@@ -169,12 +237,17 @@ pub fn run(t: &Trial<HarvestSetup>, mcap: &Path) -> Result<RowTrial> {
         .map(|t| {
             let placed_at = placed.get(&t.object_id).copied();
             let st = outcomes.get(&(t.fruit_index as i32));
-            let failure = match (placed_at, st) {
-                (Some(_), _) => None,
-                (None, Some(st)) if st.outcome == "failure" => Some(st.failure_category.clone()),
+            // By sight: the last pick tried at this fruit.
+            let tried = attempts.iter().rev().find(|a| a.chosen.is_some_and(|c| c.0 == t.object_id));
+            let failure = match (placed_at, st, tried) {
+                (Some(_), _, _) => None,
+                (None, Some(st), _) if st.outcome == "failure" => Some(st.failure_category.clone()),
+                (None, _, Some(a)) => Some(a.failure.clone().unwrap_or_else(|| "placement".into())),
                 // The node believed in success, but the world has not placed it.
-                (None, Some(_)) => Some("placement".into()),
-                (None, None) => Some("not_reached".into()),
+                (None, Some(_), None) => Some("placement".into()),
+                // By sight, a fruit the node never chose in a segment it finished.
+                (None, None, None) if finished => Some("not_detected".into()),
+                (None, None, None) => Some("not_reached".into()),
             };
             RowFruit {
                 fruit_index: t.fruit_index,
@@ -207,6 +280,11 @@ pub fn run(t: &Trial<HarvestSetup>, mcap: &Path) -> Result<RowTrial> {
     times.sort_by(f64::total_cmp);
     let cycle_times: Vec<f64> = times.iter().scan(0.0, |prev, &t| Some(t - std::mem::replace(prev, t))).collect();
     let harvested = times.len() as u64;
+    let targets_ids: BTreeSet<u32> = seg.targets.iter().map(|t| t.object_id).collect();
+    let stage_of = |id: &u32| setup.fruit.get(id).map_or(0, |f| f.stage);
+    let unripe_placed = placed.keys().filter(|id| stage_of(id) < RIPE_STAGE).count() as u64;
+    let other_ripe_placed =
+        placed.keys().filter(|id| stage_of(id) >= RIPE_STAGE && !targets_ids.contains(id)).count() as u64;
     Ok(RowTrial {
         trial: index,
         scene: t.scene,
@@ -223,6 +301,12 @@ pub fn run(t: &Trial<HarvestSetup>, mcap: &Path) -> Result<RowTrial> {
         fruit_per_hour: if sim_time > 0.0 { harvested as f64 * 3600.0 / sim_time } else { 0.0 },
         touches: touches.by_kind,
         dropped: dropped.unwrap_or(0),
+        detached: damage.events.len() as u64,
+        unripe_detached: damage.last.unripe_detached as u64,
+        unripe_placed,
+        other_ripe_placed,
+        sight: regions.is_some(),
+        attempts,
         thinking_time: thinking,
         fruit,
         path,

@@ -122,8 +122,11 @@ impl HarvestNode {
         }
         if self.phase == 0 {
             let heading = if pose.yaw.cos() >= 0.0 { 0.0 } else { std::f64::consts::PI };
-            self.aisle_y = pose.y;
-            self.base_goal = [region.centre()[0], pose.y, heading];
+            // The region reaches from its row's plant line to the aisle's centre line: the
+            // bound nearer the base (a row harvest's base may stand off it after a pick).
+            let [a, b] = region.y;
+            self.aisle_y = if (a - pose.y).abs() <= (b - pose.y).abs() { a } else { b };
+            self.base_goal = [region.centre()[0], self.aisle_y, heading];
             self.base_ctl = crate::base::BaseController::default();
             (self.scan, self.dwell_from, self.in_place_ticks) = (0, None, 0);
             self.phase = 1;
@@ -137,7 +140,7 @@ impl HarvestNode {
         if ((t_ns - since) as f64) < sight::SCAN_DWELL * 1e9 {
             return;
         }
-        if let Some(f) = sight::choose(&self.fruit_map, &region, self.aisle_y) {
+        if let Some(f) = sight::choose(&self.fruit_map, &region, self.aisle_y, &self.tried) {
             self.target_map = Some(f.center);
             self.target_r = f.radius;
             self.track = Some(f.id.clone());
