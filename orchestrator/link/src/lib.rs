@@ -13,6 +13,7 @@
 //! It runs last among the nodes, so the commands it brings reach the FMUs at this very
 //! instant, as a built-in node's would.
 
+use agrisim_bus::ground_truth::is_ground_truth;
 use agrisim_bus::{Bus, Node, Tap};
 use agrisim_error::Result;
 use agrisim_msgs::builtin_interfaces::Time;
@@ -395,10 +396,13 @@ impl<T: Transport> Node for Link<T> {
                 self.await_peers(bus)?;
             }
         }
-        // Everything new on the bus, topic by topic in name order, oldest first.
+        // Everything new on the bus, topic by topic in name order, oldest first. On a bus
+        // sealed from ground truth (a harvest by sight) the world's answers stay in: a peer
+        // may be an external algorithm node, which must not read them either.
         let inbound = &self.inbound_topics;
+        let sealed = bus.is_sealed();
         let mut reliable_written = BTreeSet::new();
-        for (topic, ty, s) in self.tap.take(bus, |t| !inbound.contains(t)) {
+        for (topic, ty, s) in self.tap.take(bus, |t| !inbound.contains(t) && !(sealed && is_ground_truth(t))) {
             if kind_of(&topic, &ty) != Kind::Sensor {
                 reliable_written.insert(topic.clone());
             }
@@ -540,6 +544,16 @@ mod tests {
         let s = l.stats.lock().unwrap().clone();
         assert_eq!((s.received, s.rejected), (0, 1));
         assert!(bus.take_rejected().iter().any(|r| r.contains("/cmd_vel") && r.contains("not a valid")));
+        // A sealed bus (a harvest by sight): ground truth is not sent to the peers.
+        let mut l = link(Some(good.clone()));
+        let mut bus = Bus::default();
+        bus.seal_ground_truth();
+        let pose = agrisim_msgs::geometry_msgs::PoseArray::default();
+        bus.publish("/fruits", 1, &pose);
+        bus.publish("/perception/fruit_map_poses", 1, &pose);
+        l.step(1_000_000, &mut bus).unwrap();
+        let sent: Vec<&str> = l.transport.written.iter().map(|(t, _)| t.as_str()).collect();
+        assert!(sent.contains(&"/perception/fruit_map_poses") && !sent.contains(&"/fruits"), "{sent:?}");
         // No answer: a counted timeout, reported once.
         let mut l = link(None);
         let mut bus = Bus::default();
