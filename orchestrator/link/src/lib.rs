@@ -401,8 +401,9 @@ impl<T: Transport> Node for Link<T> {
         // may be an external algorithm node, which must not read them either.
         let inbound = &self.inbound_topics;
         let sealed = bus.is_sealed();
+        let held = |t: &str| inbound.contains(t) || (sealed && is_ground_truth(t));
         let mut reliable_written = BTreeSet::new();
-        for (topic, ty, s) in self.tap.take(bus, |t| !inbound.contains(t) && !(sealed && is_ground_truth(t))) {
+        for (topic, ty, s) in self.tap.take(bus, |t| !held(t)) {
             if kind_of(&topic, &ty) != Kind::Sensor {
                 reliable_written.insert(topic.clone());
             }
