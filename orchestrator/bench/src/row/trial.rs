@@ -167,18 +167,21 @@ pub fn run(t: &Trial<HarvestSetup>, mcap: &Path) -> Result<RowTrial> {
                 chosen = Some((a.id, a.error));
             }
             for st in statuses.take::<HarvestStatus>(&mut m.bus)? {
-                if regions.is_some() && (st.outcome == "success" || st.outcome == "failure") {
-                    attempts.push(RowAttempt {
-                        at: k as f64 * step,
-                        chosen: chosen.map(|(id, e)| (id, setup.fruit[&id].stage, e * 1e3)),
-                        outcome: st.outcome.clone(),
-                        failure: (st.outcome == "failure").then(|| st.failure_category.clone()),
-                    });
-                    chosen = None;
-                } else if st.outcome == "success" || st.outcome == "failure" {
-                    outcomes.entry(st.target_id).or_insert(st);
-                } else if regions.is_some() && st.outcome == row::FINISHED {
-                    finished = true;
+                let pick_ended = st.outcome == "success" || st.outcome == "failure";
+                match (regions.is_some(), pick_ended) {
+                    (true, true) => {
+                        attempts.push(RowAttempt {
+                            at: k as f64 * step,
+                            chosen: chosen.take().map(|(id, e)| (id, setup.fruit[&id].stage, e * 1e3)),
+                            failure: (st.outcome == "failure").then(|| st.failure_category.clone()),
+                            outcome: st.outcome,
+                        });
+                    }
+                    (false, true) => {
+                        outcomes.entry(st.target_id).or_insert(st);
+                    }
+                    (true, false) => finished |= st.outcome == row::FINISHED,
+                    (false, false) => {}
                 }
             }
             thinking += plans.take::<PlanResult>(&mut m.bus)?.iter().map(|p| p.planning_time).sum::<f64>();
