@@ -14,6 +14,12 @@ bounded in time.
 * A malformed /cmd_vel sample and a sample on a key with a wrong type hash are rejected and
   reported on /agrisim/status; the run goes on to its end.
 * A port in use is a clear error naming the port.
+* A late joiner of the transient-local topics (/tf_static, /robot_description), subscribing as
+  rmw_zenoh does (zenoh-ext AdvancedSubscriber with history) only after the run has published
+  them, gets each byte-equal to the MCAP's record, from the publisher's cache: a plain
+  subscriber declared at the same moment gets nothing; their tokens say transient local.
+* Realtime mode over Zenoh: the /clock the peer receives advances about as its wall clock
+  (not at simulation speed), and its /cmd_vel drives the robot.
 """
 
 from __future__ import annotations
@@ -29,6 +35,7 @@ from rosbags import typesys
 
 import netns
 import rmw_zenoh_wire as w
+import zenoh_node
 from conftest import REPO, agrisim_bin, decoded_messages
 
 PY = sys.executable
@@ -44,10 +51,10 @@ def jazzy_hashes() -> dict[str, str]:
     return {ty: store.hash_rihs01(ty) for ty in TYPES.values()}
 
 
-def run_with_peer(tmp_path: Path, *peer_args: str, duration: float = 3.0, record: str = "full") -> tuple[dict, str, Path]:
+def run_with_peer(tmp_path: Path, *peer_args: str, duration: float = 3.0, record: str = "full", run_args: tuple[str, ...] = ()) -> tuple[dict, str, Path]:
     out = tmp_path / "run"
     cmd = [str(agrisim_bin()), "run", "--scenario", str(REPO / "models/scenarios/default.toml"), "--duration", str(duration), "--record", record,
-           "--zenoh", "--zenoh-listen", ENDPOINT, "--external", "command_script", "--out", str(out)]
+           "--zenoh", "--zenoh-listen", ENDPOINT, "--external", "command_script", *run_args, "--out", str(out)]
     argv = [PY, str(HERE / "zenoh_peer.py"), "--endpoint", ENDPOINT, "--timeout", "150", *peer_args, "--", *cmd]
     r = netns.run(argv, timeout=200, capture_output=True, text=True)
     assert r.returncode == 0, r.stdout + r.stderr
@@ -156,3 +163,58 @@ def test_external_navigator_over_zenoh(exact_odometry, tmp_path):  # noqa: F811
     recorded = decoded_messages(out / "trials/0000.mcap", "/points")
     assert len(recorded) >= 5
     assert sum(f"{m.header.stamp.sec}.{m.header.stamp.nanosec:09d}" in received for _, _, m in recorded) >= len(recorded) - 1
+
+
+LATCHED = {"/tf_static": "tf2_msgs/msg/TFMessage", "/robot_description": "std_msgs/msg/String"}
+
+
+def test_a_late_joiner_gets_the_transient_local_topics_from_the_cache(tmp_path):
+    """RViz over rmw_zenoh started after the run: its TRANSIENT_LOCAL subscriptions (zenoh-ext
+    AdvancedSubscribers with history, declared at the 6th /clock, when /tf_static and
+    /robot_description went out long before) get the run's one message on each from the
+    AdvancedPublisher's cache, on the topic's key, with the run's attachment."""
+    late = [f"--late={t}={ty}" for t, ty in LATCHED.items()]
+    peer, err, out = run_with_peer(tmp_path, "--drive", "0.3", "--late-after", "6", *late)
+    assert peer["late_at_tick"] == 6, peer["late_at_tick"]
+    mcap = out / "run.mcap"
+    for topic, ty in LATCHED.items():
+        recorded = raw_records(mcap, topic)
+        # Published at the first instant only (so only a cache can serve them 0.5 s later):
+        # /robot_description once, /tf_static twice (the robot's statics, then those with
+        # map -> odom: the last holds every static transform, keep last 1 suffices).
+        times = [t for _, t, _ in decoded_messages(mcap, topic)]
+        assert len(recorded) == {"/tf_static": 2, "/robot_description": 1}[topic] and set(times) == {0}, (topic, times)
+        got = peer["late"][topic]
+        # The last one (depth 1), byte for byte, on the topic's key, with the run's attachment.
+        assert [bytes.fromhex(x["payload"]) for x in got] == recorded[-1:], (topic, len(got))
+        assert w.parse_topic_key(got[0]["key"]) == (0, topic, w.dds_type(ty), zenoh_node.type_hash(ty)), got[0]["key"]
+        a = w.Attachment.decode(bytes.fromhex(got[0]["attachment"]))
+        assert 1 <= a.sequence <= len(recorded) and len(a.gid) == 16, (topic, a)
+        # The control: a plain subscriber joining at the same moment hears nothing.
+        assert peer["late_plain"][topic] == [], (topic, peer["late_plain"][topic])
+    # Their publishers' tokens: reliable, transient local, keep last 1 (as over DDS).
+    pubs = {t.topic: t for t in map(w.parse_token, peer["tokens"]) if t.kind == "MP" and t.node == "agrisim"}
+    for topic in LATCHED:
+        assert pubs[topic].qos == {"reliability": 1, "durability": 1, "history": 1, "depth": 1}, pubs[topic].qos
+    assert pubs["/odom"].qos["durability"] == 2, pubs["/odom"].qos
+    assert "Zenoh bridge: " in err and "0 rejected" in err, err
+
+
+def test_realtime_mode_over_zenoh(tmp_path):
+    """`--zenoh-mode realtime`: the run keeps pace with the wall clock (over the ~3 s the peer
+    hears /clock, simulated time advances between 0.5x and 1.5x the wall time the peer measures;
+    unpaced, in lockstep with this peer, it ran 4x faster here), nobody is waited for, and the peer's
+    /cmd_vel, taken at the instants it arrives, drives the robot."""
+    peer, err, out = run_with_peer(tmp_path, "--drive", "0.3", duration=3.5, record="standard",
+                                   run_args=("--zenoh-mode", "realtime", "--zenoh-rate", "1"))
+    clock = peer["clock"]
+    assert len(clock) > 20, len(clock)
+    wall = clock[-1][0] - clock[0][0]
+    sim = (clock[-1][1] - clock[0][1]) / 1e9
+    assert sim > 2.0 and 0.5 < sim / wall < 1.5, (sim, wall)
+    cmds = decoded_messages(out / "run.mcap", "/cmd_vel")
+    assert len(cmds) > 10 and all(abs(m.linear.x - 0.3) < 1e-12 for _, _, m in cmds), len(cmds)
+    odom = decoded_messages(out / "run.mcap", "/odom")
+    assert odom[-1][2].pose.pose.position.x - odom[0][2].pose.pose.position.x > 0.3
+    # The summary names the link; realtime has no lockstep round trips.
+    assert "Zenoh bridge: " in err and "ros2 bridge" not in err and "0 lockstep timeouts" in err, err

@@ -275,6 +275,7 @@ fn total(stats: &Arc<Mutex<Vec<Arc<Mutex<Stats>>>>>) -> Option<Stats> {
     let mut t = Stats::default();
     for s in all.iter() {
         let s = s.lock().expect("stats lock");
+        t.link = s.link;
         t.published += s.published;
         t.published_bytes += s.published_bytes;
         t.received += s.received;
@@ -310,15 +311,17 @@ pub fn report(stats: &Arc<Mutex<Vec<Arc<Mutex<Stats>>>>>, file: Option<&std::pat
         let topics: serde_json::Map<String, serde_json::Value> =
             t.topics.iter().map(|(k, (n, b))| (k.clone(), serde_json::json!({"messages": n, "bytes": b}))).collect();
         let v = serde_json::json!({
-            "instants": t.instants, "published": t.published, "published_bytes": t.published_bytes,
+            "link": t.link, "instants": t.instants, "published": t.published, "published_bytes": t.published_bytes,
             "received": t.received, "rejected": t.rejected, "lockstep_timeouts": t.lockstep_timeouts,
             "waited_s": t.waited, "round_trip_ms": {"n": rt.len(), "p50": p50, "p99": p99, "max": max}, "topics": topics,
         });
         std::fs::write(f, serde_json::to_string_pretty(&v).expect("plain value"))
             .map_err(|e| err!("cannot write {}: {e}", f.display()))?;
     }
+    // Named by its link: "ROS 2 bridge: ..." (DDS) or "Zenoh bridge: ..." (one kind per run).
     let mut line = format!(
-        "ros2 bridge: {} instants, {} messages ({:.1} MB) published, {} received, {} rejected, {} lockstep timeouts, {:.2} s waiting",
+        "{}: {} instants, {} messages ({:.1} MB) published, {} received, {} rejected, {} lockstep timeouts, {:.2} s waiting",
+        t.link,
         t.instants,
         t.published,
         t.published_bytes as f64 / 1e6,

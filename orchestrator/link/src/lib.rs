@@ -38,6 +38,8 @@ pub enum Mode {
 /// What crossed the link (for reports and benchmarks).
 #[derive(Clone, Debug, Default)]
 pub struct Stats {
+    /// Which link: its label ("ROS 2 bridge", "Zenoh bridge").
+    pub link: &'static str,
     pub published: u64,
     pub published_bytes: u64,
     pub received: u64,
@@ -263,7 +265,7 @@ impl<T: Transport> Link<T> {
     /// The link; the returned handle's [`Stats`] fill in as the run goes.
     pub fn new(transport: T, config: LinkConfig) -> Result<(Link<T>, Arc<Mutex<Stats>>)> {
         config.validate()?;
-        let stats = Arc::new(Mutex::new(Stats::default()));
+        let stats = Arc::new(Mutex::new(Stats { link: config.label, ..Stats::default() }));
         let link = Link {
             transport,
             inbound_topics: config.inbound.iter().map(|i| i.topic.clone()).collect(),

@@ -3,6 +3,11 @@
 //! subscriber per inbound topic, liveliness tokens for the node and each of them. What it
 //! does at each message instant (pacing, lockstep, checks, stats) is agrisim-link's [`Link`],
 //! shared with the DDS bridge.
+//!
+//! Transient-local topics (those agrisim-link's [`kind_of`] calls [`Kind::Latched`], the
+//! same decision the DDS bridge takes: /robot_description, /tf_static, /map, the scene's
+//! markers) are published as rmw_zenoh publishes for a TRANSIENT_LOCAL publisher, so a
+//! viewer started after the run (RViz over rmw_zenoh) still gets them; see [`Writer`].
 
 use crate::wire::{self, Attachment, Entity, Qos};
 use agrisim_bus::{Bus, Node};
@@ -18,6 +23,7 @@ use zenoh::pubsub::{Publisher, Subscriber};
 use zenoh::qos::CongestionControl;
 use zenoh::sample::{Sample, SampleKind};
 use zenoh::{Session, Wait};
+use zenoh_ext::{AdvancedPublisher, AdvancedPublisherBuilderExt, CacheConfig, MissDetectionConfig};
 
 /// Where the session listens by default: loopback, rmw_zenoh's router port.
 pub const DEFAULT_LISTEN: &str = "tcp/127.0.0.1:7447";
@@ -38,8 +44,35 @@ pub struct ZenohConfig {
     pub multicast_scouting: bool,
 }
 
+/// How a topic's samples leave: a plain publisher, or, for a transient-local topic, a
+/// zenoh-ext AdvancedPublisher that keeps the topic's last `depth` samples for late joiners.
+///
+/// This follows rmw_zenoh_cpp's `PublisherData::make` in
+/// `rmw_zenoh_cpp/src/detail/rmw_publisher_data.cpp` (ros2/rmw_zenoh, rolling at commit
+/// 3e19ec7: zenoh-cpp 1.x, `session->ext().declare_advanced_publisher`): for
+/// durability TRANSIENT_LOCAL it turns on publisher detection (a liveliness token under
+/// `<key>/@adv/pub/...` that AdvancedSubscribers with `detect_late_publishers` watch), a cache
+/// of `depth` samples (the QoS history depth) that answers their history queries, and, when
+/// the publisher is RELIABLE too, sample miss detection with a sporadic heartbeat every
+/// 500 ms (its SAMPLE_MISS_DETECTION_HEARTBEAT_PERIOD), which also gives the samples the
+/// per-publisher sequence numbers the subscribers order history by (so the session needs no
+/// timestamping). Its subscriptions of TRANSIENT_LOCAL topics (rmw_subscription_data.cpp)
+/// are AdvancedSubscribers with history (`max_samples` = depth, late publisher detection)
+/// and, when reliable, heartbeat recovery. Older rmw_zenoh (rolling in October 2024, commit
+/// bfc065f) declared a publication cache and querying subscribers instead; this is the newer
+/// scheme. Volatile topics keep a plain publisher (rmw_zenoh's advanced publisher with every
+/// option off is one), so sensor streams pay nothing for it.
+enum Outlet {
+    Plain(Publisher<'static>),
+    Cached(AdvancedPublisher<'static>),
+}
+
+/// rmw_zenoh's heartbeat period of a reliable transient-local publisher's sample miss
+/// detection (rmw_publisher_data.cpp, SAMPLE_MISS_DETECTION_HEARTBEAT_PERIOD).
+const MISS_DETECTION_HEARTBEAT: Duration = Duration::from_millis(500);
+
 struct Writer {
-    publisher: Publisher<'static>,
+    publisher: Outlet,
     gid: [u8; 16],
     sequence: i64,
     _token: LivelinessToken,
@@ -213,14 +246,24 @@ impl Zenoh {
             let kind = kind_of(topic, ros_type);
             let congestion =
                 if kind == Kind::Sensor && !self.lockstep { CongestionControl::Drop } else { CongestionControl::Block };
-            let publisher = self
-                .session
-                .declare_publisher(key.clone())
-                .congestion_control(congestion)
-                .wait()
-                .map_err(|e| z_err(&format!("publisher {key}"), e))?;
-            let (token_key, token) =
-                self.token(Entity::Publisher { topic: &name, ros_type, qos: Qos::writer(kind) })?;
+            let qos = Qos::writer(kind);
+            let builder = self.session.declare_publisher(key.clone()).congestion_control(congestion);
+            let publisher = if qos.transient_local {
+                // Keep last N (N from the QoS); a keep-all transient-local writer would keep
+                // everything, which agrisim has none of.
+                let depth = qos.keep_last.unwrap_or(1).max(1) as usize;
+                let mut b = builder.cache(CacheConfig::default().max_samples(depth)).publisher_detection();
+                if !qos.best_effort {
+                    b = b.sample_miss_detection(
+                        MissDetectionConfig::default().sporadic_heartbeat(MISS_DETECTION_HEARTBEAT),
+                    );
+                }
+                b.wait().map(Outlet::Cached)
+            } else {
+                builder.wait().map(Outlet::Plain)
+            }
+            .map_err(|e| z_err(&format!("publisher {key}"), e))?;
+            let (token_key, token) = self.token(Entity::Publisher { topic: &name, ros_type, qos })?;
             self.writers.insert(
                 topic.to_string(),
                 Writer { publisher, gid: wire::gid(&token_key), sequence: 0, _token: token },
@@ -246,11 +289,11 @@ impl Transport for Zenoh {
         let w = self.writer(topic, ros_type)?;
         w.sequence += 1;
         let att = Attachment { sequence: w.sequence, timestamp_ns: now_ns(), gid: w.gid };
-        w.publisher
-            .put(cdr.to_vec())
-            .attachment(att.encode())
-            .wait()
-            .map_err(|e| z_err(&format!("publishing on {topic}"), e))
+        match &w.publisher {
+            Outlet::Plain(p) => p.put(cdr.to_vec()).attachment(att.encode()).wait(),
+            Outlet::Cached(p) => p.put(cdr.to_vec()).attachment(att.encode()).wait(),
+        }
+        .map_err(|e| z_err(&format!("publishing on {topic}"), e))
     }
 
     fn poll(&mut self, out: &mut Vec<Arrival>) {
