@@ -246,4 +246,6 @@ fn a_harvest_by_sight_is_sealed_from_ground_truth() {
         "fruit {id} stage {stage} at {c:?}, region {r:?}"
     );
     assert!(t.target_error_mm.unwrap() < 15.0, "{:?}", t.target_error_mm);
+    // The seeing nodes charged their compute (their outputs waited for it).
+    assert!(t.perception_time > 1.0 && t.mapping_time > 1.0, "{} {}", t.perception_time, t.mapping_time);
 }

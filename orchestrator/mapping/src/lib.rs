@@ -22,6 +22,7 @@
 //! come from messages (the URDF, TF from the joint states, the fruit the harvest node
 //! grasps), never world outputs.
 
+pub mod cost;
 pub mod depth;
 pub mod map;
 pub mod node;
@@ -29,9 +30,10 @@ pub mod ray;
 pub mod robot;
 pub mod shape;
 
+pub use cost::{CostModel, MapWork};
 pub use depth::{DepthFrame, Intrinsics};
 pub use map::{MapConfig, Occupancy, OccupancyMap, ScanStats, VoxelBox, OCCUPIED_KIND};
-pub use node::{CameraTopics, DepthMapper, MapperConfig};
+pub use node::{CameraTopics, Charged, DepthMapper, MapperConfig};
 pub use ray::{Grid, Key};
 pub use robot::RobotShapes;
 pub use shape::{Primitive, Shape, Sphere};

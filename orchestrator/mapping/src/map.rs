@@ -126,6 +126,12 @@ pub struct ScanStats {
     /// Voxels updated as hits and as misses.
     pub hits: usize,
     pub misses: usize,
+    /// Work counted for the node's compute charge (deterministic): voxels stepped through by
+    /// the rays' walks, cells of the scan's dense mark grid (cleared and swept; 0 when the
+    /// scan is marked sparsely), and self-filter bound tests (in-range points times links).
+    pub ray_steps: usize,
+    pub dense_cells: usize,
+    pub self_tests: usize,
 }
 
 /// A box of voxels, both corners included.
@@ -284,6 +290,7 @@ impl OccupancyMap {
         let (mut lo, mut hi) = (ko, ko);
         for p in points {
             let (end, kind) = if range(origin, p) <= max_range {
+                stats.self_tests += links.len();
                 let q = Point3::new(p[0] as f64, p[1] as f64, p[2] as f64);
                 let on_robot = links
                     .iter()
@@ -324,9 +331,10 @@ impl OccupancyMap {
         };
         let n = [0, 1, 2].map(|i| (vhi[i] - vlo[i] + 1) as usize);
         if n[0] * n[1] * n[2] <= self.dense_limit {
-            self.mark_dense(origin, &rays, vlo, n, &mut t);
+            stats.dense_cells = n[0] * n[1] * n[2];
+            stats.ray_steps = self.mark_dense(origin, &rays, vlo, n, &mut t);
         } else {
-            self.mark_sparse(origin, &rays, &mut t);
+            stats.ray_steps = self.mark_sparse(origin, &rays, &mut t);
         }
         // Apply the marks: one update per voxel per scan.
         let (hit, miss, lo, hi, thr) = (self.hit, self.miss, self.lo, self.hi, self.threshold);
@@ -355,7 +363,8 @@ impl OccupancyMap {
 
     /// Marks a scan straight into the chunks: end voxels first (robot over hit as MoveIt,
     /// hit over free as OctoMap), then every ray's walk.
-    fn mark_sparse(&mut self, origin: &[f32; 3], rays: &[([f32; 3], u8)], t: &mut Table) {
+    /// Returns the voxels the walks stepped through.
+    fn mark_sparse(&mut self, origin: &[f32; 3], rays: &[([f32; 3], u8)], t: &mut Table) -> usize {
         for (end, kind) in rays {
             if *kind == FREE {
                 continue;
@@ -367,19 +376,30 @@ impl OccupancyMap {
             }
         }
         let grid = self.grid;
+        let mut steps = 0;
         for (end, _) in rays {
             grid.walk(origin, end, |k| {
+                steps += 1;
                 let m = self.mark(t, &k);
                 if *m == 0 {
                     *m = FREE;
                 }
             });
         }
+        steps
     }
 
     /// The same marks, made in a dense byte grid over the scan's extent (`n` voxels from
     /// `lo`; one add and a byte per step of the walks) and then moved into the chunks.
-    fn mark_dense(&mut self, origin: &[f32; 3], rays: &[([f32; 3], u8)], lo: Key, n: [usize; 3], t: &mut Table) {
+    /// Returns the voxels the walks stepped through.
+    fn mark_dense(
+        &mut self,
+        origin: &[f32; 3],
+        rays: &[([f32; 3], u8)],
+        lo: Key,
+        n: [usize; 3],
+        t: &mut Table,
+    ) -> usize {
         let mut g = std::mem::take(&mut self.scratch);
         g.clear();
         g.resize(n[0] * n[1] * n[2], 0);
@@ -389,6 +409,7 @@ impl OccupancyMap {
                 .then(|| (d[2] as usize * n[1] + d[1] as usize) * n[0] + d[0] as usize)
         };
         let mut outside = Vec::new();
+        let mut steps = 0;
         for (end, kind) in rays {
             if *kind == FREE {
                 continue;
@@ -402,12 +423,16 @@ impl OccupancyMap {
         for (end, _) in rays {
             self.grid.walk(origin, end, |k| match at(&k) {
                 Some(i) => {
+                    steps += 1;
                     if g[i] == 0 {
                         g[i] = FREE;
                     }
                 }
                 // Walks stay within a voxel of their ends; kept exact all the same.
-                None => outside.push(k),
+                None => {
+                    steps += 1;
+                    outside.push(k)
+                }
             });
         }
         for z in 0..n[2] {
@@ -431,6 +456,7 @@ impl OccupancyMap {
             }
         }
         self.scratch = g;
+        steps
     }
 
     /// The mark of voxel `k` in this scan, its chunk created if new.

@@ -15,10 +15,23 @@
 //! centre and half its largest side are a sphere; the latest message holds, an empty one
 //! clears. [`DepthMapper::set_allowed`] sets them from Rust until the next message.
 //!
+//! Compute is charged in simulated time ([`CostModel`], as the harvest node charges its
+//! planning): a frame's integration occupies the node for the frame's cost, and a scene that
+//! holds it goes out only once the simulated time has passed that (stamped, as before, with
+//! the newest frame in it). While the node is busy, newer frames wait; of each camera only
+//! the frames of its latest message instant are kept (older waiting ones are dropped, as a
+//! node that cannot keep up drops them). Resolution: nodes step at the bus's message
+//! instants (every 1 / `timing.message_rate`, 0.1 s in the scenarios), so a scene appears at
+//! the first message instant at or after its frames' finish: the delay is the cost rounded
+//! up to that period, while the busy time itself is not rounded (the next frame starts when
+//! the last finished, or when it arrived if later). [`CostModel::FREE`] (the default) puts
+//! every frame in the scene of the step it arrives at.
+//!
 //! The node reads no world output. A frame it cannot use (no CameraInfo yet, no TF from the
 //! camera to the map frame, a malformed image) is skipped and reported on /agrisim/status,
 //! never an error of the run.
 
+use crate::cost::{CostModel, MapWork};
 use crate::depth::{DepthFrame, Intrinsics};
 use crate::map::{MapConfig, OccupancyMap, ScanStats};
 use crate::robot::RobotShapes;
@@ -35,6 +48,9 @@ use agrisim_msgs::vision_msgs::Detection3DArray;
 use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion};
 use std::collections::BTreeMap;
 use std::collections::BTreeSet;
+use std::collections::VecDeque;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 
 /// The default camera's topics (namespace `/camera`).
 pub const DEPTH: &str = "/camera/aligned_depth_to_color/image_raw";
@@ -164,10 +180,36 @@ struct Camera {
     depth: Reader,
     info_seen: u64,
     info: Option<(String, u32, u32, Intrinsics)>,
+    /// Frames not yet taken up, with the step they arrived at [ns].
+    waiting: Vec<(Image, i64)>,
+}
+
+/// Simulated compute time a node charged so far [s], readable by its owner after the node is
+/// boxed (the benchmark's per-trial totals).
+#[derive(Clone, Debug, Default)]
+pub struct Charged(Arc<AtomicU64>);
+
+impl Charged {
+    pub fn seconds(&self) -> f64 {
+        f64::from_bits(self.0.load(Ordering::Relaxed))
+    }
+    fn add(&self, s: f64) {
+        self.0.store((self.seconds() + s).to_bits(), Ordering::Relaxed);
+    }
 }
 
 pub struct DepthMapper {
     config: MapperConfig,
+    cost: CostModel,
+    /// When the node is free for the next frame [ns] (simulated).
+    free_at: i64,
+    /// Scenes computed, with when they may go out [ns], in that order.
+    pending: VecDeque<(i64, PlanningScene)>,
+    charged: Charged,
+    /// The work of every frame integrated so far.
+    pub work: MapWork,
+    /// Frames replaced by newer ones of their camera while the node was busy.
+    pub dropped: u64,
     map: OccupancyMap,
     tf: TfTree,
     tf_reader: Reader,
@@ -203,11 +245,23 @@ impl DepthMapper {
         let cameras = config
             .cameras
             .iter()
-            .map(|c| Camera { topics: c.clone(), depth: Reader::new(&c.depth), info_seen: 0, info: None })
+            .map(|c| Camera {
+                topics: c.clone(),
+                depth: Reader::new(&c.depth),
+                info_seen: 0,
+                info: None,
+                waiting: Vec::new(),
+            })
             .collect();
         Ok(DepthMapper {
             map: OccupancyMap::new(config.map.clone())?,
             config,
+            cost: CostModel::FREE,
+            free_at: i64::MIN,
+            pending: VecDeque::new(),
+            charged: Charged::default(),
+            work: MapWork::default(),
+            dropped: 0,
             tf: TfTree::default(),
             tf_reader: Reader::new(TF),
             tf_static_reader: Reader::new(TF_STATIC),
@@ -225,6 +279,18 @@ impl DepthMapper {
             scene_due: false,
             last_scene_ns: None,
         })
+    }
+
+    /// Charges compute with `cost` (default [`CostModel::FREE`]; the harvest-by-sight
+    /// benchmark uses [`CostModel::CALIBRATED`]).
+    pub fn with_cost(mut self, cost: CostModel) -> DepthMapper {
+        self.cost = cost;
+        self
+    }
+
+    /// The simulated compute time charged so far, readable after the node is boxed.
+    pub fn charged(&self) -> Charged {
+        self.charged.clone()
     }
 
     /// Robot primitives in the map frame filtered out of the coming frames besides the links
@@ -315,6 +381,7 @@ impl DepthMapper {
         let robot: Vec<Primitive> =
             self.robot.iter().filter(|p| in_view(p, &pose, &k, (w, h), reach)).copied().collect();
         let stats = self.map.insert_depth_every(&frame, &k, &pose, &robot, self.config.pixel_stride);
+        self.work += MapWork::of_scan(w as u64 * h as u64, &stats);
         self.frames += 1;
         self.last = stats;
         self.newest = self.newest.max(Some(depth.header.stamp));
@@ -402,7 +469,6 @@ impl Node for DepthMapper {
             self.map.set_allowed(spheres);
             allowed_changed = true;
         }
-        let mut frames: Vec<(Time, usize, Image)> = Vec::new();
         for i in 0..self.cameras.len() {
             let info_topic = self.cameras[i].topics.camera_info.clone();
             let mut seen = self.cameras[i].info_seen;
@@ -419,32 +485,61 @@ impl Node for DepthMapper {
                 }
             }
             let images = self.cameras[i].depth.take::<Image>(bus)?;
-            frames.extend(images.into_iter().map(|d| (d.header.stamp, i, d)));
-        }
-        // Oldest first (ties by camera, then arrival): the later view clears over the earlier.
-        frames.sort_by_key(|(stamp, i, _)| (*stamp, *i));
-        let mut integrated = 0;
-        if !frames.is_empty() {
-            let fresh = self.place_robot();
-            if !fresh.is_empty() {
-                let msg = format!(
-                    "self-filter: no TF from {} to {}; left out until it appears",
-                    fresh.join(", "),
-                    self.config.map_frame
-                );
-                self.status(bus, t_ns, msg);
+            if !images.is_empty() {
+                let c = &mut self.cameras[i];
+                self.dropped += c.waiting.len() as u64;
+                c.waiting = images.into_iter().map(|d| (d, t_ns)).collect();
             }
         }
-        for (_, i, depth) in frames {
+        // Oldest first (ties by camera, then arrival): the later view clears over the earlier;
+        // while the node is free.
+        let mut integrated = 0;
+        let mut placed = false;
+        while self.free_at <= t_ns {
+            let next = (self.cameras.iter().enumerate())
+                .flat_map(|(i, c)| c.waiting.iter().enumerate().map(move |(j, (d, _))| (d.header.stamp, i, j)))
+                .min();
+            let Some((_, i, j)) = next else { break };
+            let (depth, arrived) = self.cameras[i].waiting.remove(j);
+            if !placed {
+                placed = true;
+                let fresh = self.place_robot();
+                if !fresh.is_empty() {
+                    let msg = format!(
+                        "self-filter: no TF from {} to {}; left out until it appears",
+                        fresh.join(", "),
+                        self.config.map_frame
+                    );
+                    self.status(bus, t_ns, msg);
+                }
+            }
+            let before = self.work;
             match self.integrate(i, &depth) {
                 Ok(_) => integrated += 1,
                 Err(e) => self.skip(bus, t_ns, e),
             }
+            let cost = self.cost.seconds(&(self.work - before));
+            self.charged.add(cost);
+            self.free_at = self.free_at.max(arrived) + (cost * 1e9).ceil() as i64;
         }
         if integrated > 0 {
             self.last_status.clear();
         }
         self.scene_due |= integrated > 0 || allowed_changed;
+        self.export(bus, t_ns);
+        while self.pending.front().is_some_and(|(at, _)| *at <= t_ns) {
+            let (_, scene) = self.pending.pop_front().expect("front");
+            let topic = self.config.scene_topic.clone();
+            bus.publish(&topic, t_ns, &scene);
+        }
+        Ok(())
+    }
+}
+
+impl DepthMapper {
+    /// The scene, when due and the period allows, queued to go out once the frames in it are
+    /// done.
+    fn export(&mut self, bus: &mut Bus, t_ns: i64) {
         let period_ns = (self.config.scene_period * 1e9) as i64;
         let ready = self.last_scene_ns.is_none_or(|last| t_ns - last >= period_ns);
         if let Some(stamp) = self.newest.filter(|_| self.scene_due && ready) {
@@ -461,15 +556,13 @@ impl Node for DepthMapper {
                     None => {
                         let why = format!("scene not exported: no TF from {frame} to {}", self.config.map_frame);
                         self.status(bus, t_ns, why);
-                        return Ok(());
+                        return;
                     }
                 }
             }
-            let topic = self.config.scene_topic.clone();
-            bus.publish(&topic, t_ns, &scene);
+            self.pending.push_back((self.free_at.max(t_ns), scene));
             (self.scene_due, self.last_scene_ns) = (false, Some(t_ns));
         }
-        Ok(())
     }
 }
 

@@ -361,3 +361,63 @@ fn every_link_of_the_project_robot_is_placed_from_robot_state_publisher() {
         node.robot_links().iter().filter(|p| (p.pose.translation.vector - V3::new(2.0, 0.5, 0.0)).norm() < 1.0);
     assert!(near_base.count() > 5);
 }
+
+/// Depth frames of a wall 1 m ahead stamped 0, 0.1 and 0.2 s, each published at its stamp;
+/// the node stepped every 0.1 s (the bus's message instants) to 0.6 s. Returns (step,
+/// stamp) of every scene published, and the node.
+fn charged_run(cost: agrisim_mapping::CostModel) -> (Vec<(i64, i64)>, DepthMapper) {
+    const STEP: i64 = 100_000_000;
+    let mut bus = Bus::default();
+    let mut node = DepthMapper::new(MapperConfig::default()).unwrap().with_cost(cost);
+    let mut reader = Reader::subscribe(&mut bus, SCENE);
+    bus.publish(TF_STATIC, 0, &tf("map", "optical", &camera([0.005, 0.0, 1.0], true)));
+    bus.publish(agrisim_mapping::node::CAMERA_INFO, 0, &info("optical"));
+    let mut out = vec![];
+    for k in 0..=6 {
+        let t = k * STEP;
+        if k <= 2 {
+            bus.publish(agrisim_mapping::node::DEPTH, t, &image("optical", t, |_, _| 1.0));
+        }
+        node.step(t, &mut bus).unwrap();
+        out.extend(scenes(&mut reader, &mut bus).into_iter().map(|s| (t, s.header.stamp.to_nanos())));
+    }
+    (out, node)
+}
+
+#[test]
+fn the_scene_waits_for_the_modelled_compute() {
+    use agrisim_mapping::CostModel;
+    const STEP: i64 = 100_000_000;
+    // 0.25 s per frame: frame 0 is done at 0.25 s, its scene out at the step of 0.3 s; frame
+    // 0.1 s is replaced while waiting by frame 0.2 s, taken up at 0.25 s, done at 0.5 s.
+    let cost = CostModel { per_pixel: 0.25 / (W * H) as f64, ..CostModel::FREE };
+    let (out, node) = charged_run(cost);
+    assert_eq!(out, [(3 * STEP, 0), (5 * STEP, 2 * STEP)]);
+    assert_eq!((node.frames, node.dropped), (2, 1));
+    assert!((node.charged().seconds() - 0.5).abs() < 1e-9, "{}", node.charged().seconds());
+    // Charged by the rays' walks alone: the same timing when they cost the same.
+    let steps = node.work.ray_steps as f64 / 2.0;
+    let (by_steps, _) = charged_run(CostModel { per_ray_step: 0.25 / steps, ..CostModel::FREE });
+    assert_eq!(by_steps, out);
+    // Free compute: every frame in the scene of its step, none dropped, nothing charged.
+    let (out, free) = charged_run(CostModel::FREE);
+    assert_eq!(out, [(0, 0), (STEP, STEP), (2 * STEP, 2 * STEP)]);
+    assert_eq!((free.frames, free.dropped, free.charged().seconds()), (3, 0, 0.0));
+    // The work is counted deterministically: three identical frames, three times the work of
+    // one (the first frame's walks clear the same voxels the others do).
+    let (_, one) = {
+        let mut bus = Bus::default();
+        let mut n = DepthMapper::new(MapperConfig::default()).unwrap();
+        bus.publish(TF_STATIC, 0, &tf("map", "optical", &camera([0.005, 0.0, 1.0], true)));
+        bus.publish(agrisim_mapping::node::CAMERA_INFO, 0, &info("optical"));
+        bus.publish(agrisim_mapping::node::DEPTH, 0, &image("optical", 0, |_, _| 1.0));
+        n.step(0, &mut bus).unwrap();
+        ((), n)
+    };
+    let w = one.work;
+    assert!(w.ray_steps > (W * H) as u64 && w.points == (W * H) as u64, "{w:?}");
+    assert_eq!(
+        (free.work.pixels, free.work.points, free.work.ray_steps, free.work.dense_cells),
+        (3 * w.pixels, 3 * w.points, 3 * w.ray_steps, 3 * w.dense_cells)
+    );
+}

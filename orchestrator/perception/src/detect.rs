@@ -4,6 +4,7 @@
 use crate::colour::{classify, FruitColour, Linearize};
 use crate::ripeness::{ripeness, stage_shares, surface_below, Ripeness};
 use crate::sphere::{fit_sphere, SphereBounds};
+use std::cell::Cell;
 
 /// Pinhole intrinsics (CameraInfo's K).
 pub use agrisim_msgs::sensor_msgs::Pinhole as Intrinsics;
@@ -76,6 +77,33 @@ pub struct Detection {
     pub bbox: [usize; 4],
 }
 
+/// The work one frame took, counted (deterministic: the same frame to detectors with the
+/// same history gives the same counts), so the node can charge its compute in simulated time
+/// ([`crate::cost::CostModel`]) without reading a clock.
+#[derive(Default, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DetectWork {
+    /// Pixels of the frame scanned (depth decoded, depth range and colour memo looked up).
+    pub pixels: u64,
+    /// Colours converted to CIELAB and tested (the memo's misses: many at a run's start).
+    pub conversions: u64,
+    /// Fruit-coloured pixels with depth, flooded into segments.
+    pub candidates: u64,
+    /// Points handed to sphere fits (first fits, joint fits of parts, refits after growing).
+    pub fit_points: u64,
+    /// Pixels tested against a fitted sphere's surface (growing and ripeness).
+    pub surface_tests: u64,
+}
+
+impl std::ops::AddAssign for DetectWork {
+    fn add_assign(&mut self, o: DetectWork) {
+        self.pixels += o.pixels;
+        self.conversions += o.conversions;
+        self.candidates += o.candidates;
+        self.fit_points += o.fit_points;
+        self.surface_tests += o.surface_tests;
+    }
+}
+
 /// Everything a frame gave, for the node's status and the benchmarks.
 #[derive(Default, Debug)]
 pub struct FrameResult {
@@ -84,6 +112,8 @@ pub struct FrameResult {
     pub valid_depth: usize,
     /// Segments refused by the fit (too flat, too big, too few inliers).
     pub rejected: usize,
+    /// The work it took.
+    pub work: DetectWork,
 }
 
 /// The detector with its tables, reused across frames.
@@ -99,6 +129,9 @@ pub struct Detector {
     mask: Vec<u8>,
     label: Vec<u32>,
     stack: Vec<usize>,
+    /// Points fitted and surface pixels tested in the current frame (counted from `&self`).
+    fit_points: Cell<u64>,
+    surface_tests: Cell<u64>,
 }
 
 impl Detector {
@@ -111,6 +144,8 @@ impl Detector {
             mask: vec![],
             label: vec![],
             stack: vec![],
+            fit_points: Cell::new(0),
+            surface_tests: Cell::new(0),
         }
     }
 
@@ -121,6 +156,9 @@ impl Detector {
         if f.rgb.len() < n * 3 || f.depth.len() < n || n == 0 {
             return out;
         }
+        self.fit_points.set(0);
+        self.surface_tests.set(0);
+        out.work.pixels = n as u64;
         let c = self.config.clone();
         if self.memo_for != Some(c.colour) {
             self.colour_memo.clear();
@@ -142,11 +180,13 @@ impl Detector {
             let key = (px[0] as usize) << 16 | (px[1] as usize) << 8 | px[2] as usize;
             let mut answer = self.colour_memo[key];
             if answer == 0 {
+                out.work.conversions += 1;
                 answer = if c.colour.accepts(self.lin.lab(px)) { 2 } else { 1 };
                 self.colour_memo[key] = answer;
             }
             if answer == 2 {
                 self.mask[i] = 1;
+                out.work.candidates += 1;
             }
         }
         self.label.clear();
@@ -181,6 +221,8 @@ impl Detector {
                 self.ripen(f, d)
             })
             .collect();
+        out.work.fit_points = self.fit_points.get();
+        out.work.surface_tests = self.surface_tests.get();
         out
     }
 
@@ -241,6 +283,7 @@ impl Detector {
         let (v0, v1) =
             ((uv[1] - rpx).floor().max(0.0) as usize, ((uv[1] + rpx).ceil().max(0.0) as usize).min(f.height));
         let tol = (2.5 * d.rms).max(0.003);
+        self.surface_tests.set(self.surface_tests.get() + (v1.saturating_sub(v0) * u1.saturating_sub(u0)) as u64);
         let mut all = vec![];
         for v in v0..v1 {
             for u in u0..u1 {
@@ -350,7 +393,9 @@ impl Detector {
         }
     }
 
+    /// The members' points, counted as fitted (every caller fits or splits them).
     fn points(&self, f: &Frame, members: &[usize]) -> Vec<[f64; 3]> {
+        self.fit_points.set(self.fit_points.get() + members.len() as u64);
         members.iter().map(|&i| f.k.unproject(i % f.width, i / f.width, f.depth[i] as f64)).collect()
     }
 
@@ -485,6 +530,27 @@ mod tests {
         let none = vec![0f32; w * h];
         let r = det.detect(&Frame { width: w, height: h, rgb: &rgb, depth: &none, k, up: None });
         assert!(r.detections.is_empty() && r.valid_depth == 0);
+    }
+
+    /// The work of a frame is a function of the frame (and of the colours seen before): the
+    /// same frame to two fresh detectors counts the same; seen again, only its colour
+    /// conversions are spared (the memo holds them).
+    #[test]
+    fn work_is_counted_deterministically() {
+        let (w, h) = (160usize, 120usize);
+        let k = Intrinsics { fx: 120.0, fy: 120.0, cx: 80.0, cy: 60.0 };
+        let (rgb, depth) = render(w, h, k, |_, d| hit(d, [0.0, 0.0, 0.7], 0.03).map_or(WALL, |t| (t, [190, 26, 20])));
+        let f = Frame { width: w, height: h, rgb: &rgb, depth: &depth, k, up: None };
+        let mut a = Detector::new(DetectorConfig::default());
+        let first = a.detect(&f);
+        assert_eq!(first.detections.len(), 1);
+        let again = a.detect(&f).work;
+        let fresh = Detector::new(DetectorConfig::default()).detect(&f).work;
+        assert_eq!(fresh, first.work);
+        let wk = first.work;
+        assert_eq!((wk.pixels, wk.conversions), ((w * h) as u64, 2));
+        assert!(wk.candidates > 50 && wk.fit_points >= wk.candidates && wk.surface_tests > wk.candidates, "{wk:?}");
+        assert_eq!(again, DetectWork { conversions: 0, ..wk });
     }
 
     /// A ripe fruit 0.8 m ahead with a stem 8 mm wide in front of it, across its middle: two

@@ -14,6 +14,7 @@
 //! merged or split wrongly.
 
 pub mod colour;
+pub mod cost;
 pub mod detect;
 pub mod node;
 pub mod ripeness;
@@ -22,5 +23,6 @@ pub mod tf;
 pub mod tracker;
 
 pub use colour::{is_ripe, stage_of, STAGES};
-pub use detect::{Detection, Detector, DetectorConfig, Frame, FrameResult, Intrinsics};
-pub use node::{Perception, PerceptionConfig};
+pub use cost::CostModel;
+pub use detect::{DetectWork, Detection, Detector, DetectorConfig, Frame, FrameResult, Intrinsics};
+pub use node::{Charged, Perception, PerceptionConfig};

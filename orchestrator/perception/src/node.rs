@@ -2,9 +2,22 @@
 //! the camera frame and in the world frame, and the fruit map, out. A frame it cannot use
 //! (no CameraInfo yet, no valid depth, no TF to a world frame, a malformed image) is skipped
 //! and reported on /agrisim/status, never a panic or an error of the run.
+//!
+//! Compute is charged in simulated time ([`CostModel`], as the harvest node charges its
+//! planning): a frame's outputs (detections, fruit map, its status) are held back until the
+//! simulated time has passed the frame's cost from when the node took it up, and carry the
+//! frame's stamp, as a real driver's would. While the node is busy, newer frames wait; only
+//! the newest waiting frame of each camera is kept (the others are dropped, as a node that
+//! cannot keep up drops them). Resolution: nodes step at the bus's message instants (every
+//! 1 / `timing.message_rate`, 0.1 s in the scenarios), so an output appears at the first
+//! message instant at or after its finish: the delay is the cost rounded up to that period,
+//! while the busy time itself is not rounded (the next frame starts when the last finished,
+//! or when it arrived if later). [`CostModel::FREE`] gives every output at the step its
+//! frame arrives.
 
 use crate::colour::STAGES;
-use crate::detect::{Detection, Detector, DetectorConfig, Frame, Intrinsics};
+use crate::cost::CostModel;
+use crate::detect::{DetectWork, Detection, Detector, DetectorConfig, Frame, Intrinsics};
 use crate::tf::TfBuffer;
 use crate::tracker::{FruitMap, Observation};
 use agrisim_bus::{Bus, Node, Reader};
@@ -19,6 +32,9 @@ use agrisim_msgs::vision_msgs::{
     BoundingBox3D, Detection3D, Detection3DArray, ObjectHypothesis, ObjectHypothesisWithPose,
 };
 use nalgebra::{Isometry3, Point3, Vector3 as Vec3};
+use std::collections::VecDeque;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 
 pub const IMAGE: &str = "/camera/color/image_raw";
 pub const DEPTH: &str = "/camera/aligned_depth_to_color/image_raw";
@@ -84,6 +100,8 @@ struct CameraInput {
     image: Option<Image>,
     depth: Option<Image>,
     last_stamp: Option<i64>,
+    /// The newest paired frame not yet taken up, and the step it arrived at [ns].
+    waiting: Option<(Image, Image, i64)>,
 }
 
 impl CameraInput {
@@ -98,12 +116,45 @@ impl CameraInput {
             image: None,
             depth: None,
             last_stamp: None,
+            waiting: None,
         }
+    }
+}
+
+/// An output of a frame, held until the frame's compute is done.
+enum Out {
+    Array(&'static str, Detection3DArray),
+    Status(FmuStatus),
+}
+
+/// Simulated compute time a node charged so far [s], readable by its owner after the node is
+/// boxed (the benchmark's per-trial totals).
+#[derive(Clone, Debug, Default)]
+pub struct Charged(Arc<AtomicU64>);
+
+impl Charged {
+    pub fn seconds(&self) -> f64 {
+        f64::from_bits(self.0.load(Ordering::Relaxed))
+    }
+    fn add(&self, s: f64) {
+        self.0.store((self.seconds() + s).to_bits(), Ordering::Relaxed);
     }
 }
 
 pub struct Perception {
     config: PerceptionConfig,
+    cost: CostModel,
+    /// When the node is free for the next frame [ns] (simulated).
+    free_at: i64,
+    /// Outputs of frames taken up, with when they may go out [ns], in that order.
+    pending: VecDeque<(i64, Vec<Out>)>,
+    /// The outputs of the frame being processed.
+    out: Vec<Out>,
+    charged: Charged,
+    /// The work of every frame taken up so far.
+    pub work: DetectWork,
+    /// Frames replaced by a newer one of their camera while the node was busy.
+    pub dropped: u64,
     detector: Detector,
     tf: TfBuffer,
     tf_reader: Reader,
@@ -123,6 +174,13 @@ impl Perception {
             detector: Detector::new(config.detector.clone()),
             cameras: config.cameras.iter().map(|ns| CameraInput::new(ns)).collect(),
             config,
+            cost: CostModel::FREE,
+            free_at: i64::MIN,
+            pending: VecDeque::new(),
+            out: Vec::new(),
+            charged: Charged::default(),
+            work: DetectWork::default(),
+            dropped: 0,
             tf: TfBuffer::default(),
             tf_reader: Reader::new(TF),
             tf_static_reader: Reader::new(TF_STATIC),
@@ -134,9 +192,25 @@ impl Perception {
         }
     }
 
-    /// Reports a skipped frame on /agrisim/status (once per change of reason).
-    fn status(&mut self, bus: &mut Bus, t_ns: i64, message: String) {
+    /// Charges compute with `cost` (default [`CostModel::FREE`]; the harvest-by-sight
+    /// benchmark uses [`CostModel::CALIBRATED`]).
+    pub fn with_cost(mut self, cost: CostModel) -> Perception {
+        self.cost = cost;
+        self
+    }
+
+    /// The simulated compute time charged so far, readable after the node is boxed.
+    pub fn charged(&self) -> Charged {
+        self.charged.clone()
+    }
+
+    /// A skip reported on /agrisim/status with the frame's outputs (once per change of reason).
+    fn status(&mut self, t_ns: i64, message: String) {
         self.skipped += 1;
+        self.warn(t_ns, message);
+    }
+
+    fn warn(&mut self, t_ns: i64, message: String) {
         if message != self.last_status {
             let msg = FmuStatus {
                 header: Header { stamp: Time::from_nanos(t_ns), frame_id: String::new() },
@@ -144,13 +218,23 @@ impl Perception {
                 status: "warning".into(),
                 message: message.clone(),
             };
-            bus.publish(STATUS, t_ns, &msg);
+            self.out.push(Out::Status(msg));
             self.last_status = message;
         }
     }
 
     fn ok(&mut self) {
         self.last_status.clear();
+    }
+
+    /// Publishes `out` at `t_ns`.
+    fn release(bus: &mut Bus, t_ns: i64, out: Vec<Out>) {
+        for o in out {
+            match o {
+                Out::Array(topic, msg) => bus.publish(topic, t_ns, &msg),
+                Out::Status(msg) => bus.publish(STATUS, t_ns, &msg),
+            }
+        }
     }
 
     /// The frame's pixels and depth as the detector reads them, or why not.
@@ -189,24 +273,29 @@ impl Perception {
         Ok((z, w, h))
     }
 
-    fn process(&mut self, t_ns: i64, bus: &mut Bus, cam: usize, image: &Image, depth: &Image) {
+    /// Processes one frame into `self.out`; the work it took.
+    fn process(&mut self, t_ns: i64, cam: usize, image: &Image, depth: &Image) -> DetectWork {
         let stamp = image.header.stamp.to_nanos();
         let Some((info, k)) = self.cameras[cam].info.clone() else {
-            return self.status(bus, t_ns, format!("frame at t={} s skipped: no CameraInfo yet", stamp as f64 / 1e9));
+            self.status(t_ns, format!("frame at t={} s skipped: no CameraInfo yet", stamp as f64 / 1e9));
+            return DetectWork::default();
         };
         if info.width != image.width || info.height != image.height {
-            return self.status(
-                bus,
+            self.status(
                 t_ns,
                 format!(
                     "frame skipped: CameraInfo is {}x{}, the image {}x{}",
                     info.width, info.height, image.width, image.height
                 ),
             );
+            return DetectWork::default();
         }
         let (z, w, h) = match Self::frame_data(image, depth) {
             Ok(v) => v,
-            Err(e) => return self.status(bus, t_ns, format!("frame skipped: {e}")),
+            Err(e) => {
+                self.status(t_ns, format!("frame skipped: {e}"));
+                return DetectWork::default();
+            }
         };
         let camera =
             if image.header.frame_id.is_empty() { info.header.frame_id.clone() } else { image.header.frame_id.clone() };
@@ -217,23 +306,25 @@ impl Perception {
             [u.x, u.y, u.z]
         });
         let result = self.detector.detect(&Frame { width: w, height: h, rgb: &image.data, depth: &z, k, up });
+        let work = result.work;
         if result.valid_depth == 0 {
-            return self.status(bus, t_ns, format!("frame at t={} s skipped: no valid depth", stamp as f64 / 1e9));
+            self.status(t_ns, format!("frame at t={} s skipped: no valid depth", stamp as f64 / 1e9));
+            return work;
         }
         self.frames += 1;
         let header = Header { stamp: image.header.stamp, frame_id: camera.clone() };
         let dets: Vec<Detection3D> =
             result.detections.iter().map(|d| detection(&header, d, &Isometry3::identity(), String::new())).collect();
-        bus.publish(DETECTIONS, t_ns, &Detection3DArray { header: header.clone(), detections: dets });
+        self.out.push(Out::Array(DETECTIONS, Detection3DArray { header: header.clone(), detections: dets }));
         let Some((frame, pose)) = world else {
-            return self.status(
-                bus,
+            self.status(
                 t_ns,
                 format!(
                     "frame's world update skipped: no TF from {camera} to any of {:?} yet",
                     self.config.world_frames
                 ),
             );
+            return work;
         };
         let obs: Vec<Observation> = result
             .detections
@@ -247,10 +338,11 @@ impl Perception {
         let wh = Header { stamp: image.header.stamp, frame_id: frame.clone() };
         let dets: Vec<Detection3D> =
             result.detections.iter().zip(&ids).map(|(d, id)| detection(&wh, d, &pose, id.to_string())).collect();
-        bus.publish(DETECTIONS_WORLD, t_ns, &Detection3DArray { header: wh.clone(), detections: dets });
+        self.out.push(Out::Array(DETECTIONS_WORLD, Detection3DArray { header: wh.clone(), detections: dets }));
         let period_ns = (self.config.map_period * 1e9) as i64;
         if self.last_map_ns.is_some_and(|last| t_ns - last < period_ns) {
-            return self.ok();
+            self.ok();
+            return work;
         }
         self.last_map_ns = Some(t_ns);
         let confirm = self.config.confirm;
@@ -276,8 +368,9 @@ impl Perception {
                 detection(&wh, &d, &Isometry3::identity(), t.id.to_string())
             })
             .collect();
-        bus.publish(FRUIT_MAP, t_ns, &Detection3DArray { header: wh, detections: tracks });
+        self.out.push(Out::Array(FRUIT_MAP, Detection3DArray { header: wh, detections: tracks }));
         self.ok();
+        work
     }
 }
 
@@ -329,7 +422,8 @@ impl Node for Perception {
                     Some(k) => c.info = Some((info, k)),
                     None => {
                         let why = format!("CameraInfo on {} with an unusable K {:?} ignored", c.info_topic, info.k);
-                        self.status(bus, t_ns, why);
+                        self.status(t_ns, why);
+                        Self::release(bus, t_ns, std::mem::take(&mut self.out));
                     }
                 }
             }
@@ -350,8 +444,32 @@ impl Node for Perception {
             if let Some(stamp) = pair {
                 c.last_stamp = Some(stamp);
                 let (image, depth) = (c.image.take().expect("paired"), c.depth.take().expect("paired"));
-                self.process(t_ns, bus, cam, &image, &depth);
+                if c.waiting.replace((image, depth, t_ns)).is_some() {
+                    self.dropped += 1;
+                }
             }
+        }
+        // The waiting frames, oldest stamp first (ties by camera), while the node is free.
+        while self.free_at <= t_ns {
+            let next = (self.cameras.iter().enumerate())
+                .filter_map(|(i, c)| c.waiting.as_ref().map(|w| (w.0.header.stamp.to_nanos(), i)))
+                .min();
+            let Some((_, cam)) = next else { break };
+            let (image, depth, arrived) = self.cameras[cam].waiting.take().expect("found waiting");
+            let start = self.free_at.max(arrived);
+            let work = self.process(t_ns, cam, &image, &depth);
+            let cost = self.cost.seconds(&work);
+            self.work += work;
+            self.charged.add(cost);
+            self.free_at = start + (cost * 1e9).ceil() as i64;
+            let out = std::mem::take(&mut self.out);
+            if !out.is_empty() {
+                self.pending.push_back((self.free_at, out));
+            }
+        }
+        while self.pending.front().is_some_and(|(at, _)| *at <= t_ns) {
+            let (_, out) = self.pending.pop_front().expect("front");
+            Self::release(bus, t_ns, out);
         }
         Ok(())
     }

@@ -49,6 +49,10 @@ pub fn report_html(g: &agrisim_scene::Greenhouse, sum: &HarvestSummary, results:
             "plans; planning time charged per trial [s]".to_string(),
             format!("{}; {:.3}", sum.plans, sum.thinking_time_mean),
         ),
+        (
+            "perception; mapping compute charged per trial [s]".to_string(),
+            format!("{:.3}; {:.3}", sum.perception_time_mean, sum.mapping_time_mean),
+        ),
         ("plant touches per trial".to_string(), per_kind(&sum.touches_per_trial)),
         ("crop damage (all trials)".to_string(), count_kinds(&sum.damage)),
         ("pedicel breaks by mode (trials)".to_string(), count_kinds(&sum.detach_modes)),

@@ -16,9 +16,29 @@ use std::path::Path;
 /// The row cameras of a harvest by sight (models/systems/harvest_sight.ssd).
 pub const SIGHT_CAMERAS: [&str; 2] = ["camera_left", "camera_right"];
 
+/// The simulated compute time the seeing nodes charged in a session [s] (none without sight).
+#[derive(Clone, Debug, Default)]
+pub struct SightCharges {
+    perception: Option<agrisim_perception::Charged>,
+    mapping: Option<agrisim_mapping::Charged>,
+}
+
+impl SightCharges {
+    /// Perception's compute so far [s].
+    pub fn perception(&self) -> f64 {
+        self.perception.as_ref().map_or(0.0, |c| c.seconds())
+    }
+    /// The mapper's compute so far [s].
+    pub fn mapping(&self) -> f64 {
+        self.mapping.as_ref().map_or(0.0, |c| c.seconds())
+    }
+}
+
 /// The nodes that see for a harvest by sight: perception (fruit map) and mapping (sensed
-/// planning scene, with the robot's links filtered out and the harvest node's target allowed).
-pub fn sight_nodes() -> Result<Vec<Box<dyn Node>>> {
+/// planning scene, with the robot's links filtered out and the harvest node's target allowed),
+/// their compute charged in simulated time by their calibrated cost models (outputs held back
+/// by it, as the harvest node's plans are by its planning), and handles on those charges.
+pub fn sight_nodes() -> Result<(Vec<Box<dyn Node>>, SightCharges)> {
     // Every 4th pixel and row: 5 mm between rays at the crop's 0.6 m, under the 1 cm voxels.
     // The scene: what the arms can reach from the base (1.5 m around base_link), once a second.
     // Rays beyond 1.2 m (through the row into the next aisle) only clear space out of reach.
@@ -30,23 +50,27 @@ pub fn sight_nodes() -> Result<Vec<Box<dyn Node>>> {
         scene_around: Some(("base_link".into(), 1.5)),
         ..MapperConfig::for_cameras(&SIGHT_CAMERAS)
     })
-    .map_err(|e| agrisim_error::err!("harvest by sight: mapping node: {e}"))?;
+    .map_err(|e| agrisim_error::err!("harvest by sight: mapping node: {e}"))?
+    .with_cost(agrisim_mapping::CostModel::CALIBRATED);
     let perception = PerceptionConfig { map_period: 0.5, ..PerceptionConfig::for_cameras(&SIGHT_CAMERAS) };
-    Ok(vec![Box::new(Perception::new(perception)), Box::new(mapper)])
+    let perception = Perception::new(perception).with_cost(agrisim_perception::CostModel::CALIBRATED);
+    let charges = SightCharges { perception: Some(perception.charged()), mapping: Some(mapper.charged()) };
+    Ok((vec![Box::new(perception), Box::new(mapper)], charges))
 }
 
 /// Trial `t`'s harvest system, ready to run from `start` (x, y, yaw of base_link): the map
 /// server, odometry TF, the localizer started from a seeded estimate of the start pose (never
 /// the true one), the robot state publisher, `harvest` (the node under test), the fault
 /// injector, and `task` (what tells an external node its task), recording into `mcap`. By
-/// sight (`[harvest] sight`), the perception and mapping nodes on the row cameras too.
+/// sight (`[harvest] sight`), the perception and mapping nodes on the row cameras too, with
+/// handles on their charged compute.
 pub fn harvest_session(
     t: &Trial<HarvestSetup>,
     start: [f64; 3],
     mcap: &Path,
     harvest: Box<dyn Node>,
     task: Option<TaskPublisher>,
-) -> Result<agrisim_session::Session> {
+) -> Result<(agrisim_session::Session, SightCharges)> {
     let (setup, seed) = (t.setup, t.seed);
     let mut s = t.scenario.clone();
     let chassis = s.parameters.entry("chassis".into()).or_default();
@@ -67,13 +91,16 @@ pub fn harvest_session(
     if let Some(t) = task {
         nodes.push(Box::new(t));
     }
+    let mut charges = SightCharges::default();
     if s.harvest.sight {
-        nodes.extend(sight_nodes()?);
+        let (sight, c) = sight_nodes()?;
+        nodes.extend(sight);
+        charges = c;
     }
     let mut m = prepare(&s, &RunOptions { seed: Some(seed), ..t.run.clone() }, mcap, nodes)?;
     // By sight no node may read the world's answers: a read fails the trial, naming it.
     if s.harvest.sight {
         m.bus.seal_ground_truth();
     }
-    Ok(m)
+    Ok((m, charges))
 }

@@ -49,6 +49,10 @@ pub struct HarvestSummary {
     pub planning_time_max: Option<f64>,
     /// Mean simulated planning time per trial [s] (the node's cost model).
     pub thinking_time_mean: f64,
+    /// Mean simulated compute time per trial of the perception and mapping nodes [s] (their
+    /// cost models; 0 without sight).
+    pub perception_time_mean: f64,
+    pub mapping_time_mean: f64,
     /// Simulated planning time over measured planning wall time, all timed plans: how well the
     /// node's cost model matches this machine (1 = exactly).
     pub thinking_over_wall: Option<f64>,
@@ -139,6 +143,8 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, results: &[HarvestTrial]) -> Har
         planning_time_p95: percentile(&times, 0.95),
         planning_time_max: times.last().copied(),
         thinking_time_mean: results.iter().map(|t| t.thinking_time).sum::<f64>() / n.max(1) as f64,
+        perception_time_mean: results.iter().map(|t| t.perception_time).sum::<f64>() / n.max(1) as f64,
+        mapping_time_mean: results.iter().map(|t| t.mapping_time).sum::<f64>() / n.max(1) as f64,
         thinking_over_wall: {
             let timed: Vec<&HarvestTrial> = results.iter().filter(|t| !t.planning_times.is_empty()).collect();
             let wall: f64 = timed.iter().flat_map(|t| t.planning_times.iter()).sum();

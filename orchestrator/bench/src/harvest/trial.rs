@@ -98,6 +98,12 @@ pub struct HarvestTrial {
     /// /harvest/plans) [s]: part of the time to harvest.
     #[serde(default)]
     pub thinking_time: f64,
+    /// Simulated compute time the perception and mapping nodes charged over the trial (their
+    /// cost models; 0 without sight) [s]: their outputs waited for it.
+    #[serde(default)]
+    pub perception_time: f64,
+    #[serde(default)]
+    pub mapping_time: f64,
     pub time_to_harvest: Option<f64>,
     pub placed_count: i64,
     pub contacts: BTreeMap<String, i64>,
@@ -187,7 +193,7 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
         Some(r) => TaskPublisher::region([r.x, r.y, r.z]),
         None => TaskPublisher::new(target.fruit_index),
     });
-    let mut m = harvest_session(t, target.start, mcap, harvest, task)?;
+    let (mut m, charges) = harvest_session(t, target.start, mcap, harvest, task)?;
     let (world, arm_l, arm_r) = (
         m.component("world", "harvest benchmark")?,
         m.component("arm_left", "harvest benchmark")?,
@@ -329,6 +335,8 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
         plans: reports.plans.len(),
         planning_times: reports.planning_times,
         thinking_time: reports.plans.iter().map(|p| p.planning_time).sum(),
+        perception_time: charges.perception(),
+        mapping_time: charges.mapping(),
         time_to_harvest,
         placed_count: placed,
         contacts,
@@ -397,6 +405,8 @@ impl HarvestTrial {
             plans: 0,
             planning_times: vec![],
             thinking_time: 0.0,
+            perception_time: 0.0,
+            mapping_time: 0.0,
             time_to_harvest: None,
             placed_count: 0,
             contacts: BTreeMap::new(),

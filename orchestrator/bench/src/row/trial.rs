@@ -128,7 +128,7 @@ pub fn run(t: &Trial<HarvestSetup>, mcap: &Path) -> Result<RowTrial> {
         Some(r) => Box::new(RowNode::by_sight(r.clone(), seed)),
         None => Box::new(RowNode::new(seg.targets.iter().map(|t| t.fruit_index).collect(), seed)),
     };
-    let mut m = harvest_session(t, seg.start, mcap, node, None)?;
+    let (mut m, _) = harvest_session(t, seg.start, mcap, node, None)?;
     let (world, chassis) = (m.component("world", "row benchmark")?, m.component("chassis", "row benchmark")?);
     let step = s.timing.step;
     let timeout = TIME_PER_FRUIT * seg.targets.len() as f64

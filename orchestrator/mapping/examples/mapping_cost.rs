@@ -1,0 +1,175 @@
+//! Calibrates the mapper's [`CostModel`]: replays the depth frames, CameraInfo, TF and
+//! /robot_description of a recorded harvest-by-sight trial through the mapping node (the
+//! benchmark's configuration: both row cameras, max range 1.2 m; at the benchmark's pixel
+//! stride 4 and at stride 8, so points vary apart from pixels), times each node step that
+//! integrated frames (the least of `--repeat` passes, each from a fresh node) and fits seconds
+//! per unit of the counted work by non-negative least squares.
+//!
+//! The recording: `agrisim bench harvest --scenario models/scenarios/harvest_sight.toml
+//! --trials 1 --scenes 1 --seed 1 --jobs 1 --record full --out /tmp/rec`, then
+//! `cargo run --release -p agrisim-mapping --example mapping_cost --
+//! /tmp/rec/trials/0000.mcap [--repeat 3]`.
+
+use agrisim_bus::{Bus, Node};
+use agrisim_mapping::{CostModel, DepthMapper, MapConfig, MapWork, MapperConfig};
+use std::time::Instant;
+
+/// Messages of `topics` in log order: (time, topic, type, CDR).
+fn replay(path: &str, keep: impl Fn(&str) -> bool) -> Vec<(i64, String, String, Vec<u8>)> {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let mut out = Vec::new();
+    for m in mcap::MessageStream::new(&bytes).expect("an MCAP file") {
+        let m = m.expect("a valid record");
+        if keep(&m.channel.topic) {
+            let ty = m.channel.schema.as_ref().map(|s| s.name.clone()).unwrap_or_default();
+            out.push((m.log_time as i64, m.channel.topic.clone(), ty, m.data.to_vec()));
+        }
+    }
+    out.sort_by_key(|m| m.0);
+    out
+}
+
+/// Non-negative least squares by elimination of negative coefficients: `x >= 0` minimizing
+/// |A x - b| over the columns kept.
+fn nnls(a: &[Vec<f64>], b: &[f64]) -> Vec<f64> {
+    let n = a[0].len();
+    let mut active: Vec<bool> = vec![true; n];
+    loop {
+        let cols: Vec<usize> = (0..n).filter(|&j| active[j]).collect();
+        let m = cols.len();
+        // Normal equations, columns scaled to unit norm for conditioning.
+        let scale: Vec<f64> =
+            cols.iter().map(|&j| a.iter().map(|r| r[j] * r[j]).sum::<f64>().sqrt().max(1e-300)).collect();
+        let mut ata = nalgebra::DMatrix::<f64>::zeros(m, m);
+        let mut atb = nalgebra::DVector::<f64>::zeros(m);
+        for (r, y) in a.iter().zip(b) {
+            for p in 0..m {
+                let xp = r[cols[p]] / scale[p];
+                atb[p] += xp * y;
+                for q in 0..m {
+                    ata[(p, q)] += xp * r[cols[q]] / scale[q];
+                }
+            }
+        }
+        let sol = ata
+            .clone()
+            .cholesky()
+            .map(|c| c.solve(&atb))
+            .unwrap_or_else(|| ata.pseudo_inverse(1e-12).expect("pinv") * &atb);
+        let mut x = vec![0.0; n];
+        for p in 0..m {
+            x[cols[p]] = sol[p] / scale[p];
+        }
+        match (0..n).filter(|&j| active[j] && x[j] < 0.0).min_by(|&i, &j| x[i].total_cmp(&x[j])) {
+            Some(j) => active[j] = false,
+            None => return x,
+        }
+    }
+}
+
+/// The work and least wall time of every node step that integrated frames, over `repeat`
+/// passes of `msgs`, each from a fresh node integrating every `stride`-th pixel.
+fn measure(msgs: &[(i64, String, String, Vec<u8>)], stride: usize, repeat: usize) -> Vec<(MapWork, f64)> {
+    let period = 100_000_000i64;
+    let mut steps: Vec<(MapWork, f64)> = Vec::new();
+    for pass in 0..repeat {
+        let config = MapperConfig {
+            map: MapConfig { max_range: 1.2, ..Default::default() },
+            pixel_stride: stride,
+            scene_period: 1e6,
+            ..MapperConfig::for_cameras(&["camera_left", "camera_right"])
+        };
+        let mut node = DepthMapper::new(config).expect("a mapper").with_cost(CostModel::FREE);
+        let mut bus = Bus::default();
+        let (mut i, mut k) = (0, 0usize);
+        let end = msgs.last().map_or(0, |m| m.0);
+        let mut t = 0i64;
+        while t <= end + period {
+            while i < msgs.len() && msgs[i].0 <= t {
+                let (time, topic, ty, cdr) = &msgs[i];
+                bus.publish_raw(topic, ty, *time, cdr.clone());
+                i += 1;
+            }
+            let before = node.work;
+            let start = Instant::now();
+            node.step(t, &mut bus).expect("mapping step");
+            let wall = start.elapsed().as_secs_f64();
+            bus.drain();
+            let work = node.work - before;
+            if work.pixels > 0 {
+                if pass == 0 {
+                    steps.push((work, wall));
+                } else {
+                    assert_eq!(steps[k].0, work, "the work of a step is deterministic");
+                    steps[k].1 = steps[k].1.min(wall);
+                }
+                k += 1;
+            }
+            t += period;
+        }
+    }
+    steps
+}
+
+fn row(w: &MapWork) -> Vec<f64> {
+    [w.pixels, w.points, w.ray_steps, w.dense_cells, w.updates, w.self_tests].map(|v| v as f64).to_vec()
+}
+
+fn pct(v: &mut [f64], p: f64) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[((v.len() - 1) as f64 * p).round() as usize]
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let Some(path) = args.first() else {
+        eprintln!("usage: mapping_cost RUN.mcap [--repeat N]");
+        std::process::exit(2);
+    };
+    let repeat: usize =
+        args.iter().position(|a| a == "--repeat").and_then(|i| args.get(i + 1)?.parse().ok()).unwrap_or(3);
+    let msgs = replay(path, |t| {
+        t == "/tf"
+            || t == "/tf_static"
+            || t == "/robot_description"
+            || t.ends_with("/camera_info")
+            || t.contains("/aligned_depth")
+    });
+    let real = measure(&msgs, 4, repeat);
+    let steps: Vec<(MapWork, f64)> = real.iter().copied().chain(measure(&msgs, 8, repeat)).collect();
+    println!("stride 4 steps: {}, stride 8 steps: {}", real.len(), steps.len() - real.len());
+    let a: Vec<Vec<f64>> = steps.iter().map(|(w, _)| row(w)).collect();
+    let b: Vec<f64> = steps.iter().map(|(_, s)| *s).collect();
+    let x = nnls(&a, &b);
+    // Two halves of the set: the even and the odd steps.
+    let pick = |odd: usize| -> (Vec<Vec<f64>>, Vec<f64>) {
+        (a.iter().skip(odd).step_by(2).cloned().collect(), b.iter().skip(odd).step_by(2).copied().collect())
+    };
+    let ((a1, b1), (a2, b2)) = (pick(0), pick(1));
+    let (x1, x2) = (nnls(&a1, &b1), nnls(&a2, &b2));
+    let model = |x: &[f64], r: &[f64]| r.iter().zip(x).map(|(u, c)| u * c).sum::<f64>();
+    let n = real.len();
+    let mut rel: Vec<f64> = a.iter().zip(&b).take(n).map(|(r, s)| model(&x, r) / s - 1.0).collect();
+    let real_total: f64 = b[..n].iter().sum();
+    let total: f64 = b.iter().sum();
+    let total_model: f64 = a.iter().map(|r| model(&x, r)).sum();
+    let mean = |j: usize| a[..n].iter().map(|r| r[j]).sum::<f64>() / n as f64;
+    println!("stride 4: measured {:.3} s in all, {:.2} ms per step", real_total, 1e3 * real_total / n as f64);
+    let names = ["per_pixel", "per_point", "per_ray_step", "per_dense_cell", "per_update", "per_self_test"];
+    for (j, name) in names.iter().enumerate() {
+        println!(
+            "{name}: {:.3e} (halves {:.3e}, {:.3e}); mean count per stride-4 step {:.0}",
+            x[j],
+            x1[j],
+            x2[j],
+            mean(j)
+        );
+    }
+    println!(
+        "model vs measured per stride-4 step {:+.0} % .. {:+.0} % (p5..p95); total {:+.1} % (both strides {:+.1} %)",
+        100.0 * pct(&mut rel, 0.05),
+        100.0 * pct(&mut rel, 0.95),
+        100.0 * (a[..n].iter().map(|r| model(&x, r)).sum::<f64>() / real_total - 1.0),
+        100.0 * (total_model / total - 1.0)
+    );
+}
