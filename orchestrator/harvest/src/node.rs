@@ -93,7 +93,7 @@ pub struct HarvestNode {
     fruit_index: usize,
     side: f64,
     motion: Motion,
-    stage: Stage,
+    pub(crate) stage: Stage,
     stage_start_ns: i64,
     step_in_stage: u64,
     arms: [ArmView; 2],
@@ -315,6 +315,11 @@ impl HarvestNode {
                 format!("next: fruit {i} of the world's list")
             }
             Task::Region(r) => {
+                // Named, so the first step does not take the node for a new one and skip
+                // the recovery (arms home, grippers open) for SelectTarget: the arm that
+                // placed the last fruit stayed over the box, and the next handover could
+                // not be planned from there.
+                fresh.target_name = "by sight".into();
                 format!("next: a ripe fruit in x {:.2}..{:.2}, y {:.2}..{:.2}", r.x[0], r.x[1], r.y[0], r.y[1])
             }
         };

@@ -128,6 +128,28 @@ mod tests {
         Region { x: [x, x + 1.0], y: [0.0, 1.0], z: [0.55, 1.75] }
     }
 
+    /// Regression (row by sight, 2026-11-29): after a pick the next region's task starts
+    /// with the recovery (arms home, grippers open), as a next fruit's does; it used to go
+    /// straight to SelectTarget, leaving the placing arm over the box.
+    #[test]
+    fn the_next_task_starts_with_the_recovery() {
+        for by_sight in [true, false] {
+            let mut row = if by_sight {
+                RowNode::by_sight(vec![region(0.0), region(1.0)], 1)
+            } else {
+                RowNode::new(vec![3, 4], 1)
+            };
+            let mut bus = Bus::default();
+            row.step(0, &mut bus).unwrap();
+            assert_eq!(row.inner.stage(), Stage::SelectTarget);
+            row.inner.stage = Stage::Done;
+            row.step(100_000_000, &mut bus).unwrap();
+            assert_eq!(row.inner.stage(), Stage::Recover, "by sight {by_sight}");
+            row.step(200_000_000, &mut bus).unwrap();
+            assert_eq!(row.inner.stage(), Stage::Recover, "by sight {by_sight}: the grippers open first");
+        }
+    }
+
     /// The region rule: stay while picks succeed, move on when the scan finds nothing, after
     /// MAX_FAILURES_PER_REGION failures in a row, or after MAX_PICKS_PER_REGION picks.
     #[test]
