@@ -19,7 +19,7 @@ use crate::colour::STAGES;
 use crate::cost::CostModel;
 use crate::detect::{DetectWork, Detection, Detector, DetectorConfig, Frame, Intrinsics};
 use crate::tf::TfBuffer;
-use crate::tracker::{FruitMap, Observation};
+use crate::tracker::{FruitMap, Look, Observation, Track};
 use agrisim_bus::{Bus, Node, Reader};
 use agrisim_error::Result;
 use agrisim_msgs::agrisim::FmuStatus;
@@ -335,6 +335,8 @@ impl Perception {
             })
             .collect();
         let ids = self.map.update(&obs, stamp);
+        let inverse = pose.inverse();
+        self.map.forget_seen_through(&ids, |t| look(t, &inverse, &k, &z, w, h));
         let wh = Header { stamp: image.header.stamp, frame_id: frame.clone() };
         let dets: Vec<Detection3D> =
             result.detections.iter().zip(&ids).map(|(d, id)| detection(&wh, d, &pose, id.to_string())).collect();
@@ -371,6 +373,47 @@ impl Perception {
         self.out.push(Out::Array(FRUIT_MAP, Detection3DArray { header: wh, detections: tracks }));
         self.ok();
         work
+    }
+}
+
+/// Depth beyond a fruit's back by more than this says the camera saw through where it
+/// should be [m]: 3 sigma of the D435i's stereo depth noise at 1.6 m, the farthest depth the
+/// detector keeps (Intel's RMS = z^2 x subpixel / (fx x baseline), subpixel 0.08, fx 337 px at
+/// 640x480, baseline 50 mm: 12.2 mm; the camera FMU's `fmus/camera/src/datasheet.rs`).
+const SEE_THROUGH_MARGIN: f64 = 0.035;
+/// Half the side of the pixel window whose median depth is read at a track's centre.
+const LOOK_HALF: usize = 2;
+
+/// What a frame (depth `z`, `w` x `h`, intrinsics `k`; `to_camera` from the map's frame into
+/// the camera's) says of a track it did not observe: its centre projected, at least a
+/// radius inside the image, the median of the valid depths in a small window there.
+fn look(t: &Track, to_camera: &Isometry3<f64>, k: &Intrinsics, z: &[f32], w: usize, h: usize) -> Look {
+    let c = to_camera * Point3::from(t.center);
+    if c.z < 0.1 {
+        return Look::Unseen;
+    }
+    let (u, v) = (k.fx * c.x / c.z + k.cx, k.fy * c.y / c.z + k.cy);
+    let margin = (k.fx * t.radius / c.z).max(LOOK_HALF as f64 + 1.0);
+    if !(u >= margin && v >= margin && u < w as f64 - margin && v < h as f64 - margin) {
+        return Look::Unseen;
+    }
+    let (u, v) = (u as usize, v as usize);
+    let mut d: Vec<f32> = (v - LOOK_HALF..=v + LOOK_HALF)
+        .flat_map(|y| (u - LOOK_HALF..=u + LOOK_HALF).map(move |x| z[y * w + x]))
+        .filter(|d| d.is_finite() && *d > 0.0)
+        .collect();
+    let side = 2 * LOOK_HALF + 1;
+    if d.len() * 2 <= side * side {
+        return Look::Unseen;
+    }
+    d.sort_by(f32::total_cmp);
+    let m = d[d.len() / 2] as f64;
+    if m > c.z + t.radius + SEE_THROUGH_MARGIN {
+        Look::SeenThrough
+    } else if m >= c.z - t.radius - SEE_THROUGH_MARGIN {
+        Look::Occupied
+    } else {
+        Look::Unseen
     }
 }
 
@@ -472,5 +515,56 @@ impl Node for Perception {
             Self::release(bus, t_ns, out);
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 40x30 depth image, 1 m everywhere but `patch` (depth) over a 9x9 square at the
+    /// centre, seen by a camera at the map's origin looking along +z.
+    fn frame(patch: f32) -> (Intrinsics, Vec<f32>) {
+        let (w, h) = (40, 30);
+        let mut z = vec![1.0f32; w * h];
+        for y in 11..20 {
+            for x in 16..25 {
+                z[y * w + x] = patch;
+            }
+        }
+        (Intrinsics { fx: 40.0, fy: 40.0, cx: 20.0, cy: 15.0 }, z)
+    }
+
+    fn track(center: [f64; 3]) -> Track {
+        let mut map = FruitMap::default();
+        map.update(&[Observation { center, radius: 0.03, votes: [0.0; 6] }], 0);
+        map.tracks.remove(0)
+    }
+
+    /// The frame's word on a fruit at 0.6 m on the axis: there (depth at its front), seen
+    /// through (the 1 m background), hidden (a leaf at 0.3 m), no depth, behind the camera,
+    /// out of view.
+    #[test]
+    fn a_frame_says_whether_it_saw_through_a_track() {
+        let id = Isometry3::identity();
+        let fruit = track([0.0, 0.0, 0.6]);
+        let look_at = |patch: f32, t: &Track| {
+            let (k, z) = frame(patch);
+            look(t, &id, &k, &z, 40, 30)
+        };
+        assert_eq!(look_at(0.57, &fruit), Look::Occupied);
+        assert_eq!(look_at(1.0, &fruit), Look::SeenThrough);
+        assert_eq!(look_at(0.3, &fruit), Look::Unseen);
+        assert_eq!(look_at(f32::NAN, &fruit), Look::Unseen);
+        assert_eq!(look_at(0.0, &fruit), Look::Unseen);
+        // Just beyond its back and the noise margin, and just within.
+        assert_eq!(look_at(0.6 + 0.03 + 0.036, &fruit), Look::SeenThrough);
+        assert_eq!(look_at(0.6 + 0.03 + 0.034, &fruit), Look::Occupied);
+        assert_eq!(look_at(1.0, &track([0.0, 0.0, -0.6])), Look::Unseen);
+        assert_eq!(look_at(1.0, &track([0.6, 0.0, 0.6])), Look::Unseen);
+        // Through the camera's pose: the map frame's fruit at 0.6 m ahead of a shifted camera.
+        let cam = Isometry3::translation(0.5, 0.0, 0.0);
+        let (k, z) = frame(1.0);
+        assert_eq!(look(&track([0.5, 0.0, 0.6]), &cam.inverse(), &k, &z, 40, 30), Look::SeenThrough);
     }
 }

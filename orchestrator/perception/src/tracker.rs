@@ -2,6 +2,13 @@
 //! stable ids; each track's centre is a running mean that refuses outliers once it has a few
 //! observations, and its ripeness the sum of the frames' stage probabilities (normalised:
 //! their mean over the frames, each frame's from the coloured fraction it saw).
+//!
+//! A map also forgets: a track the camera sees through (depth beyond the fruit's back where
+//! its centre projects) in [`FruitMap::drop_after`] frames in a row, with no observation in
+//! between, is removed ([`FruitMap::forget_seen_through`]). Tracks made from frames taken
+//! while the localization was still converging (trial 35 of the harvest by sight: the first
+//! two frames placed three fruit 95 mm off, the map kept them, the node aimed at one of
+//! them) and fruit that left their plant are gone after a few frames.
 
 /// One fruit of the map.
 #[derive(Clone, Debug, PartialEq)]
@@ -18,6 +25,8 @@ pub struct Track {
     /// Welford's sum of squared distances to the mean [m^2].
     m2: f64,
     pub last_seen_ns: i64,
+    /// Frames in a row that saw through where this fruit should be.
+    pub seen_through: u32,
 }
 
 impl Track {
@@ -29,6 +38,17 @@ impl Track {
             (self.m2 / (self.merged - 1) as f64).sqrt()
         }
     }
+}
+
+/// What one frame says of a track it did not observe.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Look {
+    /// Not in view, hidden behind something nearer, or no depth there: no evidence.
+    Unseen,
+    /// Something where the fruit should be (it may be there, not detected).
+    Occupied,
+    /// The depth lies beyond the fruit's back: the fruit is not there.
+    SeenThrough,
 }
 
 /// An observation to merge: centre in the map's frame, radius, stage votes.
@@ -50,11 +70,21 @@ pub struct FruitMap {
     /// An observation farther than max(outlier_sigmas x spread, outlier_floor) is refused.
     pub outlier_sigmas: f64,
     pub outlier_floor: f64,
+    /// Frames in a row that see through a track before it is removed.
+    pub drop_after: u32,
 }
 
 impl Default for FruitMap {
     fn default() -> Self {
-        FruitMap { tracks: vec![], next_id: 1, gate: 0.035, settle: 3, outlier_sigmas: 3.0, outlier_floor: 0.008 }
+        FruitMap {
+            tracks: vec![],
+            next_id: 1,
+            gate: 0.035,
+            settle: 3,
+            outlier_sigmas: 3.0,
+            outlier_floor: 0.008,
+            drop_after: 3,
+        }
     }
 }
 
@@ -92,6 +122,7 @@ impl FruitMap {
                     let t = &mut self.tracks[k];
                     let d = dist(o.center, t.center);
                     t.last_seen_ns = t_ns;
+                    t.seen_through = 0;
                     if t.merged >= settle && d > (sigmas * t.spread()).max(floor) {
                         t.refused += 1;
                     } else {
@@ -121,12 +152,31 @@ impl FruitMap {
                         votes: o.votes,
                         m2: 0.0,
                         last_seen_ns: t_ns,
+                        seen_through: 0,
                     });
                     ids.push(id);
                 }
             }
         }
         ids
+    }
+
+    /// Negative evidence of one frame: every track not among `observed` (the ids
+    /// [`FruitMap::update`] returned for it) that `look` says the frame saw through counts one
+    /// more such frame, one it says is occupied starts again from none; a track seen through
+    /// in [`FruitMap::drop_after`] frames in a row is removed. Returns the removed ids.
+    pub fn forget_seen_through(&mut self, observed: &[u32], look: impl Fn(&Track) -> Look) -> Vec<u32> {
+        for t in self.tracks.iter_mut().filter(|t| !observed.contains(&t.id)) {
+            match look(t) {
+                Look::SeenThrough => t.seen_through += 1,
+                Look::Occupied => t.seen_through = 0,
+                Look::Unseen => {}
+            }
+        }
+        let limit = self.drop_after;
+        let gone: Vec<u32> = self.tracks.iter().filter(|t| t.seen_through >= limit).map(|t| t.id).collect();
+        self.tracks.retain(|t| t.seen_through < limit);
+        gone
     }
 }
 
@@ -174,6 +224,35 @@ mod tests {
             assert!(best < 0.0015, "{t:?}");
             assert!(t.spread() > 0.001 && t.spread() < 0.006, "{t:?}");
         }
+    }
+
+    /// A track seen through in `drop_after` frames in a row goes; an observation, or a frame
+    /// that finds the place occupied, starts its count again; frames that do not see the
+    /// place change nothing.
+    #[test]
+    fn forgets_a_fruit_seen_through() {
+        let mut map = FruitMap::default();
+        let ids = map.update(&[ob([0.0, 0.0, 1.0]), ob([0.2, 0.0, 1.0])], 0);
+        let ghost = ids[0];
+        let through = |t: &Track| if t.id == ghost { Look::SeenThrough } else { Look::Occupied };
+        // Seen through twice, then observed again: it stays.
+        assert!(map.forget_seen_through(&[], through).is_empty());
+        assert!(map.forget_seen_through(&[], through).is_empty());
+        let ids = map.update(&[ob([0.0, 0.0, 1.0])], 3);
+        assert_eq!(ids, vec![ghost]);
+        assert!(map.forget_seen_through(&ids, through).is_empty());
+        // Seen through twice, occupied once, out of view, seen through twice: it stays.
+        for look in
+            [Look::SeenThrough, Look::SeenThrough, Look::Occupied, Look::Unseen, Look::SeenThrough, Look::SeenThrough]
+        {
+            assert!(map.forget_seen_through(&[], |t| if t.id == ghost { look } else { Look::Occupied }).is_empty());
+        }
+        assert_eq!(map.tracks.len(), 2);
+        // A third frame in a row: gone, the other fruit kept, ids not reused.
+        assert_eq!(map.forget_seen_through(&[], through), vec![ghost]);
+        assert_eq!(map.tracks.len(), 1);
+        assert_ne!(map.tracks[0].id, ghost);
+        assert_eq!(map.update(&[ob([0.0, 0.0, 1.0])], 9), vec![3]);
     }
 
     /// Once settled, a wild observation inside the gate is refused and does not move the mean.
