@@ -139,6 +139,9 @@ pub struct HarvestNode {
     plans: u32,
     /// Fruit this node has put in the box (a row harvest's earlier fruit included).
     boxed: u32,
+    /// The recovery is putting a fruit an arm still held (a failed handover of the last
+    /// pick) into the box: its release goes back to the recovery instead of ending the task.
+    rescuing: bool,
     /// Prices planning work in simulated seconds.
     cost: CostModel,
     /// Planning work counted up to the last plan reported.
@@ -220,6 +223,7 @@ impl HarvestNode {
             target_name: String::new(),
             plans: 0,
             boxed: 0,
+            rescuing: false,
             cost: CostModel::CALIBRATED,
             work_mark: Work::default(),
             step_thinking: 0.0,

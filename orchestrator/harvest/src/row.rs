@@ -150,6 +150,32 @@ mod tests {
         }
     }
 
+    /// Regression (row by sight, 2026-11-29): a fruit still in a gripper when the next task
+    /// starts (its handover failed) is not let go where the arm is: the holder, as the
+    /// taker, carries it into the box first; the other gripper opens as usual.
+    #[test]
+    fn the_recovery_puts_a_held_fruit_in_the_box_first() {
+        use agrisim_bus::Reader;
+        use agrisim_msgs::agrisim::GripperState;
+        use agrisim_msgs::control_msgs::GripperCommand;
+        for holder in ["left", "right"] {
+            let mut row = RowNode::by_sight(vec![region(0.0), region(1.0)], 1);
+            let mut bus = Bus::default();
+            let mut commands = ["left", "right"].map(|a| Reader::new(&format!("/{a}_gripper/command")));
+            row.step(0, &mut bus).unwrap();
+            let held = GripperState { position: 0.05, effort: 20.0, stalled: true, ..Default::default() };
+            bus.publish(&format!("/{holder}_gripper/state"), 50_000_000, &held);
+            row.inner.stage = Stage::Done;
+            row.step(100_000_000, &mut bus).unwrap();
+            assert_eq!(row.inner.stage(), Stage::Transfer, "{holder} holds a fruit");
+            let opened: Vec<usize> = (0..2)
+                .filter(|&i| commands[i].take::<GripperCommand>(&mut bus).unwrap().iter().any(|c| c.position > 0.07))
+                .collect();
+            let other = if holder == "left" { 1 } else { 0 };
+            assert_eq!(opened, vec![other], "only the free gripper opens ({holder} holds)");
+        }
+    }
+
     /// The region rule: stay while picks succeed, move on when the scan finds nothing, after
     /// MAX_FAILURES_PER_REGION failures in a row, or after MAX_PICKS_PER_REGION picks.
     #[test]

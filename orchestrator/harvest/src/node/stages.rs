@@ -42,13 +42,41 @@ const DETACH_SETTLE: f64 = 0.2;
 impl HarvestNode {
     /// Between two fruit: open both grippers and stop the base, then send home each arm that
     /// is not, the one that reached furthest first. -> select_target once both are home.
+    /// An arm that still holds a fruit (the last pick's handover failed) is not opened: it
+    /// carries the fruit into the box first, as the taker of a handover does. -> transfer.
     pub(super) fn run_recover(&mut self, t_ns: i64, bus: &mut Bus) {
         match self.phase_now() {
-            0 => {
+            0 if !self.rescuing => {
+                if let Some(arm) = [Arm::Left, Arm::Right].into_iter().find(|&a| self.holding(a)) {
+                    // The holder becomes the taker; the fruit sits GRASP_DEPTH short of its
+                    // TCP, where a giver holds it (handover offset 0).
+                    self.side = if arm == Arm::Right { 1.0 } else { -1.0 };
+                    self.handover_offset = 0.0;
+                    let r = 0.5 * self.view(arm).gripper.as_ref().map_or(0.06, |g| g.position);
+                    self.motion.set_held(arm, Some(r));
+                    self.gripper(arm.other(), geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
+                    self.stop_base(t_ns, bus);
+                    self.rescuing = true;
+                    self.enter(
+                        Stage::Transfer,
+                        t_ns,
+                        bus,
+                        &format!("{} arm still holds a fruit: into the box first", arm.name()),
+                    );
+                    return;
+                }
                 for arm in [Arm::Left, Arm::Right] {
                     self.gripper(arm, geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
                 }
                 self.stop_base(t_ns, bus);
+                self.phase = 1;
+            }
+            0 => {
+                // Back from putting a held fruit into the box: the grippers as usual.
+                self.rescuing = false;
+                for arm in [Arm::Left, Arm::Right] {
+                    self.gripper(arm, geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
+                }
                 self.phase = 1;
             }
             // The grippers open (half a second), then each arm that is not home goes
@@ -685,6 +713,11 @@ impl HarvestNode {
         // Judge, once the hand is out of the box, on a target message sent after the fruit
         // settled.
         let settled_ns = self.release_ns + (SETTLE * 1e9) as i64;
+        // A fruit the recovery put in the box is not this task's: on with the recovery.
+        if self.rescuing && self.phase == 2 && t_ns >= settled_ns {
+            self.boxed += 1;
+            return self.enter(Stage::Recover, t_ns, bus, "the held fruit released into the box");
+        }
         // By sight no camera looks into the box: the node takes the release as done (the
         // judge checks the box on ground truth).
         if self.region().is_some() && self.phase == 2 && t_ns >= settled_ns {
