@@ -16,7 +16,7 @@ pub mod recorder;
 
 pub use agrisim_error::{err, Context, Error, Result};
 pub use bus::{Bus, Published, Reader, Sample, Tap};
-pub use node::Node;
+pub use node::{Charged, Node};
 pub use policy::{Profile, RecordPolicy};
 
 /// Topics whose publisher sends a message once (or on change) and whose readers need the last

@@ -30,10 +30,11 @@ pub mod ray;
 pub mod robot;
 pub mod shape;
 
+pub use agrisim_bus::Charged;
 pub use cost::{CostModel, MapWork};
 pub use depth::{DepthFrame, Intrinsics};
 pub use map::{MapConfig, Occupancy, OccupancyMap, ScanStats, VoxelBox, OCCUPIED_KIND};
-pub use node::{CameraTopics, Charged, DepthMapper, MapperConfig};
+pub use node::{CameraTopics, DepthMapper, MapperConfig};
 pub use ray::{Grid, Key};
 pub use robot::RobotShapes;
 pub use shape::{Primitive, Shape, Sphere};

@@ -36,7 +36,7 @@ use crate::depth::{DepthFrame, Intrinsics};
 use crate::map::{MapConfig, OccupancyMap, ScanStats};
 use crate::robot::RobotShapes;
 use crate::shape::{Primitive, Sphere};
-use agrisim_bus::{Bus, Node, Reader};
+use agrisim_bus::{Bus, Charged, Node, Reader};
 use agrisim_error::Result;
 use agrisim_msgs::agrisim::{FmuStatus, PlanningScene};
 use agrisim_msgs::builtin_interfaces::Time;
@@ -49,8 +49,6 @@ use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion};
 use std::collections::BTreeMap;
 use std::collections::BTreeSet;
 use std::collections::VecDeque;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::Arc;
 
 /// The default camera's topics (namespace `/camera`).
 pub const DEPTH: &str = "/camera/aligned_depth_to_color/image_raw";
@@ -182,20 +180,6 @@ struct Camera {
     info: Option<(String, u32, u32, Intrinsics)>,
     /// Frames not yet taken up, with the step they arrived at [ns].
     waiting: Vec<(Image, i64)>,
-}
-
-/// Simulated compute time a node charged so far [s], readable by its owner after the node is
-/// boxed (the benchmark's per-trial totals).
-#[derive(Clone, Debug, Default)]
-pub struct Charged(Arc<AtomicU64>);
-
-impl Charged {
-    pub fn seconds(&self) -> f64 {
-        f64::from_bits(self.0.load(Ordering::Relaxed))
-    }
-    fn add(&self, s: f64) {
-        self.0.store((self.seconds() + s).to_bits(), Ordering::Relaxed);
-    }
 }
 
 pub struct DepthMapper {

@@ -22,7 +22,8 @@ pub mod sphere;
 pub mod tf;
 pub mod tracker;
 
+pub use agrisim_bus::Charged;
 pub use colour::{is_ripe, stage_of, STAGES};
 pub use cost::CostModel;
 pub use detect::{DetectWork, Detection, Detector, DetectorConfig, Frame, FrameResult, Intrinsics};
-pub use node::{Charged, Perception, PerceptionConfig};
+pub use node::{Perception, PerceptionConfig};

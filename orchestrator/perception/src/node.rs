@@ -20,7 +20,7 @@ use crate::cost::CostModel;
 use crate::detect::{DetectWork, Detection, Detector, DetectorConfig, Frame, Intrinsics};
 use crate::tf::TfBuffer;
 use crate::tracker::{FruitMap, Look, Observation, Track};
-use agrisim_bus::{Bus, Node, Reader};
+use agrisim_bus::{Bus, Charged, Node, Reader};
 use agrisim_error::Result;
 use agrisim_msgs::agrisim::FmuStatus;
 use agrisim_msgs::builtin_interfaces::Time;
@@ -33,8 +33,6 @@ use agrisim_msgs::vision_msgs::{
 };
 use nalgebra::{Isometry3, Point3, Vector3 as Vec3};
 use std::collections::VecDeque;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::Arc;
 
 pub const IMAGE: &str = "/camera/color/image_raw";
 pub const DEPTH: &str = "/camera/aligned_depth_to_color/image_raw";
@@ -125,20 +123,6 @@ impl CameraInput {
 enum Out {
     Array(&'static str, Detection3DArray),
     Status(FmuStatus),
-}
-
-/// Simulated compute time a node charged so far [s], readable by its owner after the node is
-/// boxed (the benchmark's per-trial totals).
-#[derive(Clone, Debug, Default)]
-pub struct Charged(Arc<AtomicU64>);
-
-impl Charged {
-    pub fn seconds(&self) -> f64 {
-        f64::from_bits(self.0.load(Ordering::Relaxed))
-    }
-    fn add(&self, s: f64) {
-        self.0.store((self.seconds() + s).to_bits(), Ordering::Relaxed);
-    }
 }
 
 pub struct Perception {
