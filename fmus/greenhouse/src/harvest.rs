@@ -36,11 +36,14 @@
 //!   squeezes with more than `bruise_grip_force`, or when a released fruit reaches more than
 //!   `bruise_impact_speed` before it settles (its impact on the box, the floor or a leaf); a
 //!   picked fruit below `ripe_stage` is an unripe fruit detached. Each fruit counts once per kind.
+//!   A main stem a robot part presses on beyond its bending strength is broken
+//!   ([`crate::stems`]); each stem counts once.
 
 use crate::pedicel::{Attachment, Load, Mode, PedicelGeometry, PedicelParams};
 use crate::robot_links::{from_rapier, to_rapier};
 use crate::robot_model::{BoxInterior, FingerPads, Side};
 use crate::scene_world::SceneWorld;
+use crate::stems::{StemLoad, StemParams};
 use agrisim_math::vec3::{norm, sub};
 use agrisim_robot::Pose as RPose;
 use agrisim_scene::scene::Kind;
@@ -131,11 +134,13 @@ pub struct DamageParams {
     pub bruise_grip_force: f64,
     pub bruise_impact_speed: f64,
     pub ripe_stage: u8,
+    /// Main stems' stiffness and strength ([`crate::stems`]).
+    pub stem: StemParams,
 }
 
 impl Default for DamageParams {
     fn default() -> Self {
-        DamageParams { bruise_grip_force: 40.0, bruise_impact_speed: 2.0, ripe_stage: 5 }
+        DamageParams { bruise_grip_force: 40.0, bruise_impact_speed: 2.0, ripe_stage: 5, stem: StemParams::default() }
     }
 }
 
@@ -148,12 +153,30 @@ pub struct Damage {
     /// The largest grip force that bruised a fruit [N] and the fastest impact that did [m/s].
     pub peak_grip: f64,
     pub peak_impact: f64,
+    /// Broken main stems (scene object indices).
+    pub stems_broken: BTreeSet<usize>,
+    /// The largest stem load so far, as a fraction of its bending strength, and its force [N].
+    pub peak_stem_ratio: f64,
+    pub peak_stem_force: f64,
 }
 
 impl Damage {
     /// Fruit bruised by grip or impact (each once).
     pub fn bruised(&self) -> usize {
         self.grip_bruised.union(&self.impact_bruised).count()
+    }
+
+    /// Takes this step's stem loads (by stem object index): a load at or above the stem's
+    /// strength breaks it.
+    pub fn press_stems(&mut self, loads: &[(usize, StemLoad)]) {
+        for &(object, load) in loads {
+            if load.ratio >= 1.0 {
+                self.stems_broken.insert(object);
+            }
+            if load.ratio > self.peak_stem_ratio {
+                (self.peak_stem_ratio, self.peak_stem_force) = (load.ratio, load.force);
+            }
+        }
     }
 }
 

@@ -24,6 +24,7 @@ pub mod robot_links;
 pub mod robot_model;
 pub mod robot_parts;
 pub mod scene_world;
+pub mod stems;
 pub mod world;
 
 pub use world::GreenhouseWorld;

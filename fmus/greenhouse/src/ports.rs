@@ -208,6 +208,16 @@ agrisim_fmi::variables! { pub VARIABLES {
         .desc("agrisim_msgs/PlantDamage (ground truth, for the judge): damage counts by kind and the last detachment, at the start and whenever they change"),
     PLANT_DAMAGE_SEQ = Var::output_discrete("plant_damage_seq", Start::Int64(0)).init_depends_on(&[])
         .desc("Sequence number of the newest message in plant_damage"),
+    STEM_MODULUS = Var::param("stem_modulus", Start::Float64(100e6)).unit("Pa").range(1e5, 1e11)
+        .desc("Young's modulus of the main stems, beams supported at foot and head (estimate from a herbaceous stem: Agriculture 12(10):1519, 2022)"),
+    STEM_STRENGTH = Var::param("stem_strength", Start::Float64(7e6)).unit("Pa").range(1e3, 1e10)
+        .desc("Bending strength (modulus of rupture) of the main stems: a press whose bending moment exceeds it breaks the stem (estimate, same source)"),
+    STEMS_BROKEN_COUNT = Var::output_discrete("stems_broken_count", Start::Int32(0)).init_depends_on(&[])
+        .desc("Main stems a robot part pressed beyond their bending strength (ground truth; each stem once)"),
+    PEAK_STEM_LOAD = Var::output("peak_stem_load").init_depends_on(&[])
+        .desc("Largest bending moment a robot part put on a main stem so far, as a fraction of its strength (1: broken)"),
+    PEAK_STEM_FORCE = Var::output("peak_stem_force").unit("N").init_depends_on(&[])
+        .desc("Lateral force of the press that gave peak_stem_load"),
 }}
 
 /// The robot's configuration inputs: base pose, lift, arm joints, finger gaps.

@@ -15,6 +15,7 @@ use crate::ports::*;
 use crate::robot_links::{base_pose, to_rapier};
 use crate::robot_model::{Coords, RobotModel, Side};
 use crate::scene_world::SceneWorld;
+use crate::stems::{stem_loads, StemGeometry, StemParams};
 use agrisim_fmi::{Log, Model, OutPort, Store, Var};
 use agrisim_msgs::agrisim::PlantDamage;
 use agrisim_msgs::builtin_interfaces::Time;
@@ -61,6 +62,8 @@ struct Running {
     harvest: Harvest,
     /// Each fruit's pedicel (by fruit index), from the scene: rebuilt, not serialized.
     pedicels: Arc<Vec<PedicelGeometry>>,
+    /// The main stems (sorted by object index), from the scene: rebuilt, not serialized.
+    stems: Arc<Vec<StemGeometry>>,
     /// Kinematic moves of one step (kept to reuse its allocation).
     moves: Vec<(RigidBodyHandle, Pose)>,
     /// Kinematic fruit to keep awake while something falls (reused allocation).
@@ -214,6 +217,17 @@ fn pedicel_params(io: &Store) -> Result<PedicelParams, String> {
     })
 }
 
+/// The `stem_*` parameters: both positive.
+fn stem_params(io: &Store) -> Result<StemParams, String> {
+    let p = StemParams { modulus: io.f64(STEM_MODULUS), strength: io.f64(STEM_STRENGTH) };
+    for (v, i) in [(p.modulus, STEM_MODULUS), (p.strength, STEM_STRENGTH)] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(format!("parameter {} must be positive and finite, got {v}", VARIABLES[i].name));
+        }
+    }
+    Ok(p)
+}
+
 /// Each fruit's pedicel from the scene's objects: `.../pedicel{t}_{f}` belongs to
 /// `.../fruit{t}_{f}`, a rod whose local z runs from the fruit's top up to the truss.
 /// `fruit` lists the fruit's indices into `objects` in fruit order.
@@ -312,14 +326,16 @@ impl Running {
         io.set_i32(GRIP_BRUISED_COUNT, n(h.damage.grip_bruised.len()));
         io.set_i32(IMPACT_BRUISED_COUNT, n(h.damage.impact_bruised.len()));
         io.set_i32(UNRIPE_DETACHED_COUNT, n(h.damage.unripe_detached.len()));
+        io.set_i32(STEMS_BROKEN_COUNT, n(h.damage.stems_broken.len()));
+        io.set_f64(PEAK_STEM_LOAD, h.damage.peak_stem_ratio);
+        io.set_f64(PEAK_STEM_FORCE, h.damage.peak_stem_force);
         let u = |k: usize| k.min(u32::MAX as usize) as u32;
         let mut msg = PlantDamage {
             header: Header::default(),
             bruised_by_grip: u(h.damage.grip_bruised.len()),
             bruised_by_impact: u(h.damage.impact_bruised.len()),
             unripe_detached: u(h.damage.unripe_detached.len()),
-            // Main stems do not break in this model (yet).
-            stems_broken: 0,
+            stems_broken: u(h.damage.stems_broken.len()),
             detached_by_pull: h.detached_by[0],
             detached_by_bend: h.detached_by[1],
             detached_by_twist: h.detached_by[2],
@@ -387,6 +403,8 @@ impl Running {
 
     fn report_contacts(&mut self, io: &mut Store, t: f64) {
         let contacts = robot_contacts(&self.world, &self.harvest);
+        let loads = stem_loads(&self.stems, &contacts, &self.harvest.params.damage.stem);
+        self.harvest.damage.press_stems(&loads);
         let changed = self.tracker.update(&contacts);
         let count = |n: u64| n.min(i32::MAX as u64) as i32;
         io.set_bool(COLLISION, !contacts.is_empty());
@@ -458,6 +476,7 @@ impl Model for GreenhouseWorld {
             damage: DamageParams {
                 bruise_grip_force: positive_param(io, BRUISE_GRIP_FORCE, 1000.0)?,
                 bruise_impact_speed: positive_param(io, BRUISE_IMPACT_SPEED, 100.0)?,
+                stem: stem_params(io)?,
                 ripe_stage: match io.i32(RIPE_STAGE) {
                     s @ 1..=7 => s as u8,
                     s => {
@@ -499,6 +518,7 @@ impl Model for GreenhouseWorld {
             physics_dt,
         };
         let harvest = Harvest::new(params, coords.widths, robot.hands(&base_link));
+        let stems = Arc::new(StemGeometry::all(&greenhouse.objects));
         let pedicels =
             Arc::new(pedicel_geometry(&greenhouse.objects, &world.fruit.iter().map(|f| f.object).collect::<Vec<_>>()));
         log.info(format_args!(
@@ -513,6 +533,7 @@ impl Model for GreenhouseWorld {
             robot,
             harvest,
             pedicels,
+            stems,
             moves: Vec::new(),
             awake: Vec::new(),
             tracker: ContactTracker::default(),
