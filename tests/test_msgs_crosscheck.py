@@ -343,6 +343,9 @@ EXPECTED.update({
         "last_detach_mode": "bend",
         "last_detach_force": 6.5,
         "last_detach_moment": 0.375,
+        "leaf_pushes": 5,
+        "peak_leaf_force": 1.25,
+        "peak_stem_load": 0.5,
     },
     "plan_result": {
         "header": hdr(12, 500_000_000, "map"),

@@ -14,6 +14,7 @@ pub mod base_box;
 pub mod clearance;
 pub mod collision_report;
 pub mod contacts;
+pub mod foliage;
 pub mod geometry;
 pub mod ground_truth;
 pub mod harvest;

@@ -218,6 +218,20 @@ agrisim_fmi::variables! { pub VARIABLES {
         .desc("Largest bending moment a robot part put on a main stem so far, as a fraction of its strength (1: broken)"),
     PEAK_STEM_FORCE = Var::output("peak_stem_force").unit("N").init_depends_on(&[])
         .desc("Lateral force of the press that gave peak_stem_load"),
+    LEAF_COMPLIANT = Var::param("leaf_compliant", Start::Boolean(true))
+        .desc("Whether leaves give way to the robot, turning about the petiole's base, and spring back (false: rigid)"),
+    LEAF_STIFFNESS = Var::param("leaf_stiffness", Start::Float64(0.3)).unit("N.m/rad").range(1e-6, 1e6)
+        .desc("Rotational stiffness of a leaf about its petiole's base (estimate)"),
+    LEAF_FREQUENCY = Var::param("leaf_frequency", Start::Float64(2.0)).unit("Hz").range(0.01, 100.0)
+        .desc("Natural frequency of a released leaf swinging back (estimate)"),
+    LEAF_DAMPING_RATIO = Var::param("leaf_damping_ratio", Start::Float64(0.5)).range(0.0, 10.0)
+        .desc("Damping ratio of a released leaf swinging back (estimate)"),
+    LEAF_PUSHES = Var::output_discrete("leaf_pushes", Start::Int32(0)).init_depends_on(&[])
+        .desc("Times a robot part started pressing a leaf aside (cumulative)"),
+    MOVING_LEAVES = Var::output_discrete("moving_leaves", Start::Int32(0)).init_depends_on(&[])
+        .desc("Leaves now turned from their grown pose (pressed, or swinging back)"),
+    PEAK_LEAF_FORCE = Var::output("peak_leaf_force").unit("N").init_depends_on(&[])
+        .desc("Largest force the robot spent holding a leaf aside so far"),
 }}
 
 /// The robot's configuration inputs: base pose, lift, arm joints, finger gaps.

@@ -221,8 +221,8 @@ impl SceneWorld {
         self.fruit.binary_search_by_key(&object, |f| f.object).ok()
     }
 
-    /// Broad and narrow phase after bodies moved.
-    fn refresh(&mut self) {
+    /// Broad and narrow phase after bodies or colliders moved.
+    pub fn refresh(&mut self) {
         self.scratch.0.step(
             self.params.prediction_distance(),
             &mut self.islands,

@@ -7,6 +7,7 @@ use crate::base_box::BaseBox;
 use crate::clearance::min_clearance;
 use crate::collision_report::collision_state;
 use crate::contacts::{robot_contacts, Category, ContactTracker, Toucher};
+use crate::foliage::{Foliage, FoliageParams, LeafTable};
 use crate::ground_truth::{fruit_poses, Target};
 use crate::harvest::{DamageParams, Harvest, HarvestParams};
 use crate::pedicel::{PedicelGeometry, PedicelParams};
@@ -64,6 +65,13 @@ struct Running {
     pedicels: Arc<Vec<PedicelGeometry>>,
     /// The main stems (sorted by object index), from the scene: rebuilt, not serialized.
     stems: Arc<Vec<StemGeometry>>,
+    /// The compound leaves and their grown poses, from the scene: rebuilt, not serialized.
+    leaves: Arc<LeafTable>,
+    foliage_params: FoliageParams,
+    /// The leaves the robot moved.
+    foliage: Foliage,
+    /// The last step's length [s] (0 before the first step).
+    last_h: f64,
     /// Kinematic moves of one step (kept to reuse its allocation).
     moves: Vec<(RigidBodyHandle, Pose)>,
     /// Kinematic fruit to keep awake while something falls (reused allocation).
@@ -85,7 +93,7 @@ struct Running {
 type SavedRun = (
     SceneWorld,
     (Coords, [f64; 3], Vec<RPose>, RPose),
-    Harvest,
+    (Harvest, Foliage, f64),
     ContactTracker,
     (Schedule, Schedule, Schedule),
     Ports,
@@ -228,6 +236,25 @@ fn stem_params(io: &Store) -> Result<StemParams, String> {
     Ok(p)
 }
 
+/// The `leaf_*` parameters.
+fn foliage_params(io: &Store) -> Result<FoliageParams, String> {
+    let p = FoliageParams {
+        enabled: io.bool(LEAF_COMPLIANT),
+        stiffness: io.f64(LEAF_STIFFNESS),
+        frequency: io.f64(LEAF_FREQUENCY),
+        damping_ratio: io.f64(LEAF_DAMPING_RATIO),
+    };
+    for (v, i) in [(p.stiffness, LEAF_STIFFNESS), (p.frequency, LEAF_FREQUENCY)] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(format!("parameter {} must be positive and finite, got {v}", VARIABLES[i].name));
+        }
+    }
+    if !(p.damping_ratio.is_finite() && p.damping_ratio >= 0.0) {
+        return Err(format!("parameter leaf_damping_ratio must be finite and not negative, got {}", p.damping_ratio));
+    }
+    Ok(p)
+}
+
 /// Each fruit's pedicel from the scene's objects: `.../pedicel{t}_{f}` belongs to
 /// `.../fruit{t}_{f}`, a rod whose local z runs from the fruit's top up to the truss.
 /// `fruit` lists the fruit's indices into `objects` in fruit order.
@@ -342,6 +369,11 @@ impl Running {
             last_detach_mode: last.map_or("", |d| d.mode.label()).to_string(),
             last_detach_force: last.map_or(0.0, |d| agrisim_math::vec3::norm(d.load.force)),
             last_detach_moment: last.map_or(0.0, |d| d.load.bend.max(d.load.twist)),
+            leaf_pushes: self.foliage.pushes.min(u32::MAX as u64) as u32,
+            // Rounded: a peak rises step by step while a press goes on, and every change is
+            // a message.
+            peak_leaf_force: (10.0 * self.foliage.peak_force).round() / 10.0,
+            peak_stem_load: (100.0 * h.damage.peak_stem_ratio).round() / 100.0,
         };
         let key = msg.to_cdr();
         if key != self.ports.damage_published {
@@ -395,6 +427,7 @@ impl Running {
             self.harvest.kinematic_fruit(&self.world, &mut self.awake);
         }
         self.world.advance(&self.moves, &self.awake, h, dynamic, r.physics_dt);
+        self.last_h = h;
         let box_vel: [f64; 3] = std::array::from_fn(|i| (box_pose.trans[i] - r.box_pose.trans[i]) / h);
         self.harvest.settle(&mut self.world, &r.model.box_interior, &box_pose, box_vel, h);
         r.box_pose = box_pose;
@@ -405,6 +438,14 @@ impl Running {
         let contacts = robot_contacts(&self.world, &self.harvest);
         let loads = stem_loads(&self.stems, &contacts, &self.harvest.params.damage.stem);
         self.harvest.damage.press_stems(&loads);
+        if self.last_h > 0.0
+            && self.foliage.step(&self.leaves, &mut self.world, &contacts, &self.foliage_params, self.last_h)
+        {
+            self.world.refresh();
+        }
+        io.set_i32(LEAF_PUSHES, self.foliage.pushes.min(i32::MAX as u64) as i32);
+        io.set_i32(MOVING_LEAVES, self.foliage.moving.len().min(i32::MAX as usize) as i32);
+        io.set_f64(PEAK_LEAF_FORCE, self.foliage.peak_force);
         let changed = self.tracker.update(&contacts);
         let count = |n: u64| n.min(i32::MAX as u64) as i32;
         io.set_bool(COLLISION, !contacts.is_empty());
@@ -519,6 +560,8 @@ impl Model for GreenhouseWorld {
         };
         let harvest = Harvest::new(params, coords.widths, robot.hands(&base_link));
         let stems = Arc::new(StemGeometry::all(&greenhouse.objects));
+        let leaves = Arc::new(LeafTable::new(&greenhouse.objects, &world));
+        let foliage_params = foliage_params(io)?;
         let pedicels =
             Arc::new(pedicel_geometry(&greenhouse.objects, &world.fruit.iter().map(|f| f.object).collect::<Vec<_>>()));
         log.info(format_args!(
@@ -534,6 +577,10 @@ impl Model for GreenhouseWorld {
             harvest,
             pedicels,
             stems,
+            leaves,
+            foliage_params,
+            foliage: Foliage::default(),
+            last_h: 0.0,
             moves: Vec::new(),
             awake: Vec::new(),
             tracker: ContactTracker::default(),
@@ -559,7 +606,7 @@ impl Model for GreenhouseWorld {
         let robot = (&r.robot.coords, &r.robot.planar, &r.robot.link_in_base, &r.robot.box_pose);
         let schedules = (&r.collision_schedule, &r.fruit_schedule, &r.scene_schedule);
         agrisim_fmi::serial::write(
-            &(&r.world, robot, &r.harvest, &r.tracker, schedules, &r.ports, r.published_target),
+            &(&r.world, robot, (&r.harvest, &r.foliage, r.last_h), &r.tracker, schedules, &r.ports, r.published_target),
             out,
         )
     }
@@ -567,8 +614,15 @@ impl Model for GreenhouseWorld {
     fn load_state(&mut self, bytes: &[u8]) -> Result<(), String> {
         let r = self.run.as_mut().ok_or("the world is not initialized")?;
         let saved: SavedRun = agrisim_fmi::serial::read(bytes)?;
-        let (world, (coords, planar, link_in_base, box_pose), harvest, tracker, schedules, ports, published_target) =
-            saved;
+        let (
+            world,
+            (coords, planar, link_in_base, box_pose),
+            (harvest, foliage, last_h),
+            tracker,
+            schedules,
+            ports,
+            published_target,
+        ) = saved;
         if world.fruit.len() != r.world.fruit.len() || link_in_base.len() != r.robot.link_in_base.len() {
             return Err("the saved world is of another scene or robot".into());
         }
@@ -576,6 +630,7 @@ impl Model for GreenhouseWorld {
         (r.robot.coords, r.robot.planar, r.robot.link_in_base, r.robot.box_pose) =
             (coords, planar, link_in_base, box_pose);
         (r.harvest, r.tracker, r.ports, r.published_target) = (harvest, tracker, ports, published_target);
+        (r.foliage, r.last_h) = (foliage, last_h);
         (r.collision_schedule, r.fruit_schedule, r.scene_schedule) = schedules;
         Ok(())
     }

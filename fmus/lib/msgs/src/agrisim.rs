@@ -161,6 +161,13 @@ ros_message! {
         pub last_detach_force: f64,
         /// Larger of the bending and twisting moment at the abscission zone then [N m].
         pub last_detach_moment: f64,
+        /// Leaves the robot pressed aside from rest: not damage, the cost of passing.
+        pub leaf_pushes: u32,
+        /// Largest force the robot spent holding a leaf aside [N] (to 0.1 N).
+        pub peak_leaf_force: f64,
+        /// Largest bending moment a robot part put on a main stem over its strength (to 0.01;
+        /// 1: broken).
+        pub peak_stem_load: f64,
     }
 }
 

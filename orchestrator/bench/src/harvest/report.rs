@@ -57,6 +57,10 @@ pub fn report_html(g: &agrisim_scene::Greenhouse, sum: &HarvestSummary, results:
         ("crop damage (all trials)".to_string(), count_kinds(&sum.damage)),
         ("pedicel breaks by mode (trials)".to_string(), count_kinds(&sum.detach_modes)),
         ("mean detach force [N]".to_string(), opt(sum.detach_force_mean)),
+        (
+            "leaves pressed aside per trial; largest holding force [N]; largest stem load / strength".to_string(),
+            format!("{:.1}; {:.1}; {:.2}", sum.leaf_pushes_per_trial, sum.peak_leaf_force, sum.peak_stem_load),
+        ),
         ("joint tracking RMS mean [rad]".to_string(), format!("{:.2e}", sum.tracking_rms_mean)),
         (
             "wall-clock figures".to_string(),

@@ -66,6 +66,14 @@ pub struct HarvestSummary {
     pub detach_modes: BTreeMap<String, u64>,
     /// Mean over trials with a break of the largest pedicel force at a break [N].
     pub detach_force_mean: Option<f64>,
+    /// Mean per trial of the leaves pressed aside; the largest force spent holding one [N]
+    /// and the largest main-stem load over its strength, over all trials.
+    #[serde(default)]
+    pub leaf_pushes_per_trial: f64,
+    #[serde(default)]
+    pub peak_leaf_force: f64,
+    #[serde(default)]
+    pub peak_stem_load: f64,
     pub time_to_harvest_mean: Option<f64>,
     pub rtf: f64,
     pub sim_time: f64,
@@ -175,6 +183,9 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, results: &[HarvestTrial]) -> Har
             let f: Vec<f64> = results.iter().filter_map(|t| t.detach_force).collect();
             (!f.is_empty()).then(|| f.iter().sum::<f64>() / f.len() as f64)
         },
+        leaf_pushes_per_trial: results.iter().map(|t| t.leaf_pushes as f64).sum::<f64>() / n.max(1) as f64,
+        peak_leaf_force: results.iter().map(|t| t.peak_leaf_force).fold(0.0, f64::max),
+        peak_stem_load: results.iter().map(|t| t.peak_stem_load).fold(0.0, f64::max),
         tracking_rms_mean: if n == 0 {
             0.0
         } else {

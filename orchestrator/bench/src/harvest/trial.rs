@@ -126,6 +126,14 @@ pub struct HarvestTrial {
     /// Largest bending or twisting moment at the abscission zone at a break [N m].
     #[serde(default)]
     pub detach_moment: Option<f64>,
+    /// Leaves the robot pressed aside from rest, the largest force it spent holding one [N],
+    /// and the largest load it put on a main stem over its strength (/plant_damage).
+    #[serde(default)]
+    pub leaf_pushes: u64,
+    #[serde(default)]
+    pub peak_leaf_force: f64,
+    #[serde(default)]
+    pub peak_stem_load: f64,
     /// Pedicel force at each break as (simulated time [s], force [N]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub detach_events: Vec<(f64, f64)>,
@@ -346,6 +354,9 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
         detach_force: damage.force,
         detach_moment: damage.moment,
         detach_events: damage.events.clone(),
+        leaf_pushes: damage.last.leaf_pushes as u64,
+        peak_leaf_force: damage.last.peak_leaf_force,
+        peak_stem_load: damage.last.peak_stem_load,
         tracking_rms: tracking,
         sim_time,
         wall_time: wall.elapsed().as_secs_f64(),
@@ -416,6 +427,9 @@ impl HarvestTrial {
             detach_force: None,
             detach_moment: None,
             detach_events: vec![],
+            leaf_pushes: 0,
+            peak_leaf_force: 0.0,
+            peak_stem_load: 0.0,
             tracking_rms: [0.0; 2],
             sim_time: 0.0,
             wall_time: 0.0,

@@ -304,6 +304,9 @@ fn manipulation_samples() -> Vec<Sample> {
                 last_detach_mode: "bend".into(),
                 last_detach_force: 6.5,
                 last_detach_moment: 0.375,
+                leaf_pushes: 5,
+                peak_leaf_force: 1.25,
+                peak_stem_load: 0.5,
             },
         ),
     ]
