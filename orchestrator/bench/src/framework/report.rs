@@ -93,6 +93,42 @@ pub fn bar_chart(values: &[f64], bin: f64, label: &str) -> String {
     svg
 }
 
+/// Series of (x, y) points as an inline SVG line chart, one coloured polyline each, titled
+/// by its name; axes from 0 to the largest x and y, labelled `x_label` and `y_label`.
+pub fn line_chart(series: &[(String, Vec<(f64, f64)>)], x_label: &str, y_label: &str) -> String {
+    let points = series.iter().flat_map(|(_, s)| s.iter());
+    let (xmax, ymax) = points.fold((0.0f64, 0.0f64), |(x, y), p| (x.max(p.0), y.max(p.1)));
+    if series.iter().all(|(_, s)| s.is_empty()) || !(xmax > 0.0 && ymax > 0.0) {
+        return "<p>no values</p>".into();
+    }
+    const COLOURS: [&str; 6] = ["#4a7ab5", "#c0504d", "#2e8b57", "#8064a2", "#d68a00", "#4bacc6"];
+    let (w, h, left) = (480.0, 220.0, 40.0);
+    let mut svg =
+        format!(r#"<svg xmlns="http://www.w3.org/2000/svg" width="{:.0}" height="{:.0}">"#, w + left + 10.0, h + 40.0);
+    let _ = write!(svg, r##"<rect x="{left}" y="0" width="{w}" height="{h}" fill="none" stroke="#999"/>"##);
+    for (i, (name, s)) in series.iter().enumerate() {
+        let pts: Vec<String> =
+            s.iter().map(|&(x, y)| format!("{:.1},{:.1}", left + x / xmax * w, h - y / ymax * h)).collect();
+        let _ = write!(
+            svg,
+            r#"<polyline points="{}" fill="none" stroke="{}" stroke-width="1.5"><title>{}</title></polyline>"#,
+            pts.join(" "),
+            COLOURS[i % COLOURS.len()],
+            escape(name)
+        );
+    }
+    let _ = write!(
+        svg,
+        r#"<text x="0" y="12" font-size="10">{ymax:.1}</text><text x="0" y="{h:.0}" font-size="10">0</text><text x="{:.0}" y="{:.0}" font-size="10">{xmax:.1}</text><text x="{left}" y="{:.0}" font-size="11">{}; {}</text></svg>"#,
+        left + w - 20.0,
+        h + 14.0,
+        h + 34.0,
+        escape(x_label),
+        escape(y_label)
+    );
+    svg
+}
+
 /// A table of success rates: one row per (key, count, successes, Wilson 95 % interval), with
 /// the fraction. `head` names the key, count and successes columns.
 pub fn rate_table(head: [&str; 3], rows: impl IntoIterator<Item = (String, u64, u64, [f64; 2])>) -> String {
@@ -262,4 +298,21 @@ pub fn per_scene_section(per_scene: &[super::scenes::SceneResult], outcome: &str
     let mut title = format!("{outcome} per scene");
     title[..1].make_ascii_uppercase();
     Some((title, rate_table(["scene", "trials", outcome], scenes) + note))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_line_chart_draws_each_series_scaled_to_the_axes() {
+        let series = vec![("a".to_string(), vec![(0.0, 0.0), (2.0, 10.0)]), ("b <x>".to_string(), vec![(1.0, 5.0)])];
+        let svg = line_chart(&series, "t [s]", "F [N]");
+        assert_eq!(svg.matches("<polyline").count(), 2);
+        // x 0..2 -> 40..520, y 0..10 -> 220..0.
+        assert!(svg.contains(r#"points="40.0,220.0 520.0,0.0""#), "{svg}");
+        assert!(svg.contains(r#"points="280.0,110.0""#), "{svg}");
+        assert!(svg.contains("<title>b &lt;x&gt;</title>"), "{svg}");
+        assert_eq!(line_chart(&[], "t", "F"), "<p>no values</p>");
+    }
 }

@@ -3,8 +3,8 @@
 use super::summary::HarvestSummary;
 use super::trial::HarvestTrial;
 use crate::framework::report::{
-    bar_chart, count_table, interval, opt, per_kind, per_scene_section, rate_table, render_with, view_bounds,
-    TrialTrace,
+    bar_chart, count_table, interval, line_chart, opt, per_kind, per_scene_section, rate_table, render_with,
+    view_bounds, TrialTrace,
 };
 
 /// report.html: the rates (harvest, planning, conditional) with their intervals, results per
@@ -76,6 +76,7 @@ pub fn report_html(g: &agrisim_scene::Greenhouse, sum: &HarvestSummary, results:
         ("Failure taxonomy (trials not harvested)".to_string(), count_table(["category", "trials"], &sum.failures)),
         ("Time to harvest (successful trials, simulated)".to_string(), bar_chart(&times, 5.0, "time to harvest [s]")),
         ("Detachment per trial".to_string(), detach_table(results)),
+        ("Pedicel force until it broke (first 6 trials with a grasp on the plant)".to_string(), force_chart(results)),
     ]);
     let traces: Vec<TrialTrace> = results
         .iter()
@@ -108,6 +109,22 @@ fn count_kinds(m: &std::collections::BTreeMap<String, u64>) -> String {
         return "none".into();
     }
     m.iter().map(|(k, v)| format!("{k} {v}")).collect::<Vec<_>>().join(", ")
+}
+
+/// The pedicel force on the hand over time, from each trial's first loaded step, for the
+/// first 6 trials that loaded a pedicel.
+fn force_chart(results: &[HarvestTrial]) -> String {
+    let series: Vec<(String, Vec<(f64, f64)>)> = results
+        .iter()
+        .filter(|t| !t.pedicel_force.is_empty())
+        .take(6)
+        .map(|t| {
+            let t0 = t.pedicel_force[0].0;
+            let label = format!("trial {} ({})", t.trial, t.detach_mode.as_deref().unwrap_or("no break"));
+            (label, t.pedicel_force.iter().map(|&(x, y)| (x - t0, y)).collect())
+        })
+        .collect();
+    line_chart(&series, "time from the first loaded step [s]", "pedicel force on the hand [N]")
 }
 
 /// One row per trial: how its pedicel broke, the force and moment then, and its damage.

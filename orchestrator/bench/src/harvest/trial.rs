@@ -134,6 +134,11 @@ pub struct HarvestTrial {
     pub peak_leaf_force: f64,
     #[serde(default)]
     pub peak_stem_load: f64,
+    /// The pedicel's force on the hand while a grasped fruit hung on its plant, as (simulated
+    /// time [s], force [N]) at every step (the world FMU's `*_load_f*` outputs, ground truth):
+    /// the build-up to each break. Rounded to 1 ms and 1 mN.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub pedicel_force: Vec<(f64, f64)>,
     /// Pedicel force at each break as (simulated time [s], force [N]).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub detach_events: Vec<(f64, f64)>,
@@ -222,9 +227,22 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
     let mut judged: Option<(Option<String>, String)> = None;
     let mut time_to_harvest = None;
     let mut touches = Touches::default();
+    let mut pedicel_force: Vec<(f64, f64)> = Vec::new();
+    let load_names =
+        ["left_load_fx", "left_load_fy", "left_load_fz", "right_load_fx", "right_load_fy", "right_load_fz"];
     let result: Result<()> = (|| {
         for k in 1..=max_ticks {
             m.advance()?;
+            let mut f = [0.0; 6];
+            for (v, name) in f.iter_mut().zip(load_names) {
+                *v = m.number(world, name)?;
+            }
+            let force = f64::max(f[0].hypot(f[1]).hypot(f[2]), f[3].hypot(f[4]).hypot(f[5]));
+            // The loaded steps, and the first unloaded one after them (the break).
+            if force > 0.0 || pedicel_force.last().is_some_and(|p| p.1 > 0.0) {
+                let t = k as f64 * s.timing.step;
+                pedicel_force.push(((t * 1e3).round() / 1e3, (force * 1e3).round() / 1e3));
+            }
             path.push([m.number(chassis, "x")?, m.number(chassis, "y")?]);
             reports.read(&mut m, &node_name)?;
             damage.read(&mut damage_reader, &mut m.bus)?;
@@ -354,6 +372,7 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
         detach_force: damage.force,
         detach_moment: damage.moment,
         detach_events: damage.events.clone(),
+        pedicel_force,
         leaf_pushes: damage.last.leaf_pushes as u64,
         peak_leaf_force: damage.last.peak_leaf_force,
         peak_stem_load: damage.last.peak_stem_load,
@@ -427,6 +446,7 @@ impl HarvestTrial {
             detach_force: None,
             detach_moment: None,
             detach_events: vec![],
+            pedicel_force: vec![],
             leaf_pushes: 0,
             peak_leaf_force: 0.0,
             peak_stem_load: 0.0,
