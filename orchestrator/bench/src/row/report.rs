@@ -32,6 +32,18 @@ pub fn report_html(g: &agrisim_scene::Greenhouse, sum: &RowSummary, results: &[R
         ("plant touches per fruit".to_string(), per_kind(&sum.touches_per_fruit)),
         ("dropped fruit".to_string(), sum.dropped.to_string()),
         (
+            "crop damage (all segments)".to_string(),
+            sum.damage.iter().filter(|(_, v)| **v > 0).map(|(k, v)| format!("{k} {v}")).collect::<Vec<_>>().join(", "),
+        ),
+        (
+            "leaves pressed aside per fruit; largest holding force [N]; largest stem load / strength".to_string(),
+            format!("{:.1}; {:.1}; {:.2}", sum.leaf_pushes_per_fruit, sum.peak_leaf_force, sum.peak_stem_load),
+        ),
+        (
+            "perception; mapping compute charged per fruit [s]".to_string(),
+            format!("{:.2}; {:.2}", sum.perception_time_per_fruit, sum.mapping_time_per_fruit),
+        ),
+        (
             "fruit detached / unripe detached (share)".to_string(),
             format!("{} / {} ({:.3})", sum.detached, sum.unripe_detached, sum.unripe_share),
         ),

@@ -41,6 +41,15 @@ pub struct RowSummary {
     pub unripe_placed: u64,
     pub other_ripe_placed: u64,
     pub thinking_time_per_fruit: f64,
+    /// Perception and mapping compute charged per reachable ripe fruit [s] (0 without sight).
+    pub perception_time_per_fruit: f64,
+    pub mapping_time_per_fruit: f64,
+    /// Crop damage over all segments, by kind; leaves pressed aside per fruit; the largest
+    /// force spent holding a leaf [N] and the largest main-stem load over its strength.
+    pub damage: BTreeMap<String, u64>,
+    pub leaf_pushes_per_fruit: f64,
+    pub peak_leaf_force: f64,
+    pub peak_stem_load: f64,
     pub rtf: f64,
     pub sim_time: f64,
     pub wall_time: f64,
@@ -111,6 +120,18 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, length: f64, results: &[RowTrial
         unripe_placed: results.iter().map(|t| t.unripe_placed).sum(),
         other_ripe_placed: results.iter().map(|t| t.other_ripe_placed).sum(),
         thinking_time_per_fruit: results.iter().map(|t| t.thinking_time).sum::<f64>() / targets.max(1) as f64,
+        perception_time_per_fruit: results.iter().map(|t| t.perception_time).sum::<f64>() / targets.max(1) as f64,
+        mapping_time_per_fruit: results.iter().map(|t| t.mapping_time).sum::<f64>() / targets.max(1) as f64,
+        damage: {
+            let mut m: BTreeMap<String, u64> = BTreeMap::new();
+            for (k, v) in results.iter().flat_map(|t| t.damage.iter()) {
+                *m.entry(k.clone()).or_insert(0) += v;
+            }
+            m
+        },
+        leaf_pushes_per_fruit: results.iter().map(|t| t.leaf_pushes as f64).sum::<f64>() / targets.max(1) as f64,
+        peak_leaf_force: results.iter().map(|t| t.peak_leaf_force).fold(0.0, f64::max),
+        peak_stem_load: results.iter().map(|t| t.peak_stem_load).fold(0.0, f64::max),
         rtf: if wall > 0.0 { sim / wall } else { 0.0 },
         sim_time: sim,
         wall_time: wall,

@@ -103,6 +103,23 @@ pub struct RowTrial {
     pub attempts: Vec<RowAttempt>,
     /// Simulated planning time the node charged [s].
     pub thinking_time: f64,
+    /// Simulated compute the perception and mapping nodes charged over the segment (their
+    /// cost models; 0 without sight) [s].
+    #[serde(default)]
+    pub perception_time: f64,
+    #[serde(default)]
+    pub mapping_time: f64,
+    /// Crop damage at the end, by kind (bruised_by_grip, bruised_by_impact, unripe_detached,
+    /// stems_broken), leaves pressed aside from rest, the largest force spent holding one [N]
+    /// and the largest main-stem load over its strength (/plant_damage, world ground truth).
+    #[serde(default)]
+    pub damage: BTreeMap<String, u64>,
+    #[serde(default)]
+    pub leaf_pushes: u64,
+    #[serde(default)]
+    pub peak_leaf_force: f64,
+    #[serde(default)]
+    pub peak_stem_load: f64,
     pub fruit: Vec<RowFruit>,
     /// Ground-truth base path (every 10th exchange); in trials/NNNN.json, not in
     /// trials.jsonl.
@@ -128,7 +145,7 @@ pub fn run(t: &Trial<HarvestSetup>, mcap: &Path) -> Result<RowTrial> {
         Some(r) => Box::new(RowNode::by_sight(r.clone(), seed)),
         None => Box::new(RowNode::new(seg.targets.iter().map(|t| t.fruit_index).collect(), seed)),
     };
-    let (mut m, _) = harvest_session(t, seg.start, mcap, node, None)?;
+    let (mut m, charges) = harvest_session(t, seg.start, mcap, node, None)?;
     let (world, chassis) = (m.component("world", "row benchmark")?, m.component("chassis", "row benchmark")?);
     let step = s.timing.step;
     let timeout = TIME_PER_FRUIT * seg.targets.len() as f64
@@ -311,6 +328,12 @@ pub fn run(t: &Trial<HarvestSetup>, mcap: &Path) -> Result<RowTrial> {
         sight: regions.is_some(),
         attempts,
         thinking_time: thinking,
+        perception_time: charges.perception(),
+        mapping_time: charges.mapping(),
+        damage: damage.by_kind(),
+        leaf_pushes: damage.last.leaf_pushes as u64,
+        peak_leaf_force: damage.last.peak_leaf_force,
+        peak_stem_load: damage.last.peak_stem_load,
         fruit,
         path,
         sim_time,
