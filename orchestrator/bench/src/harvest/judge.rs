@@ -197,6 +197,30 @@ impl Aims {
     }
 }
 
+/// What passing through the crop cost (/plant_damage, world ground truth): leaves pressed
+/// aside from rest, the largest force spent holding one [N], the largest main-stem load over
+/// its strength. Flattened into the harvest and row trial records.
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PlantEffects {
+    #[serde(default)]
+    pub leaf_pushes: u64,
+    #[serde(default)]
+    pub peak_leaf_force: f64,
+    #[serde(default)]
+    pub peak_stem_load: f64,
+}
+
+impl PlantEffects {
+    /// Over several trials: pushes added, peaks the largest.
+    pub fn total<'a>(all: impl IntoIterator<Item = &'a PlantEffects>) -> PlantEffects {
+        all.into_iter().fold(PlantEffects::default(), |a, e| PlantEffects {
+            leaf_pushes: a.leaf_pushes + e.leaf_pushes,
+            peak_leaf_force: a.peak_leaf_force.max(e.peak_leaf_force),
+            peak_stem_load: a.peak_stem_load.max(e.peak_stem_load),
+        })
+    }
+}
+
 /// What the judge keeps of /plant_damage: the last message and every pedicel break.
 #[derive(Default)]
 pub(crate) struct DamageLog {
@@ -225,6 +249,15 @@ impl DamageLog {
             self.events.push((d.header.stamp.as_secs_f64(), d.last_detach_force));
         }
         self.last = d.clone();
+    }
+
+    pub(crate) fn effects(&self) -> PlantEffects {
+        let d = &self.last;
+        PlantEffects {
+            leaf_pushes: d.leaf_pushes as u64,
+            peak_leaf_force: d.peak_leaf_force,
+            peak_stem_load: d.peak_stem_load,
+        }
     }
 
     pub(crate) fn by_kind(&self) -> BTreeMap<String, u64> {

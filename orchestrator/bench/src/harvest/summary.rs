@@ -1,6 +1,7 @@
 //! summary.json of the harvest benchmark: harvest, planning and conditional rates with their
 //! intervals, per scene and per visibility class, failure taxonomy, planning times, touches.
 
+use super::judge::PlantEffects;
 use super::trial::HarvestTrial;
 use crate::framework::scenes::{by_scene, SceneResult};
 use crate::framework::stats::{percentile, wilson, Z95};
@@ -113,6 +114,7 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, results: &[HarvestTrial]) -> Har
     let rate = |a: u64, b: u64| if b == 0 { 0.0 } else { a as f64 / b as f64 };
     let mut target_errors: Vec<f64> = results.iter().filter_map(|t| t.target_error_mm).collect();
     target_errors.sort_by(f64::total_cmp);
+    let plant = PlantEffects::total(results.iter().map(|t| &t.plant));
     HarvestSummary {
         scenario: s.name.clone(),
         perception_in_loop: s.harvest.sight,
@@ -183,9 +185,9 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, results: &[HarvestTrial]) -> Har
             let f: Vec<f64> = results.iter().filter_map(|t| t.detach_force).collect();
             (!f.is_empty()).then(|| f.iter().sum::<f64>() / f.len() as f64)
         },
-        leaf_pushes_per_trial: results.iter().map(|t| t.leaf_pushes as f64).sum::<f64>() / n.max(1) as f64,
-        peak_leaf_force: results.iter().map(|t| t.peak_leaf_force).fold(0.0, f64::max),
-        peak_stem_load: results.iter().map(|t| t.peak_stem_load).fold(0.0, f64::max),
+        leaf_pushes_per_trial: plant.leaf_pushes as f64 / n.max(1) as f64,
+        peak_leaf_force: plant.peak_leaf_force,
+        peak_stem_load: plant.peak_stem_load,
         tracking_rms_mean: if n == 0 {
             0.0
         } else {

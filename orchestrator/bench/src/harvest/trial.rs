@@ -6,7 +6,7 @@
 //! within the time limit. Planning success means every motion the trial asked for was
 //! planned.
 
-use super::judge::{base_contact, Aims, DamageLog, Reports, Touches, COLLISION_COUNTERS, SOFT_COUNTERS};
+use super::judge::{base_contact, Aims, DamageLog, PlantEffects, Reports, Touches, COLLISION_COUNTERS, SOFT_COUNTERS};
 use super::session::harvest_session;
 use super::setup::HarvestSetup;
 use super::targets::{draw, HarvestTarget, HEIGHT_RANGE, RIPE_STAGE};
@@ -128,12 +128,8 @@ pub struct HarvestTrial {
     pub detach_moment: Option<f64>,
     /// Leaves the robot pressed aside from rest, the largest force it spent holding one [N],
     /// and the largest load it put on a main stem over its strength (/plant_damage).
-    #[serde(default)]
-    pub leaf_pushes: u64,
-    #[serde(default)]
-    pub peak_leaf_force: f64,
-    #[serde(default)]
-    pub peak_stem_load: f64,
+    #[serde(flatten)]
+    pub plant: PlantEffects,
     /// The pedicel's force on the hand while a grasped fruit hung on its plant, as (simulated
     /// time [s], force [N]) at every step (the world FMU's `*_load_f*` outputs, ground truth):
     /// the build-up to each break. Rounded to 1 ms and 1 mN.
@@ -373,9 +369,7 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
         detach_moment: damage.moment,
         detach_events: damage.events.clone(),
         pedicel_force,
-        leaf_pushes: damage.last.leaf_pushes as u64,
-        peak_leaf_force: damage.last.peak_leaf_force,
-        peak_stem_load: damage.last.peak_stem_load,
+        plant: damage.effects(),
         tracking_rms: tracking,
         sim_time,
         wall_time: wall.elapsed().as_secs_f64(),
@@ -447,9 +441,7 @@ impl HarvestTrial {
             detach_moment: None,
             detach_events: vec![],
             pedicel_force: vec![],
-            leaf_pushes: 0,
-            peak_leaf_force: 0.0,
-            peak_stem_load: 0.0,
+            plant: PlantEffects::default(),
             tracking_rms: [0.0; 2],
             sim_time: 0.0,
             wall_time: 0.0,

@@ -4,6 +4,7 @@
 use super::trial::RowTrial;
 use crate::framework::stats::{cluster_bootstrap95, percentile, wilson, Z95};
 use crate::framework::TrialPlan;
+use crate::harvest::judge::PlantEffects;
 use agrisim_session::Scenario;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -94,6 +95,7 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, length: f64, results: &[RowTrial
     let unripe_detached: u64 = results.iter().map(|t| t.unripe_detached).sum();
     let clusters: Vec<(u64, u64)> =
         results.iter().filter(|t| t.targets > 0).map(|t| (t.harvested, t.targets)).collect();
+    let plant = PlantEffects::total(results.iter().map(|t| &t.plant));
     RowSummary {
         scenario: s.name.clone(),
         seed: plan.seed,
@@ -129,9 +131,9 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, length: f64, results: &[RowTrial
             }
             m
         },
-        leaf_pushes_per_fruit: results.iter().map(|t| t.leaf_pushes as f64).sum::<f64>() / targets.max(1) as f64,
-        peak_leaf_force: results.iter().map(|t| t.peak_leaf_force).fold(0.0, f64::max),
-        peak_stem_load: results.iter().map(|t| t.peak_stem_load).fold(0.0, f64::max),
+        leaf_pushes_per_fruit: plant.leaf_pushes as f64 / targets.max(1) as f64,
+        peak_leaf_force: plant.peak_leaf_force,
+        peak_stem_load: plant.peak_stem_load,
         rtf: if wall > 0.0 { sim / wall } else { 0.0 },
         sim_time: sim,
         wall_time: wall,

@@ -7,7 +7,7 @@
 
 use super::segment::{draw_segment, regions_of};
 use crate::framework::Trial;
-use crate::harvest::judge::{base_contact, Aims, DamageLog, Touches, COLLISION_COUNTERS};
+use crate::harvest::judge::{base_contact, Aims, DamageLog, PlantEffects, Touches, COLLISION_COUNTERS};
 use crate::harvest::session::harvest_session;
 use crate::harvest::targets::RIPE_STAGE;
 use crate::harvest::HarvestSetup;
@@ -114,12 +114,8 @@ pub struct RowTrial {
     /// and the largest main-stem load over its strength (/plant_damage, world ground truth).
     #[serde(default)]
     pub damage: BTreeMap<String, u64>,
-    #[serde(default)]
-    pub leaf_pushes: u64,
-    #[serde(default)]
-    pub peak_leaf_force: f64,
-    #[serde(default)]
-    pub peak_stem_load: f64,
+    #[serde(flatten)]
+    pub plant: PlantEffects,
     pub fruit: Vec<RowFruit>,
     /// Ground-truth base path (every 10th exchange); in trials/NNNN.json, not in
     /// trials.jsonl.
@@ -331,9 +327,7 @@ pub fn run(t: &Trial<HarvestSetup>, mcap: &Path) -> Result<RowTrial> {
         perception_time: charges.perception(),
         mapping_time: charges.mapping(),
         damage: damage.by_kind(),
-        leaf_pushes: damage.last.leaf_pushes as u64,
-        peak_leaf_force: damage.last.peak_leaf_force,
-        peak_stem_load: damage.last.peak_stem_load,
+        plant: damage.effects(),
         fruit,
         path,
         sim_time,
