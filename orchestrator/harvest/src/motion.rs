@@ -193,6 +193,10 @@ impl Motion {
                 // Sensed space by the target the fingers push aside (harvest by sight).
                 crate::sight::PUSHED_KIND => ObstacleKind::Soft,
                 "floor" => continue,
+                // A fruit in a hand is the hand's (`set_held` models it); the world's copy of
+                // it is no obstacle. As Solid, a fruit held from an earlier task (the
+                // recovery carrying it to the box) put the hand's start in collision.
+                "fruit_held" => ObstacleKind::Soft,
                 _ => ObstacleKind::Solid,
             };
             let p = &o.pose.position;
@@ -852,6 +856,14 @@ mod tests {
         fresh.set_target(next);
         fresh.set_scene(&later, base);
         assert!(!home_free(&fresh), "a fruit never held at the hand blocks it");
+        // The world's "fruit_held" (a fruit in a hand, of an earlier task: the recovery
+        // carries it to the box) is the hand's, never an obstacle to it.
+        let mut held = later.clone();
+        held.objects[0].kind = "fruit_held".into();
+        let mut rescue = Motion::new(1);
+        rescue.set_target(next);
+        rescue.set_scene(&held, base);
+        assert!(home_free(&rescue), "the world's held fruit must not block the hand holding it");
     }
 
     #[test]

@@ -142,6 +142,8 @@ pub struct HarvestNode {
     /// The recovery is putting a fruit an arm still held (a failed handover of the last
     /// pick) into the box: its release goes back to the recovery instead of ending the task.
     rescuing: bool,
+    /// That rescue failed (its plan could not be made): the recovery lets the fruit go.
+    rescue_failed: bool,
     /// Prices planning work in simulated seconds.
     cost: CostModel,
     /// Planning work counted up to the last plan reported.
@@ -224,6 +226,7 @@ impl HarvestNode {
             plans: 0,
             boxed: 0,
             rescuing: false,
+            rescue_failed: false,
             cost: CostModel::CALIBRATED,
             work_mark: Work::default(),
             step_thinking: 0.0,
@@ -449,7 +452,23 @@ impl HarvestNode {
         bus.publish(topics::STATUS, t_ns, &msg);
     }
 
-    fn fail(&mut self, f: Failure, t_ns: i64, bus: &mut Bus, detail: String) {
+    pub(crate) fn fail(&mut self, f: Failure, t_ns: i64, bus: &mut Bus, detail: String) {
+        if self.rescuing {
+            // Carrying the last pick's fruit into the box failed: let it go where the arm is
+            // (as before the rescue existed) and go on with this task's recovery. Failing the
+            // task would fail a fruit not tried yet, and the next task would try the same
+            // rescue from the same place (a whole row segment lost that way).
+            self.rescuing = false;
+            self.rescue_failed = true;
+            self.motion.set_held(Arm::Left, None);
+            self.motion.set_held(Arm::Right, None);
+            return self.enter(
+                Stage::Recover,
+                t_ns,
+                bus,
+                &format!("the held fruit cannot go into the box, let go: {detail}"),
+            );
+        }
         self.failure = Some(f);
         self.publish_status(t_ns, bus, "failure", f.name(), &detail);
         self.motion.end_roll();

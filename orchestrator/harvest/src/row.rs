@@ -173,6 +173,16 @@ mod tests {
                 .collect();
             let other = if holder == "left" { 1 } else { 0 };
             assert_eq!(opened, vec![other], "only the free gripper opens ({holder} holds)");
+            // The carry cannot be planned: the fruit is let go and the task goes on with its
+            // recovery (it was failed before, and every later task tried the same rescue).
+            row.inner.fail(Failure::Planning, 200_000_000, &mut bus, "start configuration in collision".into());
+            assert_eq!((row.inner.stage(), row.inner.failure()), (Stage::Recover, None), "{holder}");
+            row.step(300_000_000, &mut bus).unwrap();
+            let opened: Vec<usize> = (0..2)
+                .filter(|&i| commands[i].take::<GripperCommand>(&mut bus).unwrap().iter().any(|c| c.position > 0.07))
+                .collect();
+            assert_eq!(opened, vec![0, 1], "both grippers open after the failed rescue ({holder} held)");
+            assert_eq!(row.inner.stage(), Stage::Recover, "{holder}");
         }
     }
 

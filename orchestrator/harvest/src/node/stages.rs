@@ -46,7 +46,7 @@ impl HarvestNode {
     /// carries the fruit into the box first, as the taker of a handover does. -> transfer.
     pub(super) fn run_recover(&mut self, t_ns: i64, bus: &mut Bus) {
         match self.phase_now() {
-            0 if !self.rescuing => {
+            0 if !self.rescuing && !self.rescue_failed => {
                 if let Some(arm) = [Arm::Left, Arm::Right].into_iter().find(|&a| self.holding(a)) {
                     // The holder becomes the taker; the fruit sits GRASP_DEPTH short of its
                     // TCP, where a giver holds it (handover offset 0).
@@ -72,11 +72,13 @@ impl HarvestNode {
                 self.phase = 1;
             }
             0 => {
-                // Back from putting a held fruit into the box: the grippers as usual.
+                // Back from putting a held fruit into the box, or from failing to: the
+                // grippers as usual.
                 self.rescuing = false;
                 for arm in [Arm::Left, Arm::Right] {
                     self.gripper(arm, geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
                 }
+                self.stop_base(t_ns, bus);
                 self.phase = 1;
             }
             // The grippers open (half a second), then each arm that is not home goes
