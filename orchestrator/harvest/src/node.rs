@@ -122,6 +122,9 @@ pub struct HarvestNode {
     attempts: u32,
     regrasp_axes: [[f64; 3]; 2],
     grasp_point: [f64; 3],
+    /// The giver's joints where its approach to the fruit began (the pre-grasp): the retreat's
+    /// way back when no straight line out is free.
+    approach_from: Option<[f64; 7]>,
     /// The approach the pre-grasp plan chose (position: the target as first seen).
     grasp: TcpGoal,
     /// Joint torques of the giver right after the grasp (the fruit still hanging unloaded):
@@ -215,6 +218,7 @@ impl HarvestNode {
             attempts: 0,
             regrasp_axes: [[0.0; 3]; 2],
             grasp_point: [0.0; 3],
+            approach_from: None,
             grasp: geo::grasp([0.0; 3], side),
             detach_baseline: None,
             grasp_q: [0.0; 7],

@@ -270,6 +270,7 @@ impl HarvestNode {
             if self.attempts == 0 && (0..3).any(|i| (goals[0].position[i] - self.grasp.position[i]).abs() > 1e-3) {
                 goals.push(self.grasp);
             }
+            self.approach_from = Some(self.q(giver));
             if let Some(i) = self.plan_and_send(giver, "linear", t_ns, bus, |m, lift, start, other| {
                 m.plan_linear_any(giver, lift, start, &goals, other)
             }) {
@@ -434,8 +435,18 @@ impl HarvestNode {
                 let g = grasp.along(-back);
                 TcpGoal { position: [g.position[0], g.position[1], g.position[2] + up], ..g }
             });
+            // No straight line out (a bend or twist turned the hand, and a post or a
+            // neighbour stands where it would back into): a free motion back to where the
+            // approach began, the way the hand came in.
+            let back = self.approach_from;
             self.plan_and_send(giver, "linear", t_ns, bus, |m, lift, start, other| {
-                m.plan_linear_any(giver, lift, start, &goals, other)
+                m.plan_linear_any(giver, lift, start, &goals, other).or_else(|e| match back {
+                    Some(q) => m
+                        .plan_joints(giver, lift, start, &[q], other)
+                        .map(|p| (goals.len(), p))
+                        .map_err(|f| format!("{e}; back to the approach's start: {f}")),
+                    None => Err(e),
+                })
             });
         } else if self.arm_done(giver, t_ns, bus) == Some(true) {
             if !self.holding(giver) {
