@@ -122,9 +122,9 @@ pub struct HarvestNode {
     attempts: u32,
     regrasp_axes: [[f64; 3]; 2],
     grasp_point: [f64; 3],
-    /// The giver's joints where its approach to the fruit began (the pre-grasp): the retreat's
-    /// way back when no straight line out is free.
-    approach_from: Option<[f64; 7]>,
+    /// The giver and its joints where its approach to the fruit began (the pre-grasp): the
+    /// way back out of the plant when no straight line is free (retreat, recovery).
+    approach_from: Option<(Arm, [f64; 7])>,
     /// The approach the pre-grasp plan chose (position: the target as first seen).
     grasp: TcpGoal,
     /// Joint torques of the giver right after the grasp (the fruit still hanging unloaded):
@@ -309,6 +309,7 @@ impl HarvestNode {
         (fresh.lift, fresh.lift_target, fresh.target_seen) = (self.lift, self.lift, self.target_seen);
         fresh.target_after_ns = t_ns;
         (fresh.work_mark, fresh.boxed) = (self.work_mark, self.boxed);
+        fresh.approach_from = self.approach_from;
         (fresh.fruit_map, fresh.fruit_map_seen) = (std::mem::take(&mut self.fruit_map), self.fruit_map_seen);
         fresh.tried = std::mem::take(&mut self.tried);
         if let (Task::Region(_), Some(aim)) = (self.task, self.target_map) {
@@ -690,6 +691,16 @@ impl HarvestNode {
             TcpGoal { position: tcp.trans, approach: column(2), x_axis: Some(column(0)) }.along(-RECOVERY_BACKOFF);
         let r = self.motion.plan_linear(arm, self.lift, start, &back, other);
         self.record(arm, "linear", &r, false, t_ns, bus);
+        // Still in the plant (the last retreat failed): the free way back to where its
+        // approach began, then home from there.
+        let r = match (r, self.approach_from) {
+            (Err(e), Some((a, q))) if a == arm => {
+                let back = self.motion.plan_joints(arm, self.lift, start, &[q], other);
+                self.record(arm, "free", &back, false, t_ns, bus);
+                back.map_err(|f| format!("{e}; back to the approach's start: {f}"))
+            }
+            (r, _) => r,
+        };
         match r {
             Ok(p) => {
                 self.send(arm, p, t_ns, bus);

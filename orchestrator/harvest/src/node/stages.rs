@@ -88,6 +88,7 @@ impl HarvestNode {
                 let arm = if far(Arm::Left) >= far(Arm::Right) { Arm::Left } else { Arm::Right };
                 if far(arm) < 1e-3 {
                     self.attempts = 0;
+                    self.approach_from = None;
                     self.enter(Stage::SelectTarget, t_ns, bus, "both arms home");
                 } else if self.attempts >= RECOVERY_MOTIONS {
                     self.fail(
@@ -270,7 +271,7 @@ impl HarvestNode {
             if self.attempts == 0 && (0..3).any(|i| (goals[0].position[i] - self.grasp.position[i]).abs() > 1e-3) {
                 goals.push(self.grasp);
             }
-            self.approach_from = Some(self.q(giver));
+            self.approach_from = Some((giver, self.q(giver)));
             if let Some(i) = self.plan_and_send(giver, "linear", t_ns, bus, |m, lift, start, other| {
                 m.plan_linear_any(giver, lift, start, &goals, other)
             }) {
@@ -441,7 +442,7 @@ impl HarvestNode {
             let back = self.approach_from;
             self.plan_and_send(giver, "linear", t_ns, bus, |m, lift, start, other| {
                 m.plan_linear_any(giver, lift, start, &goals, other).or_else(|e| match back {
-                    Some(q) => m
+                    Some((_, q)) => m
                         .plan_joints(giver, lift, start, &[q], other)
                         .map(|p| (goals.len(), p))
                         .map_err(|f| format!("{e}; back to the approach's start: {f}")),
