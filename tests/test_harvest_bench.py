@@ -130,6 +130,13 @@ def test_report_shows_the_summary_classes_failures_times_and_paths(bench):
         assert f"<title>target of trial {t['trial']}</title>" in html
         if t["failure"]:
             assert f"<li>trial {t['trial']:04}: {t['failure']} (stage " in html
+    # The pedicel force until the break: one line per trial that loaded a pedicel (first 6),
+    # as many points as the trial recorded.
+    loaded = [t for t in ts if t.get("pedicel_force")][:6]
+    forces = re.findall(r'<polyline points="([^"]*)"[^>]*><title>pedicel force of trial (\d+) ', html)
+    assert [int(i) for _, i in forces] == [t["trial"] for t in loaded]
+    for (points, _), t in zip(forces, loaded):
+        assert len(points.split()) == len(t["pedicel_force"])
 
 
 def test_successful_harvests_place_the_fruit_by_ground_truth(bench):

@@ -120,7 +120,8 @@ fn force_chart(results: &[HarvestTrial]) -> String {
         .take(6)
         .map(|t| {
             let t0 = t.pedicel_force[0].0;
-            let label = format!("trial {} ({})", t.trial, t.detach_mode.as_deref().unwrap_or("no break"));
+            let label =
+                format!("pedicel force of trial {} ({})", t.trial, t.detach_mode.as_deref().unwrap_or("no break"));
             (label, t.pedicel_force.iter().map(|&(x, y)| (x - t0, y)).collect())
         })
         .collect();
