@@ -28,7 +28,6 @@
 //! controlled bending on tomato stem elongation", J. Exp. Bot. 51(352) 1825-1842, 2000,
 //! analyses bent tomato stems with the same beam theory.
 
-use crate::contacts::{Other, RobotContact, Toucher};
 use agrisim_math::vec3::{dot, norm, sub};
 use agrisim_scene::scene::{Kind, Object};
 use agrisim_scene::Shape;
@@ -109,15 +108,18 @@ impl StemGeometry {
     }
 }
 
-/// The largest load on each stem a robot part presses on now, by the stem's object index,
-/// in contact order (contacts come sorted). `stems` is sorted by object index.
-pub fn stem_loads(stems: &[StemGeometry], contacts: &[RobotContact], p: &StemParams) -> Vec<(usize, StemLoad)> {
+/// The largest load on each stem pressed now, by the stem's object index, in press order.
+/// A press is (scene object, point in the map frame, depth); presses on other objects are
+/// skipped. `stems` is sorted by object index.
+pub fn stem_loads(
+    stems: &[StemGeometry],
+    presses: impl IntoIterator<Item = (usize, [f64; 3], f64)>,
+    p: &StemParams,
+) -> Vec<(usize, StemLoad)> {
     let mut out: Vec<(usize, StemLoad)> = Vec::new();
-    for c in contacts {
-        let (Toucher::Part(_), Other::Object(object)) = (c.toucher, c.other) else { continue };
+    for (object, point, depth) in presses {
         let Ok(k) = stems.binary_search_by_key(&object, |s| s.object) else { continue };
-        let point = [c.point.x as f64, c.point.y as f64, c.point.z as f64];
-        let load = stems[k].load(point, c.depth as f64, p);
+        let load = stems[k].load(point, depth, p);
         match out.iter_mut().find(|(o, _)| *o == object) {
             Some((_, l)) if l.ratio < load.ratio => *l = load,
             Some(_) => {}
