@@ -74,6 +74,26 @@ pub struct RobotContact {
     pub depth: Real,
 }
 
+/// A robot part pressing a scene object, in f64: the object, the contact point, the object's
+/// outward normal there and the depth. What the plant models (stems, leaves) take from a
+/// contact; a carried fruit's contacts are none (they are the structure's).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Press {
+    pub object: usize,
+    pub point: [f64; 3],
+    pub normal: [f64; 3],
+    pub depth: f64,
+}
+
+impl RobotContact {
+    /// This contact as a press of a robot part on a scene object, if it is one.
+    pub fn press(&self) -> Option<Press> {
+        let (Toucher::Part(_), Other::Object(object)) = (self.toucher, self.other) else { return None };
+        let v = |v: Vector| [v.x as f64, v.y as f64, v.z as f64];
+        Some(Press { object, point: v(self.point), normal: v(self.normal), depth: self.depth as f64 })
+    }
+}
+
 pub fn category_of(kind: Kind) -> Category {
     match kind {
         Kind::Stem | Kind::Leaf | Kind::Truss | Kind::Fruit { .. } => Category::Plant,

@@ -29,7 +29,7 @@
 //! a few swings; a released leaf is back within 2 % of its turn in about
 //! `4 / (zeta w)` = 0.64 s.
 
-use crate::contacts::{Other, RobotContact, Toucher};
+use crate::contacts::Press;
 use crate::robot_links::{from_rapier, to_rapier};
 use crate::scene_world::SceneWorld;
 use agrisim_math::vec3::{add, cross, dot, norm, scale, sub};
@@ -162,14 +162,14 @@ fn rotation(theta: [f64; 3]) -> RPose {
 }
 
 impl Foliage {
-    /// One step of `h` seconds: presses from `contacts` move the leaves they touch, free
+    /// One step of `h` seconds: `presses` of robot parts move the leaves they touch, free
     /// leaves swing back; the moved leaves' colliders are put at their new poses. Returns
     /// whether any collider moved.
     pub fn step(
         &mut self,
         table: &LeafTable,
         world: &mut SceneWorld,
-        contacts: &[RobotContact],
+        presses: &[Press],
         p: &FoliageParams,
         h: f64,
     ) -> bool {
@@ -178,18 +178,13 @@ impl Foliage {
         }
         // Presses by leaf: the largest turn and its lever arm.
         let mut turns: BTreeMap<usize, ([f64; 3], f64)> = BTreeMap::new();
-        for c in contacts {
-            let (Toucher::Part(_), Other::Object(o)) = (c.toucher, c.other) else { continue };
-            let Some(l) = table.leaf_of(o) else { continue };
-            let point = [c.point.x as f64, c.point.y as f64, c.point.z as f64];
-            let normal = [c.normal.x as f64, c.normal.y as f64, c.normal.z as f64];
-            let r = sub(point, table.leaves[l].hinge);
-            let r2 = dot(r, r);
-            let e = turns.entry(l).or_insert(([0.0; 3], f64::INFINITY));
-            let arm = r2.sqrt().max(MIN_ARM);
-            let turn = scale(cross(r, scale(normal, -1.0)), c.depth as f64 / (arm * arm));
-            if norm(turn) > norm(e.0) || !e.1.is_finite() {
-                *e = (turn, arm);
+        for c in presses {
+            let Some(l) = table.leaf_of(c.object) else { continue };
+            let r = sub(c.point, table.leaves[l].hinge);
+            let arm = dot(r, r).sqrt().max(MIN_ARM);
+            let turn = scale(cross(r, scale(c.normal, -1.0)), c.depth / (arm * arm));
+            if turns.get(&l).is_none_or(|&(t, _)| norm(turn) > norm(t)) {
+                turns.insert(l, (turn, arm));
             }
         }
         let w = 2.0 * std::f64::consts::PI * p.frequency;
@@ -227,11 +222,6 @@ impl Foliage {
             place(table, world, l, theta);
         }
         !moved.is_empty()
-    }
-
-    /// A leaf's turn now [rad] (0 at rest).
-    pub fn angle(&self, leaf: usize) -> f64 {
-        self.moving.get(&leaf).map_or(0.0, |s| norm(s.theta))
     }
 }
 

@@ -6,7 +6,7 @@
 use crate::base_box::BaseBox;
 use crate::clearance::min_clearance;
 use crate::collision_report::collision_state;
-use crate::contacts::{robot_contacts, Category, ContactTracker, Other, Toucher};
+use crate::contacts::{robot_contacts, Category, ContactTracker, Press, RobotContact, Toucher};
 use crate::foliage::{Foliage, FoliageParams, LeafTable};
 use crate::ground_truth::{fruit_poses, Target};
 use crate::harvest::{DamageParams, Harvest, HarvestParams};
@@ -436,17 +436,12 @@ impl Running {
 
     fn report_contacts(&mut self, io: &mut Store, t: f64) {
         let contacts = robot_contacts(&self.world, &self.harvest);
-        // Robot parts pressing scene objects (a carried fruit's contacts are the structure's).
-        let presses = contacts.iter().filter_map(|c| match (c.toucher, c.other) {
-            (Toucher::Part(_), Other::Object(o)) => {
-                Some((o, [c.point.x as f64, c.point.y as f64, c.point.z as f64], c.depth as f64))
-            }
-            _ => None,
-        });
-        let loads = stem_loads(&self.stems, presses, &self.harvest.params.damage.stem);
+        let presses: Vec<Press> = contacts.iter().filter_map(RobotContact::press).collect();
+        let stem_presses = presses.iter().map(|p| (p.object, p.point, p.depth));
+        let loads = stem_loads(&self.stems, stem_presses, &self.harvest.params.damage.stem);
         self.harvest.damage.press_stems(&loads);
         if self.last_h > 0.0
-            && self.foliage.step(&self.leaves, &mut self.world, &contacts, &self.foliage_params, self.last_h)
+            && self.foliage.step(&self.leaves, &mut self.world, &presses, &self.foliage_params, self.last_h)
         {
             self.world.refresh();
         }
