@@ -347,6 +347,15 @@ EXPECTED.update({
         "peak_leaf_force": 1.25,
         "peak_stem_load": 0.5,
     },
+    "moved_objects": {
+        "header": hdr(41, 500_000_000, "map"),
+        "ids": [7, 1024, 70000],
+        "poses": [
+            pose(1.5, -2.0, 0.75, q(0.0, 0.0, 0.0, 1.0)),
+            pose(0.25, 0.5, 1.125, q(0.5, 0.5, 0.5, 0.5)),
+            pose(-3.0, 4.0, 0.0625, q(0.0, 0.0, 1.0, 0.0)),
+        ],
+    },
     "plan_result": {
         "header": hdr(12, 500_000_000, "map"),
         "stage": "pre_grasp",
@@ -578,7 +587,7 @@ SAMPLE_NAMES = sorted(EXPECTED)
 def test_samples_cover_every_msg_file(samples):
     assert set(samples) == set(EXPECTED)
     assert {t for t, _, _ in samples.values()} == set(msg_files())
-    assert len(msg_files()) == 59
+    assert len(msg_files()) == 60
 
 
 @pytest.mark.parametrize("name", SAMPLE_NAMES)

@@ -32,6 +32,7 @@ use agrisim_robot::model::RobotModel;
 use agrisim_robot::Pose as RPose;
 use agrisim_schedule::{to_ns, Schedule};
 use agrisim_sensor_ports::robot::{self as robot_ports, Coords, RobotBody};
+use agrisim_sensor_ports::MovedInput;
 use agrisim_sky::environment::Environment;
 use agrisim_sky::weather::Conditions;
 use std::sync::Arc;
@@ -81,6 +82,8 @@ pub struct Camera {
     ports: Option<[OutPort; 5]>,
     /// The camera's frames went out on tf_static (at the first step).
     tf_sent: bool,
+    /// Pushed leaves and picked fruit, from the world's `moved_objects`.
+    moved: MovedInput,
     window_ns: i64,
     /// The last frame's buffers, rendered into again (derived: not serialized).
     #[serde(skip)]
@@ -284,11 +287,12 @@ impl Camera {
     /// [`Camera::capture_at`] into `frame`'s buffers.
     fn render_posed(&mut self, frame: &mut Frame, x: f64, y: f64, yaw: f64, coords: &Coords) {
         let c = self.config.as_ref().expect("initialized");
-        let robot = c.robot.objects(c.robot_links.then_some(coords), x, y, yaw);
+        let mut dynamic = c.robot.objects(c.robot_links.then_some(coords), x, y, yaw);
+        dynamic.extend(self.moved.objects());
         let pose = c.camera_pose(coords, x, y, yaw);
         let shot = Shot {
-            scene: &c.scene,
-            dynamic: &robot,
+            scene: self.moved.scene(&c.scene),
+            dynamic: &dynamic,
             k: &c.intrinsics,
             pose: &pose,
             light: &c.light,
@@ -328,6 +332,7 @@ impl Model for Camera {
         self.window_ns = agrisim_fmi::port::window_ns(io, PORT_WINDOW)?;
         self.ports = Some(new_ports());
         self.tf_sent = false;
+        self.moved = MovedInput::new(&SENSOR_PORTS);
         self.sync(io, to_ns(start_time));
         let (zenith, azimuth, visibility) = match &config.conditions {
             Some(c) => (c.sun.zenith, c.sun.azimuth, c.visibility),
@@ -343,8 +348,9 @@ impl Model for Camera {
     fn do_step(&mut self, io: &mut Store, t: f64, h: f64, _log: &mut dyn Log) -> Result<(), String> {
         let (x, y, yaw) = SENSOR_PORTS.base_pose(io)?;
         let coords = placement(io)?;
+        let c = self.config.as_ref().ok_or("not initialized")?;
+        self.moved.take(io, &SENSOR_PORTS, &c.scene)?;
         if !self.tf_sent {
-            let c = self.config.as_ref().ok_or("not initialized")?;
             let stamp = to_ns(t);
             let tf = c.tf_static(stamp).to_cdr();
             self.ports.get_or_insert_with(new_ports)[4].publish(stamp, tf);

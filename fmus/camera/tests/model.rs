@@ -474,3 +474,101 @@ fn the_camera_sees_the_arms_where_the_joints_put_them() {
         .sum();
     assert!(diff < seen / 20, "{raised:?} vs {working:?}");
 }
+
+/// The world's `moved_objects` as the engine writes an input: one bare message, counter 1.
+fn set_moved(io: &mut Store, moves: &[(u32, Placement)]) {
+    use agrisim_msgs::geometry_msgs::{Point, Pose, Quaternion};
+    let msg = agrisim_msgs::agrisim::MovedObjects {
+        header: agrisim_msgs::std_msgs::Header::default(),
+        ids: moves.iter().map(|m| m.0).collect(),
+        poses: moves
+            .iter()
+            .map(|(_, p)| {
+                let [x, y, z] = p.translation;
+                let [qx, qy, qz, qw] = p.rotation;
+                Pose { position: Point { x, y, z }, orientation: Quaternion { x: qx, y: qy, z: qz, w: qw } }
+            })
+            .collect(),
+    };
+    *io.value_mut(MOVED_OBJECTS) = Value::Binary(msg.to_cdr());
+    io.set_i64(MOVED_OBJECTS_SEQ, io.i64(MOVED_OBJECTS_SEQ) + 1);
+}
+
+/// A pushed leaf and a picked fruit, as the world reports them on `moved_objects`: the
+/// camera's frame is exactly the frame of a scene generated with them where they are now
+/// (colour, depth and labels), and nothing is left where they grew.
+#[test]
+fn moved_objects_are_rendered_where_the_world_has_them() {
+    let (objects, [x, y, yaw]) = greenhouse();
+    let mut io = store(320, 240, 5);
+    let before = run(&mut io, 1);
+    let labels = image::read_32sc1(&Image::from_cdr(agrisim_fmi::port::latest(&io, LABELS_IMAGE)).unwrap()).unwrap();
+    // The fruit and the leaf part most in view.
+    let most = |f: &dyn Fn(Kind) -> bool| {
+        let mut n = std::collections::BTreeMap::new();
+        for &l in labels.iter().filter(|&&l| l > 0 && (l as usize) <= objects.len()) {
+            if f(objects[l as usize - 1].kind) {
+                *n.entry(l - 1).or_insert(0usize) += 1;
+            }
+        }
+        n.into_iter().max_by_key(|e| (e.1, std::cmp::Reverse(e.0))).unwrap()
+    };
+    let (fruit, fruit_px) = most(&|k| matches!(k, Kind::Fruit { .. }));
+    let (leaf, _) = most(&|k| k == Kind::Leaf);
+    drop(before);
+    // The fruit 12 cm to the side and turned; the leaf part 30 cm up.
+    let f = &objects[fruit as usize];
+    let l = &objects[leaf as usize];
+    let h = std::f64::consts::FRAC_1_SQRT_2;
+    let t = |o: &Object, d: [f64; 3]| {
+        let p = o.placement.translation;
+        [p[0] + d[0], p[1] + d[1], p[2] + d[2]]
+    };
+    let mut moves = vec![
+        (fruit as u32, Placement { translation: t(f, [0.12, 0.0, 0.0]), rotation: [0.0, h, 0.0, h] }),
+        (leaf as u32, Placement { translation: t(l, [0.0, 0.0, 0.3]), rotation: l.placement.rotation }),
+    ];
+    moves.sort_by_key(|m| m.0);
+    let mut io = store(320, 240, 5);
+    set_moved(&mut io, &moves);
+    let cam = run(&mut io, 1);
+    let got = (
+        Image::from_cdr(agrisim_fmi::port::latest(&io, IMAGE)).unwrap().data,
+        image::read_32fc1(&Image::from_cdr(agrisim_fmi::port::latest(&io, DEPTH)).unwrap()).unwrap(),
+        image::read_32sc1(&Image::from_cdr(agrisim_fmi::port::latest(&io, LABELS_IMAGE)).unwrap()).unwrap(),
+    );
+    // The reference: a scene built with the objects at their new placements.
+    let mut moved = objects.clone();
+    for &(id, p) in &moves {
+        moved[id as usize].placement = p;
+    }
+    let scene = Scene::from_objects(&moved);
+    let c = cam.config().unwrap();
+    // The robot where the inputs put it (the camera rides on the lift, the links in view).
+    let mut coords = agrisim_sensor_ports::robot::Coords { lift: io.f64(LIFT_POSITION), ..Default::default() };
+    for i in 0..7 {
+        (coords.arms[0][i], coords.arms[1][i]) = (io.f64(LEFT_Q1 + i), io.f64(RIGHT_Q1 + i));
+    }
+    coords.widths = [io.f64(LEFT_FINGER_WIDTH), io.f64(RIGHT_FINGER_WIDTH)];
+    let robot = c.robot.objects(c.robot_links.then_some(&coords), x, y, yaw);
+    let pose = c.camera_pose(&coords, x, y, yaw);
+    let columns = render::sun_columns(&scene, &c.light);
+    let shot = Shot {
+        scene: &scene,
+        dynamic: &robot,
+        k: &c.intrinsics,
+        pose: &pose,
+        light: &c.light,
+        columns: &columns,
+        depth: &c.depth,
+    };
+    let mut want = render::Frame::default();
+    render::render_into(&mut want, &shot, &mut Rng::new(5), 1);
+    assert!(got.2 == want.labels, "labels differ from the moved scene's");
+    assert!(got.1 == want.depth, "depth differs from the moved scene's");
+    assert!(got.0 == want.rgb, "colour differs from the moved scene's");
+    // And it is another frame than the grown scene's: the fruit moved across the image.
+    let now = got.2.iter().filter(|&&v| v == fruit + 1).count();
+    assert_ne!(got.2, labels, "the moved objects changed the frame");
+    println!("fruit {fruit}: {fruit_px} px where it grew, {now} px moved; leaf part {leaf}");
+}

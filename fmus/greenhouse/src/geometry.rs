@@ -37,6 +37,17 @@ pub fn shape_of(s: &Shape) -> Result<(SharedShape, Pose), String> {
     }
 }
 
+/// The placement (the scene object's own frame) of a collider made by [`shape_of`]: its
+/// position with a cylinder's quarter turn undone.
+pub fn object_pose(collider: &rapier3d::prelude::Collider) -> Pose {
+    let position = *collider.position();
+    if collider.shape().as_cylinder().is_some() {
+        position * Pose::from_rotation(Rotation::from_rotation_x(std::f32::consts::FRAC_PI_2)).inverse()
+    } else {
+        position
+    }
+}
+
 /// Pose of base_link in the map frame, from the planar ground truth and a height.
 pub fn planar_pose(x: f64, y: f64, yaw: f64, z: f64) -> Pose {
     Pose::from_parts(Vector::new(x as f32, y as f32, z as f32), Rotation::from_rotation_z(yaw as f32))

@@ -18,6 +18,7 @@ pub mod foliage;
 pub mod geometry;
 pub mod ground_truth;
 pub mod harvest;
+pub mod moved_objects;
 pub mod pedicel;
 pub mod planning_scene;
 pub mod ports;

@@ -9,7 +9,7 @@
 //! dropped), `fruit_held`, `fruit_falling`, `fruit_placed`.
 
 use crate::collision_report::kind_label;
-use crate::geometry::pose_msg;
+use crate::geometry::{object_pose, pose_msg};
 use crate::harvest::{FruitState, Harvest};
 use crate::scene_world::SceneWorld;
 use agrisim_msgs::agrisim::{CollisionObject, PlanningScene};
@@ -51,18 +51,17 @@ pub fn planning_scene(
 fn collision_object(world: &SceneWorld, harvest: &Harvest, object: usize) -> Option<CollisionObject> {
     let o = &world.objects[object];
     let collider = &world.colliders[o.collider];
-    let position = *collider.position();
     let shape = collider.shape();
-    let (primitive, pose) = if let Some(c) = shape.as_cuboid() {
+    // parry cylinders run along y; the scene's (and SolidPrimitive's) along z: the object's
+    // own pose undoes the quarter turn `geometry::shape_of` put in the collider's position.
+    let pose = object_pose(collider);
+    let primitive = if let Some(c) = shape.as_cuboid() {
         let h = c.half_extents;
-        (SolidPrimitive::new_box(2.0 * h.x as f64, 2.0 * h.y as f64, 2.0 * h.z as f64), position)
+        SolidPrimitive::new_box(2.0 * h.x as f64, 2.0 * h.y as f64, 2.0 * h.z as f64)
     } else if let Some(b) = shape.as_ball() {
-        (SolidPrimitive::sphere(b.radius as f64), position)
+        SolidPrimitive::sphere(b.radius as f64)
     } else if let Some(c) = shape.as_cylinder() {
-        // parry cylinders run along y; the scene's (and SolidPrimitive's) along z: undo the
-        // quarter turn `geometry::shape_of` put in the collider's position.
-        let upright = Pose::from_rotation(Rotation::from_rotation_x(std::f32::consts::FRAC_PI_2));
-        (SolidPrimitive::cylinder(2.0 * c.half_height as f64, c.radius as f64), position * upright.inverse())
+        SolidPrimitive::cylinder(2.0 * c.half_height as f64, c.radius as f64)
     } else {
         return None;
     };

@@ -13,6 +13,7 @@ pub const POSE_ARRAY_MIME: &str = "application/x-ros2-cdr-frames; version=1; typ
 pub const POSE_STAMPED_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=geometry_msgs/msg/PoseStamped";
 pub const PLANNING_SCENE_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=agrisim_msgs/msg/PlanningScene";
 pub const PLANT_DAMAGE_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=agrisim_msgs/msg/PlantDamage";
+pub use agrisim_sensor_ports::MOVED_OBJECTS_MIME;
 
 agrisim_fmi::variables! { pub VARIABLES {
     // --- scene (fixed parameters) ---
@@ -232,6 +233,10 @@ agrisim_fmi::variables! { pub VARIABLES {
         .desc("Leaves now turned from their grown pose (pressed, or swinging back)"),
     PEAK_LEAF_FORCE = Var::output("peak_leaf_force").unit("N").init_depends_on(&[])
         .desc("Largest force the robot spent holding a leaf aside so far"),
+    MOVED_OBJECTS = Var::output_discrete("moved_objects", Start::Binary(&[])).mime(MOVED_OBJECTS_MIME).init_depends_on(&[Var::TIME])
+        .desc("agrisim_msgs/MovedObjects (ground truth, for the sensor FMUs' moved_objects input): every scene object away from where the greenhouse grew it (pushed leaves, picked fruit) with its placement, at the start and whenever it changes"),
+    MOVED_OBJECTS_SEQ = Var::output_discrete("moved_objects_seq", Start::Int64(0)).init_depends_on(&[])
+        .desc("Sequence number of the newest message in moved_objects"),
 }}
 
 /// The robot's configuration inputs: base pose, lift, arm joints, finger gaps.

@@ -10,6 +10,7 @@ use crate::contacts::{robot_contacts, Category, ContactTracker, Press, RobotCont
 use crate::foliage::{Foliage, FoliageParams, LeafTable};
 use crate::ground_truth::{fruit_poses, Target};
 use crate::harvest::{DamageParams, Harvest, HarvestParams};
+use crate::moved_objects::{grown_fruit_poses, moved_objects};
 use crate::pedicel::{PedicelGeometry, PedicelParams};
 use crate::planning_scene::planning_scene;
 use crate::ports::*;
@@ -70,6 +71,8 @@ struct Running {
     foliage_params: FoliageParams,
     /// The leaves the robot moved.
     foliage: Foliage,
+    /// Each fruit body's pose as built, from the scene: rebuilt, not serialized.
+    grown_fruit: Arc<Vec<Pose>>,
     /// The last step's length [s] (0 before the first step).
     last_h: f64,
     /// Kinematic moves of one step (kept to reuse its allocation).
@@ -110,6 +113,9 @@ struct Ports {
     damage: OutPort,
     /// CDR of the last published PlantDamage with a zero header (a change publishes).
     damage_published: Vec<u8>,
+    moved: OutPort,
+    /// CDR of the last published MovedObjects with a zero header (a change publishes).
+    moved_published: Option<Vec<u8>>,
 }
 
 impl Ports {
@@ -121,11 +127,15 @@ impl Ports {
             target: OutPort::new(TARGET, TARGET_SEQ),
             damage: OutPort::new(PLANT_DAMAGE, PLANT_DAMAGE_SEQ),
             damage_published: Vec::new(),
+            moved: OutPort::new(MOVED_OBJECTS, MOVED_OBJECTS_SEQ),
+            moved_published: None,
         }
     }
 
     fn sync(&mut self, io: &mut Store, now_ns: i64, window_ns: i64) {
-        for p in [&mut self.scene, &mut self.collision, &mut self.fruit, &mut self.target, &mut self.damage] {
+        for p in
+            [&mut self.scene, &mut self.collision, &mut self.fruit, &mut self.target, &mut self.damage, &mut self.moved]
+        {
             p.sync(io, now_ns, window_ns);
         }
     }
@@ -295,6 +305,7 @@ impl Running {
         self.report_contacts(io, t);
         self.report_harvest(io, t);
         self.report_ground_truth(io, t);
+        self.report_moved(t);
         if let Some(stamp) = self.scene_schedule.due(t) {
             let [x, y, _] = self.robot.planar;
             self.ports
@@ -302,6 +313,19 @@ impl Running {
                 .publish(stamp, planning_scene(&self.world, &self.harvest, [x, y], self.scene_radius, stamp).to_cdr());
         }
         self.ports.sync(io, to_ns(t), self.window_ns);
+    }
+
+    /// The moved objects, at the start and whenever one moves (each step while a leaf swings
+    /// or a fruit is carried; nothing while the robot only drives).
+    fn report_moved(&mut self, t: f64) {
+        let mut msg = moved_objects(&self.world, &self.grown_fruit, &self.leaves, &self.foliage);
+        let key = msg.to_cdr();
+        if self.ports.moved_published.as_ref() != Some(&key) {
+            let stamp = to_ns(t);
+            msg.header = Header::new(Time::from_nanos(stamp), "map");
+            self.ports.moved.publish(stamp, msg.to_cdr());
+            self.ports.moved_published = Some(key);
+        }
     }
 
     fn report_harvest(&mut self, io: &mut Store, t: f64) {
@@ -564,6 +588,7 @@ impl Model for GreenhouseWorld {
         let stems = Arc::new(StemGeometry::all(&greenhouse.objects));
         let leaves = Arc::new(LeafTable::new(&greenhouse.objects, &world));
         let foliage_params = foliage_params(io)?;
+        let grown_fruit = Arc::new(grown_fruit_poses(&world));
         let pedicels =
             Arc::new(pedicel_geometry(&greenhouse.objects, &world.fruit.iter().map(|f| f.object).collect::<Vec<_>>()));
         log.info(format_args!(
@@ -582,6 +607,7 @@ impl Model for GreenhouseWorld {
             leaves,
             foliage_params,
             foliage: Foliage::default(),
+            grown_fruit,
             last_h: 0.0,
             moves: Vec::new(),
             awake: Vec::new(),

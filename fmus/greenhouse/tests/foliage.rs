@@ -10,7 +10,7 @@ use agrisim_fmu_greenhouse::ports::*;
 use agrisim_fmu_greenhouse::robot_links::from_rapier;
 use agrisim_fmu_greenhouse::robot_model::{Coords, RobotModel, Side};
 use agrisim_fmu_greenhouse::GreenhouseWorld;
-use agrisim_msgs::agrisim::CollisionState;
+use agrisim_msgs::agrisim::{CollisionState, MovedObjects};
 use agrisim_msgs::Message;
 use agrisim_robot::Pose as RPose;
 use agrisim_scene::scene::Object;
@@ -95,6 +95,12 @@ struct Run {
     depth: Vec<Option<f64>>,
     peak_force: f64,
     pushes: i32,
+    /// The newest `moved_objects` message after each step.
+    moved_msgs: Vec<MovedObjects>,
+    /// The leaf's object ids, and each one's placement (collider pose, cylinder turn undone)
+    /// per step.
+    ids: Vec<u32>,
+    placements: Vec<Vec<RPose>>,
 }
 
 fn run(compliant: bool, steps: usize) -> Run {
@@ -114,7 +120,17 @@ fn run(compliant: bool, steps: usize) -> Run {
         from_rapier(w.colliders[w.objects[o].collider].position())
     };
     let rest: Vec<RPose> = leaf.iter().map(|&o| pose(&m, o)).collect();
-    let mut out = Run { moved: Vec::new(), depth: Vec::new(), peak_force: 0.0, pushes: 0 };
+    let mut out = Run {
+        moved: Vec::new(),
+        depth: Vec::new(),
+        peak_force: 0.0,
+        pushes: 0,
+        moved_msgs: Vec::new(),
+        ids: leaf.iter().map(|&o| objects[o].id).collect(),
+        placements: Vec::new(),
+    };
+    let initial = MovedObjects::from_cdr(agrisim_fmi::port::latest(&io, MOVED_OBJECTS)).unwrap();
+    assert!(initial.ids.is_empty() && initial.poses.is_empty(), "nothing moved at the start: {initial:?}");
     for k in 1..=steps {
         drive(&mut io, planar, sweep(lift0, k));
         m.do_step(&mut io, (k - 1) as f64 * H, H, &mut Quiet).unwrap();
@@ -123,6 +139,22 @@ fn run(compliant: bool, steps: usize) -> Run {
         let s = CollisionState::from_cdr(agrisim_fmi::port::latest(&io, COLLISION_STATE)).unwrap();
         let d = s.contacts.iter().filter(|c| names.contains(&c.object_name.as_str())).map(|c| c.depth).reduce(f64::max);
         out.depth.push(d);
+        // A message comes only with a change; the port keeps it for port_window.
+        let newest = agrisim_fmi::port::latest(&io, MOVED_OBJECTS);
+        let current = if newest.is_empty() {
+            out.moved_msgs.last().cloned().unwrap_or(initial.clone())
+        } else {
+            MovedObjects::from_cdr(newest).unwrap()
+        };
+        out.moved_msgs.push(current);
+        let w = m.scene().unwrap();
+        out.placements.push(
+            leaf.iter()
+                .map(|&o| {
+                    from_rapier(&agrisim_fmu_greenhouse::geometry::object_pose(&w.colliders[w.objects[o].collider]))
+                })
+                .collect(),
+        );
     }
     out.peak_force = io.f64(PEAK_LEAF_FORCE);
     out.pushes = io.i32(LEAF_PUSHES);
@@ -150,6 +182,27 @@ fn a_leaf_gives_way_to_the_arm_and_springs_back_within_a_second() {
     let after = soft.moved[last + 50];
     assert!(after < 0.002 && after < 0.01 * peak, "1 s after the contact: {after} m off (peak {peak} m)");
     assert!(soft.moved[last + 100] < 1e-3, "{}", soft.moved[last + 100]);
+    // The world tells the sensors: while the leaf is off its rest pose, moved_objects lists
+    // its objects where they are; once it is back at rest, not. The rigid leaf never moves.
+    let mut listed = 0;
+    for (k, msg) in soft.moved_msgs.iter().enumerate() {
+        if soft.moved[k] > 0.0 {
+            // (The hand may turn neighbouring leaves too: they are listed beside it.)
+            assert!(msg.ids.windows(2).all(|w| w[0] < w[1]), "step {k}: ids ascending");
+            for (id, want) in soft.ids.iter().zip(&soft.placements[k]) {
+                let i = msg.ids.binary_search(id).unwrap_or_else(|_| panic!("step {k}: leaf object {id} not listed"));
+                let p = &msg.poses[i];
+                let got = [p.position.x, p.position.y, p.position.z];
+                assert!(dist(got, want.trans) < 1e-6, "step {k}: {got:?} vs {:?}", want.trans);
+            }
+            listed += 1;
+        }
+    }
+    assert!(listed > 10, "the leaf was listed at {listed} steps");
+    // (Leaves the hand still presses where it stopped stay listed.)
+    let last_msg = soft.moved_msgs.last().unwrap();
+    assert!(soft.ids.iter().all(|id| !last_msg.ids.contains(id)), "the leaf at rest is not listed: {:?}", last_msg.ids);
+    assert!(rigid.moved_msgs.iter().all(|m| m.ids.is_empty()));
     eprintln!(
         "leaf: peak move {:.3} m, deepest contact {:.4} m (rigid {:.3} m), peak force {:.3} N, {} pushes, \
          {:.2} mm off 1 s after the last contact (step {last})",

@@ -384,6 +384,13 @@ fn grasp_carry_and_place_in_the_box() {
     let in_box2 = box_now.inverse().transform_point(sim.fruit_centre(f));
     assert!(dist(in_box, in_box2) < 1e-4, "{in_box:?} -> {in_box2:?}");
     assert_eq!((sim.io.i32(PLACED_COUNT), sim.io.i32(PICKED_COUNT)), (1, 1));
+    // The sensors are told: moved_objects lists the boxed fruit where it is now (and, in
+    // this scene without leaves in reach, nothing else).
+    let moved = agrisim_msgs::agrisim::MovedObjects::from_cdr(agrisim_fmi::port::latest(&sim.io, MOVED_OBJECTS))
+        .expect("the box moved in the last step, and the fruit with it");
+    assert_eq!(moved.ids, [sim.fruit_id(f) as u32]);
+    let p = &moved.poses[0].position;
+    assert!(dist([p.x, p.y, p.z], sim.fruit_centre(f)) < 1e-6, "{p:?}");
 }
 
 #[test]

@@ -68,7 +68,7 @@ fn main() {
             for (i, r) in chunk.iter().enumerate() {
                 (origins[i], dirs[i]) = ([r[0], r[1], r[2]], [r[3], r[4], r[5]]);
             }
-            rc.cast_packet_posed(&origins[..k], &dirs[..k], lo, hi, &none, &poses[..k], &mut hits[..k]);
+            rc.cast_packet_posed(&origins[..k], &dirs[..k], lo, hi, &none, &none, &poses[..k], &mut hits[..k]);
             dist.extend(hits[..k].iter().map(|h| h.map_or(f64::INFINITY, |h| h.distance)));
         }
         dist

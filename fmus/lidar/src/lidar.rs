@@ -21,8 +21,9 @@ use agrisim_fmi::{Log, Model, OutPort, Store, Var};
 use agrisim_math::{Pose2, Rng};
 use agrisim_msgs::sensor_msgs::PointCloud2;
 use agrisim_msgs::Message;
-use agrisim_raycast::RigidPose;
+use agrisim_raycast::{RayCaster, RigidPose};
 use agrisim_schedule::{on_threads, to_ns, Schedule};
+use agrisim_sensor_ports::MovedInput;
 use agrisim_sky::environment::Environment;
 use agrisim_sky::weather::Conditions;
 use std::sync::Arc;
@@ -73,6 +74,11 @@ pub struct Lidar {
     /// The last frame's rays, cast into again (derived: not serialized).
     #[serde(skip)]
     rays: Vec<Ray>,
+    /// Pushed leaves and picked fruit, from the world's `moved_objects`.
+    moved: MovedInput,
+    /// The moved objects where they are, for the frame (derived: rebuilt at each frame).
+    #[serde(skip)]
+    placed: Option<RayCaster>,
 }
 
 /// One point's ray: direction in lidar_link, time offset in the frame, echo.
@@ -229,6 +235,9 @@ impl Lidar {
     fn cast_run(&self, n0: i64, end_ns: i64, stamp_ns: i64, out: &mut [Ray]) {
         let c = self.config.as_ref().expect("initialized");
         let robot = &self.robot.as_ref().expect("initialized").caster;
+        let empty = RayCaster::new(&[]);
+        let placed = self.placed.as_ref().unwrap_or(&empty);
+        let scene = self.moved.scene(&c.scene);
         let p = &c.pattern;
         let end_pose = self.trajectory.at(end_ns as f64 * 1e-9);
         let stamp_s = stamp_ns as f64 * 1e-9;
@@ -260,11 +269,12 @@ impl Lidar {
                 batch.poses[i] = base;
             }
             let k = rays.len();
-            c.scene.caster.cast_packet_posed(
+            scene.caster.cast_packet_posed(
                 &batch.origins[..k],
                 &batch.dirs[..k],
                 c.range.0,
                 c.range.1,
+                placed,
                 robot,
                 &batch.poses[..k],
                 &mut batch.hits[..k],
@@ -326,6 +336,8 @@ impl Model for Lidar {
         io.set_f64(VISIBILITY, config.visibility);
         let body = SENSOR_PORTS.robot_body(io, config.scene.object_count() as u32)?;
         self.robot = Some(RobotInBaseLink::new(body, SENSOR_PORTS.coords(io)?));
+        self.moved = MovedInput::new(&SENSOR_PORTS);
+        self.placed = None;
         self.config = Some(config);
         Ok(())
     }
@@ -333,8 +345,12 @@ impl Model for Lidar {
     fn do_step(&mut self, io: &mut Store, t: f64, h: f64, _log: &mut dyn Log) -> Result<(), String> {
         let period = self.config.as_ref().map_or(0.1, |c| c.frame_period);
         self.trajectory.push(t, pose(io)?, 2.0 * period + h);
+        let scene = self.config.as_ref().map(|c| c.scene.clone()).ok_or("not initialized")?;
+        self.moved.take(io, &SENSOR_PORTS, &scene)?;
         if let Some(end_ns) = self.schedule.due(t + h) {
             self.pose_robot(SENSOR_PORTS.coords(io)?);
+            let moved = self.moved.objects();
+            self.placed = (!moved.is_empty()).then(|| RayCaster::new(&moved));
             let frame = self.capture(end_ns);
             io.set_i32(POINTS_IN_FRAME, frame.cloud.width as i32);
             io.set_i32(RETURNS_IN_FRAME, frame.returns as i32);

@@ -360,3 +360,52 @@ fn through_the_fmi3_layer() {
         fmi3::free_instance::<Lidar>(p);
     }
 }
+
+/// A scene object the world reports moved (`moved_objects`: here a main stem carried upright
+/// to 1.2 m in front of the robot) is where the returns come from, and no longer where it
+/// grew; the same frame without the input is the grown scene's.
+#[test]
+fn moved_objects_are_seen_where_the_world_has_them() {
+    use agrisim_msgs::geometry_msgs::{Point as P, Pose, Quaternion};
+    let cfg = agrisim_scene::GreenhouseConfig::from_toml_str(HALL).unwrap();
+    let objects = agrisim_scene::generate(&cfg, cfg.seed).objects;
+    let stem = objects.iter().find(|o| o.kind == agrisim_scene::Kind::Stem).expect("a stem");
+    let near = |c: &PointCloud2| {
+        points(c).iter().filter(|p| (0.8..1.6).contains(&norm(p)) && p.xyz[0] > 0.0 && p.xyz[1].abs() < 0.3).count()
+    };
+    let frame = |moved: bool| {
+        let (mut m, mut io) = start(HALL, [5.0, 6.0, 0.0], |_| {});
+        if moved {
+            let g = stem.placement.translation;
+            let msg = agrisim_msgs::agrisim::MovedObjects {
+                header: Default::default(),
+                ids: vec![stem.id],
+                poses: vec![Pose {
+                    position: P { x: 6.5, y: 6.0, z: g[2] },
+                    orientation: Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 },
+                }],
+            };
+            *io.value_mut(MOVED_OBJECTS) = Value::Binary(msg.to_cdr());
+            io.set_i64(MOVED_OBJECTS_SEQ, 1);
+        }
+        run(&mut m, &mut io, 0, 10).pop().unwrap()
+    };
+    let (grown, moved) = (frame(false), frame(true));
+    assert_eq!(near(&grown), 0, "nothing stands 1.2 m ahead in the grown scene");
+    assert!(near(&moved) > 20, "the moved stem returns {} points", near(&moved));
+}
+
+/// A malformed `moved_objects` (an id beyond the scene) is an error naming the input.
+#[test]
+fn a_bad_moved_objects_message_is_an_error_naming_the_input() {
+    let (mut m, mut io) = start(HALL, [5.0, 6.0, 0.0], |_| {});
+    let msg = agrisim_msgs::agrisim::MovedObjects {
+        header: Default::default(),
+        ids: vec![u32::MAX - 1],
+        poses: vec![Default::default()],
+    };
+    *io.value_mut(MOVED_OBJECTS) = Value::Binary(msg.to_cdr());
+    io.set_i64(MOVED_OBJECTS_SEQ, 1);
+    let e = m.do_step(&mut io, 0.0, H, &mut Quiet).unwrap_err();
+    assert!(e.contains("moved_objects") && e.contains("4294967294"), "{e}");
+}

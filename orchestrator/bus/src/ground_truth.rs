@@ -1,7 +1,7 @@
 //! Ground truth on the bus: the world's answers that judges and viewers read and the
 //! algorithm layer must not (the fruit list, the handed-over target and its planning scene,
 //! contacts, plant damage, the cameras' label images, the FMUs' signal dumps, the viewers'
-//! scene markers). With the bus sealed ([`crate::Bus::seal_ground_truth`]), a node that
+//! scene markers, the world's moved objects on their way to the sensor FMUs). With the bus sealed ([`crate::Bus::seal_ground_truth`]), a node that
 //! reads one of them during its step fails the run, naming the node and the topic.
 
 /// Ground-truth topics by name.
@@ -16,9 +16,13 @@ pub const TOPICS: [&str; 7] = [
 ];
 
 /// Whether `topic` carries ground truth: one of [`TOPICS`], a camera's label image
-/// (`.../labels`), or an FMU's signal dump (`/fmu/...`, e.g. the chassis' true pose).
+/// (`.../labels`), the world's moved objects (`.../moved_objects`, the FMU-to-FMU route to
+/// the sensors), or an FMU's signal dump (`/fmu/...`, e.g. the chassis' true pose).
 pub fn is_ground_truth(topic: &str) -> bool {
-    TOPICS.contains(&topic) || topic.ends_with("/labels") || topic.starts_with("/fmu/")
+    TOPICS.contains(&topic)
+        || topic.ends_with("/labels")
+        || topic.ends_with("/moved_objects")
+        || topic.starts_with("/fmu/")
 }
 
 #[cfg(test)]
@@ -34,6 +38,7 @@ mod tests {
             "/collision",
             "/plant_damage",
             "/camera_left/labels",
+            "/world/moved_objects",
             "/fmu/chassis/signals",
         ] {
             assert!(is_ground_truth(t), "{t}");

@@ -141,6 +141,9 @@ impl RecordPolicy {
             Profile::Standard if MAP_TOPICS.contains(&topic) => Rule::Every(MAP_PERIOD),
             Profile::Standard if type_name == "vision_msgs/msg/Detection3DArray" => Rule::Every(DETECTIONS_PERIOD),
             Profile::Standard if topic == "/fruits" => Rule::Once,
+            // The world's moved objects (to the sensors) change every step something is
+            // carried: ten a second say where they went.
+            Profile::Standard if type_name == "agrisim_msgs/msg/MovedObjects" => Rule::Every(0.1),
             Profile::Standard if type_name == "sensor_msgs/msg/Imu" => Rule::Every(IMU_PERIOD),
             Profile::Standard if signals => Rule::Every(0.1),
             Profile::Standard => Rule::Keep,
@@ -190,12 +193,14 @@ mod tests {
         assert_eq!(std.rule("/points", "sensor_msgs/msg/PointCloud2"), Rule::Every(5.0));
         assert_eq!(std.rule("/cmd_vel", "geometry_msgs/msg/Twist"), Rule::Keep);
         assert_eq!(std.rule("/fruits", "geometry_msgs/msg/PoseArray"), Rule::Once);
+        assert_eq!(std.rule("/world/moved_objects", "agrisim_msgs/msg/MovedObjects"), Rule::Every(0.1));
         assert_eq!(std.rule("/mapping/planning_scene", "agrisim_msgs/msg/PlanningScene"), Rule::Every(MAP_PERIOD));
         assert_eq!(std.rule("/imu", "sensor_msgs/msg/Imu"), Rule::Every(0.02));
         assert_eq!(std.rule("/fmu/imu/signals", "agrisim_msgs/msg/Signals"), Rule::Every(0.1));
         let judge = RecordPolicy::profile(Profile::Judge);
         assert_eq!(judge.rule("/collision", "agrisim_msgs/msg/CollisionState"), Rule::Keep);
         assert_eq!(judge.rule("/plant_damage", "agrisim_msgs/msg/PlantDamage"), Rule::Keep);
+        assert_eq!(judge.rule("/world/moved_objects", "agrisim_msgs/msg/MovedObjects"), Rule::Drop);
         assert_eq!(judge.rule("/imu", "sensor_msgs/msg/Imu"), Rule::Drop);
         assert_eq!(RecordPolicy::profile(Profile::None).rule("/collision", "x"), Rule::Drop);
         for topic in VIEWER_TOPICS {

@@ -27,6 +27,10 @@ pub struct Session {
     pub recorder: Recorder,
     /// The ROS 2 type of each route's messages (None: a scalar route).
     types: Vec<Option<String>>,
+    /// Per route: an FMU-to-FMU route whose messages an earlier route of the same output
+    /// already put on the bus (one output wired to several FMUs: the world's moved_objects to
+    /// every sensor). Its copies are delivered, not published again.
+    fan_out: Vec<bool>,
     /// Wall time of each node's last step \[s\]: a speed statistic for reports, never an input.
     node_wall: Vec<f64>,
     /// What is recorded every point, built once: per FMU its signals topic and message (the
@@ -63,8 +67,17 @@ impl Session {
                 )
             })
             .collect();
+        let routes = &master.system.routes;
+        let fan_out = (0..routes.len())
+            .map(|i| {
+                let fmu_to_fmu =
+                    |r: &agrisim_cosim::Route| matches!((&r.from, &r.to), (Port::Fmu { .. }, Port::Fmu { .. }));
+                fmu_to_fmu(&routes[i]) && routes[..i].iter().any(|r| fmu_to_fmu(r) && r.topic == routes[i].topic)
+            })
+            .collect();
         Session {
             master,
+            fan_out,
             bus: Bus::default(),
             nodes,
             recorder,
@@ -107,6 +120,7 @@ impl Session {
                 nodes: &mut self.nodes,
                 recorder: &mut self.recorder,
                 types: &self.types,
+                fan_out: &self.fan_out,
                 node_wall: &mut self.node_wall,
                 signals: &mut self.signals,
                 scalars: &mut self.scalars,
@@ -211,6 +225,7 @@ struct Link<'a> {
     nodes: &'a mut Vec<Box<dyn Node>>,
     recorder: &'a mut Recorder,
     types: &'a [Option<String>],
+    fan_out: &'a [bool],
     node_wall: &'a mut [f64],
     signals: &'a mut [(String, Signals)],
     scalars: &'a mut Signals,
@@ -220,6 +235,9 @@ struct Link<'a> {
 impl Hooks for Link<'_> {
     fn message(&mut self, system: &System, route: usize, t_ns: i64, bytes: &[u8]) -> Result<()> {
         let r = &system.routes[route];
+        if self.fan_out[route] {
+            return Ok(());
+        }
         let ty = self.types[route].as_deref().expect("message routes have a type (message_types)");
         if let Port::Fmu { comp, var, .. } = &r.from {
             check_message(&system.components[*comp].name, &var.name, ty, bytes, t_ns)?;

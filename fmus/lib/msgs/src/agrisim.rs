@@ -142,6 +142,20 @@ ros_message! {
 }
 
 ros_message! {
+    /// `agrisim_msgs/msg/MovedObjects`: ground truth of the scene objects away from where the
+    /// greenhouse grew them (pushed leaves, picked fruit), all at one instant: what the sensor
+    /// FMUs render in place of their grown placement. Never for algorithm nodes.
+    #[derive(Debug, Default, Clone, PartialEq)]
+    pub struct MovedObjects = "agrisim_msgs/msg/MovedObjects" {
+        pub header: Header,
+        /// Scene object ids, ascending.
+        pub ids: Vec<u32>,
+        /// Each object's placement (its shape's frame) in the map frame.
+        pub poses: Vec<crate::geometry_msgs::Pose>,
+    }
+}
+
+ros_message! {
     /// `agrisim_msgs/msg/PlantDamage`: ground truth of what the harvest did to the crop,
     /// cumulative since the start (counts per kind) and the last pedicel break. For the
     /// judge only: algorithm nodes never read it.

@@ -62,6 +62,7 @@ pub fn check_cdr(type_name: &str, bytes: &[u8]) -> Option<Result<(), CdrError>> 
         "agrisim_msgs/msg/HarvestStatus" => ok::<agrisim::HarvestStatus>(bytes),
         "agrisim_msgs/msg/PlanResult" => ok::<agrisim::PlanResult>(bytes),
         "agrisim_msgs/msg/PlantDamage" => ok::<agrisim::PlantDamage>(bytes),
+        "agrisim_msgs/msg/MovedObjects" => ok::<agrisim::MovedObjects>(bytes),
         "vision_msgs/msg/ObjectHypothesis" => ok::<vision_msgs::ObjectHypothesis>(bytes),
         "vision_msgs/msg/ObjectHypothesisWithPose" => ok::<vision_msgs::ObjectHypothesisWithPose>(bytes),
         "vision_msgs/msg/BoundingBox3D" => ok::<vision_msgs::BoundingBox3D>(bytes),

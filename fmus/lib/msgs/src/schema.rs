@@ -77,6 +77,7 @@ msg_table! {
     "agrisim_msgs" / "HarvestStatus",
     "agrisim_msgs" / "PlanResult",
     "agrisim_msgs" / "PlantDamage",
+    "agrisim_msgs" / "MovedObjects",
     "vision_msgs" / "ObjectHypothesis",
     "vision_msgs" / "ObjectHypothesisWithPose",
     "vision_msgs" / "BoundingBox3D",

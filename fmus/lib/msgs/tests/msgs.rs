@@ -33,7 +33,7 @@ fn samples_cover_every_type() {
     let sampled: BTreeSet<&str> = all_samples().iter().map(|s| s.type_name).collect();
     let all: BTreeSet<&str> = all_type_names().iter().copied().collect();
     assert_eq!(sampled, all);
-    assert_eq!(all.len(), 59);
+    assert_eq!(all.len(), 60);
 }
 
 #[test]

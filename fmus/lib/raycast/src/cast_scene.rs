@@ -10,6 +10,7 @@ use crate::RayCaster;
 use agrisim_scene::{generate, GreenhouseConfig, Kind, Object, Placement, Shape};
 use std::sync::{Arc, Mutex};
 
+#[derive(Clone)]
 pub struct CastScene {
     pub caster: RayCaster,
     /// Kind per object id (ids dense from 0).

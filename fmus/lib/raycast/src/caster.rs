@@ -157,7 +157,8 @@ impl RayCaster {
 
     /// [`RayCaster::cast_among_posed`] for up to [`MAX_PACKET`] coherent rays with their own
     /// origins and mover poses (a run of LiDAR firings while the base moves): `out[i]` is
-    /// exactly the single-ray answer for ray i.
+    /// exactly the single-ray answer for ray i among this scene, `placed` (further objects
+    /// in the map frame: moved scene objects; often empty) and the posed `movers`.
     #[allow(clippy::too_many_arguments)]
     pub fn cast_packet_posed(
         &self,
@@ -165,6 +166,7 @@ impl RayCaster {
         dirs: &[[f64; 3]],
         min: f64,
         max: f64,
+        placed: &RayCaster,
         movers: &RayCaster,
         poses: &[RigidPose],
         out: &mut [Option<Hit>],
@@ -180,6 +182,9 @@ impl RayCaster {
         assert!(n <= MAX_PACKET, "a packet of {n} rays (at most {MAX_PACKET})");
         let mut best = [Best { t: max, id: u32::MAX, normal: [0.0; 3] }; MAX_PACKET];
         nearest_in_packets(self, origins, dirs, min, max, &mut best);
+        if !placed.is_empty() {
+            nearest_in_packets(placed, origins, dirs, min, max, &mut best);
+        }
         if movers.is_empty() {
             for i in 0..n {
                 out[i] = best[i].hit();

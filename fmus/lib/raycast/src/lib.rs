@@ -18,11 +18,13 @@
 mod bvh;
 pub mod cast_scene;
 mod caster;
+pub mod moved;
 mod packet;
 mod primitives;
 mod sun_columns;
 mod wide;
 
 pub use caster::{cast_brute_force, Hit, Occluders, RayCaster, RigidPose};
+pub use moved::MovedScene;
 pub use packet::MAX_PACKET;
 pub use sun_columns::{Shadow, SunColumns};

@@ -41,6 +41,10 @@ pub(crate) enum Prim {
 }
 
 impl Prim {
+    /// A primitive no ray within a greenhouse's reach meets: a point 1.7e9 m away (a moved
+    /// object's place in the tree it was built in, see `moved`).
+    pub(crate) const NEVER: Prim = Prim::Sphere { c: [1e9; 3], r: 0.0 };
+
     pub(crate) fn from_object(o: &Object) -> Prim {
         let c = o.placement.translation;
         match o.shape {

@@ -387,7 +387,16 @@ fn packets_equal_single_rays() {
             };
             mixed_signs += (0..3).any(|a| dirs.iter().any(|d| d[a] > 0.0) && dirs.iter().any(|d| d[a] < 0.0)) as usize;
             // No movers at all (the scene alone).
-            rc.cast_packet_posed(&origins, &dirs, tmin, tmax, &RayCaster::new(&[]), &poses, &mut out);
+            rc.cast_packet_posed(
+                &origins,
+                &dirs,
+                tmin,
+                tmax,
+                &RayCaster::new(&[]),
+                &RayCaster::new(&[]),
+                &poses,
+                &mut out,
+            );
             for i in 0..n {
                 assert_eq!(
                     out[i],
@@ -395,7 +404,7 @@ fn packets_equal_single_rays() {
                     "posed packet {k} ray {i} without movers"
                 );
             }
-            rc.cast_packet_posed(&origins, &dirs, tmin, tmax, &local, &poses, &mut out);
+            rc.cast_packet_posed(&origins, &dirs, tmin, tmax, &RayCaster::new(&[]), &local, &poses, &mut out);
             for i in 0..n {
                 let single = rc.cast_among_posed(origins[i], dirs[i], tmin, tmax, &local, &poses[i]);
                 assert_eq!(out[i], single, "posed packet {k} ray {i}");

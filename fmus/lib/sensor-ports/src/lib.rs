@@ -9,11 +9,17 @@
 //! depend on the export layer. The world FMU declares the scene and base ports from the same
 //! constants.
 
+pub mod moved;
 pub mod robot;
 
-use agrisim_fmi::{checked_f64, Start, Store, Var};
+pub use moved::MovedInput;
+
+use agrisim_fmi::{checked_f64, InPort, Start, Store, Var};
+use agrisim_msgs::agrisim::MovedObjects;
+use agrisim_msgs::Message;
 use agrisim_raycast::cast_scene::{load_cached, CastScene};
 use agrisim_robot::model::Coords;
+use agrisim_scene::Placement;
 use std::sync::Arc;
 
 #[doc(hidden)]
@@ -70,6 +76,8 @@ macro_rules! sensor_variables {
             RIGHT_Q6 = $crate::robot::ARM_JOINTS[1][5],
             RIGHT_Q7 = $crate::robot::ARM_JOINTS[1][6],
             RIGHT_FINGER_WIDTH = $crate::robot::FINGER_WIDTHS[1],
+            MOVED_OBJECTS = $crate::MOVED_OBJECTS[0],
+            MOVED_OBJECTS_SEQ = $crate::MOVED_OBJECTS[1],
         }}
 
         /// Readers of the shared sensor ports of this table.
@@ -89,6 +97,7 @@ macro_rules! sensor_variables {
                 [RIGHT_Q1, RIGHT_Q2, RIGHT_Q3, RIGHT_Q4, RIGHT_Q5, RIGHT_Q6, RIGHT_Q7],
             ],
             widths: [LEFT_FINGER_WIDTH, RIGHT_FINGER_WIDTH],
+            moved: [MOVED_OBJECTS, MOVED_OBJECTS_SEQ],
         };
     };
 }
@@ -124,6 +133,19 @@ pub const BASE_POSE: [Var; 3] = [
     Var::input("base_yaw", 0.0).unit("rad").desc("Yaw of base_link in the map frame"),
 ];
 
+/// MIME type of the world's `moved_objects` output and the sensors' input.
+pub const MOVED_OBJECTS_MIME: &str = "application/x-ros2-cdr-frames; version=1; type=agrisim_msgs/msg/MovedObjects";
+
+/// Input: the world FMU's `moved_objects` (agrisim_msgs/MovedObjects), so the sensor renders
+/// pushed leaves and picked fruit where they are. Unconnected, the scene stays as grown.
+pub const MOVED_OBJECTS: [Var; 2] = [
+    Var::input_discrete("moved_objects", Start::Binary(&[]))
+        .mime(MOVED_OBJECTS_MIME)
+        .max_size(agrisim_fmi::port::frames_max_size(64 + 60 * 16384, 64))
+        .desc("agrisim_msgs/MovedObjects from the world FMU's moved_objects (CDR frames): scene objects away from their grown placement (pushed leaves, picked fruit), rendered where they are; unconnected = the scene as grown"),
+    Var::input_discrete("moved_objects_seq", Start::Int64(0)).desc("Sequence number of the newest message in moved_objects"),
+];
+
 /// Where a sensor is on base_link: position and fixed-axis roll-pitch-yaw (URDF).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Mount {
@@ -153,6 +175,8 @@ pub struct SensorPorts {
     pub arms: [[usize; 7]; 2],
     /// `<side>_finger_width`, left then right.
     pub widths: [usize; 2],
+    /// `moved_objects` and its counter.
+    pub moved: [usize; 2],
 }
 
 impl SensorPorts {
@@ -202,6 +226,41 @@ impl SensorPorts {
     /// The robot body for this sensor (ids from `first_id`, the scene's object count).
     pub fn robot_body(&self, io: &Store, first_id: u32) -> Result<robot::RobotBody, String> {
         robot::RobotBody::new(first_id, self.base_box(io)?, self.link)
+    }
+
+    /// The newest `moved_objects` message that `port` has not taken yet, as (object id,
+    /// placement) pairs (None: nothing new). Ids must be ascending scene ids (below
+    /// `object_count`) and poses finite, with a non-zero quaternion (renormalized).
+    pub fn moved_objects(
+        &self,
+        io: &Store,
+        port: &mut InPort,
+        object_count: usize,
+    ) -> Result<Option<Vec<(u32, Placement)>>, String> {
+        let name = self.vars[self.moved[0]].name;
+        let Some(cdr) = port.take(io, name)?.pop() else { return Ok(None) };
+        let msg =
+            MovedObjects::from_cdr(&cdr).map_err(|e| format!("input {name}: not an agrisim_msgs/MovedObjects: {e}"))?;
+        if msg.ids.len() != msg.poses.len() {
+            return Err(format!("input {name}: {} ids but {} poses", msg.ids.len(), msg.poses.len()));
+        }
+        let mut out = Vec::with_capacity(msg.ids.len());
+        for (k, (&id, p)) in msg.ids.iter().zip(&msg.poses).enumerate() {
+            if id as usize >= object_count || (k > 0 && id <= msg.ids[k - 1]) {
+                return Err(format!(
+                    "input {name}: object id {id} (entry {k}) is not an ascending id of the scene's {object_count} objects"
+                ));
+            }
+            let (t, q) = (&p.position, &p.orientation);
+            let all = [t.x, t.y, t.z, q.x, q.y, q.z, q.w];
+            let norm = (q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w).sqrt();
+            if all.iter().any(|v| !v.is_finite() || v.abs() > 1e6) || norm < 1e-9 {
+                return Err(format!("input {name}: the pose of object {id} is not finite or has no rotation: {p:?}"));
+            }
+            let rotation = [q.x / norm, q.y / norm, q.z / norm, q.w / norm];
+            out.push((id, Placement { translation: [t.x, t.y, t.z], rotation }));
+        }
+        Ok(Some(out))
     }
 
     /// The base pose inputs (x, y, yaw); refused when not finite or beyond 1e6.
@@ -265,7 +324,9 @@ mod tests {
                 "right_q5",
                 "right_q6",
                 "right_q7",
-                "right_finger_width"
+                "right_finger_width",
+                "moved_objects",
+                "moved_objects_seq"
             ]
         );
         assert_eq!((OWN, OUT, SENSOR_PORTS.base_pose), (2, 16, [13, 14, 15]));

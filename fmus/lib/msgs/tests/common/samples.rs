@@ -5,8 +5,8 @@
 #![allow(dead_code)]
 
 use agrisim_msgs::agrisim::{
-    CollisionObject, CollisionState, Contact, FmuStatus, GripperState, HarvestStatus, NavigationStatus, PlanResult,
-    PlanningScene, PlantDamage, Signals, TrajectoryStatus,
+    CollisionObject, CollisionState, Contact, FmuStatus, GripperState, HarvestStatus, MovedObjects, NavigationStatus,
+    PlanResult, PlanningScene, PlantDamage, Signals, TrajectoryStatus,
 };
 use agrisim_msgs::builtin_interfaces::{Duration, Time};
 use agrisim_msgs::control_msgs::GripperCommand;
@@ -307,6 +307,18 @@ fn manipulation_samples() -> Vec<Sample> {
                 leaf_pushes: 5,
                 peak_leaf_force: 1.25,
                 peak_stem_load: 0.5,
+            },
+        ),
+        sample(
+            "moved_objects",
+            MovedObjects {
+                header: hdr(41, 500_000_000, "map"),
+                ids: vec![7, 1024, 70000],
+                poses: vec![
+                    pose(1.5, -2.0, 0.75, q(0.0, 0.0, 0.0, 1.0)),
+                    pose(0.25, 0.5, 1.125, q(0.5, 0.5, 0.5, 0.5)),
+                    pose(-3.0, 4.0, 0.0625, q(0.0, 0.0, 1.0, 0.0)),
+                ],
             },
         ),
     ]
