@@ -77,3 +77,13 @@ def test_unknown_mount_parent_names_the_component_and_the_parameter(tmp_path):
     p = run_agrisim("run", "--scenario", str(scenario), "--out", str(tmp_path / "out"), "--duration", "0.1", check=False)
     assert p.returncode != 0
     assert "left_wrist_camera" in p.stderr and "mount_parent" in p.stderr and "left_nose" in p.stderr, p.stderr
+
+
+def test_the_worlds_moved_objects_reach_every_sensor_and_the_bus_once(run):
+    """sensors.ssd wires the world's moved_objects to the LiDAR and the three cameras: four
+    FMU-to-FMU routes from one output. The recording has the message once per instant (not a
+    copy per route), here the empty list at the start (nothing has moved in 0.3 s)."""
+    msgs = list(decoded_messages(run, "/world/moved_objects"))
+    assert len(msgs) == 1, [m.header.stamp for _, _, m in msgs]
+    m = msgs[0][2]
+    assert (list(m.ids), list(m.poses), m.header.frame_id) == ([], [], "map")
