@@ -49,9 +49,4 @@ impl MovedInput {
     pub fn objects(&self) -> Vec<Object> {
         self.view.objects()
     }
-
-    /// The current list (object id, placement).
-    pub fn moves(&self) -> &[(u32, Placement)] {
-        &self.moves
-    }
 }
