@@ -345,8 +345,8 @@ impl Model for Lidar {
     fn do_step(&mut self, io: &mut Store, t: f64, h: f64, _log: &mut dyn Log) -> Result<(), String> {
         let period = self.config.as_ref().map_or(0.1, |c| c.frame_period);
         self.trajectory.push(t, pose(io)?, 2.0 * period + h);
-        let scene = self.config.as_ref().map(|c| c.scene.clone()).ok_or("not initialized")?;
-        self.moved.take(io, &SENSOR_PORTS, &scene)?;
+        let c = self.config.as_ref().ok_or("not initialized")?;
+        self.moved.take(io, &SENSOR_PORTS, &c.scene)?;
         if let Some(end_ns) = self.schedule.due(t + h) {
             self.pose_robot(SENSOR_PORTS.coords(io)?);
             let moved = self.moved.objects();
