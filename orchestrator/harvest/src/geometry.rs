@@ -52,6 +52,9 @@ pub const PLACE_DESCENT: f64 = 0.25;
 /// Height added to every place pose for the second round of goals, where none of the first
 /// could be reached [m] (a fall of at most 7.5 cm then, 1.2 m/s).
 pub const PLACE_HIGHER: f64 = 0.03;
+/// Fruit closer than this to the picked one (surface to surface) may be brushed: the
+/// fingers push them aside on the way in [m].
+pub const NEIGHBOUR_GAP: f64 = 0.02;
 /// Gripper opening for approach [m] (Franka Hand maximum).
 pub const OPEN_WIDTH: f64 = 0.08;
 

@@ -9,7 +9,7 @@
 //! passes the collision checks. Every step is deterministic (seeded sampler, iteration
 //! budgets); wall time is measured by the caller for statistics only.
 
-use super::geometry::TcpGoal;
+use super::geometry::{TcpGoal, NEIGHBOUR_GAP};
 use agrisim_manip::cartesian::cartesian_path;
 use agrisim_manip::{
     exact_check, ArmModel, Checker, Context, Ik, Meter, Obstacle, ObstacleKind, Planner, Rng, Scene, Shape, Side,
@@ -36,8 +36,6 @@ pub const SEND_DT: f64 = 0.04;
 const LINE_TOLERANCE: f64 = 0.005;
 /// TCP step between the IK waypoints of a Cartesian move [m].
 const CARTESIAN_STEP: f64 = 0.01;
-/// Fruit closer than this to the picked one (surface to surface) may be brushed [m].
-const NEIGHBOUR_GAP: f64 = 0.02;
 /// How far from the grasped fruit's centre the hand reaches as it rolls about its own axis
 /// [m]: the Franka Hand is about 0.2 m across the fingers (Franka Emika, FR3 product
 /// manual: hand dimensions) and its palm lies about 0.09 m behind the fingertip centre, so its

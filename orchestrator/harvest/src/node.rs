@@ -654,7 +654,9 @@ impl HarvestNode {
     fn update_scene(&mut self) {
         if let (Some(scene), Some(pose)) = (&self.scene, self.pose) {
             match (self.region(), self.target_map) {
-                (Some(_), Some(c)) => self.motion.set_scene(&sight::with_target(scene, c, self.target_r), pose),
+                (Some(_), Some(c)) => {
+                    self.motion.set_scene(&sight::with_target(scene, c, self.target_r, &self.fruit_map), pose)
+                }
                 _ => self.motion.set_scene(scene, pose),
             }
         }
