@@ -373,10 +373,9 @@ impl HarvestNode {
             // The chosen fruit's estimate improves as the base comes closer: follow it until
             // the pre-grasp is planned.
             let following = self.stage == Stage::PositionBase || (self.stage == Stage::PreGrasp && !self.planned);
-            if let (Some(id), true) = (&self.track, following) {
-                if let Some(f) = self.fruit_map.iter().find(|f| &f.id == id) {
-                    self.target_map = Some(f.center);
-                    self.target_r = f.radius;
+            if let (Some(id), Some(at), true) = (&self.track, self.target_map, following) {
+                if let Some(f) = sight::follow(&self.fruit_map, id, at, self.target_r) {
+                    (self.target_map, self.target_r, self.track) = (Some(f.center), f.radius, Some(f.id.clone()));
                 }
             }
         }
