@@ -54,14 +54,20 @@ struct Streak {
 impl Streak {
     fn add(&mut self, o: &Observation) {
         self.n += 1;
-        let n = self.n as f64;
-        let old = self.center;
-        for a in 0..3 {
-            self.center[a] += (o.center[a] - self.center[a]) / n;
-        }
-        self.m2 += dist(o.center, old) * dist(o.center, self.center);
-        self.radius += (o.radius - self.radius) / n;
+        welford(self.n, &mut self.center, &mut self.radius, &mut self.m2, o);
     }
+}
+
+/// Adds observation `o` as the `n`th to a running mean of centre and radius and to Welford's
+/// sum of squared distances.
+fn welford(n: u32, center: &mut [f64; 3], radius: &mut f64, m2: &mut f64, o: &Observation) {
+    let n = n as f64;
+    let old = *center;
+    for a in 0..3 {
+        center[a] += (o.center[a] - center[a]) / n;
+    }
+    *m2 += dist(o.center, old) * dist(o.center, *center);
+    *radius += (o.radius - *radius) / n;
 }
 
 impl Track {
@@ -172,13 +178,7 @@ impl FruitMap {
                     } else {
                         t.streak = Streak::default();
                         t.merged += 1;
-                        let n = t.merged as f64;
-                        let old = t.center;
-                        for a in 0..3 {
-                            t.center[a] += (o.center[a] - t.center[a]) / n;
-                        }
-                        t.m2 += dist(o.center, old) * dist(o.center, t.center);
-                        t.radius += (o.radius - t.radius) / n;
+                        welford(t.merged, &mut t.center, &mut t.radius, &mut t.m2, o);
                         for s in 0..6 {
                             t.votes[s] += o.votes[s];
                         }
