@@ -204,7 +204,7 @@ impl FruitMap {
                 }
             }
         }
-        for (gone, kept) in self.merge_overlapping() {
+        for (gone, kept) in self.merge_overlapping(t_ns) {
             ids.iter_mut().filter(|id| **id == gone).for_each(|id| *id = kept);
         }
         ids
@@ -212,14 +212,18 @@ impl FruitMap {
 
     /// Removes, of every two tracks closer than the larger radius, the one seen less
     /// recently (then: with fewer observations, then: the newer id); returns (removed id,
-    /// kept id) pairs.
-    fn merge_overlapping(&mut self) -> Vec<(u32, u32)> {
+    /// kept id) pairs. Only tracks observed at `t_ns` moved, so only pairs with one of them
+    /// are checked (the others were apart after the last update).
+    fn merge_overlapping(&mut self, t_ns: i64) -> Vec<(u32, u32)> {
         let mut out = vec![];
         loop {
             let mut worst: Option<(f64, usize, usize)> = None;
             for a in 0..self.tracks.len() {
                 for b in a + 1..self.tracks.len() {
                     let (ta, tb) = (&self.tracks[a], &self.tracks[b]);
+                    if ta.last_seen_ns != t_ns && tb.last_seen_ns != t_ns {
+                        continue;
+                    }
                     let d = dist(ta.center, tb.center);
                     if d < ta.radius.max(tb.radius) && worst.is_none_or(|w| d < w.0) {
                         worst = Some((d, a, b));
