@@ -179,12 +179,19 @@ fn a_scripted_node_is_judged_from_its_messages_and_the_ground_truth() {
     // A failure report is taken as the category and stage the node names. A failed plan
     // with a fallback does not fail planning, but a trial that ends (here at the grasp)
     // before asking for every plan leaves planning undecided; a failed required plan fails it.
+    // A failed pre-grasp plan with a fallback is a fruit declined (by sight: another taken).
+    let declined = {
+        let (t, Said::Plan(mut m)) = plan(550_000_000, false, true) else { unreachable!() };
+        m.kind = "pregrasp".into();
+        (t, Said::Plan(m))
+    };
     let grasp = b.trial(
         "grasp",
         &|_, _| {
             Box::new(Scripted {
                 script: vec![
                     plan(500_000_000, false, true),
+                    declined.clone(),
                     status(1_000_000_000, "grasp", "failure", "grasp", "closed on nothing"),
                 ],
             })
@@ -195,7 +202,8 @@ fn a_scripted_node_is_judged_from_its_messages_and_the_ground_truth() {
         (grasp.failure.as_deref(), grasp.failed_stage.as_deref(), grasp.detail.as_str()),
         (Some("grasp"), Some("grasp"), "closed on nothing")
     );
-    assert!(!grasp.planning_ok && grasp.planning == "not_reached" && grasp.plans == 1);
+    assert!(!grasp.planning_ok && grasp.planning == "not_reached" && grasp.plans == 2);
+    assert_eq!(grasp.declined, 1, "only the optional pre-grasp failure is a fruit declined");
     let planning = b.trial(
         "planning",
         &|_, _| {

@@ -168,6 +168,8 @@ pub struct HarvestNode {
     /// By sight: where earlier tasks of a row aimed (picked there, or failed on), so the
     /// next task does not choose the same fruit again ([`sight::choose`]).
     tried: Vec<[f64; 3]>,
+    /// By sight: fruit of this task declined for want of a grasp ([`sight::MAX_DECLINED`]).
+    declined: usize,
     /// Why the task failed, once it has.
     pub(crate) failure: Option<Failure>,
 }
@@ -243,6 +245,7 @@ impl HarvestNode {
             aisle_y: 0.0,
             allowed_sent: None,
             tried: vec![],
+            declined: 0,
             failure: None,
         }
     }
@@ -570,10 +573,50 @@ impl HarvestNode {
     }
 
     /// Plans to the stand-off of the first reachable grasp of `grasps`; returns its index.
+    /// Plans to the pre-grasp of the first reachable grasp of `grasps`. By sight, a fruit
+    /// with no collision-free pre-grasp is declined while another ripe fruit of the region
+    /// is in the fruit map (at most [`sight::MAX_DECLINED`] per task): nothing has moved
+    /// toward it yet, and a harvester chooses the fruit it can reach. The failed plan is
+    /// reported as optional (it had a fallback); the judge's report counts them.
     fn move_pregrasp(&mut self, arm: Arm, grasps: &[TcpGoal], t_ns: i64, bus: &mut Bus) -> Option<usize> {
-        self.plan_and_send(arm, "pregrasp", t_ns, bus, |m, lift, start, other| {
-            m.plan_pregrasp_any(arm, lift, start, grasps, geo::PRE_GRASP, other)
-        })
+        let (start, other) = (self.q(arm), self.q(arm.other()));
+        let r = self.motion.plan_pregrasp_any(arm, self.lift, start, grasps, geo::PRE_GRASP, other);
+        let next = if r.is_err() { self.next_choice() } else { None };
+        let chosen = r.as_ref().ok().map(|(i, _)| *i);
+        let r = r.map(|(_, p)| p);
+        self.record(arm, "pregrasp", &r, next.is_some(), t_ns, bus);
+        match (r, next) {
+            (Ok(p), _) => {
+                self.send(arm, p, t_ns, bus);
+                chosen
+            }
+            (Err(e), Some(f)) => {
+                let was = self.track.clone().unwrap_or_default();
+                self.tried.extend(self.target_map);
+                self.declined += 1;
+                (self.target_map, self.target_r, self.track) = (Some(f.center), f.radius, Some(f.id.clone()));
+                let detail = format!("declined track {was}: {} arm, {}: {e}", arm.name(), self.stage.name());
+                self.publish_status(t_ns, bus, "running", "", &detail);
+                self.aim(t_ns, bus);
+                None
+            }
+            (Err(e), None) => {
+                self.fail(Failure::Planning, t_ns, bus, format!("{} arm, {}: {e}", arm.name(), self.stage.name()));
+                None
+            }
+        }
+    }
+
+    /// By sight: the fruit to take if the current one is declined (None when it may not be,
+    /// or no other is left).
+    fn next_choice(&self) -> Option<Seen> {
+        let region = self.region()?;
+        if self.declined >= sight::MAX_DECLINED {
+            return None;
+        }
+        let mut tried = self.tried.clone();
+        tried.extend(self.target_map);
+        sight::choose(&self.fruit_map, &region, self.aisle_y, &tried)
     }
 
     /// Plans to the first reachable goal of `goals`.

@@ -41,6 +41,10 @@ pub fn report_html(g: &agrisim_scene::Greenhouse, sum: &HarvestSummary, results:
         ),
         ("planning Wilson 95 %".to_string(), interval(sum.planning_wilson95)),
         (
+            "fruit declined for want of a pre-grasp (trials)".to_string(),
+            format!("{} ({})", sum.declined, sum.trials_declining),
+        ),
+        (
             "harvested given planning".to_string(),
             format!("{:.3}, Wilson 95 % {}", sum.conditional_success_rate, interval(sum.conditional_wilson95)),
         ),

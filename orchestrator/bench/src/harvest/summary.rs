@@ -44,6 +44,12 @@ pub struct HarvestSummary {
     pub conditional_success_rate: f64,
     pub conditional_wilson95: [f64; 2],
     pub failures: BTreeMap<String, u64>,
+    /// Fruit declined for want of a pre-grasp (by sight: the node took another), and the
+    /// trials that declined any: a first choice without a plan, beside the planning verdict.
+    #[serde(default)]
+    pub declined: u64,
+    #[serde(default)]
+    pub trials_declining: u64,
     pub plans: u64,
     pub planning_time_p50: Option<f64>,
     pub planning_time_p95: Option<f64>,
@@ -148,6 +154,8 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, results: &[HarvestTrial]) -> Har
         conditional_success_rate: rate(ok_given_planned, planned),
         conditional_wilson95: wilson(ok_given_planned, planned, Z95),
         failures,
+        declined: results.iter().map(|t| t.declined as u64).sum(),
+        trials_declining: results.iter().filter(|t| t.declined > 0).count() as u64,
         plans: times.len() as u64,
         planning_time_p50: percentile(&times, 0.5),
         planning_time_p95: percentile(&times, 0.95),

@@ -91,6 +91,10 @@ pub struct HarvestTrial {
     /// `planning == "ok"`.
     pub planning_ok: bool,
     pub plans: usize,
+    /// Fruit the node declined: pre-grasp plans that failed with another fruit of the region
+    /// to take instead (by sight; optional plans of kind `pregrasp` on /harvest/plans).
+    #[serde(default)]
+    pub declined: usize,
     /// Wall time of each plan [s]: the harvest node's step that asked for it (IK + RRT-Connect
     /// + shortcut + time parameterization), shared among the plans of that step.
     pub planning_times: Vec<f64>,
@@ -355,6 +359,7 @@ pub fn run_with(t: &Trial<HarvestSetup>, mcap: &Path, node: HarvestNodeFactory, 
         planning: planning.into(),
         planning_ok: planning == "ok",
         plans: reports.plans.len(),
+        declined: reports.plans.iter().filter(|p| p.kind == "pregrasp" && !p.ok && p.optional).count(),
         planning_times: reports.planning_times,
         thinking_time: reports.plans.iter().map(|p| p.planning_time).sum(),
         perception_time: charges.perception(),
@@ -427,6 +432,7 @@ impl HarvestTrial {
             planning: "not_reached".into(),
             planning_ok: false,
             plans: 0,
+            declined: 0,
             planning_times: vec![],
             thinking_time: 0.0,
             perception_time: 0.0,

@@ -121,7 +121,7 @@ impl HarvestNode {
 
     /// With the target known: the side of the row, the grasp, the base's stand-off and the
     /// lift height. -> position_base.
-    fn aim(&mut self, t_ns: i64, bus: &mut Bus) {
+    pub(super) fn aim(&mut self, t_ns: i64, bus: &mut Bus) {
         {
             let t = self.target_map.expect("checked");
             // The base harvests facing along the aisle the way it already faces (+x or
