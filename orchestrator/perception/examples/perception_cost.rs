@@ -99,6 +99,8 @@ fn measure(msgs: &[(i64, String, String, Vec<u8>)], repeat: usize) -> Vec<(Detec
                 candidates: w.candidates - before.candidates,
                 fit_points: w.fit_points - before.fit_points,
                 surface_tests: w.surface_tests - before.surface_tests,
+                haze_samples: w.haze_samples - before.haze_samples,
+                cleared: w.cleared - before.cleared,
             };
             if work.pixels > 0 {
                 if pass == 0 {
@@ -151,7 +153,11 @@ fn main() {
     println!("real frames' steps: {}, black frames' steps: {}", real.len(), steps.len() - real.len());
     assert!(steps.len() > 10, "too few frames in {path}");
     let a: Vec<Vec<f64>> = steps.iter().map(|(w, _)| row(w)).collect();
-    let b: Vec<f64> = steps.iter().map(|(_, s)| *s).collect();
+    // The fog estimate's cost is calibrated apart (`haze_cost`: its samples are as many in
+    // every frame, so here they cannot be told from the scan's pixels) and taken off.
+    let haze = CostModel { per_haze_sample: CostModel::CALIBRATED.per_haze_sample, ..CostModel::FREE };
+    let haze = CostModel { per_cleared: CostModel::CALIBRATED.per_cleared, ..haze };
+    let b: Vec<f64> = steps.iter().map(|(w, s)| s - haze.seconds(w)).collect();
     let x = nnls(&a, &b);
     // Two halves of the set: the even and the odd steps.
     let pick = |odd: usize| -> (Vec<Vec<f64>>, Vec<f64>) {

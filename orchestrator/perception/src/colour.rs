@@ -42,6 +42,11 @@ impl Default for Linearize {
 }
 
 impl Linearize {
+    /// Linear value of one sRGB channel.
+    pub fn channel(&self, c: u8) -> f32 {
+        self.0[c as usize]
+    }
+
     /// CIELAB (D65 white) of an sRGB pixel: (L*, a*, b*).
     pub fn lab(&self, rgb: [u8; 3]) -> [f32; 3] {
         let [r, g, b] = rgb.map(|c| self.0[c as usize]);

@@ -2,25 +2,12 @@
 //! each fitted with a sphere, its ripeness from the coloured fraction of the skin on it.
 
 use crate::colour::{classify, FruitColour, Linearize};
+use crate::haze::{self, Haze, HazeWork, Srgb};
 use crate::ripeness::{ripeness, stage_shares, surface_below, Ripeness};
 use crate::sphere::{fit_sphere, SphereBounds};
 use std::cell::Cell;
 
-/// Pinhole intrinsics (CameraInfo's K).
-pub use agrisim_msgs::sensor_msgs::Pinhole as Intrinsics;
-
-/// A colour frame with its aligned depth (z in metres, 0 or non-finite = none).
-pub struct Frame<'a> {
-    pub width: usize,
-    pub height: usize,
-    /// rgb8, `width * height * 3` bytes, rows without padding.
-    pub rgb: &'a [u8],
-    pub depth: &'a [f32],
-    pub k: Intrinsics,
-    /// The world's up (unit) in the camera's frame, from TF; `None`: the optical frame's -y
-    /// (a level camera).
-    pub up: Option<[f64; 3]>,
-}
+pub use crate::frame::{Frame, Intrinsics};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct DetectorConfig {
@@ -92,6 +79,9 @@ pub struct DetectWork {
     pub fit_points: u64,
     /// Pixels tested against a fitted sphere's surface (growing and ripeness).
     pub surface_tests: u64,
+    /// Pixels sampled to estimate fog ([`crate::haze`]), and pixels cleared of it.
+    pub haze_samples: u64,
+    pub cleared: u64,
 }
 
 impl std::ops::AddAssign for DetectWork {
@@ -101,6 +91,8 @@ impl std::ops::AddAssign for DetectWork {
         self.candidates += o.candidates;
         self.fit_points += o.fit_points;
         self.surface_tests += o.surface_tests;
+        self.haze_samples += o.haze_samples;
+        self.cleared += o.cleared;
     }
 }
 
@@ -112,6 +104,8 @@ pub struct FrameResult {
     pub valid_depth: usize,
     /// Segments refused by the fit (too flat, too big, too few inliers).
     pub rejected: usize,
+    /// The fog the frame was cleared of (None: clear air).
+    pub haze: Option<Haze>,
     /// The work it took.
     pub work: DetectWork,
 }
@@ -120,6 +114,7 @@ pub struct FrameResult {
 pub struct Detector {
     pub config: DetectorConfig,
     lin: Linearize,
+    srgb: Srgb,
     /// The colour test's answer per sRGB colour, filled as colours appear (0 not yet asked,
     /// 1 no, 2 yes): a frame repeats most colours of the frames before it, so the CIELAB
     /// conversion (three cube roots) runs once per colour rather than once per pixel.
@@ -139,6 +134,7 @@ impl Detector {
         Detector {
             config,
             lin: Linearize::default(),
+            srgb: Srgb::default(),
             colour_memo: vec![],
             memo_for: None,
             mask: vec![],
@@ -149,13 +145,32 @@ impl Detector {
         }
     }
 
-    /// Finds the fruit of one frame. Buffers of the wrong size give an empty result.
+    /// Finds the fruit of one frame, cleared first of any fog it shows ([`crate::haze`]).
+    /// Buffers of the wrong size give an empty result.
     pub fn detect(&mut self, f: &Frame) -> FrameResult {
         let n = f.width * f.height;
-        let mut out = FrameResult::default();
         if f.rgb.len() < n * 3 || f.depth.len() < n || n == 0 {
-            return out;
+            return FrameResult::default();
         }
+        let mut work = HazeWork::default();
+        let found = haze::estimate(&self.srgb, f, &mut work);
+        let mut out = match found {
+            Some(h) => {
+                let z = (self.config.min_depth, self.config.max_depth);
+                let rgb = h.clear(&self.srgb, f, z, &mut work);
+                self.detect_clear(&Frame { rgb: &rgb, depth: f.depth, ..*f })
+            }
+            None => self.detect_clear(f),
+        };
+        out.haze = found;
+        (out.work.haze_samples, out.work.cleared) = (work.samples, work.cleared);
+        out
+    }
+
+    /// [`Self::detect`] of a frame in clear air.
+    fn detect_clear(&mut self, f: &Frame) -> FrameResult {
+        let n = f.width * f.height;
+        let mut out = FrameResult::default();
         self.fit_points.set(0);
         self.surface_tests.set(0);
         out.work.pixels = n as u64;
@@ -498,6 +513,65 @@ mod tests {
     }
 
     const WALL: (f64, [u8; 3]) = (1.2, [150, 145, 135]);
+
+    /// The same kind of frame in fog of 15 m visibility (Koschmieder, grey airlight), a far
+    /// field without depth on the right and shade below: the fog is estimated from the frame,
+    /// and the fruit are found after clearing, the farther one (in shade, as under a fog's
+    /// diffuse light) though its fogged colour fails the colour test.
+    #[test]
+    fn fruit_are_found_through_fog() {
+        let (w, h) = (160usize, 120usize);
+        let k = Intrinsics { fx: 240.0, fy: 240.0, cx: 80.0, cy: 60.0 };
+        let (beta, air) = (3.912 / 15.0, 0.27);
+        let fog = |col: [u8; 3], range: f64| -> [u8; 3] {
+            let t = (-beta * range).exp();
+            col.map(|c| {
+                let v = crate::colour::Linearize::default().channel(c) as f64;
+                let s = v * t + air * (1.0 - t);
+                let e = if s <= 0.003_130_8 { 12.92 * s } else { 1.055 * s.powf(1.0 / 2.4) - 0.055 };
+                (e * 255.0).round() as u8
+            })
+        };
+        let fruit = [([-0.15, 0.0, 1.3], 0.03, [80u8, 12, 10]), ([0.05, 0.05, 1.1], 0.033, [185, 30, 22])];
+        let (rgb, depth) = render(w, h, k, |u, d| {
+            if u >= 130 {
+                return (0.0, fog([0, 0, 0], f64::INFINITY));
+            }
+            let mut best = if d[1] > 0.15 {
+                (1.5, [3u8, 3, 3])
+            } else if u < 30 {
+                (1.2, [58u8, 112, 38])
+            } else {
+                (1.5, WALL.1)
+            };
+            for (c, r, col) in fruit {
+                if let Some(t) = hit(d, c, r).filter(|t| *t < best.0) {
+                    best = (t, col);
+                }
+            }
+            let range = best.0 * (d[0] * d[0] + d[1] * d[1] + 1.0).sqrt();
+            (best.0, fog(best.1, range))
+        });
+        // The fogged red of the farther fruit is no longer fruit-coloured.
+        let lin = Linearize::default();
+        let v = (0.0 / 1.3 * k.fy + k.cy) as usize;
+        let u = (-0.15 / 1.3 * k.fx + k.cx) as usize;
+        let i = v * w + u;
+        let px = [rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]];
+        assert!(!FruitColour::default().accepts(lin.lab(px)), "{px:?} passes the colour test in fog");
+        let mut det = Detector::new(DetectorConfig::default());
+        let r = det.detect(&Frame { width: w, height: h, rgb: &rgb, depth: &depth, k, up: None });
+        let haze = r.haze.expect("fog found");
+        assert!((haze.beta - beta).abs() < 0.05 * beta, "{haze:?}");
+        assert!(r.work.haze_samples > 0 && r.work.cleared > 0);
+        assert_eq!(r.detections.len(), 2, "{:?}", r.detections);
+        for (c, rad, _) in fruit {
+            let d = r.detections.iter().min_by(|a, b| d2(a.center, c).total_cmp(&d2(b.center, c))).unwrap();
+            assert!(d2(d.center, c).sqrt() < 0.006, "{d:?} vs {c:?}");
+            assert!((d.radius - rad).abs() < 0.006, "{d:?}");
+            assert!(d.stage >= 5, "{d:?}");
+        }
+    }
 
     /// A synthetic frame: a grey wall at 1.2 m, green leaves, and two tomatoes (a red one and
     /// a turning one) rendered by ray casting: both found, with their stage and centre.

@@ -16,6 +16,8 @@
 pub mod colour;
 pub mod cost;
 pub mod detect;
+pub mod frame;
+pub mod haze;
 pub mod node;
 pub mod ripeness;
 pub mod sphere;
