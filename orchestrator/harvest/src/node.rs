@@ -572,8 +572,8 @@ impl HarvestNode {
         .is_some()
     }
 
-    /// Plans to the stand-off of the first reachable grasp of `grasps`; returns its index.
-    /// Plans to the pre-grasp of the first reachable grasp of `grasps`. By sight, a fruit
+    /// Plans to the stand-off (pre-grasp) of the first reachable grasp of `grasps`; returns
+    /// its index. By sight, a fruit
     /// with no collision-free pre-grasp is declined while another ripe fruit of the region
     /// is in the fruit map (at most [`sight::MAX_DECLINED`] per task): nothing has moved
     /// toward it yet, and a harvester chooses the fruit it can reach. The failed plan is
