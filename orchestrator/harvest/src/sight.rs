@@ -210,14 +210,10 @@ pub const PERCEIVED_PREFIX: &str = "perceived/";
 ///   blocked the wrist at every roll and approach (by-sight trial 19, seed 1: a turning
 ///   fruit touching the target from the aisle side).
 pub fn with_target(scene: &PlanningScene, c: [f64; 3], r: f64, seen: &[Seen]) -> PlanningScene {
-    let touching: Vec<&Seen> = seen
-        .iter()
-        .filter(|n| {
-            let d = dist(n.center, c);
-            d > 0.5 * r && d < r + n.radius + NEIGHBOUR_GAP
-        })
-        .collect();
+    // The fruit map's other fruit (the target's own track lies within half a radius).
     let others: Vec<&Seen> = seen.iter().filter(|n| dist(n.center, c) > 0.5 * r).collect();
+    let touching: Vec<&Seen> =
+        others.iter().copied().filter(|n| dist(n.center, c) < r + n.radius + NEIGHBOUR_GAP).collect();
     let mut explains = vec![false; others.len()];
     let mut s = scene.clone();
     s.objects.retain(|o| {

@@ -155,8 +155,8 @@ fn main() {
     let a: Vec<Vec<f64>> = steps.iter().map(|(w, _)| row(w)).collect();
     // The fog estimate's cost is calibrated apart (`haze_cost`: its samples are as many in
     // every frame, so here they cannot be told from the scan's pixels) and taken off.
-    let haze = CostModel { per_haze_sample: CostModel::CALIBRATED.per_haze_sample, ..CostModel::FREE };
-    let haze = CostModel { per_cleared: CostModel::CALIBRATED.per_cleared, ..haze };
+    let c = CostModel::CALIBRATED;
+    let haze = CostModel { per_haze_sample: c.per_haze_sample, per_cleared: c.per_cleared, ..CostModel::FREE };
     let b: Vec<f64> = steps.iter().map(|(w, s)| s - haze.seconds(w)).collect();
     let x = nnls(&a, &b);
     // Two halves of the set: the even and the odd steps.
