@@ -53,8 +53,15 @@ fn a_few_trials_at_noon_give_sane_figures() {
     assert!(s["precision"]["rate"].as_f64().unwrap() > 0.8, "precision: {text}");
     let p50 = s["centre_error_by_distance"]["within_1m"]["p50_mm"].as_f64().unwrap();
     assert!(p50 > 0.0 && p50 < 15.0, "centre error p50 {p50} mm: {text}");
+    // Radius against the colliders' (equatorial) radius: no bias of the fit beyond 3 mm (a
+    // sphere fitted to the oblate fruit read about 2 mm small).
+    let radius = &s["radius_error_within_1m"]["ripe"];
+    assert!(radius["n"].as_u64().unwrap() >= 3, "{text}");
+    let bias = radius["median_signed_mm"].as_f64().unwrap();
+    assert!(bias.abs() < 3.0, "radius bias {bias} mm: {text}");
     assert!(s["ripe_accuracy"]["rate"].as_f64().unwrap() > 0.7, "ripeness: {text}");
     assert!(out.join("trials/0000.png").exists() && out.join("report.html").exists());
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     assert!(html.contains("trials/0000.png") && html.contains("Recall by ripeness stage"));
+    assert!(html.contains("Radius error within 1 m, ripe"), "report.html gives the radius error");
 }

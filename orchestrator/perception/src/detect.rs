@@ -1,10 +1,12 @@
 //! One frame: fruit-coloured pixels with depth, grouped into depth-connected components,
-//! each fitted with a sphere, its ripeness from the coloured fraction of the skin on it.
+//! each fitted with a sphere in the space where the oblate fruit is round ([`crate::spheroid`]),
+//! its ripeness from the coloured fraction of the skin on it.
 
 use crate::colour::{classify, FruitColour, Linearize};
 use crate::haze::{self, Haze, HazeWork, Srgb};
 use crate::ripeness::{ripeness, stage_shares, surface_below, Ripeness};
 use crate::sphere::{fit_sphere, SphereBounds};
+use crate::spheroid::Spheroid;
 use std::cell::Cell;
 
 pub use crate::frame::{Frame, Intrinsics};
@@ -12,7 +14,10 @@ pub use crate::frame::{Frame, Intrinsics};
 #[derive(Clone, Debug, PartialEq)]
 pub struct DetectorConfig {
     pub colour: FruitColour,
+    /// Bounds of the fruit's equatorial radius.
     pub sphere: SphereBounds,
+    /// The crop's fruit shape index (height / width; 1: spheres), see [`crate::spheroid`].
+    pub shape_index: f64,
     /// Least pixels of a segment.
     pub min_pixels: usize,
     /// Depth range considered [m].
@@ -28,11 +33,17 @@ pub struct DetectorConfig {
     pub min_inliers: f64,
 }
 
+/// Round greenhouse cultivars are slightly flattened: a fruit shape index of 0.85-0.90 (the
+/// range the simulated crop draws from, `fmus/camera/src/crop.rs`; not checked against a
+/// published table of cultivars), its middle here. A user's own crop sets its own.
+pub const SHAPE_INDEX: f64 = 0.875;
+
 impl Default for DetectorConfig {
     fn default() -> Self {
         DetectorConfig {
             colour: FruitColour::default(),
             sphere: SphereBounds::default(),
+            shape_index: SHAPE_INDEX,
             min_pixels: 30,
             min_depth: 0.15,
             max_depth: 1.6,
@@ -48,6 +59,7 @@ impl Default for DetectorConfig {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Detection {
     pub center: [f64; 3],
+    /// The equatorial radius (half the fruit's width; its height is `shape_index` times it).
     pub radius: f64,
     /// USDA stage 1..=6 most likely (0: unknown, too little skin seen), and its
     /// probability lowered by a poor fit.
@@ -127,6 +139,8 @@ pub struct Detector {
     /// Points fitted and surface pixels tested in the current frame (counted from `&self`).
     fit_points: Cell<u64>,
     surface_tests: Cell<u64>,
+    /// The current frame's fruit shape (the world's up from its TF).
+    shape: Spheroid,
 }
 
 impl Detector {
@@ -142,6 +156,7 @@ impl Detector {
             stack: vec![],
             fit_points: Cell::new(0),
             surface_tests: Cell::new(0),
+            shape: Spheroid::new([0.0, -1.0, 0.0], 1.0),
         }
     }
 
@@ -175,6 +190,7 @@ impl Detector {
         self.surface_tests.set(0);
         out.work.pixels = n as u64;
         let c = self.config.clone();
+        self.shape = Spheroid::new(f.up.unwrap_or([0.0, -1.0, 0.0]), c.shape_index);
         if self.memo_for != Some(c.colour) {
             self.colour_memo.clear();
             self.colour_memo.resize(1 << 24, 0);
@@ -261,9 +277,9 @@ impl Detector {
                 if s.rms <= self.config.max_rms
                     && s.inlier_fraction >= self.config.min_inliers
                     && !s.at_bound
-                    && d2(s.center, c).sqrt() < d.radius =>
+                    && d2(self.shape.unround(s.center), c).sqrt() < d.radius =>
             {
-                (Detection { center: s.center, radius: s.radius, rms: s.rms, ..d }, all.len())
+                (Detection { center: self.shape.unround(s.center), radius: s.radius, rms: s.rms, ..d }, all.len())
             }
             _ => (d, members),
         }
@@ -272,11 +288,11 @@ impl Detector {
     /// The stage of a placed fruit from its skin (every pixel on its sphere, green or not):
     /// each pixel's fraction of the surface below it along the world's up, and its colour.
     fn ripen(&self, f: &Frame, d: Detection) -> Detection {
-        let up = f.up.unwrap_or([0.0, -1.0, 0.0]);
+        let (up, rc) = (self.shape.up(), self.shape.round(d.center));
         let skin = self.on_surface(f, &d);
         let r = ripeness(skin.iter().map(|&i| {
-            let p = f.k.unproject(i % f.width, i / f.width, f.depth[i] as f64);
-            (surface_below(p, d.center, d.radius, up), [f.rgb[3 * i], f.rgb[3 * i + 1], f.rgb[3 * i + 2]])
+            let p = self.shape.round(f.k.unproject(i % f.width, i / f.width, f.depth[i] as f64));
+            (surface_below(p, rc, d.radius, up), [f.rgb[3 * i], f.rgb[3 * i + 1], f.rgb[3 * i + 2]])
         }));
         let votes = r.as_ref().map_or([0.0; 6], stage_shares);
         let (stage, p) = if r.is_some() { classify(&votes) } else { (0, 0.0) };
@@ -285,10 +301,11 @@ impl Detector {
         Detection { stage, score, votes, ripeness: r, ..d }
     }
 
-    /// The pixels near a sphere's image whose points lie on its surface (within a few noise
+    /// The pixels near a fruit's image whose points lie on its surface (within a few noise
     /// widths of its fit).
     fn on_surface(&self, f: &Frame, d: &Detection) -> Vec<usize> {
         let c = d.center;
+        let rc = self.shape.round(c);
         if c[2] <= d.radius {
             return vec![];
         }
@@ -307,8 +324,8 @@ impl Detector {
                 if !(z.is_finite() && z > 0.0) {
                     continue;
                 }
-                let p = f.k.unproject(u, v, z);
-                if (d2(p, c).sqrt() - d.radius).abs() <= tol {
+                let p = self.shape.round(f.k.unproject(u, v, z));
+                if (d2(p, rc).sqrt() - d.radius).abs() <= tol {
                     all.push(i);
                 }
             }
@@ -408,10 +425,11 @@ impl Detector {
         }
     }
 
-    /// The members' points, counted as fitted (every caller fits or splits them).
+    /// The members' points in the rounded space (where a fruit is a sphere), counted as
+    /// fitted (every caller fits or splits them).
     fn points(&self, f: &Frame, members: &[usize]) -> Vec<[f64; 3]> {
         self.fit_points.set(self.fit_points.get() + members.len() as u64);
-        members.iter().map(|&i| f.k.unproject(i % f.width, i / f.width, f.depth[i] as f64)).collect()
+        members.iter().map(|&i| self.shape.round(f.k.unproject(i % f.width, i / f.width, f.depth[i] as f64))).collect()
     }
 
     /// A sphere through one segment's points (its stage comes later, from its whole skin:
@@ -429,7 +447,7 @@ impl Detector {
             bbox = [bbox[0].min(u), bbox[1].min(v), bbox[2].max(u), bbox[3].max(v)];
         }
         Ok(Detection {
-            center: s.center,
+            center: self.shape.unround(s.center),
             radius: s.radius,
             stage: 0,
             score: 0.0,
@@ -483,12 +501,21 @@ fn d2(a: [f64; 3], b: [f64; 3]) -> f64 {
 mod tests {
     use super::*;
 
-    /// Depth (z) of the first hit of the camera ray through `d` (z = 1) on a sphere.
-    fn hit(d: [f64; 3], c: [f64; 3], r: f64) -> Option<f64> {
-        let dd = d[0] * d[0] + d[1] * d[1] + 1.0;
-        let b = d[0] * c[0] + d[1] * c[1] + c[2];
-        let disc = b * b - dd * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2] - r * r);
+    /// Depth (z) of the first hit of the camera ray through `d` (z = 1) on a fruit of
+    /// equatorial radius `r` and shape index `k` about `up`: the ray and the fruit rounded
+    /// (a linear map, so the ray's parameter, here its depth, is kept), then a sphere.
+    fn hit_shaped(d: [f64; 3], c: [f64; 3], r: f64, up: [f64; 3], k: f64) -> Option<f64> {
+        let s = Spheroid::new(up, k);
+        let (d, c) = (s.round(d), s.round(c));
+        let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let (dd, b) = (dot(d, d), dot(d, c));
+        let disc = b * b - dd * (dot(c, c) - r * r);
         (disc >= 0.0).then(|| (b - disc.sqrt()) / dd)
+    }
+
+    /// [`hit_shaped`] for a level camera and the crop's fruit.
+    fn hit(d: [f64; 3], c: [f64; 3], r: f64) -> Option<f64> {
+        hit_shaped(d, c, r, [0.0, -1.0, 0.0], SHAPE_INDEX)
     }
 
     /// A frame ray cast by `shade` (pixel column, ray direction with z = 1 -> depth, colour).
@@ -513,6 +540,27 @@ mod tests {
     }
 
     const WALL: (f64, [u8; 3]) = (1.2, [150, 145, 135]);
+
+    /// A large oblate fruit (80 mm wide, 70 mm high) seen level from 0.6 m: its width and
+    /// centre are read within 1.5 mm. Fitted as a sphere (shape index 1), the same fruit reads
+    /// more than 2 mm narrow and nearer the camera: the bias that let fruit too wide for the
+    /// hand pass as graspable.
+    #[test]
+    fn an_oblate_fruit_is_measured_at_its_width() {
+        let (w, h) = (200usize, 160usize);
+        let k = Intrinsics { fx: 300.0, fy: 300.0, cx: 100.0, cy: 80.0 };
+        let (c, r) = ([0.03, 0.02, 0.6], 0.040);
+        let (rgb, depth) = render(w, h, k, |_, d| hit(d, c, r).map_or(WALL, |t| (t, [190, 26, 20])));
+        let frame = Frame { width: w, height: h, rgb: &rgb, depth: &depth, k, up: None };
+        let found = Detector::new(DetectorConfig::default()).detect(&frame);
+        assert_eq!(found.detections.len(), 1, "{:?}", found.detections);
+        let d = &found.detections[0];
+        assert!((d.radius - r).abs() < 0.0015, "{d:?}");
+        assert!(d2(d.center, c).sqrt() < 0.0015, "{d:?}");
+        let round = Detector::new(DetectorConfig { shape_index: 1.0, ..DetectorConfig::default() }).detect(&frame);
+        let s = &round.detections[0];
+        assert!(s.radius < r - 0.002 && s.center[2] < c[2] - 0.001, "{s:?}");
+    }
 
     /// The same kind of frame in fog of 15 m visibility (Koschmieder, grey airlight), a far
     /// field without depth on the right and shade below: the fog is estimated from the frame,
@@ -681,9 +729,10 @@ mod tests {
         for (fraction, stage) in [(0.45, 4u8), (0.75, 5)] {
             let (c, r) = ([0.0, 0.0, 0.5], 0.03);
             let (rgb, depth) = render(w, h, k, |_, d| {
-                hit(d, c, r).map_or(WALL, |t| {
+                hit_shaped(d, c, r, up, SHAPE_INDEX).map_or(WALL, |t| {
                     let p = [t * d[0] - c[0], t * d[1] - c[1], t - c[2]];
-                    let below = 0.5 * ((p[0] * up[0] + p[1] * up[1] + p[2] * up[2]) / r + 1.0);
+                    let h = (p[0] * up[0] + p[1] * up[1] + p[2] * up[2]) / (SHAPE_INDEX * r);
+                    let below = 0.5 * (h + 1.0);
                     (t, if below < fraction { [232, 104, 84] } else { [132, 168, 70] })
                 })
             });

@@ -4,7 +4,8 @@
 //!
 //! Per frame ([`detect`]): pixels whose CIELAB colour may be a tomato ([`colour`]), grouped
 //! into components connected in the image and in depth, each fitted with a robust sphere on
-//! its depth points ([`sphere`]: the visible cap, radius 20-45 mm), its USDA ripeness stage
+//! its depth points ([`sphere`]: the visible cap, radius 20-45 mm) stretched along the
+//! world's up so that the oblate fruit is round ([`spheroid`]), its USDA ripeness stage
 //! from the coloured fraction of its surface ([`ripeness`]: the height of the colour's front
 //! on the sphere, along the world's up from TF). Across frames ([`tracker`]): detections
 //! moved into the world frame by TF ([`tf`]) and merged into a fruit map with stable ids.
@@ -21,6 +22,7 @@ pub mod haze;
 pub mod node;
 pub mod ripeness;
 pub mod sphere;
+pub mod spheroid;
 pub mod tf;
 pub mod tracker;
 

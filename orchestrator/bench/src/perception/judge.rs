@@ -54,6 +54,10 @@ pub struct FruitResult {
     /// far) [mm]: depth-fit bias shows here, segmentation errors in the lateral rest.
     #[serde(default)]
     pub ray_error_mm: Option<f64>,
+    /// Radius error, signed (+: the estimate is too large) [mm]: half the detection's box
+    /// side against the fruit's collider radius (its equatorial radius, half its width).
+    #[serde(default)]
+    pub radius_error_mm: Option<f64>,
     /// Pixel position (for the overlay).
     pub uv: [f64; 2],
     pub radius_px: f64,
@@ -184,6 +188,7 @@ pub fn judge_frame(
             ([p.x, p.y, p.z], stage)
         })
         .collect();
+    let det_radius = |di: usize| 0.5 * dets.detections[di].bbox.size.x;
     let mut pairs: Vec<(f64, usize, usize)> = vec![];
     for (di, (p, _)) in det.iter().enumerate() {
         for (si, (_, c)) in seen.iter().enumerate() {
@@ -239,6 +244,7 @@ pub fn judge_frame(
                 let d = det[di].0;
                 1000.0 * ((d[0] - c[0]) * c[0] + (d[1] - c[1]) * c[1] + (d[2] - c[2]) * c[2]) / n
             }),
+            radius_error_mm: m.map(|di| 1000.0 * (det_radius(di) - f.radius)),
             uv,
             radius_px: rpx,
         });
@@ -327,9 +333,13 @@ mod tests {
         }
         labels.data = data;
         let centers = [[0.0, 0.5, 1.0]];
-        let j = judge_frame(&setup, &centers, &cam, k, &labels, &dets(&[[0.0, 0.0, 0.51]]));
+        // Its box 76 mm wide: the radius read 2 mm small.
+        let mut found = dets(&[[0.0, 0.0, 0.51]]);
+        found.detections[0].bbox.size.x = 0.076;
+        let j = judge_frame(&setup, &centers, &cam, k, &labels, &found);
         assert_eq!(j.fruit.len(), 1, "{j:?}");
         assert!(j.fruit[0].detected && (j.fruit[0].error_mm.unwrap() - 10.0).abs() < 1e-9, "{j:?}");
+        assert!((j.fruit[0].radius_error_mm.unwrap() + 2.0).abs() < 1e-9, "{j:?}");
         assert_eq!((j.centre_checks, j.centre_on_label), (1, 1), "{j:?}");
         // The judge's camera 5 cm too high: the fruit's centre projects off its label.
         let high = CameraPose::new([0.0, 0.0, std::f64::consts::FRAC_PI_2], [0.0, 0.0, 1.05], 0.0);

@@ -74,6 +74,15 @@ pub fn report_html(s: &PerceptionSummary, results: &[PerceptionRecord]) -> Strin
         o(sp.ray_p95_mm),
         o(sp.lateral_p95_mm)
     );
+    for (k, r) in &s.radius_error_within_1m {
+        let _ = write!(
+            h,
+            "<p>Radius error within 1 m, {k} ({} fruit): median {} mm (signed), p95 {} mm.</p>",
+            r.n,
+            o(r.median_signed_mm),
+            o(r.p95_mm)
+        );
+    }
     h.push_str("<h2>Frames</h2><p>Green: found; magenta: missed; red cross: false detection.</p>");
     for r in results {
         let png = format!("trials/{:04}.png", r.line.trial);

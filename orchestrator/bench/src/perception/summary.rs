@@ -69,6 +69,9 @@ pub struct PerceptionSummary {
     /// Within 1 m, the error split: along the ray (signed median = the fit's depth bias, p95
     /// of its size) and across it (p95).
     pub centre_error_split_within_1m: ErrorSplit,
+    /// Within 1 m, the radius error of found fruit: signed median (the fit's bias) and p95 of
+    /// its size, of every found fruit and of the ripe ones.
+    pub radius_error_within_1m: BTreeMap<String, RadiusError>,
     /// Within 1 m, the centre error of found fruit by USDA stage ("1".."6") and of the ripe
     /// ones (stages 5-6, the harvest's targets) together: partly coloured fruit are placed
     /// from part of their surface.
@@ -82,6 +85,21 @@ pub struct ErrorSplit {
     pub ray_median_signed_mm: Option<f64>,
     pub ray_p95_mm: Option<f64>,
     pub lateral_p95_mm: Option<f64>,
+}
+
+#[derive(Serialize, Clone, Debug)]
+pub struct RadiusError {
+    pub n: usize,
+    pub median_signed_mm: Option<f64>,
+    pub p95_mm: Option<f64>,
+}
+
+fn radius_errors<'a>(found: impl Iterator<Item = &'a &'a &'a FruitResult>) -> RadiusError {
+    let mut signed: Vec<f64> = found.filter(|f| f.depth <= 1.0).filter_map(|f| f.radius_error_mm).collect();
+    signed.sort_by(f64::total_cmp);
+    let mut size: Vec<f64> = signed.iter().map(|e| e.abs()).collect();
+    size.sort_by(f64::total_cmp);
+    RadiusError { n: signed.len(), median_signed_mm: percentile(&signed, 0.5), p95_mm: percentile(&size, 0.95) }
 }
 
 fn split(found: &[&&FruitResult]) -> ErrorSplit {
@@ -179,6 +197,10 @@ pub fn summarize(w: &Whole<PerceptionSetup>, results: &[PerceptionRecord]) -> Pe
         stage_accuracy: rate(stage_ok, found.len() as u64),
         ripe_accuracy: rate(ripe_ok, found.len() as u64),
         centre_error_split_within_1m: split(&found),
+        radius_error_within_1m: BTreeMap::from([
+            ("all".to_string(), radius_errors(found.iter())),
+            ("ripe".to_string(), radius_errors(found.iter().filter(|f| is_ripe(f.stage)))),
+        ]),
         centre_error_within_1m_by_stage: {
             let mut by: BTreeMap<String, Vec<f64>> = BTreeMap::new();
             for f in found.iter().filter(|f| f.depth <= 1.0) {
