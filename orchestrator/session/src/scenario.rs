@@ -152,6 +152,10 @@ pub struct HarvestSettings {
     /// (`camera_left`, `camera_right`, as models/systems/harvest_sight.ssd). Off: the node is
     /// handed the world's target and planning scene (ground truth, as the paper).
     pub sight: bool,
+    /// By sight: the radii of the crop's fruit [m], least and largest, that the perception
+    /// node fits; a prior about the cultivar, as a grower knows it (cherry tomatoes are
+    /// 12-18 mm). Unset: the detector's 20-45 mm, for round and truss tomatoes.
+    pub fruit_radius: Option<[f64; 2]>,
 }
 
 impl Default for HarvestSettings {
@@ -159,6 +163,7 @@ impl Default for HarvestSettings {
         HarvestSettings {
             visibility: ["free", "partly_occluded", "behind_stem"].map(String::from).to_vec(),
             sight: false,
+            fruit_radius: None,
         }
     }
 }
@@ -320,6 +325,13 @@ impl Scenario {
         for inj in &self.inject {
             inj.bytes().map_err(|e| agrisim_error::err!("scenario {file}: {e}"))?;
         }
+        if let Some([lo, hi]) = self.harvest.fruit_radius {
+            if !(positive(lo) && lo < hi && hi <= 0.1) {
+                return Err(agrisim_error::err!(
+                    "scenario {file}: [harvest] fruit_radius must be [least, largest] in metres, 0 < least < largest <= 0.1, got [{lo}, {hi}]"
+                ));
+            }
+        }
         Ok(())
     }
 
@@ -412,5 +424,21 @@ mod tests {
         assert_eq!(s.environment_toml().trim(), "weather = \"fog\"");
         let s = Scenario::parse("[system]\nfile = \"a.ssd\"\n", Path::new("x.toml")).unwrap();
         assert_eq!(s.environment_toml(), "");
+    }
+
+    #[test]
+    fn the_fruit_radius_prior_is_checked() {
+        let parse = |v: &str| {
+            Scenario::parse(
+                &format!("[system]\nfile = \"a.ssd\"\n[harvest]\nfruit_radius = {v}\n"),
+                Path::new("x.toml"),
+            )
+        };
+        assert_eq!(parse("[0.012, 0.018]").unwrap().harvest.fruit_radius, Some([0.012, 0.018]));
+        for bad in ["[0.018, 0.012]", "[0.0, 0.02]", "[12.0, 18.0]"] {
+            let e = parse(bad).unwrap_err();
+            assert!(e.0.contains("x.toml") && e.0.contains("fruit_radius"), "{bad}: {e}");
+        }
+        assert!(parse("[0.012]").is_err());
     }
 }

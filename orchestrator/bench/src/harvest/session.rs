@@ -38,7 +38,9 @@ impl SightCharges {
 /// planning scene, with the robot's links filtered out and the harvest node's target allowed),
 /// their compute charged in simulated time by their calibrated cost models (outputs held back
 /// by it, as the harvest node's plans are by its planning), and handles on those charges.
-pub fn sight_nodes() -> Result<(Vec<Box<dyn Node>>, SightCharges)> {
+/// `fruit_radius` (the scenario's `[harvest] fruit_radius`): the crop's fruit radii the
+/// detector fits, pulled toward their middle; `None` keeps the detector's own.
+pub fn sight_nodes(fruit_radius: Option<[f64; 2]>) -> Result<(Vec<Box<dyn Node>>, SightCharges)> {
     // Every 4th pixel and row: 5 mm between rays at the crop's 0.6 m, under the 1 cm voxels.
     // The scene: what the arms can reach from the base (1.5 m around base_link), once a second.
     // Rays beyond 1.2 m (through the row into the next aisle) only clear space out of reach.
@@ -52,7 +54,11 @@ pub fn sight_nodes() -> Result<(Vec<Box<dyn Node>>, SightCharges)> {
     })
     .map_err(|e| agrisim_error::err!("harvest by sight: mapping node: {e}"))?
     .with_cost(agrisim_mapping::CostModel::CALIBRATED);
-    let perception = PerceptionConfig { map_period: 0.5, ..PerceptionConfig::for_cameras(&SIGHT_CAMERAS) };
+    let mut perception = PerceptionConfig { map_period: 0.5, ..PerceptionConfig::for_cameras(&SIGHT_CAMERAS) };
+    if let Some([lo, hi]) = fruit_radius {
+        let sphere = &mut perception.detector.sphere;
+        (sphere.min_radius, sphere.max_radius, sphere.prior_radius) = (lo, hi, 0.5 * (lo + hi));
+    }
     let perception = Perception::new(perception).with_cost(agrisim_perception::CostModel::CALIBRATED);
     let charges = SightCharges { perception: Some(perception.charged()), mapping: Some(mapper.charged()) };
     Ok((vec![Box::new(perception), Box::new(mapper)], charges))
@@ -93,7 +99,7 @@ pub fn harvest_session(
     }
     let mut charges = SightCharges::default();
     if s.harvest.sight {
-        let (sight, c) = sight_nodes()?;
+        let (sight, c) = sight_nodes(s.harvest.fruit_radius)?;
         nodes.extend(sight);
         charges = c;
     }
