@@ -72,11 +72,18 @@ pub fn fit_sphere(points: &[[f64; 3]], bounds: &SphereBounds) -> Option<Sphere> 
     let mut r = r0;
     let mut w = vec![1.0; pts.len()];
     let mut at_bound = false;
+    // Each point's distance to the centre and residual in this iteration, and the buffer of
+    // the median, kept across iterations (the distance once per point and iteration).
+    let (mut dist, mut res, mut abs) = (vec![0.0; pts.len()], vec![0.0; pts.len()], Vec::with_capacity(pts.len()));
     for it in 0..30 {
         // Residuals and robust weights (after the first pass).
-        let res: Vec<f64> = pts.iter().map(|p| (p - c).norm() - r).collect();
+        for ((p, d), e) in pts.iter().zip(dist.iter_mut()).zip(res.iter_mut()) {
+            *d = (p - c).norm();
+            *e = *d - r;
+        }
         if it > 0 {
-            let mut abs: Vec<f64> = res.iter().map(|e| e.abs()).collect();
+            abs.clear();
+            abs.extend(res.iter().map(|e| e.abs()));
             // The median by selection (linear) rather than a sort: the sort was a quarter of
             // the detector's time.
             let mid = abs.len() / 2;
@@ -93,19 +100,19 @@ pub fn fit_sphere(points: &[[f64; 3]], bounds: &SphereBounds) -> Option<Sphere> 
         // de/dr = -1; the prior adds sqrt(lambda) (r - r_prior) with unit scale in mm.
         let mut h = Matrix4::<f64>::zeros();
         let mut g = Vector4::<f64>::zeros();
-        for ((p, e), wi) in pts.iter().zip(&res).zip(&w) {
-            if *wi == 0.0 {
+        for (((p, e), wi), dn) in pts.iter().zip(&res).zip(&w).zip(&dist) {
+            if *wi == 0.0 || *dn < 1e-9 {
                 continue;
             }
-            let d = p - c;
-            let dn = d.norm();
-            if dn < 1e-9 {
-                continue;
+            let u = -(p - c) / *dn;
+            let j = [u.x, u.y, u.z, -1.0];
+            for a in 0..4 {
+                let wa = *wi * j[a];
+                for (b, jb) in j.iter().enumerate() {
+                    h[(a, b)] += wa * jb;
+                }
+                g[a] += wa * *e;
             }
-            let u = -d / dn;
-            let j = Vector4::new(u.x, u.y, u.z, -1.0);
-            h += *wi * j * j.transpose();
-            g += *wi * j * *e;
         }
         let lambda = bounds.prior_weight * (0.001 / bounds.prior_sigma).powi(2);
         h[(3, 3)] += lambda;
