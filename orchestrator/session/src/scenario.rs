@@ -152,7 +152,7 @@ pub struct HarvestSettings {
     /// (`camera_left`, `camera_right`, as models/systems/harvest_sight.ssd). Off: the node is
     /// handed the world's target and planning scene (ground truth, as the paper).
     pub sight: bool,
-    /// By sight: the radii of the crop's fruit [m], least and largest, that the perception
+    /// By sight: the radii of the crop's fruit in metres, least and largest, that the perception
     /// node fits; a prior about the cultivar, as a grower knows it (cherry tomatoes are
     /// 12-18 mm). Unset: the detector's 20-45 mm, for round and truss tomatoes.
     pub fruit_radius: Option<[f64; 2]>,
