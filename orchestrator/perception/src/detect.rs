@@ -272,14 +272,15 @@ impl Detector {
             return (d, members);
         }
         let c = d.center;
-        match fit_sphere(&self.points(f, &all), &self.config.sphere) {
-            Some(s)
+        let fit = fit_sphere(&self.points(f, &all), &self.config.sphere).map(|s| (self.shape.unround(s.center), s));
+        match fit {
+            Some((center, s))
                 if s.rms <= self.config.max_rms
                     && s.inlier_fraction >= self.config.min_inliers
                     && !s.at_bound
-                    && d2(self.shape.unround(s.center), c).sqrt() < d.radius =>
+                    && d2(center, c).sqrt() < d.radius =>
             {
-                (Detection { center: self.shape.unround(s.center), radius: s.radius, rms: s.rms, ..d }, all.len())
+                (Detection { center, radius: s.radius, rms: s.rms, ..d }, all.len())
             }
             _ => (d, members),
         }
