@@ -63,7 +63,7 @@ impl Linearize {
 /// yellow-green to blue-green of stems and leaves, not the greys of the structure.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FruitColour {
-    /// Least CIELAB chroma.
+    /// Least CIELAB chroma in a frame exposed at least as [`Self::exposure_reference`].
     pub min_chroma: f32,
     /// Least chroma per unit of lightness (greys and the sky are below it at any exposure).
     pub min_chroma_per_l: f32,
@@ -72,24 +72,103 @@ pub struct FruitColour {
     pub max_hue: f32,
     /// Hues above this angle [deg] wrap to red (magenta-red).
     pub wrap_hue: f32,
+    /// The frame exposure ([`exposure_lightness`]) down to which `min_chroma` holds. Daylight
+    /// frames of the crop expose at L* 46-53 (overcast, noon); at dusk 17, where a red fruit
+    /// in shadow keeps a chroma of 6-10 and `min_chroma` alone cut it to fragments.
+    pub exposure_reference: f32,
 }
 
 impl Default for FruitColour {
     fn default() -> Self {
-        FruitColour { min_chroma: 8.0, min_chroma_per_l: 0.4, max_hue: 116.0, wrap_hue: 340.0 }
+        FruitColour {
+            min_chroma: 8.0,
+            min_chroma_per_l: 0.4,
+            max_hue: 116.0,
+            wrap_hue: 340.0,
+            exposure_reference: 40.0,
+        }
     }
 }
 
+/// CIELAB lightness L* of a relative luminance Y (D65 white = 1).
+fn lightness(y: f64) -> f64 {
+    if y > 216.0 / 24389.0 {
+        116.0 * y.cbrt() - 16.0
+    } else {
+        24389.0 / 27.0 * y
+    }
+}
+
+/// Relative luminance Y of a CIELAB lightness L* (the inverse of [`lightness`]).
+fn luminance(l: f64) -> f64 {
+    if l > 8.0 {
+        ((l + 16.0) / 116.0).powi(3)
+    } else {
+        l * 27.0 / 24389.0
+    }
+}
+
+/// Rec. 709 luma of an sRGB pixel, 0..=255 (weights x 256: 54, 183, 19).
+pub fn luma(rgb: [u8; 3]) -> u8 {
+    ((54 * rgb[0] as u32 + 183 * rgb[1] as u32 + 19 * rgb[2] as u32) >> 8) as u8
+}
+
+/// A frame's exposure: the lightness L* of its bright surfaces, the 90th percentile of the
+/// luma histogram of its pixels (read as the sRGB value of a grey). A percentile, not the
+/// mean, so that how much shadow or sky a view holds moves it little.
+pub fn exposure_lightness(histogram: &[u32; 256]) -> f32 {
+    let total: u64 = histogram.iter().map(|&n| n as u64).sum();
+    if total == 0 {
+        return 0.0;
+    }
+    let want = (total * 9).div_ceil(10);
+    let mut seen = 0u64;
+    for (v, &n) in histogram.iter().enumerate() {
+        seen += n as u64;
+        if seen >= want {
+            return lightness(linear(v as u8)) as f32;
+        }
+    }
+    100.0
+}
+
+/// Chroma floors are kept in steps of this (the detector memoizes each colour's chroma in
+/// these steps, so a floor in them compares exactly).
+pub const CHROMA_STEP: f32 = 0.25;
+
 impl FruitColour {
-    pub fn accepts(&self, lab: [f32; 3]) -> bool {
+    /// Whether a pixel of CIELAB `lab` may be tomato in a frame of exposure `exposure`
+    /// ([`exposure_lightness`]).
+    pub fn accepts(&self, lab: [f32; 3], exposure: f32) -> bool {
+        self.chroma_if_hue(lab).is_some_and(|c| c >= self.chroma_floor(exposure))
+    }
+
+    /// The pixel's chroma if its hue and its chroma per lightness may be tomato; the chroma
+    /// floor ([`Self::chroma_floor`]) is the test left.
+    pub fn chroma_if_hue(&self, lab: [f32; 3]) -> Option<f32> {
         let [l, a, b] = lab;
         let chroma = a.hypot(b);
-        if chroma < self.min_chroma || chroma < self.min_chroma_per_l * l.max(1.0) {
-            return false;
+        if chroma < self.min_chroma_per_l * l.max(1.0) {
+            return None;
         }
         let h = b.atan2(a).to_degrees();
         let h = if h < 0.0 { h + 360.0 } else { h };
-        h <= self.max_hue || h >= self.wrap_hue
+        (h <= self.max_hue || h >= self.wrap_hue).then_some(chroma)
+    }
+
+    /// The least chroma in a frame of exposure `exposure` (L*), in steps of [`CHROMA_STEP`].
+    /// Under k times less light a colour's a* and b* shrink as its lightness does (by the
+    /// cube root of k, (L* + 16) / (L*ref + 16), above L* 8), so the floor shrinks with the
+    /// frame's exposure below [`Self::exposure_reference`], to a quarter at most.
+    pub fn chroma_floor(&self, exposure: f32) -> f32 {
+        let reference = self.exposure_reference as f64;
+        let k = if exposure as f64 >= reference {
+            1.0
+        } else {
+            (luminance(exposure.max(0.0) as f64) / luminance(reference)).cbrt().max(0.25)
+        };
+        let floor = self.min_chroma * k as f32;
+        (floor / CHROMA_STEP).floor() * CHROMA_STEP
     }
 }
 
@@ -196,12 +275,51 @@ mod tests {
         let lin = Linearize::default();
         let m = FruitColour::default();
         for fruit in [[195, 22, 18], [225, 72, 45], [230, 110, 80], [210, 150, 60], [165, 170, 60], [60, 8, 6]] {
-            assert!(m.accepts(lin.lab(fruit)), "{fruit:?}");
+            assert!(m.accepts(lin.lab(fruit), 50.0), "{fruit:?}");
         }
         for other in [[58, 112, 38], [96, 128, 52], [150, 145, 135], [190, 205, 212], [170, 200, 235], [228, 228, 228]]
         {
-            assert!(!m.accepts(lin.lab(other)), "{other:?}");
+            assert!(!m.accepts(lin.lab(other), 50.0), "{other:?}");
         }
+    }
+
+    /// The chroma floor holds in daylight and falls with the frame's exposure as a colour's
+    /// chroma does, in exact steps, to a quarter at most; the exposure is the luma
+    /// histogram's 90th percentile as L*.
+    #[test]
+    fn the_chroma_floor_follows_the_exposure() {
+        let m = FruitColour::default();
+        for e in [40.0, 46.0, 53.0, 100.0] {
+            assert_eq!(m.chroma_floor(e), m.min_chroma);
+        }
+        // L* 12.3 (a wall at dusk): (12.3 + 16) / (40 + 16) of 8, down to a step.
+        assert_eq!(m.chroma_floor(12.3), 4.0);
+        assert_eq!(m.chroma_floor(0.0), 2.0);
+        let mut last = m.min_chroma;
+        for e in (0..=40).rev().map(|e| e as f32) {
+            let f = m.chroma_floor(e);
+            assert!(f <= last && f >= 2.0 && (f / CHROMA_STEP).fract() == 0.0, "{e} -> {f}");
+            last = f;
+        }
+        // A colour scaled darker keeps its hue and loses chroma at about the floor's rate.
+        let lin = Linearize::default();
+        let red = [195, 22, 18];
+        let (bright, dim) = (lin.lab(red), lin.lab(scaled(red, 0.2)));
+        let chroma = |l: [f32; 3]| l[1].hypot(l[2]);
+        let rate = chroma(dim) / chroma(bright);
+        let floor_rate = m.chroma_floor(lightness(luminance(40.0) * 0.2) as f32) / m.min_chroma;
+        assert!((rate - floor_rate).abs() < 0.08, "{rate} vs {floor_rate}");
+        // The exposure: 90 % of 1000 pixels at luma 30 or below, the rest at 200.
+        let mut hist = [0u32; 256];
+        hist[30] = 900;
+        hist[200] = 100;
+        assert!((exposure_lightness(&hist) - lightness(linear(30)) as f32).abs() < 1e-4);
+        hist[30] = 899;
+        hist[31] = 1;
+        assert!((exposure_lightness(&hist) - lightness(linear(31)) as f32).abs() < 1e-4);
+        assert_eq!(exposure_lightness(&[0; 256]), 0.0);
+        assert_eq!(luma([255, 255, 255]), 255);
+        assert_eq!(luma([0, 0, 0]), 0);
     }
 
     #[test]

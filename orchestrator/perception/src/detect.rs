@@ -2,7 +2,7 @@
 //! each fitted with a sphere in the space where the oblate fruit is round ([`crate::spheroid`]),
 //! its ripeness from the coloured fraction of the skin on it.
 
-use crate::colour::{classify, FruitColour, Linearize};
+use crate::colour::{classify, exposure_lightness, luma, FruitColour, Linearize, CHROMA_STEP};
 use crate::haze::{self, Haze, HazeWork, Srgb};
 use crate::ripeness::{ripeness, stage_shares, surface_below, Ripeness};
 use crate::sphere::{fit_sphere, SphereBounds};
@@ -127,9 +127,11 @@ pub struct Detector {
     pub config: DetectorConfig,
     lin: Linearize,
     srgb: Srgb,
-    /// The colour test's answer per sRGB colour, filled as colours appear (0 not yet asked,
-    /// 1 no, 2 yes): a frame repeats most colours of the frames before it, so the CIELAB
-    /// conversion (three cube roots) runs once per colour rather than once per pixel.
+    /// The colour test per sRGB colour, filled as colours appear: 0 not yet asked, 1 not
+    /// tomato at any exposure, else 2 + its chroma in [`CHROMA_STEP`]s (capped at 253), so a
+    /// frame's chroma floor ([`FruitColour::chroma_floor`]) compares exactly. A frame repeats
+    /// most colours of the frames before it, so the CIELAB conversion (three cube roots) runs
+    /// once per colour rather than once per pixel.
     colour_memo: Vec<u8>,
     /// The colour test the memo answers for (`config` is public and may change).
     memo_for: Option<FruitColour>,
@@ -196,6 +198,9 @@ impl Detector {
             self.colour_memo.resize(1 << 24, 0);
             self.memo_for = Some(c.colour);
         }
+        // One pass keeps each pixel's memo answer and the luma histogram of the pixels in
+        // range; the frame's exposure then sets the chroma floor the answers are held to.
+        let mut histogram = [0u32; 256];
         self.mask.clear();
         self.mask.resize(n, 0);
         for i in 0..n {
@@ -208,18 +213,25 @@ impl Detector {
                 continue;
             }
             let px = [f.rgb[3 * i], f.rgb[3 * i + 1], f.rgb[3 * i + 2]];
+            histogram[luma(px) as usize] += 1;
             let key = (px[0] as usize) << 16 | (px[1] as usize) << 8 | px[2] as usize;
             let mut answer = self.colour_memo[key];
             if answer == 0 {
                 out.work.conversions += 1;
-                answer = if c.colour.accepts(self.lin.lab(px)) { 2 } else { 1 };
+                answer = match c.colour.chroma_if_hue(self.lin.lab(px)) {
+                    Some(chroma) => 2 + ((chroma / CHROMA_STEP) as u32).min(253) as u8,
+                    None => 1,
+                };
                 self.colour_memo[key] = answer;
             }
-            if answer == 2 {
-                self.mask[i] = 1;
-                out.work.candidates += 1;
-            }
+            self.mask[i] = answer;
         }
+        let floor = c.colour.chroma_floor(exposure_lightness(&histogram));
+        let least = 2 + ((floor / CHROMA_STEP) as u32).min(253) as u8;
+        for m in self.mask.iter_mut() {
+            *m = (*m >= least) as u8;
+        }
+        out.work.candidates = self.mask.iter().map(|&m| m as u64).sum();
         self.label.clear();
         self.label.resize(n, 0);
         let mut next = 0u32;
@@ -607,7 +619,7 @@ mod tests {
         let u = (-0.15 / 1.3 * k.fx + k.cx) as usize;
         let i = v * w + u;
         let px = [rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]];
-        assert!(!FruitColour::default().accepts(lin.lab(px)), "{px:?} passes the colour test in fog");
+        assert!(!FruitColour::default().accepts(lin.lab(px), 50.0), "{px:?} passes the colour test in fog");
         let mut det = Detector::new(DetectorConfig::default());
         let r = det.detect(&Frame { width: w, height: h, rgb: &rgb, depth: &depth, k, up: None });
         let haze = r.haze.expect("fog found");
@@ -620,6 +632,31 @@ mod tests {
             assert!((d.radius - rad).abs() < 0.006, "{d:?}");
             assert!(d.stage >= 5, "{d:?}");
         }
+    }
+
+    /// At dusk (a twentieth of the light) a red fruit in shade keeps a CIELAB chroma of 6.6:
+    /// found, because the frame's exposure (the wall, L* 12) lowers the chroma floor to 4;
+    /// with the daylight floor of 8 at every exposure it is not.
+    #[test]
+    fn a_shaded_fruit_is_found_at_dusk() {
+        let (w, h) = (160usize, 120usize);
+        let k = Intrinsics { fx: 120.0, fy: 120.0, cx: 80.0, cy: 60.0 };
+        let (c, r) = ([0.0, 0.0, 0.7], 0.03);
+        let (rgb, depth) = render(w, h, k, |u, d| {
+            let back = if u < 30 { (1.2, [18u8, 36, 10]) } else { (1.2, [33u8, 32, 29]) };
+            hit(d, c, r).map_or(back, |t| (t, [21, 1, 0]))
+        });
+        let frame = Frame { width: w, height: h, rgb: &rgb, depth: &depth, k, up: None };
+        let colour = FruitColour::default();
+        let lab = Linearize::default().lab([21, 1, 0]);
+        assert!((lab[1].hypot(lab[2]) - 6.6).abs() < 0.1, "{lab:?}");
+        let found = Detector::new(DetectorConfig::default()).detect(&frame);
+        assert_eq!(found.detections.len(), 1, "{:?}", found.detections);
+        let d = &found.detections[0];
+        assert!(d2(d.center, c).sqrt() < 0.004 && d.stage == 6, "{d:?}");
+        let daylight = FruitColour { exposure_reference: 0.0, ..colour };
+        let fixed = Detector::new(DetectorConfig { colour: daylight, ..DetectorConfig::default() }).detect(&frame);
+        assert!(fixed.detections.is_empty(), "{:?}", fixed.detections);
     }
 
     /// A synthetic frame: a grey wall at 1.2 m, green leaves, and two tomatoes (a red one and
