@@ -131,7 +131,7 @@ pub struct Detector {
     /// tomato at any exposure, else 2 + its chroma in [`CHROMA_STEP`]s (capped at 253), so a
     /// frame's chroma floor ([`FruitColour::chroma_floor`]) compares exactly. A frame repeats
     /// most colours of the frames before it, so the CIELAB conversion (three cube roots) runs
-    /// once per colour rather than once per pixel.
+    /// once per colour rather than once per pixel. Indexed in Morton order ([`colour_key`]).
     colour_memo: Vec<u8>,
     /// The colour test the memo answers for (`config` is public and may change).
     memo_for: Option<FruitColour>,
@@ -214,7 +214,7 @@ impl Detector {
             }
             let px = [f.rgb[3 * i], f.rgb[3 * i + 1], f.rgb[3 * i + 2]];
             histogram[luma(px) as usize] += 1;
-            let key = (px[0] as usize) << 16 | (px[1] as usize) << 8 | px[2] as usize;
+            let key = colour_key(px);
             let mut answer = self.colour_memo[key];
             if answer == 0 {
                 out.work.conversions += 1;
@@ -328,13 +328,16 @@ impl Detector {
         let (v0, v1) =
             ((uv[1] - rpx).floor().max(0.0) as usize, ((uv[1] + rpx).ceil().max(0.0) as usize).min(f.height));
         let tol = (2.5 * d.rms).max(0.003);
+        // A point whose depth alone puts it farther than the surface's band can be passed
+        // over: its rounded distance is at least the least stretch times its depth gap.
+        let (band, least) = ((d.radius + tol) * (1.0 + 1e-9) + 1e-12, self.shape.least_stretch());
         self.surface_tests.set(self.surface_tests.get() + (v1.saturating_sub(v0) * u1.saturating_sub(u0)) as u64);
         let mut all = vec![];
         for v in v0..v1 {
             for u in u0..u1 {
                 let i = v * f.width + u;
                 let z = f.depth[i] as f64;
-                if !(z.is_finite() && z > 0.0) {
+                if !(z.is_finite() && z > 0.0) || least * (z - c[2]).abs() > band {
                     continue;
                 }
                 let p = self.shape.round(f.k.unproject(u, v, z));
@@ -506,6 +509,29 @@ fn split_two(members: &[usize], pts: &[[f64; 3]]) -> (Vec<usize>, Vec<usize>) {
     (a, b)
 }
 
+/// Each of 8 bits moved to every third place (bit k to bit 3k).
+const SPREAD: [u32; 256] = {
+    let mut t = [0u32; 256];
+    let mut v = 0;
+    while v < 256 {
+        let mut k = 0;
+        while k < 8 {
+            t[v] |= ((v as u32 >> k) & 1) << (3 * k);
+            k += 1;
+        }
+        v += 1;
+    }
+    t
+};
+
+/// The colour memo's index of an sRGB colour: its channels' bits interleaved (Morton order),
+/// so colours a few levels apart share a cache line (a 4x4x4 cube per 64 bytes). With the
+/// channels side by side (r << 16 | g << 8 | b) the pixel pass waited on memory: a surface's
+/// noisy colours landed 64 KiB apart in the 16 MiB table.
+fn colour_key(px: [u8; 3]) -> usize {
+    (SPREAD[px[0] as usize] << 2 | SPREAD[px[1] as usize] << 1 | SPREAD[px[2] as usize]) as usize
+}
+
 fn d2(a: [f64; 3], b: [f64; 3]) -> f64 {
     (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)
 }
@@ -553,6 +579,23 @@ mod tests {
     }
 
     const WALL: (f64, [u8; 3]) = (1.2, [150, 145, 135]);
+
+    /// The memo's index is a bijection of the 2^24 colours, and neighbouring levels stay
+    /// within one 64-byte line.
+    #[test]
+    fn colour_keys_are_a_bijection() {
+        let mut seen = vec![false; 1 << 24];
+        for r in 0..=255u8 {
+            for g in 0..=255u8 {
+                for b in 0..=255u8 {
+                    let k = colour_key([r, g, b]);
+                    assert!(!seen[k], "{r} {g} {b}");
+                    seen[k] = true;
+                }
+            }
+        }
+        assert_eq!(colour_key([4, 4, 4]) / 64, colour_key([7, 7, 7]) / 64);
+    }
 
     /// A large oblate fruit (80 mm wide, 70 mm high) seen level from 0.6 m: its width and
     /// centre are read within 1.5 mm. Fitted as a sphere (shape index 1), the same fruit reads

@@ -102,7 +102,8 @@ pub fn fit_front(samples: &mut [(f64, bool)]) -> Option<Front> {
     if n < MIN_PIXELS {
         return None;
     }
-    samples.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    // Unstable is enough: samples equal in both keys are the same value.
+    samples.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     // errors[k]: green among the k lowest + coloured among the others.
     let mut errors = vec![samples.iter().filter(|s| s.1).count(); n + 1];
     for k in 1..=n {

@@ -41,6 +41,11 @@ impl Spheroid {
         self.scale_up(p, self.index)
     }
 
+    /// The least factor by which [`Self::round`] scales a distance (1 for an oblate fruit).
+    pub fn least_stretch(&self) -> f64 {
+        (1.0 / self.index).min(1.0)
+    }
+
     /// The world's up (unit) in the camera's frame.
     pub fn up(&self) -> [f64; 3] {
         self.up
@@ -69,5 +74,14 @@ mod tests {
         assert!((0..3).all(|i| (back[i] - c[i]).abs() < 1e-12));
         assert_eq!(Spheroid::new([0.0; 3], 0.9).round(c), c);
         assert_eq!(Spheroid::new(up, 1.0).round(c), c);
+        // No rounded distance is shorter than the least stretch of the distance.
+        for k in [0.85, 1.0, 1.3] {
+            let s = Spheroid::new([0.3, -1.0, 0.2], k);
+            for d in [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.3, -1.0, 0.2], [0.5, 0.5, -0.7]] {
+                let (r, n) = (s.round(d), (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt());
+                let rn = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+                assert!(rn >= s.least_stretch() * n * (1.0 - 1e-12), "{k} {d:?}");
+            }
+        }
     }
 }
