@@ -67,7 +67,8 @@ impl RowNode {
         let failure = self.inner.failure();
         let Plan::Regions { regions, current, picks, failures, .. } = &mut self.plan else { return None };
         *failures = if failure.is_some() { *failures + 1 } else { 0 };
-        let exhausted = failure == Some(Failure::NotDetected);
+        // Nothing left to pick there: none ripe, or none the hand opens round.
+        let exhausted = matches!(failure, Some(Failure::NotDetected | Failure::TooWide));
         if exhausted || *failures >= MAX_FAILURES_PER_REGION || *picks >= MAX_PICKS_PER_REGION {
             *current += 1;
             (*picks, *failures) = (0, 0);

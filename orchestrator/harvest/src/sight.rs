@@ -147,6 +147,20 @@ pub fn choose(seen: &[Seen], region: &Region, aisle_y: f64, tried: &[[f64; 3]]) 
         .cloned()
 }
 
+/// The ripe fruit of `region` that [`choose`] passed over only for being wider than the hand
+/// opens ([`GRASPABLE_RADIUS`]): their perceived radii [m], largest first. Non-empty when a
+/// task ends with nothing to pick: the region's ripe fruit were seen, and too wide.
+pub fn too_wide(seen: &[Seen], region: &Region, tried: &[[f64; 3]]) -> Vec<f64> {
+    let mut r: Vec<f64> = seen
+        .iter()
+        .filter(|s| s.ripe > RIPE_SHARE && s.radius > GRASPABLE_RADIUS && region.holds(s.center, REGION_MARGIN))
+        .filter(|s| tried.iter().all(|p| dist(*p, s.center) > TRIED_RADIUS))
+        .map(|s| s.radius)
+        .collect();
+    r.sort_by(|a, b| b.total_cmp(a));
+    r
+}
+
 /// The chosen fruit in a new fruit map: its track `id`, else (the perception node merged that
 /// track into another: two tracks closer than a radius are one fruit) the track nearest the
 /// last estimate `at` of radius `r`, if its centre lies within the larger radius of it.
@@ -338,13 +352,19 @@ mod tests {
             .collect();
         assert_eq!(choose(&with_edge, &region, 0.0, &[]).map(|s| s.id), Some("2".into()));
         // Ripe and nearest the aisle, but too large for the hand.
-        let large = track("7", [1.5, 0.1, 1.0], GRASPABLE_RADIUS + 0.001, &[("red", 1.0)]);
+        let large = track("7", [1.5, 0.25, 1.0], GRASPABLE_RADIUS + 0.001, &[("red", 1.0)]);
         let with_large: Vec<Seen> = seen
             .iter()
             .cloned()
             .chain(fruit_of(&Detection3DArray { detections: vec![large], ..map.clone() }, "map"))
             .collect();
         assert_eq!(choose(&with_large, &region, 0.0, &[]).map(|s| s.id), Some("2".into()));
+        // Only it left (the others tried): nothing to choose, and it is named as too wide.
+        let all_tried = [[1.8, 0.4, 1.2], [1.5, 0.7, 1.0]];
+        assert_eq!(choose(&with_large, &region, 0.0, &all_tried), None);
+        assert_eq!(too_wide(&with_large, &region, &all_tried), vec![GRASPABLE_RADIUS + 0.001]);
+        assert!(too_wide(&seen, &region, &all_tried).is_empty());
+        assert!(too_wide(&with_large, &region, &[[1.5, 0.25, 1.0]]).is_empty());
         // Another frame than the map's is not read.
         let odom = Detection3DArray { header: Header { frame_id: "odom".into(), ..Default::default() }, ..map };
         assert!(fruit_of(&odom, "map").is_empty());

@@ -62,6 +62,8 @@ pub enum Failure {
     Collision,
     /// By sight: no ripe fruit was found in the task's region.
     NotDetected,
+    /// By sight: the region's ripe fruit were found, every one wider than the hand opens.
+    TooWide,
 }
 
 impl Failure {
@@ -74,6 +76,7 @@ impl Failure {
             Failure::Timeout => "timeout",
             Failure::Collision => "collision",
             Failure::NotDetected => "not_detected",
+            Failure::TooWide => "too_wide",
         }
     }
 }

@@ -1,6 +1,7 @@
 //! `agrisim bench harvest`: the paper's dual-arm harvesting experiment, many trials, every
 //! one recorded (see [`trial`] for what a trial is and how it is judged).
 
+pub mod feasible;
 pub mod judge;
 pub mod report;
 pub mod session;
@@ -49,7 +50,9 @@ impl TrialBenchmark for Harvest {
         serde_json::to_string(&HarvestTrial { path: vec![], ..t.clone() }).expect("plain struct")
     }
     fn summarize(&self, w: &Whole<HarvestSetup>, results: &[HarvestTrial]) -> HarvestSummary {
-        summarize(w.scenario, w.plan, results)
+        // The tasks within the hand, from each trial's scene (ground truth, judge side).
+        let hand: Vec<bool> = results.iter().map(|t| feasible::hand_can_do(&w.scenes.of(t.trial).2.fruit, t)).collect();
+        summarize(w.scenario, w.plan, results, &hand)
     }
     /// On the map of scene 0 (grown again: the set-up keeps no objects).
     fn report(&self, w: &Whole<HarvestSetup>, summary: &HarvestSummary, results: &[HarvestTrial]) -> Result<String> {

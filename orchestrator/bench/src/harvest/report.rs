@@ -36,6 +36,15 @@ pub fn report_html(g: &agrisim_scene::Greenhouse, sum: &HarvestSummary, results:
         ("harvest Wilson 95 %".to_string(), interval(sum.wilson95)),
         ("harvest cluster bootstrap 95 % (over scenes)".to_string(), interval(sum.cluster_bootstrap95)),
         (
+            "harvested, of the tasks within the hand (a ripe fruit no wider than it opens)".to_string(),
+            format!(
+                "{} / {}, Wilson 95 % {}",
+                sum.within_hand.successes,
+                sum.within_hand.trials,
+                interval(sum.within_hand.wilson95)
+            ),
+        ),
+        (
             "planning (of decided trials)".to_string(),
             format!("{} / {} = {:.3}", sum.planning_successes, sum.planning_decided, sum.planning_success_rate),
         ),
@@ -200,7 +209,8 @@ mod tests {
         };
         let plan = TrialPlan { trials: 3, seed: 1, scenes: 1 };
         let (a, b) = (trials(5.0), trials(9.0));
-        let (sa, sb) = (summarize(&s, plan, &a), summarize(&s, plan, &b));
+        let hand = [true, true, false];
+        let (sa, sb) = (summarize(&s, plan, &a, &hand), summarize(&s, plan, &b, &hand));
         assert_ne!(sa.rtf, sb.rtf);
         let html = report_html(&g, &sa, &a);
         assert_eq!(html, report_html(&g, &sb, &b));
@@ -214,5 +224,6 @@ mod tests {
             assert!(html.contains(&format!("<tr><td>{k}</td><td>{}</td><td>{}</td>", c.trials, c.successes)), "{k}");
         }
         assert!(html.contains("<title>25-30: 1</title>"), "the one time to harvest in the histogram");
+        assert!(html.contains("the hand (a ripe fruit no wider than it opens)</th><td>1 / 2,"), "{html}");
     }
 }

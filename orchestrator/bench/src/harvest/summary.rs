@@ -35,6 +35,10 @@ pub struct HarvestSummary {
     pub distinct_targets: u64,
     /// Trials and successes by the target's visibility class.
     pub per_visibility: BTreeMap<String, ClassResult>,
+    /// The trials whose task the hand could do at all (a ripe fruit of the task no wider than
+    /// the hand opens: [`super::feasible`]) and their successes. The rest are beyond this
+    /// gripper whatever the method; `success_rate` counts them, this does not.
+    pub within_hand: ClassResult,
     pub planning_successes: u64,
     /// Trials whose planning verdict is "ok" or "failed" (the rate's denominator).
     pub planning_decided: u64,
@@ -95,7 +99,8 @@ pub struct ClassResult {
     pub wilson95: [f64; 2],
 }
 
-pub fn summarize(s: &Scenario, plan: TrialPlan, results: &[HarvestTrial]) -> HarvestSummary {
+/// `hand[i]`: whether trial `i`'s task was within the hand ([`super::feasible::hand_can_do`]).
+pub fn summarize(s: &Scenario, plan: TrialPlan, results: &[HarvestTrial], hand: &[bool]) -> HarvestSummary {
     let seed = plan.seed;
     let n = results.len() as u64;
     let outcomes: Vec<(u64, bool)> = results.iter().map(|t| (t.scene, t.outcome == "success")).collect();
@@ -146,6 +151,12 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, results: &[HarvestTrial]) -> Har
                 c.wilson95 = wilson(c.successes, c.trials, Z95);
             }
             m
+        },
+        within_hand: {
+            let within = results.iter().zip(hand).filter(|(_, h)| **h);
+            let (trials, successes) =
+                within.fold((0, 0), |(n, k), (t, _)| (n + 1, k + (t.outcome == "success") as u64));
+            ClassResult { trials, successes, wilson95: wilson(successes, trials, Z95) }
         },
         planning_successes: planned,
         planning_decided: decided,

@@ -181,12 +181,20 @@ impl HarvestNode {
         self.scan += 1;
         if self.scan == sight::SCAN_LIFTS.len() {
             let n = self.fruit_map.iter().filter(|f| region.contains(f.center)).count();
-            self.fail(
-                Failure::NotDetected,
-                t_ns,
-                bus,
-                format!("no ripe fruit in the region after the scan ({n} fruit of the map in it, none ripe)"),
-            );
+            let wide = sight::too_wide(&self.fruit_map, &region, &self.tried);
+            if wide.is_empty() {
+                let why = format!("no ripe fruit in the region after the scan ({n} fruit of the map in it, none ripe)");
+                self.fail(Failure::NotDetected, t_ns, bus, why);
+            } else {
+                let mm: Vec<String> = wide.iter().map(|r| format!("{:.1}", r * 1e3)).collect();
+                let why = format!(
+                    "no ripe fruit in the region the hand opens round after the scan ({n} fruit of the map in it; \
+                     ripe, perceived radius over {:.0} mm: {} mm)",
+                    sight::GRASPABLE_RADIUS * 1e3,
+                    mm.join(", ")
+                );
+                self.fail(Failure::TooWide, t_ns, bus, why);
+            }
         }
     }
 
