@@ -19,8 +19,8 @@
 //!   until they are still again, are simulated, so the cost is bounded by what the robot
 //!   touches, not by the crop's size.
 //! - Colliders move with the leaf: contacts, clearance and the world's planning scene see the
-//!   deflected leaf. The camera and LiDAR FMUs build the crop from the scene parameters and
-//!   still draw leaves where they grew.
+//!   deflected leaf, and the camera and LiDAR FMUs draw it where it is from the world's
+//!   `moved_objects` output ([`crate::moved_objects`]).
 //!
 //! Figures (defaults of the `leaf_*` parameters), all estimates: no measurement of a tomato
 //! leaf's bending stiffness at the petiole was found. `leaf_stiffness` 0.3 N m/rad: a 30 cm leaf
