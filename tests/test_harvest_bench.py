@@ -100,6 +100,13 @@ def test_report_shows_the_summary_classes_failures_times_and_paths(bench):
                        ("cluster_bootstrap95", "harvest cluster bootstrap 95 % (over scenes)")):
         lo, hi = map(float, summary[label].strip("[]").split(", "))
         assert abs(lo - s[key][0]) < 6e-4 and abs(hi - s[key][1]) < 6e-4, label
+    # The tasks within the hand (a ripe fruit no wider than it opens, from ground truth):
+    # the page's row is the summary's, and they are among the trials and successes.
+    w = s["within_hand"]
+    row = summary["harvested, of the tasks within the hand (a ripe fruit no wider than it opens)"]
+    assert row.startswith(f"{w['successes']} / {w['trials']}, Wilson 95 % ["), row
+    assert w["trials"] <= TRIALS and w["successes"] <= s["successes"]
+    assert w["successes"] >= s["successes"] - (TRIALS - w["trials"])
     # Figures the seed determines only: no wall-clock figure on the page.
     assert "real-time" not in html
     # One row per visibility class, as the summary has it.
