@@ -79,7 +79,9 @@ pub struct HarvestTrial {
     pub visibility: String,
     pub start: [f64; 3],
     pub outcome: String,
-    /// Failure category: planning, grasp, handover, placement, timeout, collision, error.
+    /// Failure category: planning, grasp, handover, placement, timeout, collision, error; by
+    /// sight also not_detected, too_wide (the region's ripe fruit all seen wider than the hand
+    /// opens) and mislocalized; damage (a bruise or a broken stem).
     pub failure: Option<String>,
     pub failed_stage: Option<String>,
     pub detail: String,
