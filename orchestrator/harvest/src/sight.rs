@@ -135,10 +135,8 @@ pub const GRASPABLE_RADIUS: f64 = 0.5 * crate::geometry::OPEN_WIDTH - 0.002;
 /// then nearest the region's centre along the row.
 pub fn choose(seen: &[Seen], region: &Region, aisle_y: f64, tried: &[[f64; 3]]) -> Option<Seen> {
     let cx = region.centre()[0];
-    let untried = |s: &&Seen| tried.iter().all(|p| dist(*p, s.center) > TRIED_RADIUS);
-    seen.iter()
-        .filter(|s| s.ripe > RIPE_SHARE && s.radius <= GRASPABLE_RADIUS && region.holds(s.center, REGION_MARGIN))
-        .filter(untried)
+    ripe_untried(seen, region, tried)
+        .filter(|s| s.radius <= GRASPABLE_RADIUS)
         .min_by(|a, b| {
             let key = |s: &Seen| ((s.center[1] - aisle_y).abs(), (s.center[0] - cx).abs());
             let (ka, kb) = (key(a), key(b));
@@ -151,14 +149,18 @@ pub fn choose(seen: &[Seen], region: &Region, aisle_y: f64, tried: &[[f64; 3]]) 
 /// opens ([`GRASPABLE_RADIUS`]): their perceived radii [m], largest first. Non-empty when a
 /// task ends with nothing to pick: the region's ripe fruit were seen, and too wide.
 pub fn too_wide(seen: &[Seen], region: &Region, tried: &[[f64; 3]]) -> Vec<f64> {
-    let mut r: Vec<f64> = seen
-        .iter()
-        .filter(|s| s.ripe > RIPE_SHARE && s.radius > GRASPABLE_RADIUS && region.holds(s.center, REGION_MARGIN))
-        .filter(|s| tried.iter().all(|p| dist(*p, s.center) > TRIED_RADIUS))
-        .map(|s| s.radius)
-        .collect();
+    let mut r: Vec<f64> =
+        ripe_untried(seen, region, tried).filter(|s| s.radius > GRASPABLE_RADIUS).map(|s| s.radius).collect();
     r.sort_by(|a, b| b.total_cmp(a));
     r
+}
+
+/// The ripe fruit [`REGION_MARGIN`] inside `region`, not within [`TRIED_RADIUS`] of a place in
+/// `tried`: what [`choose`] and [`too_wide`] sort by size.
+fn ripe_untried<'a>(seen: &'a [Seen], region: &'a Region, tried: &'a [[f64; 3]]) -> impl Iterator<Item = &'a Seen> {
+    seen.iter()
+        .filter(|s| s.ripe > RIPE_SHARE && region.holds(s.center, REGION_MARGIN))
+        .filter(|s| tried.iter().all(|p| dist(*p, s.center) > TRIED_RADIUS))
 }
 
 /// The chosen fruit in a new fruit map: its track `id`, else (the perception node merged that

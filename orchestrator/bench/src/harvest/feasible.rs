@@ -7,6 +7,7 @@
 use super::setup::TrueFruit;
 use super::targets::RIPE_STAGE;
 use super::trial::HarvestTrial;
+use agrisim_harvest::sight::Region;
 use std::collections::BTreeMap;
 
 /// The largest fruit radius the hand can close round [m]: half the Franka Hand's 80 mm
@@ -18,11 +19,10 @@ pub const HAND_RADIUS: f64 = 0.5 * agrisim_harvest::geometry::OPEN_WIDTH;
 /// From the world's ground truth (the scene's fruit by object id), for judging only.
 pub fn hand_can_do(fruit: &BTreeMap<u32, TrueFruit>, t: &HarvestTrial) -> bool {
     match t.region {
-        Some(r) => fruit.values().any(|f| {
-            f.stage >= RIPE_STAGE
-                && f.radius <= HAND_RADIUS
-                && (0..3).all(|i| r[i][0] <= f.center[i] && f.center[i] <= r[i][1])
-        }),
+        Some([x, y, z]) => {
+            let region = Region { x, y, z };
+            fruit.values().any(|f| f.stage >= RIPE_STAGE && f.radius <= HAND_RADIUS && region.contains(f.center))
+        }
         None => fruit.get(&t.fruit_id).is_some_and(|f| f.radius <= HAND_RADIUS),
     }
 }
