@@ -170,6 +170,10 @@ pub struct HarvestNode {
     tried: Vec<[f64; 3]>,
     /// By sight: fruit of this task declined for want of a grasp ([`sight::MAX_DECLINED`]).
     declined: usize,
+    /// By sight: whether the task first looks in the fruit map it already has and takes an
+    /// untried ripe fruit found there without scanning (a row's later tasks: the cameras
+    /// kept looking through the last pick). The first task of a run has an empty map.
+    look_first: bool,
     /// Why the task failed, once it has.
     pub(crate) failure: Option<Failure>,
 }
@@ -246,6 +250,7 @@ impl HarvestNode {
             allowed_sent: None,
             tried: vec![],
             declined: 0,
+            look_first: false,
             failure: None,
         }
     }
@@ -318,6 +323,7 @@ impl HarvestNode {
         if let (Task::Region(_), Some(aim)) = (self.task, self.target_map) {
             fresh.tried.push(aim);
         }
+        fresh.look_first = matches!(task, Task::Region(_));
         // The old target is no longer to be left out of the sensed scene.
         if self.allowed_sent.is_some() {
             bus.publish(sight::topics::ALLOWED, t_ns, &sight::allowed(Time::from_nanos(t_ns), None));

@@ -187,6 +187,57 @@ mod tests {
         }
     }
 
+    /// A row's later task takes a ripe fruit the fruit map already holds in its region from
+    /// where the robot stands (-> position_base in the first step), where a run's first task
+    /// scans; with none untried in the map, a later task scans too.
+    #[test]
+    fn a_later_task_takes_a_fruit_the_map_holds_without_a_scan() {
+        use crate::motion::Arm;
+        use crate::sight::topics::FRUIT_MAP;
+        use agrisim_msgs::geometry_msgs::{Point, Pose, PoseStamped, Quaternion, Vector3};
+        use agrisim_msgs::sensor_msgs::JointState;
+        use agrisim_msgs::vision_msgs::{
+            BoundingBox3D, Detection3D, Detection3DArray, ObjectHypothesis, ObjectHypothesisWithPose,
+        };
+        let ripe_at = |c: [f64; 3]| Detection3D {
+            results: vec![ObjectHypothesisWithPose {
+                hypothesis: ObjectHypothesis { class_id: "red".into(), score: 1.0 },
+                ..Default::default()
+            }],
+            bbox: BoundingBox3D {
+                center: Pose { position: Point { x: c[0], y: c[1], z: c[2] }, orientation: Quaternion::IDENTITY },
+                size: Vector3 { x: 0.06, y: 0.06, z: 0.06 },
+            },
+            id: "7".into(),
+            ..Default::default()
+        };
+        // The stage after one step at SelectTarget, for a run's first task or a later one,
+        // with a ripe fruit in the region's map at `fruit`.
+        let first_step = |later: bool, fruit: [f64; 3]| -> Stage {
+            let mut row = RowNode::by_sight(vec![region(0.0), region(1.0)], 1);
+            let mut bus = Bus::default();
+            let header = Header { frame_id: "map".into(), ..Default::default() };
+            let map = Detection3DArray { header: header.clone(), detections: vec![ripe_at(fruit)] };
+            bus.publish(FRUIT_MAP, 0, &map);
+            bus.publish(topics::POSE, 0, &PoseStamped { header, pose: Pose::default() });
+            for arm in [Arm::Left, Arm::Right] {
+                let js = JointState { name: arm.joint_names().to_vec(), position: vec![0.0; 7], ..Default::default() };
+                bus.publish(&arm.topic("joint_states"), 0, &js);
+            }
+            if later {
+                row.inner.next_task(Task::Region(region(0.0)), 0, &mut bus);
+                row.inner.stage = Stage::SelectTarget;
+            }
+            row.inner.step(100_000_000, &mut bus).unwrap();
+            row.inner.stage()
+        };
+        let inside = [0.5, 0.5, 1.0];
+        assert_eq!(first_step(false, inside), Stage::SelectTarget, "the first task scans");
+        assert_eq!(first_step(true, inside), Stage::PositionBase, "a later task takes the fruit it knows");
+        // Outside the region (along the row): the later task scans.
+        assert_eq!(first_step(true, [1.5, 0.5, 1.0]), Stage::SelectTarget);
+    }
+
     /// The region rule: stay while picks succeed, move on when the scan finds nothing, after
     /// MAX_FAILURES_PER_REGION failures in a row, or after MAX_PICKS_PER_REGION picks.
     #[test]

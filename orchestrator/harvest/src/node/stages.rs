@@ -142,8 +142,9 @@ impl HarvestNode {
         }
     }
 
-    /// By sight: drives to the middle of the region along the aisle line the base stands on,
-    /// and stops the lift at each of [`sight::SCAN_LIFTS`] while the cameras look into the
+    /// By sight: a row's later task first takes an untried ripe fruit of the region its
+    /// fruit map already holds; otherwise it drives to the middle of the region along the
+    /// aisle line the base stands on, and stops the lift at each of [`sight::SCAN_LIFTS`] while the cameras look into the
     /// row; after each stop's dwell, the ripe fruit of the fruit map in the region nearest the
     /// aisle is the target (-> position_base); none after the last stop: not detected.
     fn run_scan(&mut self, region: Region, t_ns: i64, bus: &mut Bus) {
@@ -161,6 +162,16 @@ impl HarvestNode {
             self.base_ctl = crate::base::BaseController::default();
             (self.scan, self.dwell_from, self.in_place_ticks) = (0, None, 0);
             self.phase = 1;
+            // A row's later task: a ripe fruit the map already holds is taken from where the
+            // robot stands (the cameras looked on through the last pick); none: scan.
+            if self.look_first {
+                if let Some(f) = sight::choose(&self.fruit_map, &region, self.aisle_y, &self.tried) {
+                    self.target_map = Some(f.center);
+                    self.target_r = f.radius;
+                    self.track = Some(f.id.clone());
+                    return self.aim(t_ns, bus);
+                }
+            }
         }
         let lift = sight::SCAN_LIFTS[self.scan];
         bus.set_scalar(topics::LIFT_SETPOINT, lift);
