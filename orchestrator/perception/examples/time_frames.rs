@@ -1,5 +1,7 @@
 //! Times the detector on the RGB-D frames of a recording (for python/bench_perception.py):
-//! `time_frames RUN.mcap [REPEATS]` prints one JSON line: frames, detections, ms per frame.
+//! `time_frames RUN.mcap [REPEATS]` prints one JSON line: frames, detections, ms per frame,
+//! and a digest of every detection of the last pass to the bit (its `Debug` text, whose
+//! floats round-trip), so a change meant to keep results can be checked to keep them.
 
 use agrisim_msgs::sensor_msgs::{CameraInfo, Image};
 use agrisim_msgs::Message;
@@ -41,13 +43,21 @@ fn main() {
     assert!(!frames.is_empty(), "no frame with colour and depth");
     let mut det = Detector::new(DetectorConfig::default());
     let mut found = 0;
+    let mut digest = 0xcbf2_9ce4_8422_2325u64;
     let t = Instant::now();
     let mut first_ms = 0.0;
     for r in 0..repeats {
         found = 0;
         for (i, d) in &frames {
             let f = Frame { width: i.width as usize, height: i.height as usize, rgb: &i.data, depth: d, k, up: None };
-            found += det.detect(&f).detections.len();
+            let out = det.detect(&f);
+            found += out.detections.len();
+            if r + 1 == repeats {
+                // FNV-1a over the detections' text.
+                for b in format!("{:?}", out.detections).bytes() {
+                    digest = (digest ^ b as u64).wrapping_mul(0x0100_0000_01b3);
+                }
+            }
         }
         if r == 0 {
             first_ms = 1000.0 * t.elapsed().as_secs_f64() / frames.len() as f64;
@@ -56,7 +66,7 @@ fn main() {
     let ms = 1000.0 * t.elapsed().as_secs_f64() / (repeats * frames.len()) as f64;
     // The first pass starts with the detector's colour memo empty, as a run's first frames do.
     println!(
-        "{{\"frames\": {}, \"detections\": {found}, \"ms_per_frame\": {ms:.3}, \"first_pass_ms_per_frame\": {first_ms:.3}}}",
+        "{{\"frames\": {}, \"detections\": {found}, \"ms_per_frame\": {ms:.3}, \"first_pass_ms_per_frame\": {first_ms:.3}, \"digest\": \"{digest:016x}\"}}",
         frames.len()
     );
 }

@@ -82,12 +82,14 @@ pub fn fit_sphere(points: &[[f64; 3]], bounds: &SphereBounds) -> Option<Sphere> 
             *e = *d - r;
         }
         if it > 0 {
+            // |e| as its bits: a non-negative float orders as its bit pattern, so the median
+            // is the same number, selected on integers (cheaper than f64::total_cmp).
             abs.clear();
-            abs.extend(res.iter().map(|e| e.abs()));
+            abs.extend(res.iter().map(|e| e.abs().to_bits()));
             // The median by selection (linear) rather than a sort: the sort was a quarter of
             // the detector's time.
             let mid = abs.len() / 2;
-            let mad = *abs.select_nth_unstable_by(mid, f64::total_cmp).1;
+            let mad = f64::from_bits(*abs.select_nth_unstable(mid).1);
             // Tukey's cut-off, kept between 3 and 15 mm: a fit dragged by many stray points
             // still sheds the ones a few centimetres off.
             let scale = (4.685 * 1.4826 * mad).clamp(0.003, 0.015);
