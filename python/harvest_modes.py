@@ -2,7 +2,7 @@
 sight and with ground truth, side by side.
 
     agrisim bench harvest --scenario models/scenarios/harvest_sight.toml --trials 40 --scenes 10 --seed 1 --out SIGHT
-    agrisim bench harvest --trials 40 --scenes 10 --seed 1 --out TRUTH
+    agrisim bench harvest --scenario models/scenarios/harvest.toml --trials 40 --scenes 10 --seed 1 --out TRUTH
     .venv/bin/python python/harvest_modes.py SIGHT TRUTH [--json FILE]
 
 Trial i of both runs has the same scene and the same target fruit (the by-sight task is the

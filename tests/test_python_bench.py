@@ -90,7 +90,7 @@ def test_names_are_the_cli_benchmarks():
     assert listed[:3] == ["nav", "harvest", "row"], text
     assert agrisim.bench.names() == [n for n in listed if n not in ("overhead", "help")]
     row = {b.name: b for b in agrisim.bench.benchmarks()}["row"]
-    assert (row.default_scenario, row.options) == ("harvest", {"length": 10.0})
+    assert (row.default_scenario, row.options) == ("harvest_sight", {"length": 2.0})
 
 
 def test_row_runs_by_name_with_its_option(tmp_path):

@@ -77,7 +77,8 @@ def nav(out, scenario=None, trials: int = 50, seed: int = 1, scenes: int = 1, re
 
 def harvest(out, scenario=None, trials: int = 50, seed: int = 1, scenes: int = 1, record: str | None = None, jobs: int = 0, backend: str = "local", resume: bool = False) -> Result:
     """``run("harvest", ...)``: the dual-arm harvest benchmark (default scenario:
-    models/scenarios/harvest.toml)."""
+    models/scenarios/harvest_sight.toml, by sight; models/scenarios/harvest.toml is the
+    ground-truth mode)."""
     return run("harvest", out, scenario, trials, seed, scenes, record, jobs, backend, resume)
 
 

@@ -1,5 +1,7 @@
 //! `agrisim bench harvest`: the paper's dual-arm harvesting experiment, many trials, every
-//! one recorded (see [`trial`] for what a trial is and how it is judged).
+//! one recorded (see [`trial`] for what a trial is and how it is judged). By default by
+//! sight (`models/scenarios/harvest_sight.toml`); `harvest.toml` hands the node the
+//! ground-truth target and collision scene, to isolate manipulation.
 
 pub mod feasible;
 pub mod judge;
@@ -33,8 +35,10 @@ impl TrialBenchmark for Harvest {
     fn about(&self) -> &'static str {
         "The dual-arm harvesting experiment: N trials on seeded ripe fruit"
     }
+    /// By sight: perception and a sensed collision scene in the loop. Ground truth
+    /// (`harvest.toml`) isolates manipulation.
     fn default_scenario(&self) -> &'static str {
-        "harvest"
+        "harvest_sight"
     }
     fn setup(&self, s: &Scenario, _: &OptionValues) -> Result<HarvestSetup> {
         HarvestSetup::new(s)
