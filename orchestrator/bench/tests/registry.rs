@@ -227,11 +227,12 @@ fn the_built_in_benchmarks_and_their_options() {
     assert_eq!(registry.names(), ["nav", "harvest", "row", "perception"]);
     let mut row = cli::command(&registry, &|c| c).find_subcommand("row").unwrap().clone();
     let help = row.render_long_help().to_string();
-    assert!(help.contains("--length") && help.contains("[default: 10]"), "{help}");
+    assert!(help.contains("--length") && help.contains("[default: 2]"), "{help}");
     let dir = tempfile::tempdir().unwrap();
     let (_, _, j) = job(&registry, dir.path(), &["row", "--length", "2.5"]);
     assert_eq!(j.options.f64("length"), 2.5);
-    assert!(j.scenario.path.ends_with("models/scenarios/harvest.toml"));
+    // By sight by default (harvest.toml is the ground-truth mode).
+    assert!(j.scenario.path.ends_with("models/scenarios/harvest_sight.toml"));
     let m = cli::command(&registry, &|c| c).try_get_matches_from(["bench", "nav", "--length", "2", "--out", "x"]);
     assert!(m.is_err(), "--length is the row benchmark's option only");
     let m = cli::command(&registry, &|c| c).try_get_matches_from([
