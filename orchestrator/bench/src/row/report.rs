@@ -56,11 +56,15 @@ pub fn report_html(g: &agrisim_scene::Greenhouse, sum: &RowSummary, results: &[R
     ];
     let classes = sum.per_class.iter().map(|(k, c)| (k.clone(), c.targets, c.harvested, c.wilson95));
     let cycles: Vec<f64> = results.iter().flat_map(|t| t.cycle_times.iter().copied()).collect();
-    let sections = vec![
+    let mut sections = vec![
         ("Harvested by visibility class".to_string(), rate_table(["class", "fruit", "harvested"], classes)),
         ("Failure taxonomy (fruit not harvested)".to_string(), count_table(["category", "fruit"], &sum.failures)),
-        ("Cycle times (placement to placement)".to_string(), bar_chart(&cycles, 5.0, "cycle time [s]")),
     ];
+    if sum.perception_in_loop {
+        let title = format!("Failed picks by class (by sight: {} picks tried)", sum.attempts);
+        sections.push((title, count_table(["category", "picks"], &sum.attempt_failures)));
+    }
+    sections.push(("Cycle times (placement to placement)".to_string(), bar_chart(&cycles, 5.0, "cycle time [s]")));
     let traces: Vec<TrialTrace> = results
         .iter()
         .filter(|t| t.scene == 0)

@@ -34,6 +34,11 @@ pub struct RowSummary {
     /// By sight (`[harvest] sight`): the node found the fruit itself in stretches of the
     /// segment; otherwise it was handed the reachable ripe fruit (ground truth).
     pub perception_in_loop: bool,
+    /// By sight: the picks the node tried, and the failed ones by class
+    /// ([`super::trial::RowAttempt::failure_class`]: a grasp aimed over 15 mm from any fruit
+    /// is mislocalized).
+    pub attempts: u64,
+    pub attempt_failures: BTreeMap<String, u64>,
     /// Fruit taken off their plants, of them unripe (damage), and their share.
     pub detached: u64,
     pub unripe_detached: u64,
@@ -96,6 +101,10 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, length: f64, results: &[RowTrial
     let clusters: Vec<(u64, u64)> =
         results.iter().filter(|t| t.targets > 0).map(|t| (t.harvested, t.targets)).collect();
     let plant = PlantEffects::total(results.iter().map(|t| &t.plant));
+    let mut attempt_failures: BTreeMap<String, u64> = BTreeMap::new();
+    for f in results.iter().flat_map(|t| &t.attempts).filter_map(|a| a.failure_class()) {
+        *attempt_failures.entry(f).or_insert(0) += 1;
+    }
     RowSummary {
         scenario: s.name.clone(),
         seed: plan.seed,
@@ -116,6 +125,8 @@ pub fn summarize(s: &Scenario, plan: TrialPlan, length: f64, results: &[RowTrial
         touches_per_fruit: touches,
         dropped: results.iter().map(|t| t.dropped).sum(),
         perception_in_loop: s.harvest.sight,
+        attempts: results.iter().map(|t| t.attempts.len() as u64).sum(),
+        attempt_failures,
         detached,
         unripe_detached,
         unripe_share: if detached == 0 { 0.0 } else { unripe_detached as f64 / detached as f64 },

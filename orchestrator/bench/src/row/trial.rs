@@ -10,6 +10,7 @@ use crate::framework::Trial;
 use crate::harvest::judge::{base_contact, Aims, DamageLog, PlantEffects, Touches, COLLISION_COUNTERS};
 use crate::harvest::session::harvest_session;
 use crate::harvest::targets::RIPE_STAGE;
+use crate::harvest::trial::MISLOCALIZED;
 use crate::harvest::HarvestSetup;
 use agrisim_bus::Node;
 use agrisim_bus::Reader;
@@ -58,6 +59,19 @@ pub struct RowAttempt {
     pub chosen: Option<(u32, u8, f64)>,
     pub outcome: String,
     pub failure: Option<String>,
+}
+
+impl RowAttempt {
+    /// The pick's failure class, as the harvest judge classes a trial's: a grasp that
+    /// missed, aimed more than [`MISLOCALIZED`] from the nearest fruit, failed on
+    /// perception (mislocalized); otherwise the node's own category.
+    pub fn failure_class(&self) -> Option<String> {
+        let far = self.chosen.is_some_and(|c| c.2 > MISLOCALIZED * 1e3);
+        match self.failure.as_deref() {
+            Some("grasp") if far => Some("mislocalized".into()),
+            f => f.map(str::to_string),
+        }
+    }
 }
 
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
@@ -183,12 +197,14 @@ pub fn run(t: &Trial<HarvestSetup>, mcap: &Path) -> Result<RowTrial> {
                 let pick_ended = st.outcome == "success" || st.outcome == "failure";
                 match (regions.is_some(), pick_ended) {
                     (true, true) => {
-                        attempts.push(RowAttempt {
+                        let mut a = RowAttempt {
                             at: k as f64 * step,
                             chosen: chosen.take().map(|(id, e)| (id, setup.fruit[&id].stage, e * 1e3)),
                             failure: (st.outcome == "failure").then(|| st.failure_category.clone()),
                             outcome: st.outcome,
-                        });
+                        };
+                        a.failure = a.failure_class();
+                        attempts.push(a);
                     }
                     (false, true) => {
                         outcomes.entry(st.target_id).or_insert(st);
@@ -353,5 +369,32 @@ pub fn failed(t: &Trial<HarvestSetup>, reason: String) -> RowTrial {
         ended: format!("error: {reason}"),
         mcap: format!("trials/{index:04}.mcap"),
         ..RowTrial::default()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The harvest judge's rule: a grasp that closed on nothing, aimed over 15 mm from the
+    /// nearest fruit, failed on perception; near a fruit, or another failure, keeps its class.
+    #[test]
+    fn a_grasp_aimed_far_from_any_fruit_is_mislocalized() {
+        let pick = |failure: Option<&str>, error_mm: Option<f64>| RowAttempt {
+            at: 1.0,
+            chosen: error_mm.map(|e| (7, 6, e)),
+            outcome: if failure.is_some() { "failure" } else { "success" }.into(),
+            failure: failure.map(str::to_string),
+        };
+        let class = |f, e| pick(f, e).failure_class();
+        assert_eq!(class(Some("grasp"), Some(113.0)).as_deref(), Some("mislocalized"));
+        assert_eq!(class(Some("grasp"), Some(14.9)).as_deref(), Some("grasp"));
+        assert_eq!(class(Some("grasp"), None).as_deref(), Some("grasp"));
+        assert_eq!(class(Some("planning"), Some(113.0)).as_deref(), Some("planning"));
+        assert_eq!(class(None, Some(5.0)), None);
+        // Classing twice changes nothing (summaries re-class recorded picks).
+        let mut a = pick(Some("grasp"), Some(40.0));
+        a.failure = a.failure_class();
+        assert_eq!(a.failure_class().as_deref(), Some("mislocalized"));
     }
 }
