@@ -252,14 +252,12 @@ impl Perception {
         }
     }
 
-    /// Whether `c` (in world frame `frame`) lies at a hand, as the hands were about the
-    /// time `stamp` [ns].
-    fn at_hand(&self, frame: &str, stamp: i64, c: [f64; 3]) -> bool {
-        let r2 = self.config.hand_radius * self.config.hand_radius;
+    /// Where the hands were (in world frame `frame`) about the time `stamp` [ns].
+    fn hands_about(&self, frame: &str, stamp: i64) -> Vec<[f64; 3]> {
         (self.hand_trail.iter())
             .filter(|(t, f, _)| f == frame && (t - stamp).abs() <= HAND_WINDOW_NS)
-            .flat_map(|(_, _, at)| at)
-            .any(|h| (0..3).map(|i| (h[i] - c[i]).powi(2)).sum::<f64>() <= r2)
+            .flat_map(|(_, _, at)| at.iter().copied())
+            .collect()
     }
 
     /// Publishes `out` at `t_ns`.
@@ -361,20 +359,28 @@ impl Perception {
             );
             return work;
         };
-        // The fruit at a hand are the robot's business, not the crop's: no track.
+        // The fruit at a hand are the robot's business, not the crop's: no track. Nor is a
+        // track there seen through while the hand is at it (a neighbour the fingers push
+        // aside swings back).
+        let (hands, reach) = (self.hands_about(&frame, stamp), self.config.hand_radius);
         let (kept, obs): (Vec<&Detection>, Vec<Observation>) = result
             .detections
             .iter()
             .filter_map(|d| {
                 let c = pose * Point3::from(d.center);
                 let c = [c.x, c.y, c.z];
-                (!self.at_hand(&frame, stamp, c))
-                    .then_some((d, Observation { center: c, radius: d.radius, votes: d.votes }))
+                (!near(&hands, c, reach)).then_some((d, Observation { center: c, radius: d.radius, votes: d.votes }))
             })
             .unzip();
         let ids = self.map.update(&obs, stamp);
         let inverse = pose.inverse();
-        self.map.forget_seen_through(&ids, |t| look(t, &inverse, &k, &z, w, h));
+        self.map.forget_seen_through(&ids, |t| {
+            if near(&hands, t.center, reach) {
+                Look::Unseen
+            } else {
+                look(t, &inverse, &k, &z, w, h)
+            }
+        });
         let wh = Header { stamp: image.header.stamp, frame_id: frame.clone() };
         let dets: Vec<Detection3D> =
             kept.iter().zip(&ids).map(|(d, id)| detection(&wh, d, &pose, id.to_string())).collect();
@@ -412,6 +418,11 @@ impl Perception {
         self.ok();
         work
     }
+}
+
+/// Whether `c` lies within `r` of any of `hands`.
+fn near(hands: &[[f64; 3]], c: [f64; 3], r: f64) -> bool {
+    hands.iter().any(|h| (0..3).map(|i| (h[i] - c[i]).powi(2)).sum::<f64>() <= r * r)
 }
 
 /// Depth beyond a fruit's back by more than this says the camera saw through where it
@@ -609,6 +620,12 @@ mod tests {
 
     /// A fruit at a hand is one where the hand was (in that world frame) within the window
     /// about the frame's stamp: a carried fruit seen just before or after the TF moved on.
+    /// Whether `c` (in world frame `frame`) lies at a hand of `node`, as the hands were
+    /// about the time `stamp` [ns].
+    fn at_hand(node: &Perception, frame: &str, stamp: i64, c: [f64; 3]) -> bool {
+        near(&node.hands_about(frame, stamp), c, node.config.hand_radius)
+    }
+
     #[test]
     fn a_fruit_at_a_hand_is_where_the_hand_was_about_the_frame() {
         use agrisim_msgs::geometry_msgs::{Quaternion, Transform, TransformStamped, Vector3};
@@ -626,15 +643,15 @@ mod tests {
             node.record_hands(k * 100_000_000);
         }
         let s = 1_000_000_000;
-        assert!(node.at_hand("map", s, [0.3, 1.0, 1.05]), "at the hand now");
-        assert!(node.at_hand("map", s - 200_000_000, [0.24, 1.02, 1.0]), "where it was 0.2 s before");
-        assert!(!node.at_hand("map", s, [0.1, 1.0, 1.0]), "where it was 0.7 s before: a fruit hanging there");
-        assert!(!node.at_hand("map", s, [0.3, 1.0, 1.0 + 0.061]), "beyond the radius");
-        assert!(!node.at_hand("odom", s, [0.3, 1.0, 1.0]), "no TF from odom to the hand");
+        assert!(at_hand(&node, "map", s, [0.3, 1.0, 1.05]), "at the hand now");
+        assert!(at_hand(&node, "map", s - 200_000_000, [0.24, 1.02, 1.0]), "where it was 0.2 s before");
+        assert!(!at_hand(&node, "map", s, [0.1, 1.0, 1.0]), "where it was 0.7 s before: a fruit hanging there");
+        assert!(!at_hand(&node, "map", s, [0.3, 1.0, 1.0 + 0.061]), "beyond the radius");
+        assert!(!at_hand(&node, "odom", s, [0.3, 1.0, 1.0]), "no TF from odom to the hand");
         // Without hands configured nothing is at a hand.
         let mut none = Perception::new(PerceptionConfig { hands: vec![], ..PerceptionConfig::default() });
         none.tf.add(&hand_at(0.3));
         none.record_hands(s);
-        assert!(!none.at_hand("map", s, [0.3, 1.0, 1.0]));
+        assert!(!at_hand(&none, "map", s, [0.3, 1.0, 1.0]));
     }
 }
