@@ -35,7 +35,7 @@ use crate::cost::{CostModel, MapWork};
 use crate::depth::{DepthFrame, Intrinsics};
 use crate::map::{MapConfig, OccupancyMap, ScanStats};
 use crate::robot::RobotShapes;
-use crate::shape::{Primitive, Sphere};
+use crate::shape::{Primitive, Shape, Sphere};
 use agrisim_bus::{Bus, Charged, Node, Reader};
 use agrisim_error::Result;
 use agrisim_msgs::agrisim::{FmuStatus, PlanningScene};
@@ -107,7 +107,17 @@ pub struct MapperConfig {
     /// Only the occupied space within this horizontal distance of this frame's origin is
     /// exported (e.g. base_link and the arms' reach; None: all of the map). The map keeps it all.
     pub scene_around: Option<(String, f64)>,
+    /// TF frames of the robot's hands (the grasp point): a sphere of
+    /// [`MapperConfig::hand_radius`] about each is the robot's too, as MoveIt's attached
+    /// object is: a fruit in a hand leaves no voxels where it is carried. A frame TF does
+    /// not reach is skipped silently (a robot without these hands).
+    pub hands: Vec<String>,
+    /// [m]: the largest fruit's radius (45 mm) and the fit's error.
+    pub hand_radius: f64,
 }
+
+/// The hand TCP frames of agrisim's robot (models/robot/agrisim_robot.urdf).
+pub const HANDS: [&str; 2] = ["left_hand_tcp", "right_hand_tcp"];
 
 impl Default for MapperConfig {
     /// The single camera `/camera`.
@@ -121,6 +131,8 @@ impl Default for MapperConfig {
             pixel_stride: 1,
             scene_period: 0.0,
             scene_around: None,
+            hands: HANDS.iter().map(|h| h.to_string()).collect(),
+            hand_radius: 0.06,
         }
     }
 }
@@ -342,6 +354,12 @@ impl DepthMapper {
             }
         }
         self.robot.extend_from_slice(&self.extra_robot);
+        let sphere = Shape::Sphere { radius: self.config.hand_radius };
+        for hand in &self.config.hands {
+            if let Some(pose) = self.tf.lookup(&self.config.map_frame, hand) {
+                self.robot.push(Primitive::new(sphere, pose));
+            }
+        }
         fresh
     }
 

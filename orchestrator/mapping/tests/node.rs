@@ -238,6 +238,35 @@ fn the_robot_links_from_the_description_are_filtered_out() {
     assert_eq!(node.robot_links().len(), 2);
 }
 
+/// A fruit at a hand (the face 2.5 cm before the hand's grasp point, here with no links
+/// described) is the robot's: its pixels within the hand's sphere leave no voxels; the rest
+/// of the face does, and without hands configured all of it.
+#[test]
+fn a_fruit_at_a_hand_is_filtered_out() {
+    let near_hand = |k: &Key| {
+        let c = [k[0], k[1], k[2]].map(|i| (i as f64 + 0.5) * RES);
+        (c[0] - 0.72).powi(2) + c[1].powi(2) + (c[2] - 1.0).powi(2) < 0.05f64.powi(2)
+    };
+    let face = |k: &Key| (0.68..0.72).contains(&((k[0] as f64 + 0.5) * RES));
+    let run = |hands: Vec<String>| {
+        let (mut bus, _) = arm_scene_bus(None);
+        let mut node = DepthMapper::new(MapperConfig { hands, ..MapperConfig::default() }).unwrap();
+        bus.publish(TF, 0, &tf("map", "left_hand_tcp", &Isometry3::translation(0.72, 0.0, 1.0)));
+        node.step(1, &mut bus).unwrap();
+        node
+    };
+    let node = run(MapperConfig::default().hands);
+    assert_eq!(node.robot_links().len(), 1);
+    let occ = node.map().occupied();
+    assert!(node.last.self_filtered > 50, "{:?}", node.last);
+    assert_eq!(occ.iter().filter(|k| near_hand(k)).count(), 0);
+    assert!(occ.iter().filter(|k| face(k)).count() > 100, "the face beyond the hand's sphere is seen");
+    let plain = run(vec![]);
+    assert_eq!((plain.robot_links().len(), plain.last.self_filtered), (0, 0));
+    let n = plain.map().occupied().iter().filter(|k| near_hand(k)).count();
+    assert!(n > 20, "{n}");
+}
+
 #[test]
 fn the_allowed_fruit_comes_from_the_message() {
     let mut bus = Bus::default();
@@ -354,7 +383,8 @@ fn every_link_of_the_project_robot_is_placed_from_robot_state_publisher() {
     node.step(1, &mut bus).unwrap();
     assert_eq!((node.frames, node.skipped), (1, 0));
     assert_eq!(node.missing_links().count(), 0);
-    assert_eq!(node.robot_links().len(), n);
+    // Every collision shape, and a sphere about each hand's grasp point.
+    assert_eq!(node.robot_links().len(), n + 2);
     assert!(statuses(&mut status, &mut bus).is_empty());
     // Placed, not left at the origin: the base's collision box is about the base's pose.
     let near_base =

@@ -63,7 +63,23 @@ pub struct PerceptionConfig {
     /// The fruit map is published at most this often [s] (0: after every frame); it holds
     /// every fruit seen so far, so it grows along the row.
     pub map_period: f64,
+    /// TF frames of the robot's hands (the grasp point between the fingers). A fruit seen
+    /// within [`PerceptionConfig::hand_radius`] of one, where the hand was about when the
+    /// frame was taken, is in or at the hand (grasped, carried, handed over): it goes into
+    /// no track, as the mapper leaves the robot's own links out of its map. Without this a
+    /// carried fruit leaves a track where no fruit hangs, and a row's next pick closes on
+    /// nothing there.
+    pub hands: Vec<String>,
+    /// [m]: the largest fruit's radius (45 mm) and the fit's error.
+    pub hand_radius: f64,
 }
+
+/// The hand TCP frames of agrisim's robot (models/robot/agrisim_robot.urdf).
+pub const HANDS: [&str; 2] = ["left_hand_tcp", "right_hand_tcp"];
+/// Hand positions this close in time to a frame's stamp are where the hand may have been
+/// when it was taken [ns]: the TF the node holds is the newest, and a frame may wait for the
+/// node (its compute is charged), while a hand moves at up to about 0.5 m/s.
+const HAND_WINDOW_NS: i64 = 300_000_000;
 
 impl Default for PerceptionConfig {
     fn default() -> Self {
@@ -73,6 +89,8 @@ impl Default for PerceptionConfig {
             cameras: vec!["camera".into()],
             confirm: 1,
             map_period: 0.0,
+            hands: HANDS.iter().map(|h| h.to_string()).collect(),
+            hand_radius: 0.06,
         }
     }
 }
@@ -145,6 +163,9 @@ pub struct Perception {
     tf_static_reader: Reader,
     cameras: Vec<CameraInput>,
     map: FruitMap,
+    /// Where the hands were in each world frame, by step [ns], over the last
+    /// [`HAND_WINDOW_NS`] and more (oldest first).
+    hand_trail: VecDeque<(i64, String, Vec<[f64; 3]>)>,
     last_map_ns: Option<i64>,
     last_status: String,
     /// Frames processed and skipped so far.
@@ -169,6 +190,7 @@ impl Perception {
             tf_reader: Reader::new(TF),
             tf_static_reader: Reader::new(TF_STATIC),
             map: FruitMap::default(),
+            hand_trail: VecDeque::new(),
             last_map_ns: None,
             last_status: String::new(),
             frames: 0,
@@ -209,6 +231,33 @@ impl Perception {
 
     fn ok(&mut self) {
         self.last_status.clear();
+    }
+
+    /// Notes where the hands are now in each world frame TF reaches them in.
+    fn record_hands(&mut self, t_ns: i64) {
+        if self.config.hands.is_empty() {
+            return;
+        }
+        for f in &self.config.world_frames {
+            let at: Vec<[f64; 3]> = (self.config.hands.iter())
+                .filter_map(|h| self.tf.lookup(f, h))
+                .map(|p| [p.translation.x, p.translation.y, p.translation.z])
+                .collect();
+            if !at.is_empty() {
+                self.hand_trail.push_back((t_ns, f.clone(), at));
+            }
+        }
+        while self.hand_trail.front().is_some_and(|(t, _, _)| *t < t_ns - 2 * HAND_WINDOW_NS) {
+            self.hand_trail.pop_front();
+        }
+    }
+
+    /// Where the hands were (in world frame `frame`) about the time `stamp` [ns].
+    fn hands_about(&self, frame: &str, stamp: i64) -> Vec<[f64; 3]> {
+        (self.hand_trail.iter())
+            .filter(|(t, f, _)| f == frame && (t - stamp).abs() <= HAND_WINDOW_NS)
+            .flat_map(|(_, _, at)| at.iter().copied())
+            .collect()
     }
 
     /// Publishes `out` at `t_ns`.
@@ -310,20 +359,31 @@ impl Perception {
             );
             return work;
         };
-        let obs: Vec<Observation> = result
+        // The fruit at a hand are the robot's business, not the crop's: no track. Nor is a
+        // track there seen through while the hand is at it (a neighbour the fingers push
+        // aside swings back).
+        let (hands, reach) = (self.hands_about(&frame, stamp), self.config.hand_radius);
+        let (kept, obs): (Vec<&Detection>, Vec<Observation>) = result
             .detections
             .iter()
-            .map(|d| {
+            .filter_map(|d| {
                 let c = pose * Point3::from(d.center);
-                Observation { center: [c.x, c.y, c.z], radius: d.radius, votes: d.votes }
+                let c = [c.x, c.y, c.z];
+                (!near(&hands, c, reach)).then_some((d, Observation { center: c, radius: d.radius, votes: d.votes }))
             })
-            .collect();
+            .unzip();
         let ids = self.map.update(&obs, stamp);
         let inverse = pose.inverse();
-        self.map.forget_seen_through(&ids, |t| look(t, &inverse, &k, &z, w, h));
+        self.map.forget_seen_through(&ids, |t| {
+            if near(&hands, t.center, reach) {
+                Look::Unseen
+            } else {
+                look(t, &inverse, &k, &z, w, h)
+            }
+        });
         let wh = Header { stamp: image.header.stamp, frame_id: frame.clone() };
         let dets: Vec<Detection3D> =
-            result.detections.iter().zip(&ids).map(|(d, id)| detection(&wh, d, &pose, id.to_string())).collect();
+            kept.iter().zip(&ids).map(|(d, id)| detection(&wh, d, &pose, id.to_string())).collect();
         self.out.push(Out::Array(DETECTIONS_WORLD, Detection3DArray { header: wh.clone(), detections: dets }));
         let period_ns = (self.config.map_period * 1e9) as i64;
         if self.last_map_ns.is_some_and(|last| t_ns - last < period_ns) {
@@ -358,6 +418,11 @@ impl Perception {
         self.ok();
         work
     }
+}
+
+/// Whether `c` lies within `r` of any of `hands`.
+fn near(hands: &[[f64; 3]], c: [f64; 3], r: f64) -> bool {
+    hands.iter().any(|h| (0..3).map(|i| (h[i] - c[i]).powi(2)).sum::<f64>() <= r * r)
 }
 
 /// Depth beyond a fruit's back by more than this says the camera saw through where it
@@ -442,6 +507,7 @@ impl Node for Perception {
         for m in self.tf_reader.take::<TFMessage>(bus)? {
             self.tf.add(&m);
         }
+        self.record_hands(t_ns);
         for cam in 0..self.cameras.len() {
             let c = &mut self.cameras[cam];
             if let Some(info) = bus.take_new::<CameraInfo>(&c.info_topic, &mut c.seen[2])? {
@@ -550,5 +616,42 @@ mod tests {
         let cam = Isometry3::translation(0.5, 0.0, 0.0);
         let (k, z) = frame(1.0);
         assert_eq!(look(&track([0.5, 0.0, 0.6]), &cam.inverse(), &k, &z, 40, 30), Look::SeenThrough);
+    }
+
+    /// A fruit at a hand is one where the hand was (in that world frame) within the window
+    /// about the frame's stamp: a carried fruit seen just before or after the TF moved on.
+    /// Whether `c` (in world frame `frame`) lies at a hand of `node`, as the hands were
+    /// about the time `stamp` [ns].
+    fn at_hand(node: &Perception, frame: &str, stamp: i64, c: [f64; 3]) -> bool {
+        near(&node.hands_about(frame, stamp), c, node.config.hand_radius)
+    }
+
+    #[test]
+    fn a_fruit_at_a_hand_is_where_the_hand_was_about_the_frame() {
+        use agrisim_msgs::geometry_msgs::{Quaternion, Transform, TransformStamped, Vector3};
+        let mut node = Perception::new(PerceptionConfig::default());
+        let hand_at = |x: f64| TFMessage {
+            transforms: vec![TransformStamped {
+                header: Header { stamp: Time::from_nanos(0), frame_id: "map".into() },
+                child_frame_id: "left_hand_tcp".into(),
+                transform: Transform { translation: Vector3 { x, y: 1.0, z: 1.0 }, rotation: Quaternion::IDENTITY },
+            }],
+        };
+        // The hand carries a fruit from x = 0 to x = 0.3 m over a second, in steps of 0.1 s.
+        for k in 0..=10 {
+            node.tf.add(&hand_at(0.03 * k as f64));
+            node.record_hands(k * 100_000_000);
+        }
+        let s = 1_000_000_000;
+        assert!(at_hand(&node, "map", s, [0.3, 1.0, 1.05]), "at the hand now");
+        assert!(at_hand(&node, "map", s - 200_000_000, [0.24, 1.02, 1.0]), "where it was 0.2 s before");
+        assert!(!at_hand(&node, "map", s, [0.1, 1.0, 1.0]), "where it was 0.7 s before: a fruit hanging there");
+        assert!(!at_hand(&node, "map", s, [0.3, 1.0, 1.0 + 0.061]), "beyond the radius");
+        assert!(!at_hand(&node, "odom", s, [0.3, 1.0, 1.0]), "no TF from odom to the hand");
+        // Without hands configured nothing is at a hand.
+        let mut none = Perception::new(PerceptionConfig { hands: vec![], ..PerceptionConfig::default() });
+        none.tf.add(&hand_at(0.3));
+        none.record_hands(s);
+        assert!(!at_hand(&none, "map", s, [0.3, 1.0, 1.0]));
     }
 }
