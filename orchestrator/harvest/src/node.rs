@@ -600,7 +600,7 @@ impl HarvestNode {
                 let was = self.track.clone().unwrap_or_default();
                 self.tried.extend(self.target_map);
                 self.declined += 1;
-                (self.target_map, self.target_r, self.track) = (Some(f.center), f.radius, Some(f.id.clone()));
+                self.target_seen(&f);
                 let detail = format!("declined track {was}: {} arm, {}: {e}", arm.name(), self.stage.name());
                 self.publish_status(t_ns, bus, "running", "", &detail);
                 self.aim(t_ns, bus);
@@ -611,6 +611,11 @@ impl HarvestNode {
                 None
             }
         }
+    }
+
+    /// By sight: `f` of the fruit map is the target (its estimate, radius and track).
+    fn target_seen(&mut self, f: &Seen) {
+        (self.target_map, self.target_r, self.track) = (Some(f.center), f.radius, Some(f.id.clone()));
     }
 
     /// By sight: the fruit to take if the current one is declined (None when it may not be,

@@ -166,9 +166,7 @@ impl HarvestNode {
             // robot stands (the cameras looked on through the last pick); none: scan.
             if self.look_first {
                 if let Some(f) = sight::choose(&self.fruit_map, &region, self.aisle_y, &self.tried) {
-                    self.target_map = Some(f.center);
-                    self.target_r = f.radius;
-                    self.track = Some(f.id.clone());
+                    self.target_seen(&f);
                     return self.aim(t_ns, bus);
                 }
             }
@@ -183,9 +181,7 @@ impl HarvestNode {
             return;
         }
         if let Some(f) = sight::choose(&self.fruit_map, &region, self.aisle_y, &self.tried) {
-            self.target_map = Some(f.center);
-            self.target_r = f.radius;
-            self.track = Some(f.id.clone());
+            self.target_seen(&f);
             return self.aim(t_ns, bus);
         }
         self.dwell_from = None;
