@@ -135,6 +135,9 @@ pub struct HarvestNode {
     /// How the fruit came off: "bend" (the wrist roll) or "pull" (the retreat).
     pub detach_motion: &'static str,
     handover_attempts: u32,
+    /// How far the TCP of the hand that takes the fruit to the box is past the giver's TCP at
+    /// the handover ([`geo::HANDOVER_DEPTHS`]): the fruit's centre sits this minus
+    /// GRASP_DEPTH short of that TCP.
     handover_offset: f64,
     release_ns: i64,
     target_name: String,
@@ -230,7 +233,7 @@ impl HarvestNode {
             grasp_q: [0.0; 7],
             detach_motion: "",
             handover_attempts: 0,
-            handover_offset: 0.0,
+            handover_offset: geo::HANDOVER_DEPTHS[0],
             release_ns: 0,
             target_name: String::new(),
             plans: 0,

@@ -18,8 +18,6 @@ const SETTLE: f64 = 1.5;
 /// pads tolerate least across them, and a base that stands off a little too far (lateral
 /// localization error) leaves the fruit beyond the pads' tips.
 const REGRASP_SHIFTS: [(f64, f64); 3] = [(0.012, 0.0), (-0.012, 0.0), (0.0, 0.015)];
-/// Taker TCP positions along its approach for the second and third handover attempt [m].
-const HANDOVER_OFFSETS: [f64; 2] = [0.015, -0.015];
 /// Sphere-check margin of the taker's final approach [m]: the hands meet by design there.
 const HANDOVER_PADDING: f64 = 0.002;
 /// How far the giver backs off along its approach after letting go [m].
@@ -49,9 +47,9 @@ impl HarvestNode {
             0 if !self.rescuing && !self.rescue_failed => {
                 if let Some(arm) = [Arm::Left, Arm::Right].into_iter().find(|&a| self.holding(a)) {
                     // The holder becomes the taker; the fruit sits GRASP_DEPTH short of its
-                    // TCP, where a giver holds it (handover offset 0).
+                    // TCP, where a giver holds it, as a taker's first attempt holds it.
                     self.side = if arm == Arm::Right { 1.0 } else { -1.0 };
-                    self.handover_offset = 0.0;
+                    self.handover_offset = geo::HANDOVER_DEPTHS[0];
                     let r = 0.5 * self.view(arm).gripper.as_ref().map_or(0.06, |g| g.position);
                     self.motion.set_held(arm, Some(r));
                     self.gripper(arm.other(), geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
@@ -500,7 +498,7 @@ impl HarvestNode {
                 // fruit is valid too; the hands meet by design, the exact check decides.
                 let (_, t) = geo::handover_goals(geo::handover_point(self.lift), self.side);
                 self.motion.set_padding(HANDOVER_PADDING);
-                let ok = self.move_pregrasp(taker, &[t], t_ns, bus).is_some();
+                let ok = self.move_pregrasp(taker, &[t.along(geo::HANDOVER_DEPTHS[0])], t_ns, bus).is_some();
                 self.motion.set_padding(agrisim_manip::checker::DEFAULT_PADDING);
                 if ok {
                     self.phase = 3;
@@ -512,8 +510,8 @@ impl HarvestNode {
     }
 
     /// The taker closes on the fruit in the giver's hand and the giver lets go and backs
-    /// off; where the taker closed on nothing, it tries again deeper, then shallower
-    /// ([`HANDOVER_OFFSETS`]). -> transfer.
+    /// off; where the taker closed on nothing, it tries again deeper ([`geo::HANDOVER_DEPTHS`]).
+    /// -> transfer.
     // A phase's guard says when it may act; the motion request inside is the action, kept out
     // of the guard so no arm's condition has side effects.
     #[allow(clippy::collapsible_match)]
@@ -544,8 +542,8 @@ impl HarvestNode {
             }
             2 if self.view(taker).gripper.as_ref().is_some_and(|g| g.reached_goal && g.position < 0.005) => {
                 // Where the fruit sits between the giver's pads (along the approach)
-                // is not known: open, back off and try deeper / shallower.
-                if self.handover_attempts as usize >= HANDOVER_OFFSETS.len() {
+                // is not known: open, back off and try deeper.
+                if self.handover_attempts as usize + 1 >= geo::HANDOVER_DEPTHS.len() {
                     self.fail(
                         Failure::Handover,
                         t_ns,
@@ -583,8 +581,8 @@ impl HarvestNode {
                 }
             }
             5 if self.arm_done(taker, t_ns, bus) == Some(true) => {
-                self.handover_offset = HANDOVER_OFFSETS[self.handover_attempts as usize];
                 self.handover_attempts += 1;
+                self.handover_offset = geo::HANDOVER_DEPTHS[self.handover_attempts as usize];
                 self.publish_status(
                     t_ns,
                     bus,
