@@ -98,6 +98,29 @@ pub struct Planned {
     pub goal_q: [f64; DOF],
 }
 
+impl Planned {
+    /// The configuration `t` s after the start (linear between samples; the last after the end).
+    pub fn at(&self, t: f64) -> [f64; DOF] {
+        let pts = &self.msg.points;
+        let time = |k: usize| pts[k].time_from_start.to_nanos() as f64 * 1e-9;
+        let q = |k: usize| -> [f64; DOF] { std::array::from_fn(|i| pts[k].positions.get(i).copied().unwrap_or(0.0)) };
+        let Some(k) = pts.iter().position(|p| p.time_from_start.to_nanos() as f64 * 1e-9 > t) else {
+            return pts.last().map_or([0.0; DOF], |_| q(pts.len() - 1));
+        };
+        if k == 0 {
+            return q(0);
+        }
+        let (t0, t1) = (time(k - 1), time(k));
+        let s = if t1 > t0 { (t - t0) / (t1 - t0) } else { 1.0 };
+        agrisim_manip::checker::lerp(&q(k - 1), &q(k), s)
+    }
+}
+
+/// How far apart in time two trajectories sent together are checked against each other [s]:
+/// both arms start them at the same stamp and track within a millimetre, so this covers a
+/// step of lag either way and more.
+pub const TIMING_SLACK: f64 = 0.1;
+
 pub struct Motion {
     arms: [ArmModel; 2],
     rng: Rng,
@@ -297,6 +320,35 @@ impl Motion {
             [Arm::Left, Arm::Right]
                 .iter()
                 .all(|&a| Checker::new(self.context(a, lift, q[a.other().index()])).is_valid(&q[a.index()]))
+        })
+    }
+
+    /// Whether `arm` may follow `mine` while the other arm follows `theirs`, both sent to
+    /// start at the same instant: each configuration of `mine` keeps the arms apart (with
+    /// what each holds) from every configuration the other arm passes through within
+    /// [`TIMING_SLACK`] of the same time, both sampled every 10 ms (an arm at rest at its
+    /// end after it). Each trajectory was checked against the scene when it was planned;
+    /// this adds only what moving both at once adds, so the scene is left out.
+    pub fn trajectories_clear(&self, arm: Arm, lift: f64, mine: &Planned, theirs: &Planned) -> bool {
+        const DT: f64 = 0.01;
+        let n = (mine.duration.max(theirs.duration) / DT).ceil() as usize + 1;
+        let w = (TIMING_SLACK / DT).round() as usize;
+        let qs: Vec<[f64; DOF]> = (0..n).map(|i| mine.at(i as f64 * DT)).collect();
+        let empty = Scene::new(vec![]);
+        let o = self.model(arm.other());
+        (0..n).all(|j| {
+            let q_other = theirs.at(j as f64 * DT);
+            let mut ctx = Context::new(self.model(arm), lift, &empty).with_other(o, q_other, o.finger_limits.upper);
+            ctx.padding = self.padding;
+            ctx.meter = Some(&self.meter);
+            if let Some(r) = self.held[arm.index()] {
+                ctx = ctx.holding(r);
+            }
+            if let Some(r) = self.held[arm.other().index()] {
+                ctx = ctx.other_holding(r);
+            }
+            let checker = Checker::new(ctx);
+            qs[j.saturating_sub(w)..(j + w + 1).min(n)].iter().all(|q| checker.arms_contact(q).is_none())
         })
     }
 
@@ -544,7 +596,7 @@ impl Motion {
         let plan = {
             let ctx = self.context(arm, lift, other);
             let mut rng = self.rng.clone();
-            let p = self.planner.plan(&ctx, &start, goals, &mut rng);
+            let p = self.planner.plan_out_of_contact(&ctx, &start, goals, &mut rng);
             self.rng = rng;
             p.map_err(|e| format!("motion planning: {e}"))?
         };
@@ -765,6 +817,62 @@ mod tests {
                 assert!(down.is_ok(), "{arm:?}, spot {i}: {:?}", down.err());
             }
         }
+    }
+
+    /// Two trajectories sent together are checked against each other in time: arms that
+    /// would meet at the same moment are refused; the same ways, one starting after the
+    /// other has left, pass. The configurations are drawn until the arms meet in them but
+    /// each way passes the other arm at home.
+    #[test]
+    fn trajectories_sent_together_are_checked_in_time() {
+        let m = Motion::new(1);
+        let (l, r) = (m.model(Arm::Left), m.model(Arm::Right));
+        let empty = Scene::new(vec![]);
+        let lift = 0.3;
+        let meet = |ql: &[f64; DOF], qr: &[f64; DOF]| {
+            Checker::new(Context::new(l, lift, &empty).with_other(r, *qr, r.finger_limits.upper))
+                .arms_contact(ql)
+                .is_some()
+        };
+        let way = |a: &[f64; DOF], b: &[f64; DOF]| -> Vec<[f64; DOF]> {
+            (0..=50).map(|k| agrisim_manip::checker::lerp(a, b, k as f64 / 50.0)).collect()
+        };
+        let mut rng = Rng::new(3);
+        let (ql, qr) = (0..20_000)
+            .map(|_| (l.random_q(&mut rng), r.random_q(&mut rng)))
+            .find(|(ql, qr)| {
+                meet(ql, qr)
+                    && way(&HOME, ql).iter().all(|q| !meet(q, &HOME))
+                    && way(&HOME, qr).iter().all(|q| !meet(&HOME, q))
+            })
+            .expect("a pair of configurations where the arms meet");
+        let timed = |points: &[(f64, [f64; DOF])]| {
+            let pts = points
+                .iter()
+                .map(|(t, q)| JointTrajectoryPoint {
+                    positions: q.to_vec(),
+                    time_from_start: Duration::from_nanos((t * 1e9) as i64),
+                    ..Default::default()
+                })
+                .collect();
+            let (t, q) = *points.last().expect("points");
+            Planned { msg: JointTrajectory { points: pts, ..Default::default() }, duration: t, goal_q: q }
+        };
+        // Out to ql and back home in 2 s; the right arm out to qr at once, or after 3 s.
+        let left = timed(&[(0.0, HOME), (1.0, ql), (2.0, HOME)]);
+        let together = timed(&[(0.0, HOME), (1.0, qr)]);
+        let after = timed(&[(0.0, HOME), (3.0, HOME), (4.0, qr)]);
+        assert!(!m.trajectories_clear(Arm::Left, lift, &left, &together));
+        assert!(!m.trajectories_clear(Arm::Right, lift, &together, &left));
+        assert!(m.trajectories_clear(Arm::Left, lift, &left, &after));
+        assert!(m.trajectories_clear(Arm::Right, lift, &after, &left));
+        // The left arm at ql for 1 s, home by 1.5 s; the right arm jumps to qr within the
+        // slack of the left's leaving (refused), or well after it is home (passes).
+        let stay = timed(&[(0.0, ql), (1.0, ql), (1.5, HOME)]);
+        let soon = timed(&[(0.0, HOME), (1.0 + 0.5 * TIMING_SLACK, HOME), (1.01 + 0.5 * TIMING_SLACK, qr)]);
+        let later = timed(&[(0.0, HOME), (1.5 + 3.0 * TIMING_SLACK, HOME), (1.51 + 3.0 * TIMING_SLACK, qr)]);
+        assert!(!m.trajectories_clear(Arm::Left, lift, &stay, &soon));
+        assert!(m.trajectories_clear(Arm::Left, lift, &stay, &later));
     }
 
     #[test]

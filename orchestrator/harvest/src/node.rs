@@ -86,6 +86,9 @@ struct ArmView {
     /// here, not at the measured joints (which lag by the tracking error, and the arm
     /// refuses a first point away from its commanded position).
     commanded: Option<[f64; 7]>,
+    /// The opening last commanded to the gripper: its state reads true of that command
+    /// only once it no longer moves.
+    gripper_commanded: Option<f64>,
 }
 
 pub struct HarvestNode {
@@ -150,6 +153,8 @@ pub struct HarvestNode {
     rescuing: bool,
     /// That rescue failed (its plan could not be made): the recovery lets the fruit go.
     rescue_failed: bool,
+    /// Recovery: both grippers were open when it began (see `open_grippers`).
+    grippers_were_open: bool,
     /// Prices planning work in simulated seconds.
     cost: CostModel,
     /// Planning work counted up to the last plan reported.
@@ -240,6 +245,7 @@ impl HarvestNode {
             boxed: 0,
             rescuing: false,
             rescue_failed: false,
+            grippers_were_open: false,
             cost: CostModel::CALIBRATED,
             work_mark: Work::default(),
             step_thinking: 0.0,
@@ -660,8 +666,16 @@ impl HarvestNode {
         v.commanded = Some(p.goal_q);
     }
 
-    fn gripper(&self, arm: Arm, width: f64, effort: f64, t_ns: i64, bus: &mut Bus) {
+    fn gripper(&mut self, arm: Arm, width: f64, effort: f64, t_ns: i64, bus: &mut Bus) {
         bus.publish(&arm.gripper_topic("command"), t_ns, &GripperCommand { position: width, max_effort: effort });
+        self.arms[arm.index()].gripper_commanded = Some(width);
+    }
+
+    /// Whether the arm's gripper was told to open and reads open, holding nothing.
+    pub(super) fn gripper_open(&self, arm: Arm) -> bool {
+        let v = self.view(arm);
+        v.gripper_commanded == Some(geo::OPEN_WIDTH)
+            && v.gripper.as_ref().is_some_and(|g| !g.stalled && g.position > geo::OPEN_WIDTH - 0.005)
     }
 
     /// Whether the arm finished its last trajectory. A rejected trajectory is a planning

@@ -124,6 +124,7 @@ impl Node for RowNode {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry as geo;
 
     fn region(x: f64) -> Region {
         Region { x: [x, x + 1.0], y: [0.0, 1.0], z: [0.55, 1.75] }
@@ -149,6 +150,49 @@ mod tests {
             row.step(200_000_000, &mut bus).unwrap();
             assert_eq!(row.inner.stage(), Stage::Recover, "by sight {by_sight}: the grippers open first");
         }
+    }
+
+    /// The recovery waits half a second for the grippers to open only when they were not
+    /// both open already (told to open, and reading so): after a placed fruit both are, and
+    /// the arms at home go straight on to the next fruit.
+    #[test]
+    fn the_recovery_waits_for_grippers_only_when_they_were_not_open() {
+        use crate::motion::{Arm, HOME};
+        use agrisim_msgs::agrisim::GripperState;
+        use agrisim_msgs::sensor_msgs::JointState;
+        // Steps (100 ms each) from a pick's end to the next fruit's selection, with the
+        // grippers reading `width` wide throughout.
+        let steps_to_select = |width: f64, rounds: usize| -> Vec<usize> {
+            let mut row = RowNode::new(vec![3, 4, 5], 1);
+            let mut bus = Bus::default();
+            for arm in [Arm::Left, Arm::Right] {
+                let js = JointState { name: arm.joint_names().to_vec(), position: HOME.to_vec(), ..Default::default() };
+                bus.publish(&arm.topic("joint_states"), 0, &js);
+                let g = GripperState { position: width, ..Default::default() };
+                bus.publish(&arm.gripper_topic("state"), 0, &g);
+            }
+            row.step(0, &mut bus).unwrap();
+            let mut t = 0;
+            (0..rounds)
+                .map(|_| {
+                    row.inner.stage = Stage::Done;
+                    let mut n = 0;
+                    while row.inner.stage() != Stage::SelectTarget {
+                        t += 100_000_000;
+                        n += 1;
+                        row.step(t, &mut bus).unwrap();
+                        assert!(n < 50, "stuck in {:?}", row.inner.stage());
+                    }
+                    n
+                })
+                .collect()
+        };
+        // Not told to open before the first recovery: it waits; the second does not.
+        let open = steps_to_select(geo::OPEN_WIDTH, 2);
+        assert!(open[0] >= 6 && open[1] <= 2, "{open:?}");
+        // Reading half closed: every recovery waits.
+        let half = steps_to_select(0.03, 2);
+        assert!(half.iter().all(|&n| n >= 6), "{half:?}");
     }
 
     /// Regression (row by sight, 2026-11-29): a fruit still in a gripper when the next task

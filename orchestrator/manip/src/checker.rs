@@ -225,17 +225,8 @@ impl<'a> Checker<'a> {
                 }
             }
         }
-        if let Some(o) = &ctx.other {
-            let ooff = &o.arm.spheres.offsets;
-            for a in 0..NBODIES {
-                for b in 0..NBODIES {
-                    if spheres_touch(&bounds[a], &self.other_bounds[b], pad)
-                        && bodies_touch(s, rng(a), &self.other, ooff[b]..ooff[b + 1], pad)
-                    {
-                        return Some(Contact { body: a, hit: Hit::OtherArm(b) });
-                    }
-                }
-            }
+        if let Some(c) = self.links_contact(s, &bounds) {
+            return Some(c);
         }
         let scene = ctx.scene;
         for b in 0..NBODIES {
@@ -254,11 +245,72 @@ impl<'a> Checker<'a> {
                 return Some(c);
             }
         }
-        if let Some(f) = &self.other_held {
-            for b in 0..HAND {
-                if spheres_touch(f, &bounds[b], pad) && bodies_touch(std::slice::from_ref(f), 0..1, s, rng(b), pad) {
-                    return Some(Contact { body: b, hit: Hit::OtherArm(HELD) });
+        self.other_held_contact(s, &bounds)
+    }
+
+    /// The first contact at `q` between the two arms alone (links, and what each holds), or
+    /// `None`: for checking two motions against each other, each already checked against
+    /// everything else.
+    pub fn arms_contact(&self, q: &[f64; DOF]) -> Option<Contact> {
+        self.checks.set(self.checks.get() + 1);
+        if let Some(m) = self.ctx.meter {
+            m.add_check();
+        }
+        let ctx = &self.ctx;
+        let mut buf = self.buf.borrow_mut();
+        let (bounds, tcp) = world_spheres(ctx.arm, ctx.lift, q, ctx.finger, &mut buf);
+        let s = &buf[..];
+        if let Some(c) = self.links_contact(s, &bounds) {
+            return Some(c);
+        }
+        if let Some(h) = ctx.held {
+            let fruit = (tcp * Point3::from(h.offset), h.radius);
+            if let Some(c) = self.held_other_contact(&fruit) {
+                return Some(c);
+            }
+        }
+        self.other_held_contact(s, &bounds)
+    }
+
+    /// This arm's links against the other arm's.
+    fn links_contact(&self, s: &[(Point3<f64>, f64)], bounds: &[(Point3<f64>, f64); NBODIES]) -> Option<Contact> {
+        let o = self.ctx.other.as_ref()?;
+        let (pad, off, ooff) = (self.ctx.padding, &self.ctx.arm.spheres.offsets, &o.arm.spheres.offsets);
+        for a in 0..NBODIES {
+            for b in 0..NBODIES {
+                if spheres_touch(&bounds[a], &self.other_bounds[b], pad)
+                    && bodies_touch(s, off[a]..off[a + 1], &self.other, ooff[b]..ooff[b + 1], pad)
+                {
+                    return Some(Contact { body: a, hit: Hit::OtherArm(b) });
                 }
+            }
+        }
+        None
+    }
+
+    /// The fruit the other arm holds against this arm's links.
+    fn other_held_contact(&self, s: &[(Point3<f64>, f64)], bounds: &[(Point3<f64>, f64); NBODIES]) -> Option<Contact> {
+        let f = self.other_held.as_ref()?;
+        let (pad, off) = (self.ctx.padding, &self.ctx.arm.spheres.offsets);
+        for b in 0..HAND {
+            if spheres_touch(f, &bounds[b], pad)
+                && bodies_touch(std::slice::from_ref(f), 0..1, s, off[b]..off[b + 1], pad)
+            {
+                return Some(Contact { body: b, hit: Hit::OtherArm(HELD) });
+            }
+        }
+        None
+    }
+
+    /// This arm's held sphere against the other arm's links.
+    fn held_other_contact(&self, f: &(Point3<f64>, f64)) -> Option<Contact> {
+        let o = self.ctx.other.as_ref()?;
+        let (pad, ooff, one) = (self.ctx.padding, &o.arm.spheres.offsets, std::slice::from_ref(f));
+        for b in 0..HAND {
+            if spheres_touch(f, &self.other_bounds[b], pad)
+                && bodies_touch(one, 0..1, &self.other, ooff[b]..ooff[b + 1], pad)
+            {
+                return Some(Contact { body: HELD, hit: Hit::OtherArm(b) });
             }
         }
         None
@@ -286,15 +338,8 @@ impl<'a> Checker<'a> {
                 return Some(Contact { body: HELD, hit: Hit::RobotBody(i) });
             }
         }
-        if let Some(o) = &ctx.other {
-            let ooff = &o.arm.spheres.offsets;
-            for b in 0..HAND {
-                if spheres_touch(f, &self.other_bounds[b], pad)
-                    && bodies_touch(one, 0..1, &self.other, ooff[b]..ooff[b + 1], pad)
-                {
-                    return Some(Contact { body: HELD, hit: Hit::OtherArm(b) });
-                }
-            }
+        if let Some(c) = self.held_other_contact(f) {
+            return Some(c);
         }
         let scene = ctx.scene;
         object_contact(scene, HELD, &f.0, f.1 + pad, |i| scene.prim(i).overlaps_sphere(&f.0, f.1 + pad))

@@ -151,4 +151,41 @@ impl Planner {
         stats.planning_time_s = t0.elapsed().as_secs_f64();
         Ok(Plan { waypoints: path, goal_index, stats })
     }
+
+    /// [`Planner::plan`] from a start that touches something (a hand ended against a leaf,
+    /// or within the padding of the other hand after a handover), which `plan` refuses, and
+    /// with it every later plan from there; what MoveIt's FixStartStateCollision adapter
+    /// does. Configurations are drawn about the start, at most [`UNSTICK_STEPS`] rad per
+    /// joint, the smallest first; the first valid one whose straight way from the start is
+    /// valid beyond its first third (it leaves the contact, not through it) is planned from,
+    /// and the start put before it. Other errors of `plan` are returned as they are.
+    pub fn plan_out_of_contact(&self, ctx: &Context, start: &Q, goals: &[Q], rng: &mut Rng) -> Result<Plan, PlanError> {
+        let first = match self.plan(ctx, start, goals, rng) {
+            Err(PlanError::StartInCollision(what)) => PlanError::StartInCollision(what),
+            r => return r,
+        };
+        let checker = Checker::new(*ctx);
+        let res = self.config.rrt.resolution;
+        for scale in UNSTICK_STEPS {
+            for _ in 0..UNSTICK_DRAWS {
+                let q: Q = std::array::from_fn(|i| start[i] + scale * (2.0 * rng.uniform() - 1.0));
+                let n = crate::checker::steps(start, &q, res);
+                let leaves =
+                    (n / 3..=n).all(|k| checker.is_valid(&crate::checker::lerp(start, &q, k as f64 / n as f64)));
+                if !leaves {
+                    continue;
+                }
+                let mut p = self.plan(ctx, &q, goals, rng)?;
+                p.waypoints.insert(0, *start);
+                return Ok(p);
+            }
+        }
+        Err(first)
+    }
 }
+
+/// How far [`Planner::plan_out_of_contact`] looks about a start in contact [rad per joint],
+/// step by step.
+pub const UNSTICK_STEPS: [f64; 4] = [0.02, 0.05, 0.1, 0.2];
+/// Configurations drawn at each step.
+pub const UNSTICK_DRAWS: usize = 20;

@@ -211,3 +211,55 @@ fn a_held_fruit_collides_where_the_empty_gripper_does_not() {
         }
     }
 }
+
+/// `arms_contact` is the two-arm part of `contact`: over random configurations, held
+/// fruit and obstacles, it finds a contact whenever the full check's first contact is with
+/// the other arm (or its fruit), any contact it finds fails the full check too, and it finds
+/// one only where the arms alone meet (the same check with the other arm moved far away
+/// and nothing held finds none there).
+#[test]
+fn arms_contact_is_the_two_arm_part_of_the_full_check() {
+    let left = ArmModel::new(Side::Left);
+    let right = ArmModel::new(Side::Right);
+    let mut rng = Rng::new(5);
+    let (mut arm_hits, mut other_first) = (0, 0);
+    for trial in 0..300 {
+        let scene = Scene::new((0..6).map(|i| random_obstacle(&mut rng, i)).collect());
+        let empty = Scene::new(vec![]);
+        let lift = 0.8 * rng.uniform();
+        let q_other = right.random_q(&mut rng);
+        let held = (trial % 3 == 1).then(|| 0.02 + 0.03 * rng.uniform());
+        let other_held = (trial % 4 == 2).then(|| 0.02 + 0.03 * rng.uniform());
+        let build = |scene, other: bool| {
+            let mut ctx = Context::new(&left, lift, scene);
+            if other {
+                ctx = ctx.with_other(&right, q_other, 0.04);
+            }
+            if let Some(r) = held {
+                ctx = ctx.holding(r);
+            }
+            if let Some(r) = other_held {
+                ctx = ctx.other_holding(r);
+            }
+            Checker::new(ctx)
+        };
+        let (full, alone) = (build(&scene, true), build(&empty, false));
+        for _ in 0..20 {
+            let q = left.random_q(&mut rng);
+            let a = full.arms_contact(&q);
+            assert!(alone.arms_contact(&q).is_none(), "trial {trial}: no other arm, no contact between arms");
+            if let Some(c) = full.contact(&q) {
+                if matches!(c.hit, Hit::OtherArm(_)) {
+                    other_first += 1;
+                    assert!(a.is_some(), "trial {trial}: the full check met the other arm at {q:?}");
+                }
+            }
+            if let Some(c) = a {
+                arm_hits += 1;
+                assert!(matches!(c.hit, Hit::OtherArm(_)), "trial {trial}: {c:?}");
+                assert!(!full.is_valid(&q), "trial {trial}: the full check passes {q:?}");
+            }
+        }
+    }
+    assert!(other_first > 50 && arm_hits >= other_first, "too few arm contacts drawn: {other_first}, {arm_hits}");
+}

@@ -181,3 +181,64 @@ fn cartesian_approach_is_a_straight_line_and_stops_at_obstacles() {
     assert!(e.fraction > 0.2 && e.fraction < 0.9, "{e}");
     assert!(e.partial.iter().all(|q| checker.is_valid(q)));
 }
+
+/// A start whose fingers touch a small object (a hand that ended against a leaf) is refused
+/// by `plan`; `plan_out_of_contact` moves out of the contact and plans on: the path starts
+/// at the start, leaves the contact within the first third of its first segment, and is
+/// valid from there on. A start clear of everything gets `plan`'s own answer.
+#[test]
+fn a_start_in_contact_is_planned_out_of() {
+    // The harvest's home pose (READY's elbow meets the lift rails at low lift heights).
+    const HOME: [f64; 7] = [0.0, -0.3, 0.0, -2.356, 0.0, 1.571, 0.785];
+    let arm = ArmModel::new(Side::Left);
+    assert!(Checker::new(Context::new(&arm, 0.3, &Scene::new(vec![]))).is_valid(&HOME));
+    let planner = Planner::default();
+    let tcp = arm.fk_iso(0.3, &HOME);
+    // A 1 cm leaf beside the hand, as far out as it still touches (within the padding).
+    let leaf_at = |d: f64| {
+        let c = tcp * nalgebra::Point3::new(0.0, d, -0.05);
+        Scene::new(vec![Obstacle::new(
+            "leaf",
+            Shape::Sphere { radius: 0.01 },
+            Isometry3::translation(c.x, c.y, c.z),
+            ObstacleKind::Solid,
+        )])
+    };
+    let d = (0..300)
+        .map(|k| 0.3 - 0.001 * k as f64)
+        .find(|&d| !Checker::new(Context::new(&arm, 0.3, &leaf_at(d))).is_valid(&HOME))
+        .expect("a leaf beside the hand");
+    let scene = leaf_at(d);
+    let ctx = Context::new(&arm, 0.3, &scene);
+    let checker = Checker::new(ctx);
+    assert!(!checker.is_valid(&HOME), "the start touches the leaf");
+    let goal = [0.8, -0.8, 0.5, -0.5]
+        .iter()
+        .map(|dq| {
+            let mut g = HOME;
+            g[0] += dq;
+            g
+        })
+        .find(|g| checker.is_valid(g))
+        .expect("a valid goal");
+    let mut rng = Rng::new(4);
+    assert!(matches!(planner.plan(&ctx, &HOME, &[goal], &mut rng.clone()), Err(PlanError::StartInCollision(_))));
+    let p = planner.plan_out_of_contact(&ctx, &HOME, &[goal], &mut rng).expect("out of the contact");
+    assert_eq!(p.waypoints[0], HOME);
+    assert_eq!(*p.waypoints.last().unwrap(), goal);
+    let (a, b) = (p.waypoints[0], p.waypoints[1]);
+    let n = agrisim_manip::checker::steps(&a, &b, 0.02);
+    for k in n / 3..=n {
+        assert!(checker.is_valid(&agrisim_manip::checker::lerp(&a, &b, k as f64 / n as f64)), "step {k} of {n}");
+    }
+    assert!(p.waypoints[1..].iter().all(|q| checker.is_valid(q)));
+    for w in p.waypoints[1..].windows(2) {
+        assert!(checker.edge_valid(&w[0], &w[1], 0.02));
+    }
+    // Clear of everything: the same as plan.
+    let free = Scene::new(vec![]);
+    let ctx = Context::new(&arm, 0.3, &free);
+    let a = planner.plan(&ctx, &HOME, &[goal], &mut Rng::new(9)).unwrap().waypoints;
+    let b = planner.plan_out_of_contact(&ctx, &HOME, &[goal], &mut Rng::new(9)).unwrap().waypoints;
+    assert_eq!(a, b);
+}

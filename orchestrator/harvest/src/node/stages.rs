@@ -3,7 +3,7 @@
 
 use super::{topics, HarvestNode};
 use crate::geometry::{self as geo, TcpGoal};
-use crate::motion::Arm;
+use crate::motion::{Arm, Planned};
 use crate::sight::{self, Region};
 use crate::stage::{Failure, Stage};
 use agrisim_bus::Bus;
@@ -63,25 +63,18 @@ impl HarvestNode {
                     );
                     return;
                 }
-                for arm in [Arm::Left, Arm::Right] {
-                    self.gripper(arm, geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
-                }
-                self.stop_base(t_ns, bus);
-                self.phase = 1;
+                self.open_grippers(t_ns, bus);
             }
             0 => {
                 // Back from putting a held fruit into the box, or from failing to: the
                 // grippers as usual.
                 self.rescuing = false;
-                for arm in [Arm::Left, Arm::Right] {
-                    self.gripper(arm, geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
-                }
-                self.stop_base(t_ns, bus);
-                self.phase = 1;
+                self.open_grippers(t_ns, bus);
             }
-            // The grippers open (half a second), then each arm that is not home goes
-            // home, the one that reached furthest first (it may stand in the other's way).
-            1 if self.step_in_stage > 5 => {
+            // The grippers open (half a second, unless both were open already), then each
+            // arm that is not home goes home, the one that reached furthest first (it may
+            // stand in the other's way).
+            1 if self.step_in_stage > 5 || self.grippers_were_open => {
                 let far = |a: Arm| agrisim_manip::ik::dist(&self.q(a), &crate::motion::HOME);
                 let arm = if far(Arm::Left) >= far(Arm::Right) { Arm::Left } else { Arm::Right };
                 if far(arm) < 1e-3 {
@@ -103,6 +96,17 @@ impl HarvestNode {
             2 if [Arm::Left, Arm::Right].iter().all(|&a| self.arm_done(a, t_ns, bus) == Some(true)) => self.phase = 1,
             _ => {}
         }
+    }
+
+    /// Recovery's start: both grippers told to open (noting whether both already were, told
+    /// so and reading so: then nothing waits for them), the base stopped.
+    fn open_grippers(&mut self, t_ns: i64, bus: &mut Bus) {
+        self.grippers_were_open = [Arm::Left, Arm::Right].iter().all(|&a| self.gripper_open(a));
+        for arm in [Arm::Left, Arm::Right] {
+            self.gripper(arm, geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
+        }
+        self.stop_base(t_ns, bus);
+        self.phase = 1;
     }
 
     /// Waits for the target, the localized pose and both arms' joints, then chooses the side
@@ -563,11 +567,14 @@ impl HarvestNode {
                         return;
                     }
                     // The giver backs off if a straight line allows it; otherwise
-                    // its plan home (next stage) starts right here.
+                    // its plan home (next stage) starts right here. The hands met by
+                    // design, so the line is checked with the taker's approach's margin.
                     let (g, _) = geo::handover_goals(geo::handover_point(self.lift), self.side);
                     let goal = TcpGoal { x_axis: None, ..g.along(-GIVER_BACKOFF) };
                     let (start, other) = (self.q(giver), self.q(taker));
+                    self.motion.set_padding(HANDOVER_PADDING);
                     let r = self.motion.plan_linear(giver, self.lift, start, &goal, other);
+                    self.motion.set_padding(agrisim_manip::checker::DEFAULT_PADDING);
                     self.record(giver, "linear", &r, true, t_ns, bus);
                     if let Ok(p) = r {
                         self.send(giver, p, t_ns, bus);
@@ -599,7 +606,10 @@ impl HarvestNode {
     /// The giver, whose back-off was sent on entering, goes home, the lift goes to the
     /// transfer height, then the taker carries the fruit over the box and lowers it straight
     /// down into it, to just above the floor or the fruit already there
-    /// ([`geo::place_goals`]). -> release.
+    /// ([`geo::place_goals`]). With the lift already there, the taker sets off for the box
+    /// as the giver sets off home, where the two trajectories keep the arms apart
+    /// ([`Motion::trajectories_clear`](crate::motion::Motion::trajectories_clear)); the way
+    /// down waits for both. -> release.
     // A phase's guard says when it may act; the motion request inside is the action, kept out
     // of the guard so no arm's condition has side effects.
     #[allow(clippy::collapsible_match)]
@@ -607,6 +617,24 @@ impl HarvestNode {
         let (giver, taker) = (self.giver(), self.taker());
         match self.phase_now() {
             0 if self.arm_done(giver, t_ns, bus) == Some(true) => {
+                if self.lift_at(geo::LIFT_TRANSFER) {
+                    match self.plan_transfer_together(t_ns, bus) {
+                        (Ok(h), Some(p)) => {
+                            self.send(giver, h, t_ns, bus);
+                            self.send(taker, p, t_ns, bus);
+                            self.phase = 2;
+                        }
+                        (Ok(h), None) => {
+                            self.send(giver, h, t_ns, bus);
+                            self.phase = 1;
+                        }
+                        (Err(e), _) => {
+                            let why = format!("{} arm, {}: {e}", giver.name(), self.stage.name());
+                            self.fail(Failure::Planning, t_ns, bus, why);
+                        }
+                    }
+                    return;
+                }
                 if self.move_home(giver, t_ns, bus) {
                     self.phase = 1;
                 }
@@ -628,15 +656,7 @@ impl HarvestNode {
                 // spread instead of heaping up under one. The fruit sits in the taker's
                 // pads where the giver held it (GRASP_DEPTH short of its TCP), shifted by
                 // the handover attempt's offset.
-                let radius = self
-                    .motion
-                    .target_radius()
-                    .unwrap_or(0.5 * self.view(taker).gripper.as_ref().map_or(0.06, |g| g.position));
-                let below_tcp = geo::GRASP_DEPTH - self.handover_offset;
-                let mut goals = geo::place_goals(radius, below_tcp, &self.box_heap());
-                let spot = self.boxed as usize % geo::DROP_SPOTS;
-                goals[..geo::DROP_SPOTS].rotate_left(spot);
-                goals[geo::DROP_SPOTS..].rotate_left(spot);
+                let goals = self.place_goals();
                 // Over the place pose first, with a roll whose straight way down is free.
                 let (start, other) = (self.q(taker), self.q(giver));
                 let r = self
@@ -659,7 +679,7 @@ impl HarvestNode {
                     }
                 }
             }
-            2 if self.arm_done(taker, t_ns, bus) == Some(true) => {
+            2 if [taker, giver].iter().all(|&a| self.arm_done(a, t_ns, bus) == Some(true)) => {
                 if !self.holding(taker) {
                     self.fail(Failure::Handover, t_ns, bus, "the fruit was lost on the way to the box".into());
                     return;
@@ -682,6 +702,48 @@ impl HarvestNode {
             }
             _ => {}
         }
+    }
+
+    /// Where the taker may put the fruit down: successive fruit of a row go to successive
+    /// spots in the box, so they spread instead of heaping up under one. The fruit sits in
+    /// the taker's pads where the giver held it (GRASP_DEPTH short of its TCP), shifted by
+    /// the handover attempt's offset.
+    fn place_goals(&self) -> Vec<TcpGoal> {
+        let radius = self
+            .motion
+            .target_radius()
+            .unwrap_or(0.5 * self.view(self.taker()).gripper.as_ref().map_or(0.06, |g| g.position));
+        let below_tcp = geo::GRASP_DEPTH - self.handover_offset;
+        let mut goals = geo::place_goals(radius, below_tcp, &self.box_heap());
+        let spot = self.boxed as usize % geo::DROP_SPOTS;
+        goals[..geo::DROP_SPOTS].rotate_left(spot);
+        goals[geo::DROP_SPOTS..].rotate_left(spot);
+        goals
+    }
+
+    /// The giver's way home and, where it can set off at once, the taker's way to the stand-off
+    /// over the box: planned with the giver home, and checked against the giver's way in
+    /// time. Both reported (the taker's as optional: it has the sequential way as fallback).
+    fn plan_transfer_together(&mut self, t_ns: i64, bus: &mut Bus) -> (Result<Planned, String>, Option<Planned>) {
+        let (giver, taker) = (self.giver(), self.taker());
+        let (g0, t0) = (self.q(giver), self.q(taker));
+        let home = self.motion.plan_home(giver, self.lift, g0, t0);
+        self.record(giver, "home", &home, false, t_ns, bus);
+        let Ok(home) = home else { return (home, None) };
+        let goals = self.place_goals();
+        let place = self
+            .motion
+            .plan_pregrasp_any(taker, self.lift, t0, &goals, geo::PLACE_DESCENT, home.goal_q)
+            .map(|(_, p)| p)
+            .and_then(|p| {
+                if self.motion.trajectories_clear(taker, self.lift, &p, &home) {
+                    Ok(p)
+                } else {
+                    Err("the way to the box meets the giver's way home".into())
+                }
+            });
+        self.record(taker, "pregrasp", &place, true, t_ns, bus);
+        (Ok(home), place.ok())
     }
 
     /// What lies in the harvest box by the planning scene (base frame): every sphere (centre,
