@@ -327,27 +327,16 @@ impl Motion {
     /// start at the same instant: each configuration of `mine` keeps the arms apart (with
     /// what each holds) from every configuration the other arm passes through within
     /// [`TIMING_SLACK`] of the same time, both sampled every 10 ms (an arm at rest at its
-    /// end after it). Each trajectory was checked against the scene when it was planned;
-    /// this adds only what moving both at once adds, so the scene is left out.
+    /// end after it). Each trajectory was checked against the scene and the robot when it
+    /// was planned; this adds only what moving both at once adds
+    /// ([`Checker::arms_contact`]).
     pub fn trajectories_clear(&self, arm: Arm, lift: f64, mine: &Planned, theirs: &Planned) -> bool {
         const DT: f64 = 0.01;
         let n = (mine.duration.max(theirs.duration) / DT).ceil() as usize + 1;
         let w = (TIMING_SLACK / DT).round() as usize;
         let qs: Vec<[f64; DOF]> = (0..n).map(|i| mine.at(i as f64 * DT)).collect();
-        let empty = Scene::new(vec![]);
-        let o = self.model(arm.other());
         (0..n).all(|j| {
-            let q_other = theirs.at(j as f64 * DT);
-            let mut ctx = Context::new(self.model(arm), lift, &empty).with_other(o, q_other, o.finger_limits.upper);
-            ctx.padding = self.padding;
-            ctx.meter = Some(&self.meter);
-            if let Some(r) = self.held[arm.index()] {
-                ctx = ctx.holding(r);
-            }
-            if let Some(r) = self.held[arm.other().index()] {
-                ctx = ctx.other_holding(r);
-            }
-            let checker = Checker::new(ctx);
+            let checker = Checker::new(self.context(arm, lift, theirs.at(j as f64 * DT)));
             qs[j.saturating_sub(w)..(j + w + 1).min(n)].iter().all(|q| checker.arms_contact(q).is_none())
         })
     }
