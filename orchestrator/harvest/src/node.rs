@@ -138,10 +138,6 @@ pub struct HarvestNode {
     /// How the fruit came off: "bend" (the wrist roll) or "pull" (the retreat).
     pub detach_motion: &'static str,
     handover_attempts: u32,
-    /// How far the TCP of the hand that takes the fruit to the box is past the giver's TCP at
-    /// the handover ([`geo::HANDOVER_DEPTHS`]): the fruit's centre sits this minus
-    /// GRASP_DEPTH short of that TCP.
-    handover_offset: f64,
     release_ns: i64,
     target_name: String,
     /// Motions planned so far (reported in the status).
@@ -238,7 +234,6 @@ impl HarvestNode {
             grasp_q: [0.0; 7],
             detach_motion: "",
             handover_attempts: 0,
-            handover_offset: geo::HANDOVER_DEPTHS[0],
             release_ns: 0,
             target_name: String::new(),
             plans: 0,
@@ -367,6 +362,14 @@ impl HarvestNode {
 
     fn taker(&self) -> Arm {
         self.giver().other()
+    }
+
+    /// How far the TCP of the hand that takes the fruit to the box is past the giver's TCP at
+    /// the handover ([`geo::HANDOVER_DEPTHS`], by attempt): the fruit's centre sits this
+    /// minus GRASP_DEPTH short of that TCP. A fruit carried to the box by the arm that
+    /// picked it (a rescue, no handover tried) sits as at a first attempt.
+    fn handover_offset(&self) -> f64 {
+        geo::HANDOVER_DEPTHS[self.handover_attempts as usize]
     }
 
     fn view(&self, arm: Arm) -> &ArmView {

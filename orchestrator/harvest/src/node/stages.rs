@@ -47,9 +47,9 @@ impl HarvestNode {
             0 if !self.rescuing && !self.rescue_failed => {
                 if let Some(arm) = [Arm::Left, Arm::Right].into_iter().find(|&a| self.holding(a)) {
                     // The holder becomes the taker; the fruit sits GRASP_DEPTH short of its
-                    // TCP, where a giver holds it, as a taker's first attempt holds it.
+                    // TCP, where a giver holds it, as a taker's first attempt holds it
+                    // (`handover_offset` with no attempt made).
                     self.side = if arm == Arm::Right { 1.0 } else { -1.0 };
-                    self.handover_offset = geo::HANDOVER_DEPTHS[0];
                     let r = 0.5 * self.view(arm).gripper.as_ref().map_or(0.06, |g| g.position);
                     self.motion.set_held(arm, Some(r));
                     self.gripper(arm.other(), geo::OPEN_WIDTH, GRASP_FORCE, t_ns, bus);
@@ -526,7 +526,7 @@ impl HarvestNode {
             0 => {
                 self.motion.set_padding(HANDOVER_PADDING);
                 let ok =
-                    self.move_arm(taker, &TcpGoal { x_axis: None, ..t.along(self.handover_offset) }, true, t_ns, bus);
+                    self.move_arm(taker, &TcpGoal { x_axis: None, ..t.along(self.handover_offset()) }, true, t_ns, bus);
                 self.motion.set_padding(agrisim_manip::checker::DEFAULT_PADDING);
                 if ok {
                     self.phase = 1;
@@ -589,7 +589,6 @@ impl HarvestNode {
             }
             5 if self.arm_done(taker, t_ns, bus) == Some(true) => {
                 self.handover_attempts += 1;
-                self.handover_offset = geo::HANDOVER_DEPTHS[self.handover_attempts as usize];
                 self.publish_status(
                     t_ns,
                     bus,
@@ -713,7 +712,7 @@ impl HarvestNode {
             .motion
             .target_radius()
             .unwrap_or(0.5 * self.view(self.taker()).gripper.as_ref().map_or(0.06, |g| g.position));
-        let below_tcp = geo::GRASP_DEPTH - self.handover_offset;
+        let below_tcp = geo::GRASP_DEPTH - self.handover_offset();
         let mut goals = geo::place_goals(radius, below_tcp, &self.box_heap());
         let spot = self.boxed as usize % geo::DROP_SPOTS;
         goals[..geo::DROP_SPOTS].rotate_left(spot);
