@@ -104,8 +104,8 @@ impl Planned {
         let pts = &self.msg.points;
         let time = |k: usize| pts[k].time_from_start.to_nanos() as f64 * 1e-9;
         let q = |k: usize| -> [f64; DOF] { std::array::from_fn(|i| pts[k].positions.get(i).copied().unwrap_or(0.0)) };
-        let Some(k) = pts.iter().position(|p| p.time_from_start.to_nanos() as f64 * 1e-9 > t) else {
-            return pts.last().map_or([0.0; DOF], |_| q(pts.len() - 1));
+        let Some(k) = (0..pts.len()).position(|k| time(k) > t) else {
+            return if pts.is_empty() { [0.0; DOF] } else { q(pts.len() - 1) };
         };
         if k == 0 {
             return q(0);

@@ -651,10 +651,6 @@ impl HarvestNode {
                 self.phase = 5;
             }
             5 if self.lift_at(self.lift_target) => {
-                // Successive fruit of a row go to successive spots in the box, so they
-                // spread instead of heaping up under one. The fruit sits in the taker's
-                // pads where the giver held it (GRASP_DEPTH short of its TCP), shifted by
-                // the handover attempt's offset.
                 let goals = self.place_goals();
                 // Over the place pose first, with a roll whose straight way down is free.
                 let (start, other) = (self.q(taker), self.q(giver));
