@@ -178,6 +178,9 @@ pub struct HarvestNode {
     /// untried ripe fruit found there without scanning (a row's later tasks: the cameras
     /// kept looking through the last pick). The first task of a run has an empty map.
     look_first: bool,
+    /// By sight: how far inside (or, negative, outside) the region's faces a fruit's
+    /// estimate must lie to be chosen ([`sight::TASK_MARGIN`], a row's [`sight::ROW_MARGIN`]).
+    region_margin: [f64; 3],
     /// Why the task failed, once it has.
     pub(crate) failure: Option<Failure>,
 }
@@ -255,6 +258,7 @@ impl HarvestNode {
             tried: vec![],
             declined: 0,
             look_first: false,
+            region_margin: sight::TASK_MARGIN,
             failure: None,
         }
     }
@@ -289,6 +293,12 @@ impl HarvestNode {
         self
     }
 
+    /// By sight: chooses fruit with `margin` at the region's faces ([`sight::choose`]).
+    pub fn with_region_margin(mut self, margin: [f64; 3]) -> HarvestNode {
+        self.region_margin = margin;
+        self
+    }
+
     pub fn stage(&self) -> Stage {
         self.stage
     }
@@ -309,7 +319,7 @@ impl HarvestNode {
     /// arms home), then selects the new target. Target messages sent before `t_ns` are of
     /// the old fruit.
     pub fn next_task(&mut self, task: Task, t_ns: i64, bus: &mut Bus) {
-        let mut fresh = HarvestNode::with_task(task, 0).with_cost(self.cost);
+        let mut fresh = HarvestNode::with_task(task, 0).with_cost(self.cost).with_region_margin(self.region_margin);
         std::mem::swap(&mut fresh.motion, &mut self.motion);
         fresh.motion.set_held(Arm::Left, None);
         fresh.motion.set_held(Arm::Right, None);
@@ -639,7 +649,7 @@ impl HarvestNode {
         }
         let mut tried = self.tried.clone();
         tried.extend(self.target_map);
-        sight::choose(&self.fruit_map, &region, self.aisle_y, &tried)
+        sight::choose(&self.fruit_map, &region, self.region_margin, self.aisle_y, &tried)
     }
 
     /// Plans to the first reachable goal of `goals`.

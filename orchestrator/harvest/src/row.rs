@@ -58,7 +58,7 @@ impl RowNode {
         let first = regions.first().copied().unwrap_or(Region { x: [0.0; 2], y: [0.0; 2], z: [0.0; 2] });
         RowNode {
             plan: Plan::Regions { regions, current: 0, picks: 1, failures: 0, finished: false },
-            inner: HarvestNode::by_sight(first, seed),
+            inner: HarvestNode::by_sight(first, seed).with_region_margin(super::sight::ROW_MARGIN),
         }
     }
 
@@ -280,6 +280,10 @@ mod tests {
         assert_eq!(first_step(true, inside), Stage::PositionBase, "a later task takes the fruit it knows");
         // Outside the region (along the row): the later task scans.
         assert_eq!(first_step(true, [1.5, 0.5, 1.0]), Stage::SelectTarget);
+        // On the boundary with the next stretch, either side of it within the perception's
+        // error: the row's margin takes it (an inward margin left it to neither stretch).
+        assert_eq!(first_step(true, [0.995, 0.5, 1.0]), Stage::PositionBase);
+        assert_eq!(first_step(true, [1.005, 0.5, 1.0]), Stage::PositionBase);
     }
 
     /// The region rule: stay while picks succeed, move on when the scan finds nothing, after

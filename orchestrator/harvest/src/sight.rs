@@ -62,9 +62,10 @@ impl Region {
         [self.x, self.y, self.z].iter().zip(p).all(|(r, v)| r[0] <= v && v <= r[1])
     }
 
-    /// Whether `p` lies at least `margin` inside every face.
-    pub fn holds(&self, p: [f64; 3], margin: f64) -> bool {
-        [self.x, self.y, self.z].iter().zip(p).all(|(r, v)| r[0] + margin <= v && v <= r[1] - margin)
+    /// Whether `p` lies at least `margin[axis]` inside both faces of each axis (a negative
+    /// margin: at most that far outside).
+    pub fn holds(&self, p: [f64; 3], margin: [f64; 3]) -> bool {
+        [self.x, self.y, self.z].iter().zip(p).zip(margin).all(|((r, v), m)| r[0] + m <= v && v <= r[1] - m)
     }
 
     pub fn centre(&self) -> [f64; 3] {
@@ -115,10 +116,21 @@ pub fn fruit_of(map: &Detection3DArray, frame: &str) -> Vec<Seen> {
 /// failed on) is taken for that fruit and not chosen again [m]: about a fruit's radius, so
 /// the next fruit of a truss (its centre a diameter away) is still chosen.
 pub const TRIED_RADIUS: f64 = 0.025;
-/// A fruit is chosen only when its estimated centre lies this far inside the region [m]:
-/// the perception's centre error (p95 about 12 mm in the harvest by sight) could otherwise
-/// put a fruit just outside the task's stretch of row inside it.
+/// The perception's centre error to allow for at a region's faces [m] (p95 about 12 mm in
+/// the harvest by sight).
 pub const REGION_MARGIN: f64 = 0.015;
+/// A single task's margins ([`Region::holds`], per axis): a fruit is chosen only when its
+/// estimated centre lies [`REGION_MARGIN`] inside every face, as one outside the task's
+/// region fails the task.
+pub const TASK_MARGIN: [f64; 3] = [REGION_MARGIN; 3];
+/// A row's margins: along the row (x) and in height (z) a fruit is chosen when its estimate
+/// lies up to [`REGION_MARGIN`] outside. A row's regions abut along x, so an inward margin
+/// there left every fruit within it of a boundary to neither region (row by sight, seed 1,
+/// code of f2e38eb: 5 of the 23 ripe fruit never chosen lay within 15 mm of a region's
+/// face); a fruit just beyond the segment costs one pick and is still a ripe fruit in the
+/// box. Across the row (y) the margin stays inward: beyond the plant line hang the fruit of
+/// the row's far side, behind its stems.
+pub const ROW_MARGIN: [f64; 3] = [-REGION_MARGIN, REGION_MARGIN, -REGION_MARGIN];
 
 /// Fruit one task may decline for want of a collision-free pre-grasp before its planning
 /// failure stands (the node then takes the next ripe fruit of the region).
@@ -130,12 +142,13 @@ pub const MAX_DECLINED: usize = 2;
 /// trial 2: a 43.8 mm fruit, perceived 41.4 mm, 2.7 mm off) every grasp closed on nothing.
 pub const GRASPABLE_RADIUS: f64 = 0.5 * crate::geometry::OPEN_WIDTH - 0.002;
 
-/// The fruit to pick: ripe, no larger than [`GRASPABLE_RADIUS`], [`REGION_MARGIN`] inside `region`, not within [`TRIED_RADIUS`]
-/// of a place in `tried`; of those the one nearest the aisle line `aisle_y` (least plant in front of it),
-/// then nearest the region's centre along the row.
-pub fn choose(seen: &[Seen], region: &Region, aisle_y: f64, tried: &[[f64; 3]]) -> Option<Seen> {
+/// The fruit to pick: ripe, no larger than [`GRASPABLE_RADIUS`], held by `region` with
+/// `margin` ([`Region::holds`]), not within [`TRIED_RADIUS`] of a place in `tried`; of those
+/// the one nearest the aisle line `aisle_y` (least plant in front of it), then nearest the
+/// region's centre along the row.
+pub fn choose(seen: &[Seen], region: &Region, margin: [f64; 3], aisle_y: f64, tried: &[[f64; 3]]) -> Option<Seen> {
     let cx = region.centre()[0];
-    ripe_untried(seen, region, tried)
+    ripe_untried(seen, region, margin, tried)
         .filter(|s| s.radius <= GRASPABLE_RADIUS)
         .min_by(|a, b| {
             let key = |s: &Seen| ((s.center[1] - aisle_y).abs(), (s.center[0] - cx).abs());
@@ -148,18 +161,23 @@ pub fn choose(seen: &[Seen], region: &Region, aisle_y: f64, tried: &[[f64; 3]]) 
 /// The ripe fruit of `region` that [`choose`] passed over only for being wider than the hand
 /// opens ([`GRASPABLE_RADIUS`]): their perceived radii [m], largest first. Non-empty when a
 /// task ends with nothing to pick: the region's ripe fruit were seen, and too wide.
-pub fn too_wide(seen: &[Seen], region: &Region, tried: &[[f64; 3]]) -> Vec<f64> {
+pub fn too_wide(seen: &[Seen], region: &Region, margin: [f64; 3], tried: &[[f64; 3]]) -> Vec<f64> {
     let mut r: Vec<f64> =
-        ripe_untried(seen, region, tried).filter(|s| s.radius > GRASPABLE_RADIUS).map(|s| s.radius).collect();
+        ripe_untried(seen, region, margin, tried).filter(|s| s.radius > GRASPABLE_RADIUS).map(|s| s.radius).collect();
     r.sort_by(|a, b| b.total_cmp(a));
     r
 }
 
-/// The ripe fruit [`REGION_MARGIN`] inside `region`, not within [`TRIED_RADIUS`] of a place in
+/// The ripe fruit `region` holds with `margin`, not within [`TRIED_RADIUS`] of a place in
 /// `tried`: what [`choose`] and [`too_wide`] sort by size.
-fn ripe_untried<'a>(seen: &'a [Seen], region: &'a Region, tried: &'a [[f64; 3]]) -> impl Iterator<Item = &'a Seen> {
+fn ripe_untried<'a>(
+    seen: &'a [Seen],
+    region: &'a Region,
+    margin: [f64; 3],
+    tried: &'a [[f64; 3]],
+) -> impl Iterator<Item = &'a Seen> {
     seen.iter()
-        .filter(|s| s.ripe > RIPE_SHARE && region.holds(s.center, REGION_MARGIN))
+        .filter(move |s| s.ripe > RIPE_SHARE && region.holds(s.center, margin))
         .filter(|s| tried.iter().all(|p| dist(*p, s.center) > TRIED_RADIUS))
 }
 
@@ -335,13 +353,13 @@ mod tests {
         let seen = fruit_of(&map, "map");
         assert_eq!(seen.len(), 5);
         assert!((seen[1].radius - 0.03).abs() < 1e-12 && (seen[1].ripe - 0.6).abs() < 1e-12);
-        assert_eq!(choose(&seen, &region, 0.0, &[]).map(|s| s.id), Some("2".into()));
+        assert_eq!(choose(&seen, &region, TASK_MARGIN, 0.0, &[]).map(|s| s.id), Some("2".into()));
         // Tried there already (picked, or failed on): the next one, 1 being within
         // TRIED_RADIUS of its try only when that try was at it.
-        assert_eq!(choose(&seen, &region, 0.0, &[[1.81, 0.41, 1.2]]).map(|s| s.id), Some("1".into()));
-        assert_eq!(choose(&seen, &region, 0.0, &[[1.81, 0.41, 1.2], [1.5, 0.7, 1.02]]), None);
+        assert_eq!(choose(&seen, &region, TASK_MARGIN, 0.0, &[[1.81, 0.41, 1.2]]).map(|s| s.id), Some("1".into()));
+        assert_eq!(choose(&seen, &region, TASK_MARGIN, 0.0, &[[1.81, 0.41, 1.2], [1.5, 0.7, 1.02]]), None);
         assert_eq!(
-            choose(&seen, &region, 0.0, &[[1.8, 0.4, 1.2 + 1.5 * TRIED_RADIUS]]).map(|s| s.id),
+            choose(&seen, &region, TASK_MARGIN, 0.0, &[[1.8, 0.4, 1.2 + 1.5 * TRIED_RADIUS]]).map(|s| s.id),
             Some("2".into())
         );
         // Ripe and nearest the aisle, but within REGION_MARGIN of the region's end: its true
@@ -352,7 +370,23 @@ mod tests {
             .cloned()
             .chain(fruit_of(&Detection3DArray { detections: vec![edge], ..map.clone() }, "map"))
             .collect();
-        assert_eq!(choose(&with_edge, &region, 0.0, &[]).map(|s| s.id), Some("2".into()));
+        assert_eq!(choose(&with_edge, &region, TASK_MARGIN, 0.0, &[]).map(|s| s.id), Some("2".into()));
+        // A row's stretches abut along x: there it is chosen, and so is one just beyond the
+        // end, or just below the lowest height; one just beyond the plant line (y) is not.
+        assert_eq!(choose(&with_edge, &region, ROW_MARGIN, 0.0, &[]).map(|s| s.id), Some("6".into()));
+        for (c, chosen) in [
+            ([2.0 + 0.5 * REGION_MARGIN, 0.25, 1.0], true),
+            ([2.0 + 1.5 * REGION_MARGIN, 0.25, 1.0], false),
+            ([1.5, 0.25, 0.5 - 0.5 * REGION_MARGIN], true),
+            ([1.5, 1.0 + 0.5 * REGION_MARGIN, 1.0], false),
+            ([1.5, 1.0 - 0.5 * REGION_MARGIN, 1.0], false),
+        ] {
+            let one = fruit_of(
+                &Detection3DArray { detections: vec![track("8", c, 0.03, &[("red", 1.0)])], ..map.clone() },
+                "map",
+            );
+            assert_eq!(choose(&one, &region, ROW_MARGIN, 0.0, &[]).is_some(), chosen, "{c:?}");
+        }
         // Ripe and nearest the aisle, but too large for the hand.
         let large = track("7", [1.5, 0.25, 1.0], GRASPABLE_RADIUS + 0.001, &[("red", 1.0)]);
         let with_large: Vec<Seen> = seen
@@ -360,17 +394,17 @@ mod tests {
             .cloned()
             .chain(fruit_of(&Detection3DArray { detections: vec![large], ..map.clone() }, "map"))
             .collect();
-        assert_eq!(choose(&with_large, &region, 0.0, &[]).map(|s| s.id), Some("2".into()));
+        assert_eq!(choose(&with_large, &region, TASK_MARGIN, 0.0, &[]).map(|s| s.id), Some("2".into()));
         // Only it left (the others tried): nothing to choose, and it is named as too wide.
         let all_tried = [[1.8, 0.4, 1.2], [1.5, 0.7, 1.0]];
-        assert_eq!(choose(&with_large, &region, 0.0, &all_tried), None);
-        assert_eq!(too_wide(&with_large, &region, &all_tried), vec![GRASPABLE_RADIUS + 0.001]);
-        assert!(too_wide(&seen, &region, &all_tried).is_empty());
-        assert!(too_wide(&with_large, &region, &[[1.5, 0.25, 1.0]]).is_empty());
+        assert_eq!(choose(&with_large, &region, TASK_MARGIN, 0.0, &all_tried), None);
+        assert_eq!(too_wide(&with_large, &region, TASK_MARGIN, &all_tried), vec![GRASPABLE_RADIUS + 0.001]);
+        assert!(too_wide(&seen, &region, TASK_MARGIN, &all_tried).is_empty());
+        assert!(too_wide(&with_large, &region, TASK_MARGIN, &[[1.5, 0.25, 1.0]]).is_empty());
         // Another frame than the map's is not read.
         let odom = Detection3DArray { header: Header { frame_id: "odom".into(), ..Default::default() }, ..map };
         assert!(fruit_of(&odom, "map").is_empty());
-        assert_eq!(choose(&[], &region, 0.0, &[]), None);
+        assert_eq!(choose(&[], &region, TASK_MARGIN, 0.0, &[]), None);
     }
 
     #[test]

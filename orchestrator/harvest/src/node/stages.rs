@@ -167,7 +167,8 @@ impl HarvestNode {
             // A row's later task: a ripe fruit the map already holds is taken from where the
             // robot stands (the cameras looked on through the last pick); none: scan.
             if self.look_first {
-                if let Some(f) = sight::choose(&self.fruit_map, &region, self.aisle_y, &self.tried) {
+                if let Some(f) = sight::choose(&self.fruit_map, &region, self.region_margin, self.aisle_y, &self.tried)
+                {
                     self.target_seen(&f);
                     return self.aim(t_ns, bus);
                 }
@@ -182,7 +183,7 @@ impl HarvestNode {
         if ((t_ns - since) as f64) < sight::SCAN_DWELL * 1e9 {
             return;
         }
-        if let Some(f) = sight::choose(&self.fruit_map, &region, self.aisle_y, &self.tried) {
+        if let Some(f) = sight::choose(&self.fruit_map, &region, self.region_margin, self.aisle_y, &self.tried) {
             self.target_seen(&f);
             return self.aim(t_ns, bus);
         }
@@ -190,7 +191,7 @@ impl HarvestNode {
         self.scan += 1;
         if self.scan == sight::SCAN_LIFTS.len() {
             let n = self.fruit_map.iter().filter(|f| region.contains(f.center)).count();
-            let wide = sight::too_wide(&self.fruit_map, &region, &self.tried);
+            let wide = sight::too_wide(&self.fruit_map, &region, self.region_margin, &self.tried);
             if wide.is_empty() {
                 let why = format!("no ripe fruit in the region after the scan ({n} fruit of the map in it, none ripe)");
                 self.fail(Failure::NotDetected, t_ns, bus, why);
