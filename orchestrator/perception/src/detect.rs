@@ -252,16 +252,16 @@ impl Detector {
             .into_iter()
             .map(|(mut d, members)| {
                 // Each round reaches a little further round a partly coloured fruit.
-                let mut n = members.len();
+                let (mut n, mut skin) = (members.len(), None);
                 for _ in 0..3 {
-                    let (grown, m) = self.grow(f, d, n);
-                    d = grown;
+                    let (grown, m, surface) = self.grow(f, d, n);
+                    (d, skin) = (grown, surface);
                     if m <= n {
                         break;
                     }
                     n = m;
                 }
-                self.ripen(f, d)
+                self.ripen(f, d, skin)
             })
             .collect();
         out.work.fit_points = self.fit_points.get();
@@ -275,13 +275,14 @@ impl Detector {
     /// image whose point lies on its surface (within a few noise widths) is the same fruit,
     /// green or not; the sphere is fitted again to them all.
     /// (Growing over all depth-continuous pixels instead reached leaves and calyces: the
-    /// perception benchmark's centre error p95 rose from 13 to 14 mm.) Returns the detection
-    /// and the count of pixels it now rests on.
-    fn grow(&self, f: &Frame, d: Detection, members: usize) -> (Detection, usize) {
+    /// perception benchmark's centre error p95 rose from 13 to 14 mm.) Returns the detection,
+    /// the count of pixels it now rests on, and, when it is the detection given, its surface
+    /// (which [`Self::ripen`] then need not find again).
+    fn grow(&self, f: &Frame, d: Detection, members: usize) -> (Detection, usize, Option<Vec<usize>>) {
         let all = self.on_surface(f, &d);
         // A fit through a tenth more of the surface or less moves little.
         if all.len() * 10 <= members * 11 {
-            return (d, members);
+            return (d, members, Some(all));
         }
         let c = d.center;
         let fit = fit_sphere(&self.points(f, &all), &self.config.sphere).map(|s| (self.shape.unround(s.center), s));
@@ -292,17 +293,18 @@ impl Detector {
                     && !s.at_bound
                     && d2(center, c).sqrt() < d.radius =>
             {
-                (Detection { center, radius: s.radius, rms: s.rms, ..d }, all.len())
+                (Detection { center, radius: s.radius, rms: s.rms, ..d }, all.len(), None)
             }
-            _ => (d, members),
+            _ => (d, members, Some(all)),
         }
     }
 
     /// The stage of a placed fruit from its skin (every pixel on its sphere, green or not):
     /// each pixel's fraction of the surface below it along the world's up, and its colour.
-    fn ripen(&self, f: &Frame, d: Detection) -> Detection {
+    /// `skin`: the detection's surface when already found ([`Self::on_surface`]).
+    fn ripen(&self, f: &Frame, d: Detection, skin: Option<Vec<usize>>) -> Detection {
         let (up, rc) = (self.shape.up(), self.shape.round(d.center));
-        let skin = self.on_surface(f, &d);
+        let skin = skin.unwrap_or_else(|| self.on_surface(f, &d));
         let r = ripeness(skin.iter().map(|&i| {
             let p = self.shape.round(f.k.unproject(i % f.width, i / f.width, f.depth[i] as f64));
             (surface_below(p, rc, d.radius, up), [f.rgb[3 * i], f.rgb[3 * i + 1], f.rgb[3 * i + 2]])
