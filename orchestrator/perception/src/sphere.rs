@@ -248,12 +248,11 @@ pub(crate) mod tests {
         ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
     }
 
-    /// Noise-free caps give the sphere back to well under a millimetre.
     /// The cut-off by counting past the bounds is the cut-off by selecting the median, to the
     /// bit: 20 000 random residual sets of 8-600 points, their medians spread over and around
     /// both bounds, with residuals placed exactly on a bound's preimage, and NaNs.
     #[test]
-    fn the_cut_off_by_counting_is_the_median_s() {
+    fn counting_past_the_bounds_gives_the_median_cut_off() {
         let k = 4.685 * 1.4826;
         let by_median = |res: &[f64]| {
             let mut a: Vec<u64> = res.iter().map(|e| e.abs().to_bits()).collect();
@@ -296,6 +295,7 @@ pub(crate) mod tests {
         assert!(at_lo > 1000 && at_hi > 1000 && between > 1000, "{at_lo} {at_hi} {between}");
     }
 
+    /// Noise-free caps give the sphere back to well under a millimetre.
     #[test]
     fn exact_cap_is_recovered() {
         let mut rng = Mix(1);
