@@ -118,6 +118,9 @@ pub struct HarvestNode {
     base_ctl: super::base::BaseController,
     /// The current stage has sent its plan.
     planned: bool,
+    /// By sight: the target was chosen again while the base positioned or the pre-grasp was
+    /// being planned (its track was dropped): aim anew.
+    reaim: bool,
     /// Sub-step of multi-motion stages.
     phase: u8,
     /// Grasp attempts after the first, the hand's axes (across the pads, approach) at the
@@ -227,6 +230,7 @@ impl HarvestNode {
             in_place_ticks: 0,
             base_ctl: super::base::BaseController::default(),
             planned: false,
+            reaim: false,
             phase: 0,
             attempts: 0,
             regrasp_axes: [[0.0; 3]; 2],
@@ -405,8 +409,20 @@ impl HarvestNode {
             // the pre-grasp is planned.
             let following = self.stage == Stage::PositionBase || (self.stage == Stage::PreGrasp && !self.planned);
             if let (Some(id), Some(at), true) = (&self.track, self.target_map, following) {
-                if let Some(f) = sight::follow(&self.fruit_map, id, at, self.target_r) {
-                    (self.target_map, self.target_r, self.track) = (Some(f.center), f.radius, Some(f.id.clone()));
+                match sight::follow(&self.fruit_map, id, at, self.target_r).cloned() {
+                    Some(f) => self.target_seen(&f),
+                    // The track is gone and none took its place: the perception node dropped
+                    // it (frames saw through where it was), so its estimate is stale. Choose
+                    // again from the map as it stands, before any arm has moved toward it.
+                    None => {
+                        let again = self.region().and_then(|region| {
+                            sight::choose(&self.fruit_map, &region, self.region_margin, self.aisle_y, &self.tried)
+                        });
+                        if let Some(f) = again {
+                            self.target_seen(&f);
+                            self.reaim = true;
+                        }
+                    }
                 }
             }
         }
@@ -815,6 +831,9 @@ impl HarvestNode {
         if elapsed > STAGE_TIMEOUT && !matches!(self.stage, Stage::Done | Stage::Failed) {
             self.fail(Failure::Timeout, t_ns, bus, format!("stage {} took over {STAGE_TIMEOUT} s", self.stage.name()));
             return;
+        }
+        if std::mem::take(&mut self.reaim) && matches!(self.stage, Stage::PositionBase | Stage::PreGrasp) {
+            return self.aim(t_ns, bus);
         }
         match self.stage {
             Stage::Recover => self.run_recover(t_ns, bus),

@@ -286,6 +286,67 @@ mod tests {
         assert_eq!(first_step(true, [1.005, 0.5, 1.0]), Stage::PositionBase);
     }
 
+    /// A target whose track the perception node drops (frames saw through it) while the base
+    /// positions is chosen again from the map as it stands: the node aims at the fruit the
+    /// map now holds, not at the dropped track's last estimate. A track that merely moves, or
+    /// one that took the dropped one's place within its radius, is followed as before.
+    #[test]
+    fn a_dropped_target_track_is_chosen_again() {
+        use crate::motion::Arm;
+        use crate::sight::topics::{ALLOWED, FRUIT_MAP};
+        use agrisim_bus::Reader;
+        use agrisim_msgs::geometry_msgs::{Point, Pose, PoseStamped, Quaternion, Vector3};
+        use agrisim_msgs::sensor_msgs::JointState;
+        use agrisim_msgs::vision_msgs::{
+            BoundingBox3D, Detection3D, Detection3DArray, ObjectHypothesis, ObjectHypothesisWithPose,
+        };
+        let ripe = |id: &str, c: [f64; 3]| Detection3D {
+            results: vec![ObjectHypothesisWithPose {
+                hypothesis: ObjectHypothesis { class_id: "red".into(), score: 1.0 },
+                ..Default::default()
+            }],
+            bbox: BoundingBox3D {
+                center: Pose { position: Point { x: c[0], y: c[1], z: c[2] }, orientation: Quaternion::IDENTITY },
+                size: Vector3 { x: 0.06, y: 0.06, z: 0.06 },
+            },
+            id: id.into(),
+            ..Default::default()
+        };
+        let header = Header { frame_id: "map".into(), ..Default::default() };
+        let map = |d: Vec<Detection3D>| Detection3DArray { header: header.clone(), detections: d };
+        // Where the node aims after the second map, the first holding fruit "7" at `a`.
+        let aim_after = |second: Detection3DArray| -> [f64; 3] {
+            let mut row = RowNode::by_sight(vec![region(0.0), region(1.0)], 1);
+            let mut bus = Bus::default();
+            let mut allowed = Reader::new(ALLOWED);
+            bus.publish(FRUIT_MAP, 0, &map(vec![ripe("7", [0.5, 0.5, 1.0])]));
+            bus.publish(topics::POSE, 0, &PoseStamped { header: header.clone(), pose: Pose::default() });
+            for arm in [Arm::Left, Arm::Right] {
+                let js = JointState { name: arm.joint_names().to_vec(), position: vec![0.0; 7], ..Default::default() };
+                bus.publish(&arm.topic("joint_states"), 0, &js);
+            }
+            row.inner.next_task(Task::Region(region(0.0)), 0, &mut bus);
+            row.inner.stage = Stage::SelectTarget;
+            row.inner.step(100_000_000, &mut bus).unwrap();
+            assert_eq!(row.inner.stage(), Stage::PositionBase);
+            bus.publish(FRUIT_MAP, 150_000_000, &second);
+            row.inner.step(200_000_000, &mut bus).unwrap();
+            assert_eq!(row.inner.stage(), Stage::PositionBase);
+            let sent = allowed.take::<Detection3DArray>(&mut bus).unwrap();
+            let p = &sent.last().expect("an aim").detections[0].bbox.center.position;
+            [p.x, p.y, p.z]
+        };
+        let near = |a: [f64; 3], b: [f64; 3]| (0..3).all(|i| (a[i] - b[i]).abs() < 1e-9);
+        // Track 7 moved: followed.
+        assert!(near(aim_after(map(vec![ripe("7", [0.51, 0.5, 1.0])])), [0.51, 0.5, 1.0]));
+        // Dropped, another track within its radius: that one (the merge rule).
+        assert!(near(aim_after(map(vec![ripe("8", [0.52, 0.5, 1.0])])), [0.52, 0.5, 1.0]));
+        // Dropped, the region's fruit elsewhere: chosen again.
+        assert!(near(aim_after(map(vec![ripe("9", [0.2, 0.5, 1.3])])), [0.2, 0.5, 1.3]));
+        // Dropped, nothing in the region: the last estimate stays (nothing better is known).
+        assert!(near(aim_after(map(vec![ripe("9", [1.7, 0.5, 1.3])])), [0.5, 0.5, 1.0]));
+    }
+
     /// The region rule: stay while picks succeed, move on when the scan finds nothing, after
     /// MAX_FAILURES_PER_REGION failures in a row, or after MAX_PICKS_PER_REGION picks.
     #[test]
