@@ -1,33 +1,46 @@
-//! Compliant leaves: a leaf the robot presses gives way, turning about its petiole's base on
-//! the stem, and springs back when the robot leaves it.
+//! Compliant foliage: a leaf or a truss the robot presses gives way, turning about where it
+//! grows from the stem, and springs back when the robot leaves it.
 //!
 //! Model:
 //! - A compound leaf (its rachis and leaflets, [`agrisim_scene::generate::compound_leaf`]) is
-//!   one rigid blade hinged at the petiole's base: its state is a rotation vector `theta`
-//!   from its grown pose and a rate.
-//! - In contact, the robot moves it: a robot part pressing on the blade at `p` by `depth`
-//!   along the leaf's surface normal `n` (pointing to the part) turns it by the least
+//!   one rigid blade hinged at the petiole's base. A truss is its rachis (`.../truss{t}`)
+//!   hinged where it leaves the stem, carrying its pedicels (`.../pedicel{t}_{f}`) and the
+//!   fruit that still hang from it (`.../fruit{t}_{f}`). Each such part's state is a
+//!   rotation vector `theta` from its grown pose and a rate.
+//! - In contact, the robot moves it: a robot part pressing on the part at `p` by `depth`
+//!   along the surface normal `n` (pointing to the robot part) turns it by the least
 //!   rotation that takes `p` out of the way, `d theta = (p - hinge) x (-n) depth / |p - hinge|^2`
-//!   (of several presses on one leaf, the largest turn: the parts of one blade overlap, and
-//!   their turns are mostly one). The robot is kinematic, so the leaf follows it; holding the leaf
+//!   (of several presses on one part, the largest turn: its colliders overlap, and their
+//!   turns are mostly one). The robot is kinematic, so the part follows it; holding it
 //!   turned costs the robot the spring's moment: a force `k |theta| / |p - hinge|` at the press.
 //! - Free, it swings back as a damped rotational oscillator of natural frequency `f` and
 //!   damping ratio `zeta`: `theta'' = -w^2 theta - 2 zeta w theta'` (`w = 2 pi f`), integrated
 //!   semi-implicitly per step.
-//! - A leaf turns at most [`MAX_ANGLE`]; back within [`REST_ANGLE`] and slow, it is put back at
-//!   its grown pose and leaves the simulation: only leaves the robot has moved, and only
+//! - A part turns at most [`MAX_ANGLE`]; back within [`REST_ANGLE`] and slow, it is put back at
+//!   its grown pose and leaves the simulation: only parts the robot has moved, and only
 //!   until they are still again, are simulated, so the cost is bounded by what the robot
 //!   touches, not by the crop's size.
-//! - Colliders move with the leaf: contacts, clearance and the world's planning scene see the
-//!   deflected leaf, and the camera and LiDAR FMUs draw it where it is from the world's
-//!   `moved_objects` output ([`crate::moved_objects`]).
+//! - Colliders move with the part: contacts, clearance and the world's planning scene see the
+//!   deflected leaf or truss, and the camera and LiDAR FMUs draw it where it is from the
+//!   world's `moved_objects` output ([`crate::moved_objects`]).
+//! - A truss's fruit move with it only while they hang free on the plant. A fruit a gripper
+//!   holds (its pedicel not yet broken, [`crate::pedicel`]) follows the hand, and its pedicel
+//!   spring stands for the give of pedicel and truss together under the hand's pull; a press
+//!   on a fruit turns neither it nor its truss (only presses on the truss or its pedicels do).
 //!
-//! Figures (defaults of the `leaf_*` parameters), all estimates: no measurement of a tomato
-//! leaf's bending stiffness at the petiole was found. `leaf_stiffness` 0.3 N m/rad: a 30 cm leaf
-//! pushed 10 cm at its tip (0.33 rad) resists with about 0.3 N, a light brush.
-//! `leaf_frequency` 2 Hz, `leaf_damping_ratio` 0.5: leaves sway at a few hertz and settle in
-//! a few swings; a released leaf is back within 2 % of its turn in about
-//! `4 / (zeta w)` = 0.64 s.
+//! Figures (defaults of the `leaf_*` and `truss_*` parameters), all estimates: no
+//! measurement of a tomato leaf's or truss's bending stiffness at the stem was found.
+//! - `leaf_stiffness` 0.3 N m/rad: a 30 cm leaf pushed 10 cm at its tip (0.33 rad) resists
+//!   with about 0.3 N, a light brush. `leaf_frequency` 2 Hz, `leaf_damping_ratio` 0.5: leaves
+//!   sway at a few hertz and settle in a few swings; a released leaf is back within 2 % of
+//!   its turn in about `4 / (zeta w)` = 0.64 s.
+//! - `truss_stiffness` 1.5 N m/rad: a truss of 5 fruit of about 100 g whose weight acts some
+//!   8 cm from the stem (0.4 N m) would sag 0.26 rad on it, the kink that makes growers hang
+//!   heavy trusses in truss supports. Pushed 5 cm at 10 cm out (0.46 rad), it resists with
+//!   about 7 N. `truss_frequency` 2.5 Hz (that stiffness against about 0.5 kg at 8 cm gives
+//!   2.8 Hz), `truss_damping_ratio` 0.3: back within 2 % in about 0.85 s.
+//! - Compliant trusses are off by default (`truss_compliant = false`): the benchmarks' figures
+//!   were measured with rigid ones.
 
 use crate::contacts::Press;
 use crate::robot_links::{from_rapier, to_rapier};
@@ -36,6 +49,7 @@ use agrisim_math::vec3::{add, cross, dot, norm, scale, sub};
 use agrisim_robot::Pose as RPose;
 use agrisim_scene::scene::{Kind, Object};
 use agrisim_scene::Shape;
+use rapier3d::prelude::Pose;
 use std::collections::BTreeMap;
 
 /// Largest turn of a leaf from its grown pose [rad].
@@ -46,58 +60,125 @@ pub const MIN_ARM: f64 = 0.03;
 /// A free leaf turned less than this [rad], and slower than `REST_ANGLE` per second, is at rest.
 pub const REST_ANGLE: f64 = 1e-4;
 
-/// The foliage parameters (the FMU's `leaf_*` parameters).
+/// How one kind of part gives way (the FMU's `leaf_*` or `truss_*` parameters).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct FoliageParams {
-    /// Whether leaves give way (false: rigid, as before).
+pub struct Spring {
+    /// Whether parts of this kind give way (false: rigid).
     pub enabled: bool,
-    /// Rotational stiffness about the petiole's base [N m/rad].
+    /// Rotational stiffness about the hinge [N m/rad].
     pub stiffness: f64,
-    /// Natural frequency [Hz] and damping ratio of the free leaf.
+    /// Natural frequency [Hz] and damping ratio of the free part.
     pub frequency: f64,
     pub damping_ratio: f64,
 }
 
+/// The foliage parameters: leaves and trusses.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FoliageParams {
+    pub leaf: Spring,
+    pub truss: Spring,
+}
+
 impl Default for FoliageParams {
     fn default() -> Self {
-        FoliageParams { enabled: true, stiffness: 0.3, frequency: 2.0, damping_ratio: 0.5 }
+        FoliageParams {
+            leaf: Spring { enabled: true, stiffness: 0.3, frequency: 2.0, damping_ratio: 0.5 },
+            truss: Spring { enabled: false, stiffness: 1.5, frequency: 2.5, damping_ratio: 0.3 },
+        }
     }
 }
 
-/// A leaf: its objects (the rachis, then its leaflets) and its hinge, in the map frame.
+impl FoliageParams {
+    fn of(&self, part: Part) -> &Spring {
+        match part {
+            Part::Leaf => &self.leaf,
+            Part::Truss => &self.truss,
+        }
+    }
+}
+
+/// What kind of part turns about a hinge.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum Part {
+    Leaf,
+    Truss,
+}
+
+/// A leaf or a truss: its static objects (a leaf's rachis then its leaflets; a truss's rachis
+/// then its pedicels), the fruit hanging from it (scene object indices; none for a leaf) and
+/// its hinge, in the map frame.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Leaf {
+pub struct Hinged {
+    pub part: Part,
     pub objects: Vec<usize>,
+    pub fruit: Vec<usize>,
     pub hinge: [f64; 3],
+}
+
+/// The end of a cylinder on its local -z axis (where a rachis meets the stem).
+fn base_of(o: &Object) -> Option<[f64; 3]> {
+    match o.shape {
+        Shape::Cylinder { half_height, .. } => Some(o.placement.transform_point([0.0, 0.0, -half_height])),
+        _ => None,
+    }
 }
 
 /// Every compound leaf of `objects`: a rachis (`.../leaf{k}`, a cylinder whose local -z end
 /// is the petiole's base) and the leaflets named after it (`.../leaf{k}_{j}`), in object order.
-pub fn leaves(objects: &[Object]) -> Vec<Leaf> {
-    let mut out: Vec<Leaf> = Vec::new();
+pub fn leaves(objects: &[Object]) -> Vec<Hinged> {
+    let mut out: Vec<Hinged> = Vec::new();
     let mut rachis_name = String::new();
     for (i, o) in objects.iter().enumerate() {
         if o.kind != Kind::Leaf {
             continue;
         }
-        match o.shape {
-            Shape::Cylinder { half_height, .. } => {
-                let hinge = o.placement.transform_point([0.0, 0.0, -half_height]);
-                out.push(Leaf { objects: vec![i], hinge });
+        match base_of(o) {
+            Some(hinge) => {
+                out.push(Hinged { part: Part::Leaf, objects: vec![i], fruit: vec![], hinge });
                 rachis_name = format!("{}_", o.name);
             }
-            _ if !rachis_name.is_empty() && o.name.starts_with(&rachis_name) => {
+            None if !rachis_name.is_empty() && o.name.starts_with(&rachis_name) => {
                 if let Some(l) = out.last_mut() {
                     l.objects.push(i);
                 }
             }
-            _ => {}
+            None => {}
         }
     }
     out
 }
 
-/// A leaf the robot has moved and that is not at rest yet.
+/// Every truss of `objects`: a rachis (`{plant}/truss{t}`, a cylinder whose local -z end is
+/// at the stem) and, in the objects that follow it, its pedicels (`{plant}/pedicel{t}_{f}`)
+/// and fruit (`{plant}/fruit{t}_{f}`), as the scene generator grows them.
+pub fn trusses(objects: &[Object]) -> Vec<Hinged> {
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < objects.len() {
+        let o = &objects[i];
+        let split =
+            o.name.rsplit_once("/truss").filter(|(_, t)| !t.is_empty() && t.bytes().all(|b| b.is_ascii_digit()));
+        let (Kind::Truss, Some((plant, t)), Some(hinge)) = (o.kind, split, base_of(o)) else {
+            i += 1;
+            continue;
+        };
+        let (pedicel, fruit) = (format!("{plant}/pedicel{t}_"), format!("{plant}/fruit{t}_"));
+        let mut truss = Hinged { part: Part::Truss, objects: vec![i], fruit: vec![], hinge };
+        i += 1;
+        while let Some(o) = objects.get(i) {
+            match o.kind {
+                Kind::Truss if o.name.starts_with(&pedicel) => truss.objects.push(i),
+                Kind::Fruit { .. } if o.name.starts_with(&fruit) => truss.fruit.push(i),
+                _ => break,
+            }
+            i += 1;
+        }
+        out.push(truss);
+    }
+    out
+}
+
+/// A part the robot has moved and that is not at rest yet.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LeafState {
     /// Rotation vector from the grown pose [rad] and its rate [rad/s].
@@ -105,50 +186,68 @@ pub struct LeafState {
     pub rate: [f64; 3],
 }
 
-/// The moving leaves and what pushing them has cost.
+/// The moving leaves and trusses and what pushing them has cost.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Foliage {
-    /// By leaf index (into [`leaves`]).
+    /// By part index (into [`FoliageTable::parts`]).
     pub moving: BTreeMap<usize, LeafState>,
     /// Leaves the robot moved from rest (a leaf pushed again before it came to rest counts once).
     pub pushes: u64,
     /// The largest force the robot spent holding a leaf turned [N].
     pub peak_force: f64,
+    /// The same for trusses.
+    pub truss_pushes: u64,
+    pub peak_truss_force: f64,
 }
 
-/// The static per-scene data: leaves, the leaf of each object, each leaf object's grown pose.
+impl Foliage {
+    /// How many parts of this kind are off their grown pose.
+    pub fn moving_of(&self, table: &FoliageTable, part: Part) -> usize {
+        self.moving.keys().filter(|&&l| table.parts[l].part == part).count()
+    }
+}
+
+/// The static per-scene data: leaves and trusses, the part of each static object, each such
+/// object's grown pose, and each truss's fruit with their grown poses.
 #[derive(Clone, Debug, Default)]
-pub struct LeafTable {
-    pub leaves: Vec<Leaf>,
-    /// Leaf index by object index (sorted by object).
+pub struct FoliageTable {
+    /// The leaves, then the trusses.
+    pub parts: Vec<Hinged>,
+    /// Part index by object index (sorted by object).
     of_object: Vec<(usize, usize)>,
-    /// Grown collider pose of each leaf object, by object index (sorted).
+    /// Grown collider pose of each part's objects, by object index (sorted).
     rest: Vec<(usize, RPose)>,
+    /// By part: its fruit (fruit-list index) and their grown body poses.
+    hanging: Vec<Vec<(usize, Pose)>>,
 }
 
-impl LeafTable {
-    pub fn new(objects: &[Object], world: &SceneWorld) -> LeafTable {
-        let leaves = leaves(objects);
+impl FoliageTable {
+    pub fn new(objects: &[Object], world: &SceneWorld) -> FoliageTable {
+        let mut parts = leaves(objects);
+        parts.extend(trusses(objects));
         let mut of_object = Vec::new();
         let mut rest = Vec::new();
-        for (l, leaf) in leaves.iter().enumerate() {
-            for &o in &leaf.objects {
+        let mut hanging = Vec::new();
+        for (l, part) in parts.iter().enumerate() {
+            for &o in &part.objects {
                 of_object.push((o, l));
                 rest.push((o, from_rapier(world.colliders[world.objects[o].collider].position())));
             }
+            let fruit = part.fruit.iter().filter_map(|&o| world.fruit_of_object(o));
+            hanging.push(fruit.map(|f| (f, world.fruit_pose(f))).collect());
         }
         of_object.sort_unstable();
         rest.sort_unstable_by_key(|r| r.0);
-        LeafTable { leaves, of_object, rest }
+        FoliageTable { parts, of_object, rest, hanging }
     }
 
-    /// The leaf an object belongs to.
-    pub fn leaf_of(&self, object: usize) -> Option<usize> {
+    /// The part (leaf or truss) an object belongs to.
+    pub fn part_of(&self, object: usize) -> Option<usize> {
         self.of_object.binary_search_by_key(&object, |e| e.0).ok().map(|k| self.of_object[k].1)
     }
 
     fn rest(&self, object: usize) -> &RPose {
-        &self.rest[self.rest.binary_search_by_key(&object, |r| r.0).expect("a leaf object")].1
+        &self.rest[self.rest.binary_search_by_key(&object, |r| r.0).expect("a leaf or truss object")].1
     }
 }
 
@@ -162,42 +261,51 @@ fn rotation(theta: [f64; 3]) -> RPose {
 }
 
 impl Foliage {
-    /// One step of `h` seconds: `presses` of robot parts move the leaves they touch, free
-    /// leaves swing back; the moved leaves' colliders are put at their new poses. Returns
-    /// whether any collider moved.
+    /// One step of `h` seconds: `presses` of robot parts move the leaves and trusses they
+    /// touch, free ones swing back; the moved parts' colliders are put at their new poses,
+    /// and a truss's fruit with it while `hangs(fruit)` (fruit-list index) says the fruit
+    /// hangs free on its plant. Returns whether any collider moved.
     pub fn step(
         &mut self,
-        table: &LeafTable,
+        table: &FoliageTable,
         world: &mut SceneWorld,
         presses: &[Press],
         p: &FoliageParams,
         h: f64,
+        hangs: impl Fn(usize) -> bool,
     ) -> bool {
-        if !p.enabled {
+        if !p.leaf.enabled && !p.truss.enabled {
             return false;
         }
-        // Presses by leaf: the largest turn and its lever arm.
+        // Presses by part: the largest turn and its lever arm.
         let mut turns: BTreeMap<usize, ([f64; 3], f64)> = BTreeMap::new();
         for c in presses {
-            let Some(l) = table.leaf_of(c.object) else { continue };
-            let r = sub(c.point, table.leaves[l].hinge);
+            let Some(l) = table.part_of(c.object) else { continue };
+            if !p.of(table.parts[l].part).enabled {
+                continue;
+            }
+            let r = sub(c.point, table.parts[l].hinge);
             let arm = dot(r, r).sqrt().max(MIN_ARM);
             let turn = scale(cross(r, scale(c.normal, -1.0)), c.depth / (arm * arm));
             if turns.get(&l).is_none_or(|&(t, _)| norm(turn) > norm(t)) {
                 turns.insert(l, (turn, arm));
             }
         }
-        let w = 2.0 * std::f64::consts::PI * p.frequency;
         let mut moved = Vec::new();
         for (&l, &(turn, arm)) in &turns {
-            if !self.moving.contains_key(&l) {
-                self.pushes += 1;
-            }
+            let part = table.parts[l].part;
+            let new = !self.moving.contains_key(&l);
             let s = self.moving.entry(l).or_default();
             let before = s.theta;
             s.theta = clamp_angle(add(s.theta, turn));
             s.rate = scale(sub(s.theta, before), 1.0 / h);
-            self.peak_force = self.peak_force.max(p.stiffness * norm(s.theta) / arm);
+            let force = p.of(part).stiffness * norm(s.theta) / arm;
+            let (pushes, peak) = match part {
+                Part::Leaf => (&mut self.pushes, &mut self.peak_force),
+                Part::Truss => (&mut self.truss_pushes, &mut self.peak_truss_force),
+            };
+            *pushes += new as u64;
+            *peak = peak.max(force);
             moved.push(l);
         }
         let mut rested = Vec::new();
@@ -205,8 +313,10 @@ impl Foliage {
             if turns.contains_key(&l) {
                 continue;
             }
+            let sp = p.of(table.parts[l].part);
+            let w = 2.0 * std::f64::consts::PI * sp.frequency;
             // Semi-implicit Euler: the rate first, then the angle with the new rate.
-            let acc = sub(scale(s.theta, -w * w), scale(s.rate, 2.0 * p.damping_ratio * w));
+            let acc = sub(scale(s.theta, -w * w), scale(s.rate, 2.0 * sp.damping_ratio * w));
             s.rate = add(s.rate, scale(acc, h));
             s.theta = clamp_angle(add(s.theta, scale(s.rate, h)));
             if norm(s.theta) < REST_ANGLE && norm(s.rate) < REST_ANGLE {
@@ -218,8 +328,8 @@ impl Foliage {
             self.moving.remove(l);
         }
         for &l in &moved {
-            let theta = self.moving.get(&l).map_or([0.0; 3], |s| s.theta);
-            place(table, world, l, theta);
+            let theta = self.moving.get(&l).map(|s| s.theta);
+            place(table, world, l, theta, &hangs);
         }
         !moved.is_empty()
     }
@@ -234,15 +344,30 @@ fn clamp_angle(theta: [f64; 3]) -> [f64; 3] {
     }
 }
 
-/// Puts leaf `l`'s colliders at their grown poses turned by `theta` about its hinge.
-fn place(table: &LeafTable, world: &mut SceneWorld, l: usize, theta: [f64; 3]) {
-    let leaf = &table.leaves[l];
-    let about = RPose::from_translation(leaf.hinge)
-        .mul(&rotation(theta))
-        .mul(&RPose::from_translation(scale(leaf.hinge, -1.0)));
-    for &o in &leaf.objects {
+/// Puts part `l`'s colliders at their grown poses turned by `theta` about its hinge (`None`:
+/// back at rest), and its fruit that hang free with them: a fruit at rest exactly at its
+/// grown pose, so that `moved_objects` no longer lists it.
+fn place(
+    table: &FoliageTable,
+    world: &mut SceneWorld,
+    l: usize,
+    theta: Option<[f64; 3]>,
+    hangs: &impl Fn(usize) -> bool,
+) {
+    let part = &table.parts[l];
+    let about = RPose::from_translation(part.hinge)
+        .mul(&rotation(theta.unwrap_or([0.0; 3])))
+        .mul(&RPose::from_translation(scale(part.hinge, -1.0)));
+    for &o in &part.objects {
         let pose = to_rapier(&about.mul(table.rest(o)));
         let handle = world.objects[o].collider;
         world.colliders[handle].set_position(pose);
+    }
+    for &(f, grown) in &table.hanging[l] {
+        if hangs(f) {
+            let pose = if theta.is_some() { to_rapier(&about.mul(&from_rapier(&grown))) } else { grown };
+            let body = world.fruit[f].body;
+            world.bodies[body].set_position(pose, true);
+        }
     }
 }

@@ -3,12 +3,13 @@
 //! pushed leaf where it is pushed to and a picked fruit in the gripper or the box, not where
 //! the scene generator put it.
 //!
-//! Two kinds of objects ever move: the leaves the foliage model turns (each leaf's rachis and
-//! leaflets, while the leaf is off its rest pose) and fruit (a body that left its grown pose:
-//! pulled on its pedicel, carried, falling, boxed, dropped). Everything else is static, so
+//! Two kinds of objects ever move: the leaves and trusses the foliage model turns (a leaf's
+//! rachis and leaflets, a truss's rachis and pedicels, while off their rest pose) and fruit
+//! (a body that left its grown pose: on a turned truss, pulled on its pedicel, carried,
+//! falling, boxed, dropped). Everything else is static, so
 //! the list stays as short as what the robot touched.
 
-use crate::foliage::{Foliage, LeafTable};
+use crate::foliage::{Foliage, FoliageTable};
 use crate::geometry::{object_pose, pose_msg};
 use crate::scene_world::SceneWorld;
 use agrisim_msgs::agrisim::MovedObjects;
@@ -22,10 +23,15 @@ pub fn grown_fruit_poses(world: &SceneWorld) -> Vec<Pose> {
 
 /// Every moved object (ids ascending) with its placement in the map frame; `header` left
 /// default (the caller stamps it).
-pub fn moved_objects(world: &SceneWorld, grown_fruit: &[Pose], leaves: &LeafTable, foliage: &Foliage) -> MovedObjects {
+pub fn moved_objects(
+    world: &SceneWorld,
+    grown_fruit: &[Pose],
+    parts: &FoliageTable,
+    foliage: &Foliage,
+) -> MovedObjects {
     let mut moved: Vec<(u32, Pose)> = Vec::new();
     for &l in foliage.moving.keys() {
-        for &o in &leaves.leaves[l].objects {
+        for &o in &parts.parts[l].objects {
             let object = &world.objects[o];
             moved.push((object.id, object_pose(&world.colliders[object.collider])));
         }

@@ -233,6 +233,20 @@ agrisim_fmi::variables! { pub VARIABLES {
         .desc("Leaves now turned from their grown pose (pressed, or swinging back)"),
     PEAK_LEAF_FORCE = Var::output("peak_leaf_force").unit("N").init_depends_on(&[])
         .desc("Largest force the robot spent holding a leaf aside so far"),
+    TRUSS_COMPLIANT = Var::param("truss_compliant", Start::Boolean(false))
+        .desc("Whether trusses give way to the robot, turning about where they leave the stem with their pedicels and hanging fruit, and spring back (false: rigid)"),
+    TRUSS_STIFFNESS = Var::param("truss_stiffness", Start::Float64(1.5)).unit("N.m/rad").range(1e-6, 1e6)
+        .desc("Rotational stiffness of a truss about where it leaves the stem (estimate)"),
+    TRUSS_FREQUENCY = Var::param("truss_frequency", Start::Float64(2.5)).unit("Hz").range(0.01, 100.0)
+        .desc("Natural frequency of a released truss swinging back (estimate)"),
+    TRUSS_DAMPING_RATIO = Var::param("truss_damping_ratio", Start::Float64(0.3)).range(0.0, 10.0)
+        .desc("Damping ratio of a released truss swinging back (estimate)"),
+    TRUSS_PUSHES = Var::output_discrete("truss_pushes", Start::Int32(0)).init_depends_on(&[])
+        .desc("Times a robot part started pressing a truss aside (cumulative)"),
+    MOVING_TRUSSES = Var::output_discrete("moving_trusses", Start::Int32(0)).init_depends_on(&[])
+        .desc("Trusses now turned from their grown pose (pressed, or swinging back)"),
+    PEAK_TRUSS_FORCE = Var::output("peak_truss_force").unit("N").init_depends_on(&[])
+        .desc("Largest force the robot spent holding a truss aside so far"),
     MOVED_OBJECTS = Var::output_discrete("moved_objects", Start::Binary(&[])).mime(MOVED_OBJECTS_MIME).init_depends_on(&[Var::TIME])
         .desc("agrisim_msgs/MovedObjects (ground truth, for the sensor FMUs' moved_objects input): every scene object away from where the greenhouse grew it (pushed leaves, picked fruit) with its placement, at the start and whenever it changes"),
     MOVED_OBJECTS_SEQ = Var::output_discrete("moved_objects_seq", Start::Int64(0)).init_depends_on(&[])

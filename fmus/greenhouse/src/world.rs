@@ -7,9 +7,9 @@ use crate::base_box::BaseBox;
 use crate::clearance::min_clearance;
 use crate::collision_report::collision_state;
 use crate::contacts::{robot_contacts, Category, ContactTracker, Press, RobotContact, Toucher};
-use crate::foliage::{Foliage, FoliageParams, LeafTable};
+use crate::foliage::{Foliage, FoliageParams, FoliageTable, Part, Spring};
 use crate::ground_truth::{fruit_poses, Target};
-use crate::harvest::{DamageParams, Harvest, HarvestParams};
+use crate::harvest::{DamageParams, FruitState, Harvest, HarvestParams};
 use crate::moved_objects::{grown_fruit_poses, moved_objects};
 use crate::pedicel::{PedicelGeometry, PedicelParams};
 use crate::planning_scene::planning_scene;
@@ -67,7 +67,7 @@ struct Running {
     /// The main stems (sorted by object index), from the scene: rebuilt, not serialized.
     stems: Arc<Vec<StemGeometry>>,
     /// The compound leaves and their grown poses, from the scene: rebuilt, not serialized.
-    leaves: Arc<LeafTable>,
+    foliage_table: Arc<FoliageTable>,
     foliage_params: FoliageParams,
     /// The leaves the robot moved.
     foliage: Foliage,
@@ -246,23 +246,32 @@ fn stem_params(io: &Store) -> Result<StemParams, String> {
     Ok(p)
 }
 
-/// The `leaf_*` parameters.
+/// The `leaf_*` and `truss_*` parameters.
 fn foliage_params(io: &Store) -> Result<FoliageParams, String> {
-    let p = FoliageParams {
-        enabled: io.bool(LEAF_COMPLIANT),
-        stiffness: io.f64(LEAF_STIFFNESS),
-        frequency: io.f64(LEAF_FREQUENCY),
-        damping_ratio: io.f64(LEAF_DAMPING_RATIO),
-    };
-    for (v, i) in [(p.stiffness, LEAF_STIFFNESS), (p.frequency, LEAF_FREQUENCY)] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(format!("parameter {} must be positive and finite, got {v}", VARIABLES[i].name));
+    let spring = |[enabled, stiffness, frequency, damping_ratio]: [usize; 4]| -> Result<Spring, String> {
+        let s = Spring {
+            enabled: io.bool(enabled),
+            stiffness: io.f64(stiffness),
+            frequency: io.f64(frequency),
+            damping_ratio: io.f64(damping_ratio),
+        };
+        for (v, i) in [(s.stiffness, stiffness), (s.frequency, frequency)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("parameter {} must be positive and finite, got {v}", VARIABLES[i].name));
+            }
         }
-    }
-    if !(p.damping_ratio.is_finite() && p.damping_ratio >= 0.0) {
-        return Err(format!("parameter leaf_damping_ratio must be finite and not negative, got {}", p.damping_ratio));
-    }
-    Ok(p)
+        if !(s.damping_ratio.is_finite() && s.damping_ratio >= 0.0) {
+            return Err(format!(
+                "parameter {} must be finite and not negative, got {}",
+                VARIABLES[damping_ratio].name, s.damping_ratio
+            ));
+        }
+        Ok(s)
+    };
+    Ok(FoliageParams {
+        leaf: spring([LEAF_COMPLIANT, LEAF_STIFFNESS, LEAF_FREQUENCY, LEAF_DAMPING_RATIO])?,
+        truss: spring([TRUSS_COMPLIANT, TRUSS_STIFFNESS, TRUSS_FREQUENCY, TRUSS_DAMPING_RATIO])?,
+    })
 }
 
 /// Each fruit's pedicel from the scene's objects: `.../pedicel{t}_{f}` belongs to
@@ -318,7 +327,7 @@ impl Running {
     /// The moved objects, at the start and whenever one moves (each step while a leaf swings
     /// or a fruit is carried; nothing while the robot only drives).
     fn report_moved(&mut self, t: f64) {
-        let mut msg = moved_objects(&self.world, &self.grown_fruit, &self.leaves, &self.foliage);
+        let mut msg = moved_objects(&self.world, &self.grown_fruit, &self.foliage_table, &self.foliage);
         let key = msg.to_cdr();
         if self.ports.moved_published.as_ref() != Some(&key) {
             let stamp = to_ns(t);
@@ -464,16 +473,29 @@ impl Running {
         let stem_presses = presses.iter().map(|p| (p.object, p.point, p.depth));
         let loads = stem_loads(&self.stems, stem_presses, &self.harvest.params.damage.stem);
         self.harvest.damage.press_stems(&loads);
+        let harvest = &self.harvest;
+        let hangs = |f: usize| harvest.state(f) == FruitState::OnPlant;
         if self.last_h > 0.0
-            && self.foliage.step(&self.leaves, &mut self.world, &presses, &self.foliage_params, self.last_h)
+            && self.foliage.step(
+                &self.foliage_table,
+                &mut self.world,
+                &presses,
+                &self.foliage_params,
+                self.last_h,
+                hangs,
+            )
         {
             self.world.refresh();
         }
-        io.set_i32(LEAF_PUSHES, self.foliage.pushes.min(i32::MAX as u64) as i32);
-        io.set_i32(MOVING_LEAVES, self.foliage.moving.len().min(i32::MAX as usize) as i32);
-        io.set_f64(PEAK_LEAF_FORCE, self.foliage.peak_force);
-        let changed = self.tracker.update(&contacts);
+        let (foliage, table) = (&self.foliage, &*self.foliage_table);
         let count = |n: u64| n.min(i32::MAX as u64) as i32;
+        io.set_i32(LEAF_PUSHES, count(foliage.pushes));
+        io.set_i32(MOVING_LEAVES, count(foliage.moving_of(table, Part::Leaf) as u64));
+        io.set_f64(PEAK_LEAF_FORCE, foliage.peak_force);
+        io.set_i32(TRUSS_PUSHES, count(foliage.truss_pushes));
+        io.set_i32(MOVING_TRUSSES, count(foliage.moving_of(table, Part::Truss) as u64));
+        io.set_f64(PEAK_TRUSS_FORCE, foliage.peak_truss_force);
+        let changed = self.tracker.update(&contacts);
         io.set_bool(COLLISION, !contacts.is_empty());
         io.set_i32(COLLISION_COUNT, count(self.tracker.onsets()));
         io.set_i32(CONTACT_ROBOT_PLANT, count(self.tracker.onsets_in(Category::Plant)));
@@ -586,7 +608,7 @@ impl Model for GreenhouseWorld {
         };
         let harvest = Harvest::new(params, coords.widths, robot.hands(&base_link));
         let stems = Arc::new(StemGeometry::all(&greenhouse.objects));
-        let leaves = Arc::new(LeafTable::new(&greenhouse.objects, &world));
+        let foliage_table = Arc::new(FoliageTable::new(&greenhouse.objects, &world));
         let foliage_params = foliage_params(io)?;
         let grown_fruit = Arc::new(grown_fruit_poses(&world));
         let pedicels =
@@ -604,7 +626,7 @@ impl Model for GreenhouseWorld {
             harvest,
             pedicels,
             stems,
-            leaves,
+            foliage_table,
             foliage_params,
             foliage: Foliage::default(),
             grown_fruit,
