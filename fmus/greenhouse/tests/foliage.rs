@@ -3,89 +3,39 @@
 //! into a rigid leaf), costs a force, and is back at its grown pose within 1 s after the
 //! contact ends; the state restores bit for bit mid-swing.
 
+mod common;
+
 use agrisim_fmi::{Model, Quiet, Store, Value};
 use agrisim_fmu_greenhouse::foliage::leaves;
 use agrisim_fmu_greenhouse::ports::SCENE as SCENE_VAR;
 use agrisim_fmu_greenhouse::ports::*;
 use agrisim_fmu_greenhouse::robot_links::from_rapier;
-use agrisim_fmu_greenhouse::robot_model::{Coords, RobotModel, Side};
+use agrisim_fmu_greenhouse::robot_model::{Coords, RobotModel};
 use agrisim_fmu_greenhouse::GreenhouseWorld;
 use agrisim_msgs::agrisim::{CollisionState, MovedObjects};
 use agrisim_msgs::Message;
 use agrisim_robot::Pose as RPose;
 use agrisim_scene::scene::Object;
+use common::*;
 
 const H: f64 = 0.02;
 
 /// Two short rows with their leaves, one fruit per truss.
 const SCENE: &str = "rows = 2\nactive_rows = 2\nwidth = 12.0\nlength = 20.0\nrow_length = 8.0\nfruit_per_truss = 1\ntrusses_per_plant = 2";
 
-const LEFT_Q: [usize; 7] = [LEFT_Q1, LEFT_Q2, LEFT_Q3, LEFT_Q4, LEFT_Q5, LEFT_Q6, LEFT_Q7];
-const RIGHT_Q: [usize; 7] = [RIGHT_Q1, RIGHT_Q2, RIGHT_Q3, RIGHT_Q4, RIGHT_Q5, RIGHT_Q6, RIGHT_Q7];
-
-fn objects() -> Vec<Object> {
-    let cfg = agrisim_scene::config::GreenhouseConfig::from_toml_str(SCENE).unwrap();
-    agrisim_scene::generate(&cfg, cfg.seed).objects
-}
-
-fn tcp(model: &RobotModel, c: &Coords) -> [f64; 3] {
-    let mut out = Vec::new();
-    model.fk(c, &mut out);
-    out[model.link_index("left_hand_tcp").unwrap()].trans
-}
-
 /// The leaf to sweep (its objects) and the robot's pose: the left TCP, at the default arm
 /// pose and lift `lift0`, 35 cm below the middle of the leaf's rachis. Of the leaves past
 /// x = 8 m whose rachis middle is in the lift's range, the first.
 fn setup(model: &RobotModel, objects: &[Object]) -> (Vec<usize>, [f64; 3], f64) {
-    let c0 = Coords::default();
-    let t0 = tcp(model, &c0);
+    let t0 = tcp(model, &Coords::default());
     for leaf in leaves(objects) {
-        let r = &objects[leaf.objects[0]];
-        let mid = r.placement.translation;
-        if !(mid[0] > 8.0 && mid[2] > t0[2] + 0.5 && mid[2] < t0[2] + 0.8) {
-            continue;
+        let mid = objects[leaf.objects[0]].placement.translation;
+        if mid[0] > 8.0 && mid[2] > t0[2] + 0.5 && mid[2] < t0[2] + 0.8 {
+            let (planar, lift) = under(model, mid, 0.35);
+            return (leaf.objects, planar, lift);
         }
-        let lift = mid[2] - 0.35 - t0[2];
-        let t = tcp(model, &Coords { lift, ..c0 });
-        let yaw = -std::f64::consts::FRAC_PI_2;
-        let (s, co) = yaw.sin_cos();
-        let planar = [mid[0] - (co * t[0] - s * t[1]), mid[1] - (s * t[0] + co * t[1]), yaw];
-        return (leaf.objects, planar, lift);
     }
     panic!("no leaf in the lift's range");
-}
-
-fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
-    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
-}
-
-fn drive(io: &mut Store, planar: [f64; 3], lift: f64) {
-    io.set_f64(BASE_X, planar[0]);
-    io.set_f64(BASE_Y, planar[1]);
-    io.set_f64(BASE_YAW, planar[2]);
-    io.set_f64(LIFT_POSITION, lift);
-    let c = Coords::default();
-    for (i, vr) in LEFT_Q.into_iter().enumerate() {
-        io.set_f64(vr, c.arms[Side::Left as usize][i]);
-    }
-    for (i, vr) in RIGHT_Q.into_iter().enumerate() {
-        io.set_f64(vr, c.arms[Side::Right as usize][i]);
-    }
-}
-
-/// The lift at step k of the sweep: up 0.5 m at 0.2 m/s, then down again, then still.
-fn sweep(lift0: f64, k: usize) -> f64 {
-    let t = k as f64 * H;
-    lift0
-        + 0.2
-            * if t < 2.5 {
-                t
-            } else if t < 5.0 {
-                5.0 - t
-            } else {
-                0.0
-            }
 }
 
 struct Run {
@@ -105,7 +55,7 @@ struct Run {
 
 fn run(compliant: bool, steps: usize) -> Run {
     let model = RobotModel::load().unwrap();
-    let objects = objects();
+    let objects = objects(SCENE);
     let (leaf, planar, lift0) = setup(&model, &objects);
     let names: Vec<&str> = leaf.iter().map(|&o| objects[o].name.as_str()).collect();
     let mut io = Store::new(GreenhouseWorld::VARIABLES);
@@ -132,21 +82,15 @@ fn run(compliant: bool, steps: usize) -> Run {
     let initial = MovedObjects::from_cdr(agrisim_fmi::port::latest(&io, MOVED_OBJECTS)).unwrap();
     assert!(initial.ids.is_empty() && initial.poses.is_empty(), "nothing moved at the start: {initial:?}");
     for k in 1..=steps {
-        drive(&mut io, planar, sweep(lift0, k));
+        drive(&mut io, planar, sweep(lift0, k as f64 * H, 0.5));
         m.do_step(&mut io, (k - 1) as f64 * H, H, &mut Quiet).unwrap();
         let moved = leaf.iter().zip(&rest).map(|(&o, r)| dist(pose(&m, o).trans, r.trans)).fold(0.0, f64::max);
         out.moved.push(moved);
         let s = CollisionState::from_cdr(agrisim_fmi::port::latest(&io, COLLISION_STATE)).unwrap();
         let d = s.contacts.iter().filter(|c| names.contains(&c.object_name.as_str())).map(|c| c.depth).reduce(f64::max);
         out.depth.push(d);
-        // A message comes only with a change; the port keeps it for port_window.
-        let newest = agrisim_fmi::port::latest(&io, MOVED_OBJECTS);
-        let current = if newest.is_empty() {
-            out.moved_msgs.last().cloned().unwrap_or(initial.clone())
-        } else {
-            MovedObjects::from_cdr(newest).unwrap()
-        };
-        out.moved_msgs.push(current);
+        let now = moved_now(&io, out.moved_msgs.last().unwrap_or(&initial));
+        out.moved_msgs.push(now);
         let w = m.scene().unwrap();
         out.placements.push(
             leaf.iter()
@@ -220,8 +164,8 @@ fn a_leaf_gives_way_to_the_arm_and_springs_back_within_a_second() {
 #[test]
 fn serialized_state_restores_with_a_moving_leaf() {
     let model = RobotModel::load().unwrap();
-    let (_, planar, lift0) = setup(&model, &objects());
-    let drive = move |io: &mut Store, k: usize| drive(io, planar, sweep(lift0, k + 1));
+    let (_, planar, lift0) = setup(&model, &objects(SCENE));
+    let drive = move |io: &mut Store, k: usize| drive(io, planar, sweep(lift0, (k + 1) as f64 * H, 0.5));
     let n = agrisim_fmi_testing::assert_state_round_trip::<GreenhouseWorld>(
         &[(SCENE_VAR, Value::String(SCENE.to_string()))],
         H,

@@ -130,6 +130,24 @@ mod tests {
         Region { x: [x, x + 1.0], y: [0.0, 1.0], z: [0.55, 1.75] }
     }
 
+    /// A fruit-map entry: ripe (class "red"), 6 cm across, track `id` at `c`.
+    fn ripe(id: &str, c: [f64; 3]) -> agrisim_msgs::vision_msgs::Detection3D {
+        use agrisim_msgs::geometry_msgs::{Point, Pose, Quaternion, Vector3};
+        use agrisim_msgs::vision_msgs::{BoundingBox3D, Detection3D, ObjectHypothesis, ObjectHypothesisWithPose};
+        Detection3D {
+            results: vec![ObjectHypothesisWithPose {
+                hypothesis: ObjectHypothesis { class_id: "red".into(), score: 1.0 },
+                ..Default::default()
+            }],
+            bbox: BoundingBox3D {
+                center: Pose { position: Point { x: c[0], y: c[1], z: c[2] }, orientation: Quaternion::IDENTITY },
+                size: Vector3 { x: 0.06, y: 0.06, z: 0.06 },
+            },
+            id: id.into(),
+            ..Default::default()
+        }
+    }
+
     /// Regression (row by sight, 2026-11-29): after a pick the next region's task starts
     /// with the recovery (arms home, grippers open), as a next fruit's does; it used to go
     /// straight to SelectTarget, leaving the placing arm over the box.
@@ -238,30 +256,16 @@ mod tests {
     fn a_later_task_takes_a_fruit_the_map_holds_without_a_scan() {
         use crate::motion::Arm;
         use crate::sight::topics::FRUIT_MAP;
-        use agrisim_msgs::geometry_msgs::{Point, Pose, PoseStamped, Quaternion, Vector3};
+        use agrisim_msgs::geometry_msgs::{Pose, PoseStamped};
         use agrisim_msgs::sensor_msgs::JointState;
-        use agrisim_msgs::vision_msgs::{
-            BoundingBox3D, Detection3D, Detection3DArray, ObjectHypothesis, ObjectHypothesisWithPose,
-        };
-        let ripe_at = |c: [f64; 3]| Detection3D {
-            results: vec![ObjectHypothesisWithPose {
-                hypothesis: ObjectHypothesis { class_id: "red".into(), score: 1.0 },
-                ..Default::default()
-            }],
-            bbox: BoundingBox3D {
-                center: Pose { position: Point { x: c[0], y: c[1], z: c[2] }, orientation: Quaternion::IDENTITY },
-                size: Vector3 { x: 0.06, y: 0.06, z: 0.06 },
-            },
-            id: "7".into(),
-            ..Default::default()
-        };
+        use agrisim_msgs::vision_msgs::Detection3DArray;
         // The stage after one step at SelectTarget, for a run's first task or a later one,
         // with a ripe fruit in the region's map at `fruit`.
         let first_step = |later: bool, fruit: [f64; 3]| -> Stage {
             let mut row = RowNode::by_sight(vec![region(0.0), region(1.0)], 1);
             let mut bus = Bus::default();
             let header = Header { frame_id: "map".into(), ..Default::default() };
-            let map = Detection3DArray { header: header.clone(), detections: vec![ripe_at(fruit)] };
+            let map = Detection3DArray { header: header.clone(), detections: vec![ripe("7", fruit)] };
             bus.publish(FRUIT_MAP, 0, &map);
             bus.publish(topics::POSE, 0, &PoseStamped { header, pose: Pose::default() });
             for arm in [Arm::Left, Arm::Right] {
@@ -295,23 +299,9 @@ mod tests {
         use crate::motion::Arm;
         use crate::sight::topics::{ALLOWED, FRUIT_MAP};
         use agrisim_bus::Reader;
-        use agrisim_msgs::geometry_msgs::{Point, Pose, PoseStamped, Quaternion, Vector3};
+        use agrisim_msgs::geometry_msgs::{Pose, PoseStamped};
         use agrisim_msgs::sensor_msgs::JointState;
-        use agrisim_msgs::vision_msgs::{
-            BoundingBox3D, Detection3D, Detection3DArray, ObjectHypothesis, ObjectHypothesisWithPose,
-        };
-        let ripe = |id: &str, c: [f64; 3]| Detection3D {
-            results: vec![ObjectHypothesisWithPose {
-                hypothesis: ObjectHypothesis { class_id: "red".into(), score: 1.0 },
-                ..Default::default()
-            }],
-            bbox: BoundingBox3D {
-                center: Pose { position: Point { x: c[0], y: c[1], z: c[2] }, orientation: Quaternion::IDENTITY },
-                size: Vector3 { x: 0.06, y: 0.06, z: 0.06 },
-            },
-            id: id.into(),
-            ..Default::default()
-        };
+        use agrisim_msgs::vision_msgs::{Detection3D, Detection3DArray};
         let header = Header { frame_id: "map".into(), ..Default::default() };
         let map = |d: Vec<Detection3D>| Detection3DArray { header: header.clone(), detections: d };
         // Where the node aims after the second map, the first holding fruit "7" at `a`.
