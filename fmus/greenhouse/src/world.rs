@@ -66,10 +66,11 @@ struct Running {
     pedicels: Arc<Vec<PedicelGeometry>>,
     /// The main stems (sorted by object index), from the scene: rebuilt, not serialized.
     stems: Arc<Vec<StemGeometry>>,
-    /// The compound leaves and their grown poses, from the scene: rebuilt, not serialized.
+    /// The compound leaves and trusses and their grown poses, from the scene: rebuilt, not
+    /// serialized.
     foliage_table: Arc<FoliageTable>,
     foliage_params: FoliageParams,
-    /// The leaves the robot moved.
+    /// The leaves and trusses the robot moved.
     foliage: Foliage,
     /// Each fruit body's pose as built, from the scene: rebuilt, not serialized.
     grown_fruit: Arc<Vec<Pose>>,
