@@ -200,13 +200,6 @@ pub struct Foliage {
     pub peak_truss_force: f64,
 }
 
-impl Foliage {
-    /// How many parts of this kind are off their grown pose.
-    pub fn moving_of(&self, table: &FoliageTable, part: Part) -> usize {
-        self.moving.keys().filter(|&&l| table.parts[l].part == part).count()
-    }
-}
-
 /// The static per-scene data: leaves and trusses, the part of each static object, each such
 /// object's grown pose, and each truss's fruit with their grown poses.
 #[derive(Clone, Debug, Default)]
@@ -261,6 +254,11 @@ fn rotation(theta: [f64; 3]) -> RPose {
 }
 
 impl Foliage {
+    /// How many parts of this kind are off their grown pose.
+    pub fn moving_of(&self, table: &FoliageTable, part: Part) -> usize {
+        self.moving.keys().filter(|&&l| table.parts[l].part == part).count()
+    }
+
     /// One step of `h` seconds: `presses` of robot parts move the leaves and trusses they
     /// touch, free ones swing back; the moved parts' colliders are put at their new poses,
     /// and a truss's fruit with it while `hangs(fruit)` (fruit-list index) says the fruit

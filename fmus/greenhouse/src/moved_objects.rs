@@ -26,12 +26,12 @@ pub fn grown_fruit_poses(world: &SceneWorld) -> Vec<Pose> {
 pub fn moved_objects(
     world: &SceneWorld,
     grown_fruit: &[Pose],
-    parts: &FoliageTable,
+    table: &FoliageTable,
     foliage: &Foliage,
 ) -> MovedObjects {
     let mut moved: Vec<(u32, Pose)> = Vec::new();
     for &l in foliage.moving.keys() {
-        for &o in &parts.parts[l].objects {
+        for &o in &table.parts[l].objects {
             let object = &world.objects[o];
             moved.push((object.id, object_pose(&world.colliders[object.collider])));
         }
