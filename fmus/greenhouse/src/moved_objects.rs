@@ -43,6 +43,8 @@ pub fn moved_objects(
         }
     }
     moved.sort_unstable_by_key(|m| m.0);
+    // A pedicel turning with its truss and on its own is listed by both: once is enough.
+    moved.dedup_by_key(|m| m.0);
     MovedObjects {
         header: Header::default(),
         ids: moved.iter().map(|m| m.0).collect(),

@@ -242,11 +242,11 @@ agrisim_fmi::variables! { pub VARIABLES {
     TRUSS_DAMPING_RATIO = Var::param("truss_damping_ratio", Start::Float64(0.3)).range(0.0, 10.0)
         .desc("Damping ratio of a released truss swinging back (estimate)"),
     TRUSS_PUSHES = Var::output_discrete("truss_pushes", Start::Int32(0)).init_depends_on(&[])
-        .desc("Times a robot part started pressing a truss aside (cumulative)"),
+        .desc("Times a robot part started pressing a truss or one of its pedicels aside (cumulative)"),
     MOVING_TRUSSES = Var::output_discrete("moving_trusses", Start::Int32(0)).init_depends_on(&[])
-        .desc("Trusses now turned from their grown pose (pressed, or swinging back)"),
+        .desc("Trusses and pedicels now turned from their grown pose (pressed, or swinging back)"),
     PEAK_TRUSS_FORCE = Var::output("peak_truss_force").unit("N").init_depends_on(&[])
-        .desc("Largest force the robot spent holding a truss aside so far"),
+        .desc("Largest force the robot spent holding a truss or a pedicel aside so far"),
     MOVED_OBJECTS = Var::output_discrete("moved_objects", Start::Binary(&[])).mime(MOVED_OBJECTS_MIME).init_depends_on(&[Var::TIME])
         .desc("agrisim_msgs/MovedObjects (ground truth, for the sensor FMUs' moved_objects input): every scene object away from where the greenhouse grew it (pushed leaves, picked fruit) with its placement, at the start and whenever it changes"),
     MOVED_OBJECTS_SEQ = Var::output_discrete("moved_objects_seq", Start::Int64(0)).init_depends_on(&[])

@@ -269,9 +269,14 @@ fn foliage_params(io: &Store) -> Result<FoliageParams, String> {
         }
         Ok(s)
     };
+    let truss = spring([TRUSS_COMPLIANT, TRUSS_STIFFNESS, TRUSS_FREQUENCY, TRUSS_DAMPING_RATIO])?;
+    // A pedicel bends on its own stiffness (that of the pedicel model, checked there).
+    let pedicel =
+        Spring { stiffness: io.f64(PEDICEL_BEND_STIFFNESS), frequency: crate::foliage::PEDICEL_FREQUENCY, ..truss };
     Ok(FoliageParams {
         leaf: spring([LEAF_COMPLIANT, LEAF_STIFFNESS, LEAF_FREQUENCY, LEAF_DAMPING_RATIO])?,
-        truss: spring([TRUSS_COMPLIANT, TRUSS_STIFFNESS, TRUSS_FREQUENCY, TRUSS_DAMPING_RATIO])?,
+        truss,
+        pedicel,
     })
 }
 
@@ -494,7 +499,10 @@ impl Running {
         io.set_i32(MOVING_LEAVES, count(foliage.moving_of(table, Part::Leaf) as u64));
         io.set_f64(PEAK_LEAF_FORCE, foliage.peak_force);
         io.set_i32(TRUSS_PUSHES, count(foliage.truss_pushes));
-        io.set_i32(MOVING_TRUSSES, count(foliage.moving_of(table, Part::Truss) as u64));
+        io.set_i32(
+            MOVING_TRUSSES,
+            count((foliage.moving_of(table, Part::Truss) + foliage.moving_of(table, Part::Pedicel)) as u64),
+        );
         io.set_f64(PEAK_TRUSS_FORCE, foliage.peak_truss_force);
         let changed = self.tracker.update(&contacts);
         io.set_bool(COLLISION, !contacts.is_empty());

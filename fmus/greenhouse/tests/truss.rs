@@ -1,18 +1,23 @@
 //! Compliant trusses through the Model trait: the left hand, raised by the lift, sweeps up
 //! through a truss and back down. With `truss_compliant` the truss gives way, turning about
-//! where it leaves the stem, its pedicels and hanging fruit with it, costs a force, and is
-//! back at its grown pose within 1 s after the contact ends; `moved_objects` lists its
-//! fruit where they are while it is turned and not once it is back. Rigid (the default),
-//! nothing moves. The state restores bit for bit mid-swing.
+//! where it leaves the stem, its pedicels and hanging fruit with it (each fruit swinging on
+//! its pedicel too), costs a force, and is back at its grown pose within 1 s after the
+//! contact ends; `moved_objects` lists its fruit where they are while it is turned and not
+//! once it is back. Rigid (the default), nothing moves. The state restores bit for bit
+//! mid-swing. And through [`Foliage::step`] alone: a press on one pedicel swings that
+//! pedicel's fruit only.
 
 mod common;
 
 use agrisim_fmi::{Model, Quiet, Store, Value};
-use agrisim_fmu_greenhouse::foliage::{trusses, Hinged, Part};
+use agrisim_fmu_greenhouse::base_box::BaseBox;
+use agrisim_fmu_greenhouse::contacts::Press;
+use agrisim_fmu_greenhouse::foliage::{pedicels, trusses, Foliage, FoliageParams, FoliageTable, Hinged, Part, Spring};
 use agrisim_fmu_greenhouse::ports::SCENE as SCENE_VAR;
 use agrisim_fmu_greenhouse::ports::*;
 use agrisim_fmu_greenhouse::robot_links::from_rapier;
 use agrisim_fmu_greenhouse::robot_model::{Coords, RobotModel};
+use agrisim_fmu_greenhouse::scene_world::SceneWorld;
 use agrisim_fmu_greenhouse::GreenhouseWorld;
 use agrisim_msgs::agrisim::{CollisionState, MovedObjects};
 use agrisim_msgs::Message;
@@ -47,6 +52,8 @@ struct Run {
     touched: Vec<bool>,
     /// Each fruit's pose (map frame), and the rachis's.
     fruit: Vec<Vec<RPose>>,
+    /// Each pedicel's pose and its fruit's (map frame).
+    on_pedicel: Vec<Vec<(RPose, RPose)>>,
     rachis: Vec<RPose>,
     pushes: i32,
     peak_force: f64,
@@ -81,6 +88,7 @@ fn run(compliant: bool, steps: usize) -> Run {
         moved: vec![],
         touched: vec![],
         fruit: vec![],
+        on_pedicel: vec![],
         rachis: vec![],
         pushes: 0,
         peak_force: 0.0,
@@ -99,6 +107,8 @@ fn run(compliant: bool, steps: usize) -> Run {
         let s = CollisionState::from_cdr(agrisim_fmi::port::latest(&io, COLLISION_STATE)).unwrap_or_default();
         out.touched.push(s.contacts.iter().any(|c| names.contains(&c.object_name.as_str())));
         out.fruit.push(truss.fruit.iter().map(|&o| pose(&m, o)).collect());
+        out.on_pedicel
+            .push(pedicels(&objects, &truss).iter().map(|p| (pose(&m, p.objects[0]), pose(&m, p.fruit[0]))).collect());
         out.rachis.push(pose(&m, truss.objects[0]));
         out.moving.push(io.i32(MOVING_TRUSSES));
         let now = moved_now(&io, out.moved_msgs.last().unwrap_or(&initial));
@@ -125,8 +135,13 @@ fn a_truss_gives_way_with_its_fruit_and_springs_back_within_a_second() {
     assert!(peak > 0.05, "the truss deflects: {peak} m");
     assert!(soft.pushes >= 1 && soft.peak_force > 0.0, "{} pushes, {} N", soft.pushes, soft.peak_force);
     assert!(soft.moving.iter().any(|&n| n >= 1));
-    // Its fruit turn with it, rigidly: each keeps its pose relative to the rachis.
-    let rel = |k: usize, i: usize| soft.rachis[k].inverse().mul(&soft.fruit[k][i]);
+    // Its fruit turn with it, each rigidly with its pedicel (which the fingers may swing on
+    // its own): each keeps its pose relative to its pedicel.
+    assert_eq!(soft.on_pedicel[0].len(), soft.fruit_ids.len(), "every fruit has its pedicel");
+    let rel = |k: usize, i: usize| {
+        let (p, f) = &soft.on_pedicel[k][i];
+        p.inverse().mul(f)
+    };
     let mut fruit_moved = 0.0_f64;
     for k in 0..soft.fruit.len() {
         for i in 0..soft.fruit_ids.len() {
@@ -216,4 +231,61 @@ fn serialized_state_restores_with_a_moving_truss() {
         &drive,
     );
     assert!(n > 0);
+}
+
+/// A press on one fruit's pedicel swings that fruit on it, about where the pedicel meets the
+/// rachis: the rachis and the truss's other fruit stay put (a finger brushing a neighbour's
+/// pedicel does not swing the fruit being grasped). Released, it is back at its grown pose.
+/// A press on the rachis turns the whole truss, every fruit with it.
+#[test]
+fn a_pressed_pedicel_swings_its_own_fruit_only() {
+    let objects = objects(SCENE);
+    let base = BaseBox { length: 1.0, width: 0.6, height: 0.3, clearance: 0.1 };
+    let mut world = SceneWorld::build(&objects, base, base.pose(-5.0, -5.0, 0.0)).unwrap();
+    let table = FoliageTable::new(&objects, &world);
+    let truss = trusses(&objects).into_iter().find(|t| t.fruit.len() == 2).expect("a truss with two fruit");
+    let peds = pedicels(&objects, &truss);
+    assert_eq!(peds.len(), 2);
+    assert!(peds.iter().all(|p| p.part == Part::Pedicel && p.fruit.len() == 1));
+    let on = Spring { enabled: true, stiffness: 0.3, frequency: 7.0, damping_ratio: 0.3 };
+    let params =
+        FoliageParams { truss: Spring { stiffness: 1.5, frequency: 2.5, ..on }, pedicel: on, ..Default::default() };
+    let fruit: Vec<usize> = truss.fruit.iter().map(|&o| world.fruit_of_object(o).unwrap()).collect();
+    let target = world.fruit_of_object(peds[0].fruit[0]).unwrap();
+    let collider = |w: &SceneWorld, o: usize| from_rapier(w.colliders[w.objects[o].collider].position()).trans;
+    let snapshot = |w: &SceneWorld| -> (Vec<[f64; 3]>, [f64; 3]) {
+        (fruit.iter().map(|&f| from_rapier(&w.fruit_pose(f)).trans).collect(), collider(w, truss.objects[0]))
+    };
+    let (grown, rachis) = snapshot(&world);
+    let press =
+        |o: usize| Press { object: o, point: objects[o].placement.translation, normal: [1.0, 0.0, 0.0], depth: 0.004 };
+    let mut foliage = Foliage::default();
+    for _ in 0..10 {
+        assert!(foliage.step(&table, &mut world, &[press(peds[0].objects[0])], &params, H, |_| true));
+    }
+    let (now, rachis_now) = snapshot(&world);
+    let i = fruit.iter().position(|&f| f == target).unwrap();
+    assert!(dist(now[i], grown[i]) > 0.01, "the pressed pedicel's fruit swings: {} m", dist(now[i], grown[i]));
+    assert!(now[i][0] < grown[i][0], "away from the press");
+    for (j, (a, b)) in now.iter().zip(&grown).enumerate() {
+        if j != i {
+            assert_eq!(a, b, "another fruit of the truss stays put");
+        }
+    }
+    assert_eq!(rachis_now, rachis, "the rachis stays put");
+    assert_eq!(foliage.truss_pushes, 1);
+    assert!(foliage.peak_truss_force > 0.0);
+    // Released: back at its grown pose, simulated no more.
+    for _ in 0..200 {
+        foliage.step(&table, &mut world, &[], &params, H, |_| true);
+    }
+    assert!(foliage.moving.is_empty());
+    assert_eq!(snapshot(&world), (grown.clone(), rachis));
+    // The rachis pressed: every fruit moves.
+    for _ in 0..10 {
+        foliage.step(&table, &mut world, &[press(truss.objects[0])], &params, H, |_| true);
+    }
+    let (now, rachis_now) = snapshot(&world);
+    assert!(dist(rachis_now, rachis) > 0.005);
+    assert!(now.iter().zip(&grown).all(|(a, b)| dist(*a, *b) > 0.005), "{now:?} vs {grown:?}");
 }
