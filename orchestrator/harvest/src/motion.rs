@@ -41,6 +41,14 @@ const CARTESIAN_STEP: f64 = 0.01;
 /// manual: hand dimensions) and its palm lies about 0.09 m behind the fingertip centre, so its
 /// corners sweep a sphere of about sqrt(0.1^2 + 0.09^2) = 0.135 m about the grasp point.
 const ROLL_SWEEP: f64 = 0.14;
+/// Truss parts (rachis, pedicels) this near the target's centre, beyond its surface, are
+/// kept clear while the hand comes in, where a grasp allows it ([`Motion::guard_trusses`])
+/// [m]: with compliant trusses, a hand that presses the target's truss swings the target
+/// away. About a truss's reach around its fruit.
+const TRUSS_GUARD: f64 = 0.08;
+/// A truss part this near the target's surface is its own pedicel (it joins the fruit's
+/// top): never guarded [m].
+const OWN_PEDICEL: f64 = 0.01;
 /// Rolls about the approach axis tried for a grasp.
 const ROLLS: usize = 12;
 /// Distinct IK solutions asked for per free goal, and their minimum joint-space spread [rad].
@@ -98,6 +106,20 @@ pub struct Planned {
     pub goal_q: [f64; DOF],
 }
 
+/// Distance from `p` to the surface of `o` (negative inside): cylinders and capsules taken
+/// as capsules (a truss's parts are thin rods), boxes as their bounding spheres.
+fn surface_distance(o: &Obstacle, p: Vector3<f64>) -> f64 {
+    let c = o.pose.translation.vector;
+    let (half, radius) = match o.shape {
+        Shape::Sphere { radius } => (0.0, radius),
+        Shape::Cylinder { radius, length } | Shape::Capsule { radius, length } => (0.5 * length, radius),
+        Shape::Box { size } => (0.0, 0.5 * Vector3::from(size).norm()),
+    };
+    let axis = o.pose.rotation * Vector3::z();
+    let t = (p - c).dot(&axis).clamp(-half, half);
+    (p - (c + t * axis)).norm() - radius
+}
+
 impl Planned {
     /// The configuration `t` s after the start (linear between samples; the last after the end).
     pub fn at(&self, t: f64) -> [f64; DOF] {
@@ -134,6 +156,12 @@ pub struct Motion {
     ignore_target: bool,
     /// Radius of the fruit each arm holds (it moves with the hand in collision checks).
     held: [Option<f64>; 2],
+    /// Indices into `obstacles` of the truss parts (soft, but see [`TRUSS_GUARD`]).
+    trusses: Vec<usize>,
+    /// Whether truss parts near the target are obstacles ([`Motion::guard_trusses`]), and
+    /// how many the scene has.
+    guard: bool,
+    guarded: usize,
     /// Scene ids of the fruit this node has held (in the box, or dropped: one that fell on
     /// the robot would otherwise block its arm for good): loose, pushed aside, never
     /// planned around.
@@ -157,6 +185,9 @@ impl Motion {
             planner: Planner::default(),
             timing: TimingConfig::panda(SEND_DT),
             obstacles: vec![],
+            trusses: vec![],
+            guard: false,
+            guarded: 0,
             scene: Scene::new(vec![]),
             target: None,
             target_map: None,
@@ -188,6 +219,19 @@ impl Motion {
         self.target_map = Some(center_map);
     }
 
+    /// Whether the truss parts near the target (its truss's rachis, its neighbours' pedicels:
+    /// [`TRUSS_GUARD`]) are obstacles until the fruit is in the hand. The pre-grasp plans with
+    /// them first and falls back to pressing them aside (as leaves) where no grasp keeps clear.
+    pub fn guard_trusses(&mut self, guard: bool) {
+        self.guard = guard;
+        self.rebuild();
+    }
+
+    /// Truss parts the guard makes obstacles in the current scene (0: guarding changes nothing).
+    pub fn guarded_trusses(&self) -> usize {
+        self.guarded
+    }
+
     /// Once the fruit is in the hand (or about to be), nothing of it is an obstacle.
     pub fn ignore_target(&mut self, ignore: bool) {
         self.ignore_target = ignore;
@@ -204,6 +248,7 @@ impl Motion {
         };
         let yaw_inv = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), -base.yaw);
         self.obstacles.clear();
+        self.trusses.clear();
         self.target = None;
         let mut best = f64::INFINITY;
         for o in &scene.objects {
@@ -232,6 +277,9 @@ impl Motion {
                     self.target = Some(self.obstacles.len());
                 }
             }
+            if o.kind == "truss" {
+                self.trusses.push(self.obstacles.len());
+            }
             self.obstacles.push(Obstacle::new(o.id.clone(), shape, pose, kind));
         }
         self.rebuild();
@@ -239,6 +287,7 @@ impl Motion {
 
     fn rebuild(&mut self) {
         let mut objs = self.obstacles.clone();
+        self.guarded = 0;
         for o in objs.iter_mut().filter(|o| self.loose.contains(&o.name)) {
             o.kind = ObstacleKind::Soft;
         }
@@ -265,6 +314,15 @@ impl Motion {
                 if let Shape::Sphere { radius } = o.shape {
                     if j != i && (o.pose.translation.vector - c).norm() < rt + radius + NEIGHBOUR_GAP {
                         o.kind = ObstacleKind::Soft;
+                    }
+                }
+            }
+            if self.guard && !self.ignore_target {
+                for &j in &self.trusses {
+                    let gap = surface_distance(&objs[j], c) - rt;
+                    if gap > OWN_PEDICEL && gap < TRUSS_GUARD {
+                        objs[j].kind = ObstacleKind::Solid;
+                        self.guarded += 1;
                     }
                 }
             }
@@ -973,5 +1031,52 @@ mod tests {
         let l = m.plan_linear(Arm::Left, 0.2, p.goal_q, &goal.along(0.1), HOME).expect("short line");
         let tcp = m.model(Arm::Left).fk(0.2, &l.goal_q).trans;
         assert!((tcp[1] - 0.6).abs() < 2e-3);
+    }
+
+    /// With the guard on, the truss parts near the target (a neighbour's pedicel, the
+    /// rachis above) are obstacles; the target's own pedicel (touching it) and a far truss
+    /// are not; nor is anything once the fruit is in the hand, or with the guard off.
+    #[test]
+    fn the_target_truss_is_guarded_but_not_its_own_pedicel() {
+        use agrisim_msgs::agrisim::CollisionObject;
+        use agrisim_msgs::geometry_msgs::{Point, Pose, Quaternion};
+        let (c, r) = ([0.4, 0.85, 1.2], 0.03);
+        let object = |id: &str, kind: &str, primitive: SolidPrimitive, p: [f64; 3]| CollisionObject {
+            id: id.into(),
+            kind: kind.into(),
+            primitive,
+            pose: Pose { position: Point { x: p[0], y: p[1], z: p[2] }, orientation: Quaternion::IDENTITY },
+        };
+        // Vertical rods of 4 cm: the own pedicel on the fruit's top, a neighbour's 5 cm
+        // aside, one 30 cm away; a rachis (horizontal: turned about x) 3 cm above the top.
+        let rod = || SolidPrimitive::cylinder(0.04, 0.002);
+        let along_y =
+            Quaternion { x: std::f64::consts::FRAC_1_SQRT_2, y: 0.0, z: 0.0, w: std::f64::consts::FRAC_1_SQRT_2 };
+        let mut rachis = object("rachis", "truss", SolidPrimitive::cylinder(0.3, 0.004), [c[0], c[1], c[2] + r + 0.03]);
+        rachis.pose.orientation = along_y;
+        let scene = PlanningScene {
+            objects: vec![
+                object("target", "fruit", SolidPrimitive::sphere(r), c),
+                object("own", "truss", rod(), [c[0], c[1], c[2] + r + 0.02]),
+                object("neighbour", "truss", rod(), [c[0] + 0.05, c[1], c[2] + r]),
+                object("far", "truss", rod(), [c[0] + 0.3, c[1], c[2]]),
+                rachis,
+            ],
+            ..Default::default()
+        };
+        let mut m = Motion::new(1);
+        m.set_target(c);
+        m.set_scene(&scene, Pose2 { x: 0.0, y: 0.0, yaw: 0.0 });
+        assert_eq!(m.guarded_trusses(), 0, "off by default");
+        m.guard_trusses(true);
+        assert_eq!(m.guarded_trusses(), 2, "the neighbour's pedicel and the rachis");
+        let solid: Vec<&str> =
+            m.scene.objects().iter().filter(|o| o.kind == ObstacleKind::Solid).map(|o| o.name.as_str()).collect();
+        assert_eq!(solid, ["neighbour", "rachis"]);
+        m.ignore_target(true);
+        assert_eq!(m.guarded_trusses(), 0, "the fruit in the hand: trusses pressed aside again");
+        m.ignore_target(false);
+        m.guard_trusses(false);
+        assert_eq!(m.guarded_trusses(), 0);
     }
 }

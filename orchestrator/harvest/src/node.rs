@@ -624,7 +624,14 @@ impl HarvestNode {
     /// reported as optional (it had a fallback); the judge's report counts them.
     fn move_pregrasp(&mut self, arm: Arm, grasps: &[TcpGoal], t_ns: i64, bus: &mut Bus) -> Option<usize> {
         let (start, other) = (self.q(arm), self.q(arm.other()));
-        let r = self.motion.plan_pregrasp_any(arm, self.lift, start, grasps, geo::PRE_GRASP, other);
+        // Clear of the target's truss where a grasp allows it (a pressed truss swings the
+        // target away); failing that, pressing it aside.
+        self.motion.guard_trusses(true);
+        let mut r = self.motion.plan_pregrasp_any(arm, self.lift, start, grasps, geo::PRE_GRASP, other);
+        if r.is_err() && self.motion.guarded_trusses() > 0 {
+            self.motion.guard_trusses(false);
+            r = self.motion.plan_pregrasp_any(arm, self.lift, start, grasps, geo::PRE_GRASP, other);
+        }
         let next = if r.is_err() { self.next_choice() } else { None };
         let chosen = r.as_ref().ok().map(|(i, _)| *i);
         let r = r.map(|(_, p)| p);
