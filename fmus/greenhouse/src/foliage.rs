@@ -442,14 +442,17 @@ fn place(
     l: usize,
     hangs: &impl Fn(usize) -> bool,
 ) {
+    // The part and its pedicels, each displacement computed once.
+    let shown: Vec<(usize, RPose)> =
+        std::iter::once(l).chain(table.children[l].iter().copied()).map(|k| (k, about(table, moving, k))).collect();
+    let at = |k: usize| shown.iter().find(|s| s.0 == k).map_or_else(|| about(table, moving, k), |s| s.1);
     for &o in &table.parts[l].objects {
-        let owner = table.part_of(o).unwrap_or(l);
-        let pose = to_rapier(&about(table, moving, owner).mul(table.rest(o)));
+        let pose = to_rapier(&at(table.part_of(o).unwrap_or(l)).mul(table.rest(o)));
         let handle = world.objects[o].collider;
         world.colliders[handle].set_position(pose);
     }
-    for &k in std::iter::once(&l).chain(&table.children[l]) {
-        let (at, off) = (about(table, moving, k), off_rest(table, moving, k));
+    for &(k, at) in &shown {
+        let off = off_rest(table, moving, k);
         for &(f, grown) in &table.hanging[k] {
             if hangs(f) {
                 let pose = if off { to_rapier(&at.mul(&from_rapier(&grown))) } else { grown };

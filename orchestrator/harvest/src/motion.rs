@@ -223,8 +223,10 @@ impl Motion {
     /// [`TRUSS_GUARD`]) are obstacles until the fruit is in the hand. The pre-grasp plans with
     /// them first and falls back to pressing them aside (as leaves) where no grasp keeps clear.
     pub fn guard_trusses(&mut self, guard: bool) {
-        self.guard = guard;
-        self.rebuild();
+        if self.guard != guard {
+            self.guard = guard;
+            self.rebuild();
+        }
     }
 
     /// Truss parts the guard makes obstacles in the current scene (0: guarding changes nothing).
