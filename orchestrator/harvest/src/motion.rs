@@ -11,6 +11,7 @@
 
 use super::geometry::{TcpGoal, NEIGHBOUR_GAP};
 use agrisim_manip::cartesian::cartesian_path;
+use agrisim_manip::prim::Prim;
 use agrisim_manip::{
     exact_check, ArmModel, Checker, Context, Ik, Meter, Obstacle, ObstacleKind, Planner, Rng, Scene, Shape, Side,
     Target, Work, DOF,
@@ -24,7 +25,7 @@ use agrisim_msgs::trajectory_msgs::{JointTrajectory, JointTrajectoryPoint};
 use agrisim_trajectory::{
     time_state_to_state, time_waypoints, JointState, PathParam, PathShape, Sampled, TimingConfig,
 };
-use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
 /// Where both arms start and end (the harvest system's `q_init` of both Arm FMUs): Franka's
 /// "ready" pose with the upper arm 0.3 rad instead of 0.785 rad back, because on this robot
@@ -104,20 +105,6 @@ pub struct Planned {
     pub msg: JointTrajectory,
     pub duration: f64,
     pub goal_q: [f64; DOF],
-}
-
-/// Distance from `p` to the surface of `o` (negative inside): cylinders and capsules taken
-/// as capsules (a truss's parts are thin rods), boxes as their bounding spheres.
-fn surface_distance(o: &Obstacle, p: Vector3<f64>) -> f64 {
-    let c = o.pose.translation.vector;
-    let (half, radius) = match o.shape {
-        Shape::Sphere { radius } => (0.0, radius),
-        Shape::Cylinder { radius, length } | Shape::Capsule { radius, length } => (0.5 * length, radius),
-        Shape::Box { size } => (0.0, 0.5 * Vector3::from(size).norm()),
-    };
-    let axis = o.pose.rotation * Vector3::z();
-    let t = (p - c).dot(&axis).clamp(-half, half);
-    (p - (c + t * axis)).norm() - radius
 }
 
 impl Planned {
@@ -321,7 +308,7 @@ impl Motion {
             }
             if self.guard && !self.ignore_target {
                 for &j in &self.trusses {
-                    let gap = surface_distance(&objs[j], c) - rt;
+                    let gap = Prim::new(objs[j].shape, objs[j].pose).point_distance(&Point3::from(c)) - rt;
                     if gap > OWN_PEDICEL && gap < TRUSS_GUARD {
                         objs[j].kind = ObstacleKind::Solid;
                         self.guarded += 1;
@@ -543,6 +530,31 @@ impl Motion {
         other: [f64; DOF],
     ) -> Result<(usize, Planned), String> {
         first_ok(goals, "goal", |g| self.plan_free(arm, lift, start, g, other))
+    }
+
+    /// [`Self::plan_pregrasp_any`] clear of the target's truss ([`Self::guard_trusses`]) where
+    /// a grasp allows it, else pressing the truss aside. The second try starts from the same
+    /// random state as the first, so it plans exactly as if the guard had never been tried:
+    /// guarding can cost planning time, never a grasp found without it. The guard stays as
+    /// the plan found it (on, or off after the fallback) for the approach that follows.
+    pub fn plan_pregrasp_guarded(
+        &mut self,
+        arm: Arm,
+        lift: f64,
+        start: [f64; DOF],
+        grasps: &[TcpGoal],
+        standoff: f64,
+        other: [f64; DOF],
+    ) -> Result<(usize, Planned), String> {
+        self.guard_trusses(true);
+        let rng = self.rng.clone();
+        let r = self.plan_pregrasp_any(arm, lift, start, grasps, standoff, other);
+        if r.is_ok() || self.guarded == 0 {
+            return r;
+        }
+        self.rng = rng;
+        self.guard_trusses(false);
+        self.plan_pregrasp_any(arm, lift, start, grasps, standoff, other)
     }
 
     /// The first of `grasps` [`Self::plan_pregrasp`] reaches, with its index.
@@ -976,6 +988,71 @@ mod tests {
         assert!(plan(&all[..3]).is_err(), "straight in and tilted must be blocked by the fruit in front");
         let i = plan(&all).expect("an approach along the row reaches it");
         assert!(i >= 3 && crate::geometry::APPROACHES[i].0 != 0.0, "approach {i}");
+    }
+
+    /// Where the guarded truss blocks every grasp, the fallback plans from the random state
+    /// the guarded try started with: the same trajectory as a node that never guarded.
+    #[test]
+    fn the_guard_fallback_plans_as_if_unguarded() {
+        use agrisim_msgs::agrisim::CollisionObject;
+        use agrisim_msgs::geometry_msgs::{Point, Pose, Quaternion};
+        let (r, lift) = (0.035, 0.3);
+        let c = [
+            0.4,
+            0.85,
+            crate::geometry::ARM_Z0 + lift + crate::geometry::SHOULDER_UP - crate::geometry::REACH_BELOW_SHOULDER,
+        ];
+        let object = |id: String, kind: &str, primitive: SolidPrimitive, p: [f64; 3]| CollisionObject {
+            id,
+            kind: kind.into(),
+            primitive,
+            pose: Pose { position: Point { x: p[0], y: p[1], z: p[2] }, orientation: Quaternion::IDENTITY },
+        };
+        // A closed cage of six truss slabs 3 cm off the fruit's surface: guarded, it walls the
+        // fruit in; pressed aside, it is no obstacle.
+        let mut objects = vec![object("target".into(), "fruit", SolidPrimitive::sphere(r), c)];
+        let (off, thick) = (r + 0.03 + 0.005, 0.01);
+        for axis in 0..3 {
+            for sign in [-1.0, 1.0] {
+                let mut size = [0.3; 3];
+                size[axis] = thick;
+                let mut p = c;
+                p[axis] += sign * off;
+                objects.push(object(
+                    format!("slab{axis}{sign}"),
+                    "truss",
+                    SolidPrimitive::new_box(size[0], size[1], size[2]),
+                    p,
+                ));
+            }
+        }
+        let scene = PlanningScene { objects, ..Default::default() };
+        let grasps = crate::geometry::grasp_candidates(c, 1.0);
+        let fresh = || {
+            let mut m = Motion::new(1);
+            m.set_target(c);
+            m.set_scene(&scene, Pose2 { x: 0.0, y: 0.0, yaw: 0.0 });
+            m
+        };
+        let mut walled = fresh();
+        walled.guard_trusses(true);
+        assert_eq!(walled.guarded_trusses(), 6);
+        let blocked = walled.plan_pregrasp_any(Arm::Left, lift, HOME, &grasps, crate::geometry::PRE_GRASP, HOME);
+        assert!(blocked.is_err(), "the guarded cage must block every grasp");
+        let mut guarded = fresh();
+        let (i, a) = guarded
+            .plan_pregrasp_guarded(Arm::Left, lift, HOME, &grasps, crate::geometry::PRE_GRASP, HOME)
+            .expect("the fallback presses the cage aside");
+        assert_eq!(guarded.guarded_trusses(), 0, "the guard is off after the fallback");
+        let mut unguarded = fresh();
+        let (j, b) = unguarded
+            .plan_pregrasp_any(Arm::Left, lift, HOME, &grasps, crate::geometry::PRE_GRASP, HOME)
+            .expect("unguarded, the cage is soft");
+        assert_eq!(i, j);
+        assert_eq!(a.goal_q, b.goal_q);
+        assert_eq!(a.msg.points, b.msg.points);
+        // And the random stream goes on the same, for every plan after this one.
+        assert_eq!(format!("{:?}", guarded.rng), format!("{:?}", unguarded.rng));
     }
 
     /// A fruit this node once held is loose: lying against the hand afterwards (dropped on

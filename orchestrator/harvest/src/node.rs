@@ -328,6 +328,8 @@ impl HarvestNode {
         fresh.motion.set_held(Arm::Left, None);
         fresh.motion.set_held(Arm::Right, None);
         fresh.motion.ignore_target(false);
+        // The old target's truss is no obstacle for the recovery and the next choice.
+        fresh.motion.guard_trusses(false);
         fresh.arms = std::mem::take(&mut self.arms);
         fresh.arms.iter_mut().for_each(|a| a.pending = None);
         (fresh.pose, fresh.pose_seen) = (self.pose, self.pose_seen);
@@ -626,12 +628,7 @@ impl HarvestNode {
         let (start, other) = (self.q(arm), self.q(arm.other()));
         // Clear of the target's truss where a grasp allows it (a pressed truss swings the
         // target away); failing that, pressing it aside.
-        self.motion.guard_trusses(true);
-        let mut r = self.motion.plan_pregrasp_any(arm, self.lift, start, grasps, geo::PRE_GRASP, other);
-        if r.is_err() && self.motion.guarded_trusses() > 0 {
-            self.motion.guard_trusses(false);
-            r = self.motion.plan_pregrasp_any(arm, self.lift, start, grasps, geo::PRE_GRASP, other);
-        }
+        let r = self.motion.plan_pregrasp_guarded(arm, self.lift, start, grasps, geo::PRE_GRASP, other);
         let next = if r.is_err() { self.next_choice() } else { None };
         let chosen = r.as_ref().ok().map(|(i, _)| *i);
         let r = r.map(|(_, p)| p);
