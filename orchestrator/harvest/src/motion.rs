@@ -953,28 +953,39 @@ mod tests {
         }
     }
 
+    /// A point in the left arm's reach at `lift`, 0.85 m aside (where a fruit hangs).
+    fn reach_centre(lift: f64) -> [f64; 3] {
+        [
+            0.4,
+            0.85,
+            crate::geometry::ARM_Z0 + lift + crate::geometry::SHOULDER_UP - crate::geometry::REACH_BELOW_SHOULDER,
+        ]
+    }
+
+    /// A planning-scene object at `p`, unrotated.
+    fn object(
+        id: String,
+        kind: &str,
+        primitive: SolidPrimitive,
+        p: [f64; 3],
+    ) -> agrisim_msgs::agrisim::CollisionObject {
+        use agrisim_msgs::geometry_msgs::{Point, Pose, Quaternion};
+        agrisim_msgs::agrisim::CollisionObject {
+            id,
+            kind: kind.into(),
+            primitive,
+            pose: Pose { position: Point { x: p[0], y: p[1], z: p[2] }, orientation: Quaternion::IDENTITY },
+        }
+    }
+
     /// A tomato hanging right in front of the target (toward the aisle, 2.5 cm apart: not a
     /// touching neighbour) blocks the wrist of every straight-in and tilted approach; an
     /// approach turned along the row reaches round it.
     #[test]
     fn a_fruit_in_front_is_reached_round_from_the_side() {
-        use agrisim_msgs::agrisim::CollisionObject;
-        use agrisim_msgs::geometry_msgs::{Point, Pose, Quaternion};
         let (r, lift) = (0.035, 0.3);
-        let c = [
-            0.4,
-            0.85,
-            crate::geometry::ARM_Z0 + lift + crate::geometry::SHOULDER_UP - crate::geometry::REACH_BELOW_SHOULDER,
-        ];
-        let fruit = |id: &str, y: f64| CollisionObject {
-            id: id.into(),
-            kind: "fruit".into(),
-            primitive: SolidPrimitive::sphere(r),
-            pose: Pose {
-                position: Point { x: c[0], y, z: c[2] },
-                orientation: Quaternion { x: 0.0, y: 0.0, z: 0.0, w: 1.0 },
-            },
-        };
+        let c = reach_centre(lift);
+        let fruit = |id: &str, y: f64| object(id.into(), "fruit", SolidPrimitive::sphere(r), [c[0], y, c[2]]);
         let scene =
             PlanningScene { objects: vec![fruit("1", c[1]), fruit("2", c[1] - 2.0 * r - 0.025)], ..Default::default() };
         let plan = |candidates: &[TcpGoal]| {
@@ -994,20 +1005,8 @@ mod tests {
     /// the guarded try started with: the same trajectory as a node that never guarded.
     #[test]
     fn the_guard_fallback_plans_as_if_unguarded() {
-        use agrisim_msgs::agrisim::CollisionObject;
-        use agrisim_msgs::geometry_msgs::{Point, Pose, Quaternion};
         let (r, lift) = (0.035, 0.3);
-        let c = [
-            0.4,
-            0.85,
-            crate::geometry::ARM_Z0 + lift + crate::geometry::SHOULDER_UP - crate::geometry::REACH_BELOW_SHOULDER,
-        ];
-        let object = |id: String, kind: &str, primitive: SolidPrimitive, p: [f64; 3]| CollisionObject {
-            id,
-            kind: kind.into(),
-            primitive,
-            pose: Pose { position: Point { x: p[0], y: p[1], z: p[2] }, orientation: Quaternion::IDENTITY },
-        };
+        let c = reach_centre(lift);
         // A closed cage of six truss slabs 3 cm off the fruit's surface: guarded, it walls the
         // fruit in; pressed aside, it is no obstacle.
         let mut objects = vec![object("target".into(), "fruit", SolidPrimitive::sphere(r), c)];
